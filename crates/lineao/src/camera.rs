@@ -1,0 +1,195 @@
+//! Camera, scene bounds and the per-frame view that every pass shares (CONTRACT.md
+//! "Coordinates and buffers").
+//!
+//! View space: camera at the origin looking down −z, +y up. The depth range that normalizes the
+//! ND map's linear depth comes from the bounding sphere (c, r) of all geometry:
+//! near = max(−c_z − r, 1e-3 r), far = −c_z + r. The zoom z(P) is how many pixels `zoom_unit`
+//! world units span at P's depth: f_px · zoom_unit / (−z_view) (perspective) or f_px · zoom_unit
+//! (orthographic), with f_px = proj[1][1] · H / 2.
+//!
+//! The G-buffer is rendered `guard` pixels larger on every side (paper §3.4); the projection is
+//! widened so that the visible W × H window shows exactly what the camera frames, and f_px is the
+//! same for both.
+
+use glam::camera::rh::proj::directx;
+use glam::{Mat4, Vec3};
+
+/// How the camera projects.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Projection {
+    /// Vertical field of view in degrees, (0, 180).
+    Perspective { fov_y_deg: f32 },
+    /// Height of the visible window in world units.
+    Orthographic { height: f32 },
+}
+
+/// A look-at camera in world units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    pub eye: Vec3,
+    pub target: Vec3,
+    pub up: Vec3,
+    pub projection: Projection,
+}
+
+impl Camera {
+    /// World → view transform (right-handed, looking down −z).
+    pub fn view_matrix(&self) -> Mat4 {
+        glam::camera::rh::view::look_at_mat4(self.eye, self.target, self.up)
+    }
+}
+
+/// The bounding sphere of all geometry in world units.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bounds {
+    pub center: Vec3,
+    pub radius: f32,
+}
+
+impl Bounds {
+    /// The sphere around the axis-aligned box of `points` that contains them all; `None` when
+    /// there are no finite points.
+    pub fn of_points<'a>(points: impl IntoIterator<Item = &'a [f32; 3]>) -> Option<Bounds> {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        let mut any = false;
+        let finite: Vec<Vec3> = points
+            .into_iter()
+            .map(|p| Vec3::from_array(*p))
+            .filter(|p| p.is_finite())
+            .inspect(|p| {
+                lo = lo.min(*p);
+                hi = hi.max(*p);
+                any = true;
+            })
+            .collect();
+        if !any {
+            return None;
+        }
+        let center = (lo + hi) * 0.5;
+        let radius = finite.iter().map(|p| p.distance(center)).fold(0.0f32, f32::max);
+        Some(Bounds { center, radius: radius.max(1e-6) })
+    }
+}
+
+/// Everything about one frame's view that the passes need: matrices for the guard-banded
+/// G-buffer, the depth range and the zoom.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameView {
+    pub view: Mat4,
+    /// Projection of the guard-banded G-buffer (wgpu clip space, depth in [0, 1]).
+    pub proj: Mat4,
+    /// Visible size in pixels (without the guard band).
+    pub width: u32,
+    pub height: u32,
+    /// Guard band in pixels on each side.
+    pub guard: u32,
+    /// Normalized depth range, as −z_view.
+    pub near: f32,
+    pub far: f32,
+    /// Focal length in pixels.
+    pub f_px: f32,
+    pub zoom_unit: f32,
+    pub orthographic: bool,
+}
+
+impl FrameView {
+    pub fn new(camera: &Camera, bounds: &Bounds, width: u32, height: u32, guard: u32, zoom_unit: f32) -> Self {
+        let view = camera.view_matrix();
+        let c_z = view.transform_point3(bounds.center).z;
+        let r = bounds.radius;
+        let near = (-c_z - r).max(1e-3 * r);
+        let far = (-c_z + r).max(near * (1.0 + 1e-4) + 1e-6);
+        let (w, h) = (width.max(1) as f32, height.max(1) as f32);
+        let (gw, gh) = (w + 2.0 * guard as f32, h + 2.0 * guard as f32);
+        // Clip a little outside [near, far] so geometry on the bounding sphere is never clipped.
+        let (clip_near, clip_far) = (near * (1.0 - 1e-3), far * (1.0 + 1e-3));
+        let (proj, f_px) = match camera.projection {
+            Projection::Perspective { fov_y_deg } => {
+                let tan_half = (fov_y_deg.to_radians() * 0.5).tan();
+                let banded_fov = 2.0 * (tan_half * gh / h).atan();
+                (directx::perspective(banded_fov, gw / gh, clip_near, clip_far), h / (2.0 * tan_half))
+            }
+            Projection::Orthographic { height: view_h } => {
+                let half_h = 0.5 * view_h * gh / h;
+                let half_w = half_h * gw / gh;
+                (directx::orthographic(-half_w, half_w, -half_h, half_h, clip_near, clip_far), h / view_h)
+            }
+        };
+        FrameView {
+            view,
+            proj,
+            width,
+            height,
+            guard,
+            near,
+            far,
+            f_px,
+            zoom_unit,
+            orthographic: matches!(camera.projection, Projection::Orthographic { .. }),
+        }
+    }
+
+    /// Size of the guard-banded G-buffer.
+    pub fn banded_size(&self) -> (u32, u32) {
+        (self.width + 2 * self.guard, self.height + 2 * self.guard)
+    }
+
+    /// The largest zoom anywhere in the image: at the nearest geometry for perspective.
+    pub fn zoom_max(&self) -> f32 {
+        if self.orthographic { self.f_px * self.zoom_unit } else { self.f_px * self.zoom_unit / self.near }
+    }
+
+    /// Normalized linear depth of a view-space z (CONTRACT.md).
+    pub fn normalized_depth(&self, z_view: f32) -> f32 {
+        ((-z_view - self.near) / (self.far - self.near)).clamp(0.0, 1.0)
+    }
+}
+
+/// The guard band of CONTRACT.md: `radius_px` rounded up to a multiple of 2^(s_r−1), capped.
+pub fn guard_band(radius_px: f32, s_r: u32, cap: u32) -> u32 {
+    let step = 1u32 << s_r.saturating_sub(1).min(16);
+    let needed = radius_px.max(0.0).ceil().min(u32::MAX as f32 / 2.0) as u32;
+    needed.div_ceil(step).saturating_mul(step).min(cap)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn camera(projection: Projection) -> Camera {
+        Camera { eye: Vec3::new(0.0, 0.0, 100.0), target: Vec3::ZERO, up: Vec3::Y, projection }
+    }
+
+    #[test]
+    fn guard_keeps_the_visible_window_and_focal_length() {
+        let bounds = Bounds { center: Vec3::ZERO, radius: 10.0 };
+        for projection in [Projection::Perspective { fov_y_deg: 40.0 }, Projection::Orthographic { height: 30.0 }] {
+            let cam = camera(projection);
+            let plain = FrameView::new(&cam, &bounds, 200, 100, 0, 1.0);
+            let banded = FrameView::new(&cam, &bounds, 200, 100, 16, 1.0);
+            assert!((plain.f_px - banded.f_px).abs() < 1e-3);
+            assert_eq!((plain.near, plain.far), (90.0, 110.0));
+            // A point that projects to a visible pixel lands on the same pixel + guard.
+            let p = Vec3::new(3.0, -2.0, 5.0);
+            let to_pixel = |fv: &FrameView| {
+                let c = fv.proj.project_point3(fv.view.transform_point3(p));
+                let (w, h) = fv.banded_size();
+                ((c.x + 1.0) * 0.5 * w as f32, (1.0 - c.y) * 0.5 * h as f32)
+            };
+            let (a, b) = (to_pixel(&plain), to_pixel(&banded));
+            assert!((a.0 + 16.0 - b.0).abs() < 1e-3 && (a.1 + 16.0 - b.1).abs() < 1e-3, "{a:?} {b:?}");
+            // f_px = proj[1][1] · H / 2 for the unbanded projection.
+            assert!((plain.proj.col(1).y * 50.0 - plain.f_px).abs() < 1e-3);
+        }
+    }
+
+    #[test]
+    fn guard_band_rounding() {
+        assert_eq!(guard_band(13.2, 3, 128), 16);
+        assert_eq!(guard_band(16.0, 3, 128), 16);
+        assert_eq!(guard_band(0.0, 3, 128), 0);
+        assert_eq!(guard_band(500.0, 3, 128), 128);
+        assert_eq!(guard_band(5.0, 1, 128), 5);
+    }
+}

@@ -1,0 +1,164 @@
+//! The pass chain: geometry → ND pyramid → LineAO → composite, for one chosen method. It owns
+//! the passes and every size-dependent texture ([`FrameTargets`]); `resize` follows the window,
+//! `prepare` follows the camera (and grows the guard band when the sampling radius needs it),
+//! `encode` records a frame into the caller's encoder and target view.
+//!
+//! ```text
+//!   LineGeometry ─▶ LineRenderer ─▶ color, nd[0], zoom, specular, depth
+//!                                       │
+//!                          NdPyramid ◀──┘ nd[1..s_r]
+//!                                       │
+//!                          LineAo    ◀──┘ ao
+//!                                       │
+//!   target view ◀─ Composite ◀──────────┘ color · (1 − strength · ao) + specular
+//! ```
+
+use crate::Error;
+use crate::camera::{self, Bounds, Camera, FrameView};
+use crate::passes::composite::Composite;
+use crate::passes::line_ao::LineAo;
+use crate::passes::lines::{LineGeometry, LineRenderer};
+use crate::passes::nd_pyramid::NdPyramid;
+use crate::settings::{AoMethod, ChainSettings};
+use crate::targets::FrameTargets;
+
+pub struct AoChain {
+    settings: ChainSettings,
+    lines: LineRenderer,
+    pyramid: NdPyramid,
+    line_ao: LineAo,
+    composite: Composite,
+    size: (u32, u32),
+    max_texture: u32,
+    targets: Option<FrameTargets>,
+    view: Option<FrameView>,
+}
+
+impl AoChain {
+    /// A chain that composites into targets of `format`.
+    pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat, settings: ChainSettings) -> Result<AoChain, Error> {
+        settings.validate()?;
+        Ok(AoChain {
+            lines: LineRenderer::new(device),
+            pyramid: NdPyramid::new(device),
+            line_ao: LineAo::new(device, &settings.line_ao),
+            composite: Composite::new(device, format),
+            settings,
+            size: (0, 0),
+            max_texture: device.limits().max_texture_dimension_2d,
+            targets: None,
+            view: None,
+        })
+    }
+
+    pub fn settings(&self) -> &ChainSettings {
+        &self.settings
+    }
+
+    /// Changes settings; pipelines and targets are rebuilt only where needed.
+    pub fn set_settings(&mut self, device: &wgpu::Device, settings: ChainSettings) -> Result<(), Error> {
+        settings.validate()?;
+        if !self.line_ao.matches(&settings.line_ao) {
+            self.line_ao = LineAo::new(device, &settings.line_ao);
+            self.targets = None;
+        }
+        if settings.levels() != self.settings.levels() {
+            self.targets = None;
+        }
+        self.settings = settings;
+        Ok(())
+    }
+
+    /// Sets the visible size. 0 × 0 (a minimized window) is allowed: nothing is rendered until a
+    /// real size comes back.
+    pub fn resize(&mut self, width: u32, height: u32) -> Result<(), Error> {
+        let limit = self.max_texture.saturating_sub(2 * self.settings.line_ao.guard_max_px);
+        if width > limit || height > limit {
+            return Err(Error::TooLarge(format!(
+                "{width} x {height} px exceeds the adapter's {} px textures less the guard band",
+                self.max_texture
+            )));
+        }
+        if (width, height) != self.size {
+            self.size = (width, height);
+            self.targets = None;
+        }
+        Ok(())
+    }
+
+    /// The guard band for this view: the largest sampling radius over the image (CONTRACT.md).
+    pub fn guard_for(&self, camera: &Camera, bounds: &Bounds) -> u32 {
+        let s = &self.settings;
+        match s.method {
+            AoMethod::None => 0,
+            AoMethod::LineAo => {
+                let unguarded = FrameView::new(camera, bounds, self.size.0, self.size.1, 0, s.zoom_unit);
+                let radius = s.r0_px() + (s.line_ao.s_r - 1) as f32 * unguarded.zoom_max();
+                camera::guard_band(radius, s.line_ao.s_r, s.line_ao.guard_max_px)
+            }
+        }
+    }
+
+    /// Writes the frame's uniforms for `camera` over geometry within `bounds`, (re)allocating
+    /// the targets when the size, guard band or pyramid depth changed. Returns the frame's view,
+    /// or `None` while the size is 0 × 0.
+    pub fn prepare(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        camera: &Camera,
+        bounds: &Bounds,
+    ) -> Option<FrameView> {
+        let (width, height) = self.size;
+        if width == 0 || height == 0 {
+            self.view = None;
+            return None;
+        }
+        let guard = self.guard_for(camera, bounds);
+        let s = &self.settings;
+        let levels = s.levels();
+        let stale = self.targets.as_ref().is_none_or(|t| t.guard != guard || t.nd.len() != levels as usize);
+        if stale {
+            let targets = FrameTargets::new(device, width, height, guard, levels);
+            self.pyramid.resize(device, &targets);
+            self.line_ao.resize(device, &targets);
+            self.composite.resize(device, &targets);
+            self.targets = Some(targets);
+        }
+        let targets = self.targets.as_ref()?;
+        let view = FrameView::new(camera, bounds, width, height, guard, s.zoom_unit);
+        self.lines.prepare(queue, &view, s.line_width_px, s.line_color, &s.lighting);
+        self.line_ao.prepare(queue, targets, &s.line_ao, s.r0_px(), &s.lighting);
+        let strength = if s.method == AoMethod::None { 0.0 } else { s.strength };
+        self.composite.prepare(queue, targets, strength, s.debug_view, view.zoom_max());
+        self.view = Some(view);
+        Some(view)
+    }
+
+    /// Records the frame into `encoder`, compositing into `target` (the visible size, the format
+    /// given to `new`). Does nothing before the first `prepare` with a non-zero size.
+    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, geometry: &LineGeometry, target: &wgpu::TextureView) {
+        let Some(targets) = &self.targets else { return };
+        if self.view.is_none() {
+            return;
+        }
+        encoder.push_debug_group("lineao");
+        self.lines.encode(encoder, targets, geometry, self.settings.background);
+        if self.settings.method == AoMethod::LineAo {
+            self.pyramid.encode(encoder, targets);
+            self.line_ao.encode(encoder, targets);
+        }
+        self.composite.encode(encoder, target);
+        encoder.pop_debug_group();
+    }
+
+    /// The targets of the last `prepare` (for readback, debugging, or a host's own passes).
+    pub fn targets(&self) -> Option<&FrameTargets> {
+        self.targets.as_ref()
+    }
+
+    /// The view of the last `prepare`.
+    pub fn frame_view(&self) -> Option<&FrameView> {
+        self.view.as_ref()
+    }
+}

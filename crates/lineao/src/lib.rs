@@ -1,0 +1,74 @@
+//! # lineao — ambient occlusion for dense 3D lines, as wgpu passes
+//!
+//! Screen-space ambient occlusion fails on thin lines: a line has too little volume to occlude,
+//! its width on screen stays fixed while one zooms, and sparse samples turn into noise. LineAO
+//! (Eichelbaum, Hlawitschka, Scheuermann, TVCG 2013) samples several hemispheres of growing
+//! radius, each on a coarser level of a Gaussian pyramid of normals and depth, and weights
+//! occluders by depth difference and by the scene's lights. This crate implements it as wgpu
+//! passes a host renderer can embed, with a plain-Rust CPU reference that proves every shader.
+//!
+//! - [`AoChain`] wires the passes for a method and owns every size-dependent texture:
+//!   `resize`, `prepare`, `encode` into your `CommandEncoder` and target view.
+//! - [`passes`]: [`LineRenderer`](passes::lines::LineRenderer) (fixed-width lines writing the
+//!   G-buffer), [`NdPyramid`](passes::nd_pyramid::NdPyramid), [`LineAo`](passes::line_ao::LineAo),
+//!   [`Composite`](passes::composite::Composite) — each usable alone.
+//! - [`reference`]: the CPU reference of each pass.
+//!
+//! The G-buffer contract (the ND map, the zoom map, normalized depth) is in [`targets`] and
+//! [`camera`]; CONTRACT.md in the repository is the full specification.
+//!
+//! ```no_run
+//! use lineao::{AoChain, ChainSettings, Gpu, camera::{Camera, Projection}, passes::lines::LineGeometry};
+//! # fn main() -> Result<(), lineao::Error> {
+//! let gpu = Gpu::headless()?;
+//! let positions = [[0.0, 0.0, 0.0], [10.0, 0.0, 0.0], [10.0, 10.0, 0.0]];
+//! let geometry = LineGeometry::new(&gpu.device, &positions, &[0, 3])?;
+//! let format = wgpu::TextureFormat::Rgba8UnormSrgb;
+//! let mut chain = AoChain::new(&gpu.device, format, ChainSettings::default())?;
+//! chain.resize(640, 480)?;
+//! let camera = Camera { eye: [5.0, 5.0, 40.0].into(), target: [5.0, 5.0, 0.0].into(), up: glam::Vec3::Y,
+//!                       projection: Projection::Perspective { fov_y_deg: 45.0 } };
+//! chain.prepare(&gpu.device, &gpu.queue, &camera, &geometry.bounds.unwrap());
+//! # let target: wgpu::TextureView = todo!();
+//! let mut encoder = gpu.device.create_command_encoder(&Default::default());
+//! chain.encode(&mut encoder, &geometry, &target);
+//! gpu.queue.submit([encoder.finish()]);
+//! # Ok(()) }
+//! ```
+
+pub mod binding;
+pub mod camera;
+pub mod chain;
+pub mod gpu;
+pub mod lighting;
+pub mod noise;
+pub mod passes;
+pub mod readback;
+pub mod reference;
+pub mod settings;
+pub mod shader;
+pub mod targets;
+
+pub use chain::AoChain;
+pub use gpu::Gpu;
+pub use settings::{AoMethod, ChainSettings, DebugView, LineAoSettings, LineColor};
+
+/// Pyramid levels (and so LineAO hemispheres) the shaders can bind.
+pub const MAX_LEVELS: u32 = 5;
+
+/// Errors at the crate boundary: device creation, settings, sizes, geometry, readback.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    #[error("no GPU adapter found (install a Vulkan driver, e.g. mesa-vulkan-drivers): {0}")]
+    NoAdapter(String),
+    #[error("the GPU adapter refused a device: {0}")]
+    RequestDevice(String),
+    #[error("invalid settings: {0}")]
+    InvalidSettings(String),
+    #[error("invalid line geometry: {0}")]
+    InvalidGeometry(String),
+    #[error("too large for this adapter: {0}")]
+    TooLarge(String),
+    #[error("GPU operation failed: {0}")]
+    Gpu(String),
+}

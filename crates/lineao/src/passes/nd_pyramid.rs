@@ -1,0 +1,72 @@
+//! ND pyramid (paper §3.4): the Gaussian pyramid n_l(P), d_l(P) that lets LineAO's wider
+//! hemispheres see merged bundles instead of single lines.
+//!
+//! Level j is the separable binomial [1 4 6 4 1]/16 of level j−1 centred at texel (2x, 2y)
+//! with clamp-to-edge, over normal and depth alike (background included: sparse lines fade into
+//! the background at coarse levels, dense bundles merge into solid surfaces). The normal is
+//! renormalized, or zero (background) when its filtered length is below 1e-6. See
+//! `shaders/nd_pyramid.wgsl` and [`crate::reference::nd_downsample`].
+
+use crate::binding::{self, Slot};
+use crate::passes::dispatch_size;
+use crate::targets::{FrameTargets, ND_FORMAT};
+
+pub struct NdPyramid {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    /// One bind group per level ≥ 1, reading level j−1 and writing level j.
+    groups: Vec<wgpu::BindGroup>,
+}
+
+impl NdPyramid {
+    pub fn new(device: &wgpu::Device) -> NdPyramid {
+        let layout = binding::layout(
+            device,
+            "lineao::NdPyramid::layout",
+            wgpu::ShaderStages::COMPUTE,
+            &[Slot::Texture, Slot::StorageTexture(ND_FORMAT)],
+        );
+        let module = crate::shader::module(device, "nd_pyramid.wgsl");
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("lineao::NdPyramid::pipeline"),
+            layout: Some(&binding::pipeline_layout(device, "lineao::NdPyramid::pipeline_layout", &layout)),
+            module: &module,
+            entry_point: Some("downsample"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        NdPyramid { pipeline, layout, groups: Vec::new() }
+    }
+
+    pub fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets) {
+        self.groups = targets
+            .nd
+            .windows(2)
+            .enumerate()
+            .map(|(j, pair)| {
+                binding::group(
+                    device,
+                    &format!("lineao::NdPyramid::group[{}]", j + 1),
+                    &self.layout,
+                    &[
+                        wgpu::BindingResource::TextureView(&pair[0].view),
+                        wgpu::BindingResource::TextureView(&pair[1].view),
+                    ],
+                )
+            })
+            .collect();
+    }
+
+    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, targets: &FrameTargets) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("lineao::NdPyramid"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        for (group, level) in self.groups.iter().zip(&targets.nd[1..]) {
+            let (x, y) = dispatch_size(level.size());
+            pass.set_bind_group(0, group, &[]);
+            pass.dispatch_workgroups(x, y, 1);
+        }
+    }
+}

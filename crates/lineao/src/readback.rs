@@ -1,0 +1,67 @@
+//! Reading textures back to the CPU, for tests, `--dump` and PNG output.
+
+use crate::Error;
+
+/// A texture's texels, rows tightly packed.
+pub struct TextureData {
+    pub width: u32,
+    pub height: u32,
+    pub format: wgpu::TextureFormat,
+    pub bytes: Vec<u8>,
+}
+
+impl TextureData {
+    /// The texels as f32 (R32Float, Rgba32Float, Depth32Float).
+    pub fn to_f32(&self) -> Vec<f32> {
+        bytemuck::pod_collect_to_vec(&self.bytes)
+    }
+
+    /// The texels as [f32; 4] (Rgba32Float).
+    pub fn to_vec4(&self) -> Vec<[f32; 4]> {
+        bytemuck::pod_collect_to_vec(&self.bytes)
+    }
+}
+
+/// Copies `texture` (mip 0) to the CPU and waits for it.
+pub fn read_texture(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture) -> Result<TextureData, Error> {
+    let format = texture.format();
+    let (width, height) = (texture.width(), texture.height());
+    let aspect =
+        if format.is_depth_stencil_format() { wgpu::TextureAspect::DepthOnly } else { wgpu::TextureAspect::All };
+    let texel =
+        format.block_copy_size(Some(aspect)).ok_or_else(|| Error::Gpu(format!("cannot read back {format:?}")))?;
+    let row = width * texel;
+    let padded_row = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("lineao::readback"),
+        size: padded_row as u64 * height as u64,
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder =
+        device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::readback") });
+    encoder.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo { texture, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect },
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(padded_row),
+                rows_per_image: Some(height),
+            },
+        },
+        wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+    );
+    queue.submit([encoder.finish()]);
+    buffer.slice(..).map_async(wgpu::MapMode::Read, |_| {});
+    device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| Error::Gpu(e.to_string()))?;
+    let mapped = buffer.slice(..).get_mapped_range().map_err(|e| Error::Gpu(e.to_string()))?;
+    let mut bytes = Vec::with_capacity((row * height) as usize);
+    for r in 0..height as usize {
+        let start = r * padded_row as usize;
+        bytes.extend_from_slice(&mapped[start..start + row as usize]);
+    }
+    drop(mapped);
+    buffer.unmap();
+    Ok(TextureData { width, height, format, bytes })
+}

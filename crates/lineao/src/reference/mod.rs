@@ -1,0 +1,109 @@
+//! The CPU reference: every screen-space pass in plain Rust over f32 images.
+//!
+//! It exists to prove the shaders. Tests read the GPU's inputs back, run these functions on
+//! exactly those inputs (same noise) and compare pixel by pixel (CONTRACT.md "GPU vs CPU
+//! agreement"). The arithmetic follows the WGSL line by line, in f32 and in the same order, so
+//! the two differ only by rounding inside the GPU (fused multiply-adds, `pow`, `sqrt`).
+
+mod line_ao;
+
+pub use line_ao::{LineAoParams, delta, depth_weight, hermite, light_weight, line_ao, line_ao_pixel};
+
+/// A row-major image, `data[y * width + x]`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image<T> {
+    pub width: usize,
+    pub height: usize,
+    pub data: Vec<T>,
+}
+
+/// An ND map level: normal xyz, normalized depth w.
+pub type NdImage = Image<[f32; 4]>;
+
+impl<T: Copy> Image<T> {
+    pub fn filled(width: usize, height: usize, value: T) -> Image<T> {
+        Image { width, height, data: vec![value; width * height] }
+    }
+
+    pub fn from_fn(width: usize, height: usize, mut f: impl FnMut(usize, usize) -> T) -> Image<T> {
+        let mut data = Vec::with_capacity(width * height);
+        for y in 0..height {
+            for x in 0..width {
+                data.push(f(x, y));
+            }
+        }
+        Image { width, height, data }
+    }
+
+    pub fn get(&self, x: usize, y: usize) -> T {
+        self.data[y * self.width + x]
+    }
+
+    /// The texel at (x, y) clamped to the image.
+    pub fn clamped(&self, x: i64, y: i64) -> T {
+        let x = x.clamp(0, self.width as i64 - 1) as usize;
+        let y = y.clamp(0, self.height as i64 - 1) as usize;
+        self.get(x, y)
+    }
+}
+
+const BINOMIAL: [f32; 5] = [0.0625, 0.25, 0.375, 0.25, 0.0625];
+
+/// One pyramid step (`shaders/nd_pyramid.wgsl`): ⌈W/2⌉ × ⌈H/2⌉, binomial 5 × 5 around (2x, 2y).
+pub fn nd_downsample(src: &NdImage) -> NdImage {
+    Image::from_fn(src.width.div_ceil(2), src.height.div_ceil(2), |x, y| {
+        let (cx, cy) = (2 * x as i64, 2 * y as i64);
+        let mut sum = [0.0f32; 4];
+        for (dy, wy) in BINOMIAL.iter().enumerate() {
+            let mut row = [0.0f32; 4];
+            for (dx, wx) in BINOMIAL.iter().enumerate() {
+                let t = src.clamped(cx + dx as i64 - 2, cy + dy as i64 - 2);
+                for c in 0..4 {
+                    row[c] += wx * t[c];
+                }
+            }
+            for c in 0..4 {
+                sum[c] += wy * row[c];
+            }
+        }
+        let len = (sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]).sqrt();
+        if len > 1e-6 { [sum[0] / len, sum[1] / len, sum[2] / len, sum[3]] } else { [0.0, 0.0, 0.0, sum[3]] }
+    })
+}
+
+/// The pyramid of `levels` levels over `level0`.
+pub fn nd_pyramid(level0: NdImage, levels: u32) -> Vec<NdImage> {
+    let mut pyramid = vec![level0];
+    for _ in 1..levels {
+        let next = nd_downsample(pyramid.last().expect("level 0 exists"));
+        pyramid.push(next);
+    }
+    pyramid
+}
+
+/// The nearest texel of a level of size `size` for full-resolution pixel `pixel` displaced by
+/// `offset` pixels (CONTRACT.md "Addressing"; `shared/nd.wgsl::level_texel`).
+pub fn level_texel(pixel: [u32; 2], offset: [f32; 2], scale: [f32; 2], size: [usize; 2]) -> [i64; 2] {
+    let t = |k: usize| {
+        let uv = (pixel[k] as f32 + 0.5 + offset[k]) * scale[k];
+        (uv.floor() as i64).clamp(0, size[k] as i64 - 1)
+    };
+    [t(0), t(1)]
+}
+
+/// The composite (`shaders/composite.wgsl`, final view) over the visible window: linear RGB.
+pub fn composite(
+    color: &Image<[f32; 4]>,
+    specular: &Image<f32>,
+    ao: &Image<f32>,
+    guard: usize,
+    strength: f32,
+) -> Image<[f32; 3]> {
+    Image::from_fn(color.width - 2 * guard, color.height - 2 * guard, |x, y| {
+        let (gx, gy) = (x + guard, y + guard);
+        let c = color.get(gx, gy);
+        let keep = 1.0 - (strength * ao.get(gx, gy)).clamp(0.0, 1.0);
+        let s = specular.get(gx, gy);
+        [c[0] * keep + s, c[1] * keep + s, c[2] * keep + s]
+    })
+}

@@ -1,0 +1,189 @@
+//! User-facing settings of the LineAO pass chain, with the paper's values as defaults.
+
+use crate::lighting::Lighting;
+
+/// Which ambient occlusion the chain computes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum AoMethod {
+    /// Plain lines (with the illuminated-lines specular), no occlusion.
+    None,
+    /// LineAO (Eichelbaum et al. 2013).
+    #[default]
+    LineAo,
+}
+
+impl AoMethod {
+    /// The name used on the command line and in `params.json`.
+    pub fn name(self) -> &'static str {
+        match self {
+            AoMethod::None => "none",
+            AoMethod::LineAo => "lineao",
+        }
+    }
+}
+
+/// The LineAO parameters of Eq. 7–15 (CONTRACT.md "LineAO").
+#[derive(Clone, Debug, PartialEq)]
+pub struct LineAoSettings {
+    /// s_r: number of hemispheres and pyramid levels, 1..=5; the paper uses 3 (and needs > 1
+    /// for δ(l) to fall off).
+    pub s_r: u32,
+    /// s_h: samples on the first hemisphere, 1..=256; hemisphere j takes ⌈s_h/(j+1)⌉. Default 32.
+    pub s_h: u32,
+    /// r0 in pixels for lines; `None` = 1.5 × the line width (paper §3.2.3).
+    pub r0_px: Option<f32>,
+    /// δ0, the depth difference below which an occluder counts fully. Default 1e-4.
+    pub delta0: f32,
+    /// ε: occluded iff Δd > ε. Default 1e-6 (CONTRACT.md departs from Eq. 8's Δd ≥ 0).
+    pub epsilon: f32,
+    /// Light attenuation g_light of Eq. 15; off means g_light = 1.
+    pub light_attenuation: bool,
+    /// Seed of the R1/R2 noise (CONTRACT.md "Noise"). Default 1.
+    pub noise_seed: u32,
+    /// Upper bound of the guard band in pixels. Default 128.
+    pub guard_max_px: u32,
+}
+
+impl Default for LineAoSettings {
+    fn default() -> Self {
+        LineAoSettings {
+            s_r: 3,
+            s_h: 32,
+            r0_px: None,
+            delta0: 1e-4,
+            epsilon: 1e-6,
+            light_attenuation: true,
+            noise_seed: 1,
+            guard_max_px: 128,
+        }
+    }
+}
+
+/// What the composite shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum DebugView {
+    /// color · (1 − strength · ao) + specular.
+    #[default]
+    Final,
+    /// 1 − ao as gray.
+    Ao,
+    /// Level-0 normals as n · 0.5 + 0.5.
+    Normals,
+    /// Normalized linear depth.
+    Depth,
+    /// z(P) / z_max.
+    Zoom,
+    /// Normals of pyramid level k.
+    Level(u32),
+}
+
+impl DebugView {
+    pub(crate) fn code(self) -> (u32, u32) {
+        match self {
+            DebugView::Final => (0, 0),
+            DebugView::Ao => (1, 0),
+            DebugView::Normals => (2, 0),
+            DebugView::Depth => (3, 0),
+            DebugView::Zoom => (4, 0),
+            DebugView::Level(k) => (5, k),
+        }
+    }
+}
+
+/// How lines are colored.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LineColor {
+    /// |T| of the world-space tangent as RGB (x red, y green, z blue: the DEC colormap of
+    /// tractography, left-right red, anterior-posterior green, superior-inferior blue).
+    Tangent,
+    /// One linear RGB color.
+    Constant([f32; 3]),
+}
+
+/// Everything the pass chain needs to know besides the camera.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ChainSettings {
+    pub method: AoMethod,
+    pub line_ao: LineAoSettings,
+    pub lighting: Lighting,
+    /// Line width in pixels, > 0. Default 2.
+    pub line_width_px: f32,
+    pub line_color: LineColor,
+    /// Linear RGB of the background.
+    pub background: [f32; 3],
+    /// AO strength in the composite, ≥ 0. Default 1.
+    pub strength: f32,
+    pub debug_view: DebugView,
+    /// World units per zoom unit (1 mm for tractography). Default 1.
+    pub zoom_unit: f32,
+}
+
+impl Default for ChainSettings {
+    fn default() -> Self {
+        ChainSettings {
+            method: AoMethod::LineAo,
+            line_ao: LineAoSettings::default(),
+            lighting: Lighting::default(),
+            line_width_px: 2.0,
+            line_color: LineColor::Tangent,
+            background: [1.0, 1.0, 1.0],
+            strength: 1.0,
+            debug_view: DebugView::Final,
+            zoom_unit: 1.0,
+        }
+    }
+}
+
+impl ChainSettings {
+    /// r0 in pixels: the explicit value or 1.5 × the line width.
+    pub fn r0_px(&self) -> f32 {
+        self.line_ao.r0_px.unwrap_or(1.5 * self.line_width_px)
+    }
+
+    /// Pyramid levels the chain needs: s_r for LineAO; one for plain lines.
+    pub fn levels(&self) -> u32 {
+        match self.method {
+            AoMethod::LineAo => self.line_ao.s_r,
+            AoMethod::None => 1,
+        }
+    }
+
+    /// Checks every range documented above.
+    pub fn validate(&self) -> Result<(), crate::Error> {
+        let bad = |what: String| Err(crate::Error::InvalidSettings(what));
+        let ao = &self.line_ao;
+        if !(1..=crate::MAX_LEVELS).contains(&ao.s_r) {
+            return bad(format!("s_r must be in 1..={}, got {}", crate::MAX_LEVELS, ao.s_r));
+        }
+        if !(1..=256).contains(&ao.s_h) {
+            return bad(format!("s_h must be in 1..=256, got {}", ao.s_h));
+        }
+        if !(self.line_width_px.is_finite() && self.line_width_px > 0.0 && self.line_width_px <= 256.0) {
+            return bad(format!("line width must be in (0, 256] px, got {}", self.line_width_px));
+        }
+        if !(self.r0_px().is_finite() && self.r0_px() >= 0.0) {
+            return bad(format!("r0 must be a finite number of pixels >= 0, got {}", self.r0_px()));
+        }
+        if !(ao.delta0.is_finite() && ao.delta0 >= 0.0 && ao.delta0 < (1.0 / ao.s_r as f32).powi(2)) {
+            return bad(format!("delta0 must be in [0, (1/s_r)^2), got {}", ao.delta0));
+        }
+        if !(ao.epsilon.is_finite() && ao.epsilon >= 0.0) {
+            return bad(format!("epsilon must be >= 0, got {}", ao.epsilon));
+        }
+        if !(self.strength.is_finite() && self.strength >= 0.0) {
+            return bad(format!("strength must be >= 0, got {}", self.strength));
+        }
+        if !(self.zoom_unit.is_finite() && self.zoom_unit > 0.0) {
+            return bad(format!("zoom unit must be > 0, got {}", self.zoom_unit));
+        }
+        if self.lighting.lights.len() > crate::lighting::MAX_LIGHTS {
+            return bad(format!("at most {} lights, got {}", crate::lighting::MAX_LIGHTS, self.lighting.lights.len()));
+        }
+        if let DebugView::Level(k) = self.debug_view
+            && k >= self.levels()
+        {
+            return bad(format!("debug level {k} does not exist: the pyramid has {} levels", self.levels()));
+        }
+        Ok(())
+    }
+}

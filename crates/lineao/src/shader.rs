@@ -1,0 +1,57 @@
+//! WGSL sources, embedded at compile time, and the one-line `#import path` directive that lets a
+//! pass shader include code from `shaders/shared/` instead of pasting it.
+//!
+//! Imports are resolved recursively, each file at most once per composed module, before the
+//! source reaches naga; the naga validation test composes every file the same way.
+
+use std::borrow::Cow;
+
+/// Every WGSL file under `shaders/`, by path relative to that folder.
+pub const FILES: &[(&str, &str)] = &[
+    ("shared/fullscreen.wgsl", include_str!("../shaders/shared/fullscreen.wgsl")),
+    ("shared/lighting.wgsl", include_str!("../shaders/shared/lighting.wgsl")),
+    ("shared/nd.wgsl", include_str!("../shaders/shared/nd.wgsl")),
+    ("composite.wgsl", include_str!("../shaders/composite.wgsl")),
+    ("line_ao.wgsl", include_str!("../shaders/line_ao.wgsl")),
+    ("lines.wgsl", include_str!("../shaders/lines.wgsl")),
+    ("nd_pyramid.wgsl", include_str!("../shaders/nd_pyramid.wgsl")),
+];
+
+/// The embedded source of `path` (relative to `shaders/`), without imports resolved.
+pub fn raw(path: &str) -> Option<&'static str> {
+    FILES.iter().find(|(p, _)| *p == path).map(|(_, s)| *s)
+}
+
+/// `path` with every `#import` resolved. Panics only on a missing import, which the naga test
+/// catches for every embedded file.
+pub fn compose(path: &str) -> String {
+    let mut out = String::new();
+    let mut seen = Vec::new();
+    append(path, &mut out, &mut seen);
+    out
+}
+
+fn append(path: &str, out: &mut String, seen: &mut Vec<String>) {
+    if seen.iter().any(|p| p == path) {
+        return;
+    }
+    seen.push(path.to_owned());
+    let source = raw(path).unwrap_or_else(|| panic!("WGSL file {path} is not embedded"));
+    for line in source.lines() {
+        match line.trim().strip_prefix("#import ") {
+            Some(import) => append(import.trim(), out, seen),
+            None => {
+                out.push_str(line);
+                out.push('\n');
+            }
+        }
+    }
+}
+
+/// A shader module from the composed `path`, labelled `lineao::<path>`.
+pub fn module(device: &wgpu::Device, path: &str) -> wgpu::ShaderModule {
+    device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(&format!("lineao::{path}")),
+        source: wgpu::ShaderSource::Wgsl(Cow::Owned(compose(path))),
+    })
+}

@@ -1,0 +1,70 @@
+// Composite (paper §3.3): color · (1 - clamp(strength · ao, 0, 1)) + illuminated-lines specular,
+// cropped from the guard-banded G-buffer into the caller's target; plus the debug views.
+#import shared/fullscreen.wgsl
+#import shared/nd.wgsl
+
+// Keep in sync with `lineao::passes::composite::CompositeUniform`.
+struct CompositeUniform {
+    level_scale: array<vec4<f32>, 5>,
+    level_size: array<vec4<u32>, 5>,
+    guard: vec2<u32>,
+    strength: f32,
+    // 0 final, 1 AO only, 2 normals, 3 depth, 4 zoom, 5 pyramid level `debug_level`.
+    debug_view: u32,
+    debug_level: u32,
+    // The zoom value shown as white in the zoom view.
+    zoom_max: f32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+@group(0) @binding(0) var<uniform> params: CompositeUniform;
+@group(0) @binding(1) var color_map: texture_2d<f32>;
+@group(0) @binding(2) var specular_map: texture_2d<f32>;
+@group(0) @binding(3) var ao_map: texture_2d<f32>;
+@group(0) @binding(4) var zoom_map: texture_2d<f32>;
+@group(0) @binding(5) var nd0: texture_2d<f32>;
+@group(0) @binding(6) var nd1: texture_2d<f32>;
+@group(0) @binding(7) var nd2: texture_2d<f32>;
+@group(0) @binding(8) var nd3: texture_2d<f32>;
+@group(0) @binding(9) var nd4: texture_2d<f32>;
+
+@vertex
+fn vs_main(@builtin(vertex_index) vertex_index: u32) -> @builtin(position) vec4<f32> {
+    return fullscreen_position(vertex_index);
+}
+
+fn show_normal(nd: vec4<f32>) -> vec3<f32> {
+    return select(nd.xyz * 0.5 + 0.5, vec3<f32>(0.0), nd_is_background(nd));
+}
+
+fn pyramid_level(k: u32, pixel: vec2<u32>) -> vec4<f32> {
+    let texel = level_texel(pixel, vec2<f32>(0.0), params.level_scale[k].xy, params.level_size[k].xy);
+    switch k {
+        case 0u: { return textureLoad(nd0, texel, 0); }
+        case 1u: { return textureLoad(nd1, texel, 0); }
+        case 2u: { return textureLoad(nd2, texel, 0); }
+        case 3u: { return textureLoad(nd3, texel, 0); }
+        default: { return textureLoad(nd4, texel, 0); }
+    }
+}
+
+@fragment
+fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
+    let pixel = vec2<u32>(position.xy) + params.guard;
+    let ao = textureLoad(ao_map, pixel, 0).r;
+    var rgb: vec3<f32>;
+    switch params.debug_view {
+        case 1u: { rgb = vec3<f32>(1.0 - ao); }
+        case 2u: { rgb = show_normal(textureLoad(nd0, pixel, 0)); }
+        case 3u: { rgb = vec3<f32>(textureLoad(nd0, pixel, 0).w); }
+        case 4u: { rgb = vec3<f32>(textureLoad(zoom_map, pixel, 0).r / params.zoom_max); }
+        case 5u: { rgb = show_normal(pyramid_level(params.debug_level, pixel)); }
+        default: {
+            let color = textureLoad(color_map, pixel, 0).rgb;
+            let specular = textureLoad(specular_map, pixel, 0).r;
+            rgb = color * (1.0 - clamp(params.strength * ao, 0.0, 1.0)) + vec3<f32>(specular);
+        }
+    }
+    return vec4<f32>(rgb, 1.0);
+}

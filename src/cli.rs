@@ -1,0 +1,153 @@
+//! The command line.
+
+use std::path::PathBuf;
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use lineao_tracts::SceneKind;
+
+#[derive(Parser, Debug)]
+#[command(name = "lineao", version, about = "Ambient occlusion for dense 3D lines (LineAO) on wgpu")]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Render a built-in scene to a PNG.
+    Render(RenderArgs),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Method {
+    None,
+    Lineao,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Variant {
+    /// The paper's equations with CONTRACT.md's conventions.
+    Paper,
+}
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    /// Built-in scene.
+    #[arg(long, default_value = "bundles", value_parser = parse_scene)]
+    pub scene: SceneKind,
+    /// Approximate vertex count of the built-in scene [default: 400000].
+    #[arg(long)]
+    pub vertices: Option<usize>,
+    /// Seed of the built-in scene.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Ambient occlusion method.
+    #[arg(long, value_enum, default_value_t = Method::Lineao)]
+    pub method: Method,
+    /// LineAO variant.
+    #[arg(long, value_enum, default_value_t = Variant::Paper)]
+    pub variant: Variant,
+    /// Output PNG.
+    #[arg(short, long, default_value = "lineao.png")]
+    pub output: PathBuf,
+    #[arg(long, default_value_t = 1280, value_parser = clap::value_parser!(u32).range(1..=8192))]
+    pub width: u32,
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=8192))]
+    pub height: u32,
+    /// Line width in pixels.
+    #[arg(long, default_value_t = 2.0)]
+    pub line_width: f32,
+    /// Camera position, world units: X,Y,Z [default: the scene's].
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub eye: Option<[f32; 3]>,
+    /// Point the camera looks at: X,Y,Z [default: the scene's].
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub target: Option<[f32; 3]>,
+    /// Camera up vector: X,Y,Z [default: the scene's].
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub up: Option<[f32; 3]>,
+    /// Vertical field of view in degrees (perspective) [default: the scene's].
+    #[arg(long, conflicts_with = "ortho")]
+    pub fov: Option<f32>,
+    /// Orthographic camera showing this many world units vertically.
+    #[arg(long)]
+    pub ortho: Option<f32>,
+    /// World units per zoom unit of z(P) [default: the scene's, 1 mm].
+    #[arg(long)]
+    pub zoom_unit: Option<f32>,
+    /// LineAO s_r: hemispheres and pyramid levels (1..=5).
+    #[arg(long, default_value_t = 3)]
+    pub s_r: u32,
+    /// LineAO s_h: samples on the first hemisphere.
+    #[arg(long, default_value_t = 32)]
+    pub s_h: u32,
+    /// LineAO r0 in pixels [default: 1.5 × line width].
+    #[arg(long)]
+    pub r0: Option<f32>,
+    /// LineAO δ0.
+    #[arg(long, default_value_t = 1e-4)]
+    pub delta0: f32,
+    /// LineAO ε: occluded iff Δd > ε.
+    #[arg(long, default_value_t = 1e-6)]
+    pub epsilon: f32,
+    /// AO strength in the composite.
+    #[arg(long, default_value_t = 1.0)]
+    pub strength: f32,
+    /// Disable LineAO's light attenuation (g_light = 1).
+    #[arg(long)]
+    pub no_light_attenuation: bool,
+    /// Seed of the R1/R2 noise.
+    #[arg(long, default_value_t = 1)]
+    pub noise_seed: u32,
+    /// Upper bound of the guard band in pixels.
+    #[arg(long, default_value_t = 128)]
+    pub guard_max: u32,
+    /// Line color: `tangent` (|T| as RGB) or R,G,B in [0, 1].
+    #[arg(long, default_value = "tangent", value_parser = parse_color)]
+    pub color: ColorArg,
+    /// Background color R,G,B in [0, 1].
+    #[arg(long, default_value = "1,1,1", value_parser = parse_vec3)]
+    pub background: [f32; 3],
+    /// What to show: final, ao, normals, depth, zoom, or level:K (pyramid level K).
+    #[arg(long, default_value = "final", value_parser = parse_debug_view)]
+    pub debug_view: lineao::DebugView,
+    /// Write the method's inputs and output as .npy files and params.json into this folder.
+    #[arg(long)]
+    pub dump: Option<PathBuf>,
+}
+
+#[derive(Clone, Copy, Debug)]
+pub enum ColorArg {
+    Tangent,
+    Constant([f32; 3]),
+}
+
+fn parse_scene(s: &str) -> Result<SceneKind, String> {
+    s.parse()
+}
+
+fn parse_vec3(s: &str) -> Result<[f32; 3], String> {
+    let parts: Vec<f32> =
+        s.split(',').map(|p| p.trim().parse::<f32>().map_err(|e| format!("'{p}': {e}"))).collect::<Result<_, _>>()?;
+    let v: [f32; 3] = parts.try_into().map_err(|_| format!("expected three numbers X,Y,Z, got '{s}'"))?;
+    if v.iter().all(|c| c.is_finite()) { Ok(v) } else { Err(format!("'{s}' is not finite")) }
+}
+
+fn parse_color(s: &str) -> Result<ColorArg, String> {
+    if s == "tangent" { Ok(ColorArg::Tangent) } else { parse_vec3(s).map(ColorArg::Constant) }
+}
+
+fn parse_debug_view(s: &str) -> Result<lineao::DebugView, String> {
+    use lineao::DebugView as D;
+    Ok(match s {
+        "final" => D::Final,
+        "ao" => D::Ao,
+        "normals" => D::Normals,
+        "depth" => D::Depth,
+        "zoom" => D::Zoom,
+        _ => match s.strip_prefix("level:").map(str::parse::<u32>) {
+            Some(Ok(k)) => D::Level(k),
+            _ => return Err(format!("unknown debug view '{s}' (final, ao, normals, depth, zoom, level:K)")),
+        },
+    })
+}

@@ -1,0 +1,102 @@
+//! `--dump DIR` (CONTRACT.md): the method's inputs and raw output at the guard-banded size, so an
+//! outside implementation can recompute the result: `nd_<j>.npy`, `zoom.npy`, `ao.npy`,
+//! `noise.npy`, `samples.npy` and `params.json`.
+
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use lineao::camera::{Camera, Projection};
+use lineao::readback::read_texture;
+use lineao::{AoChain, AoMethod, Gpu, noise};
+use npyz::WriterBuilder;
+use serde_json::json;
+
+use crate::cli::RenderArgs;
+
+fn write_npy(dir: &Path, name: &str, shape: &[u64], data: &[f32]) -> Result<()> {
+    let path = dir.join(name);
+    let file = File::create(&path).with_context(|| format!("cannot create {}", path.display()))?;
+    let mut writer = npyz::WriteOptions::new()
+        .default_dtype()
+        .shape(shape)
+        .writer(BufWriter::new(file))
+        .begin_nd()
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    writer.extend(data.iter().copied()).with_context(|| format!("cannot write {}", path.display()))?;
+    writer.finish().with_context(|| format!("cannot write {}", path.display()))?;
+    Ok(())
+}
+
+fn flat3(vectors: &[[f32; 3]]) -> Vec<f32> {
+    vectors.iter().flatten().copied().collect()
+}
+
+pub fn write(dir: &Path, gpu: &Gpu, chain: &AoChain, camera: &Camera, args: &RenderArgs) -> Result<()> {
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let (targets, view) = chain.targets().zip(chain.frame_view()).context("nothing was rendered")?;
+    let s = chain.settings();
+    let read = |texture: &wgpu::Texture| read_texture(&gpu.device, &gpu.queue, texture);
+
+    for (j, level) in targets.nd.iter().enumerate() {
+        let data = read(&level.texture)?;
+        write_npy(dir, &format!("nd_{j}.npy"), &[data.height as u64, data.width as u64, 4], &data.to_f32())?;
+    }
+    let (w, h) = (targets.size.0 as u64, targets.size.1 as u64);
+    write_npy(dir, "zoom.npy", &[h, w], &read(&targets.zoom.texture)?.to_f32())?;
+    write_npy(dir, "ao.npy", &[h, w], &read(&targets.ao.texture)?.to_f32())?;
+
+    let mut params = json!({
+        "method": s.method.name(),
+        "geometry": "lines",
+        "line_width_px": s.line_width_px,
+        "strength": s.strength,
+        "zoom_unit": s.zoom_unit,
+        "guard_px": targets.guard,
+        "depth_near": view.near,
+        "depth_far": view.far,
+        "width": view.width,
+        "height": view.height,
+        "camera": match camera.projection {
+            Projection::Perspective { fov_y_deg } => json!({
+                "eye": camera.eye.to_array(), "target": camera.target.to_array(), "up": camera.up.to_array(), "fov_y_deg": fov_y_deg,
+            }),
+            Projection::Orthographic { height } => json!({
+                "eye": camera.eye.to_array(), "target": camera.target.to_array(), "up": camera.up.to_array(), "ortho_height": height,
+            }),
+        },
+    });
+    if s.method == AoMethod::LineAo {
+        let ao = &s.line_ao;
+        let lights: Vec<_> = s
+            .lighting
+            .normalized()
+            .iter()
+            .map(|l| json!({"dir": l.dir.to_array(), "intensity": l.intensity}))
+            .collect();
+        let extra = json!({
+            "variant": format!("{:?}", args.variant).to_lowercase(),
+            "s_r": ao.s_r,
+            "s_h": ao.s_h,
+            "r0_px": s.r0_px(),
+            "delta0": ao.delta0,
+            "epsilon": ao.epsilon,
+            "light_attenuation": ao.light_attenuation,
+            "lights": lights,
+            "kd": s.lighting.kd,
+            "ks": s.lighting.ks,
+            "shininess": s.lighting.shininess,
+            "noise_seed": ao.noise_seed,
+            "outer": "full",
+        });
+        params.as_object_mut().expect("object").extend(extra.as_object().expect("object").clone());
+        write_npy(dir, "noise.npy", &[64, 64, 3], &flat3(&noise::noise_tile(ao.noise_seed)))?;
+        let samples = noise::sample_table(ao.noise_seed, ao.s_r, ao.s_h);
+        write_npy(dir, "samples.npy", &[ao.s_r as u64, ao.s_h as u64, 3], &flat3(&samples))?;
+    }
+    let path = dir.join("params.json");
+    let text = serde_json::to_string_pretty(&params)?;
+    std::fs::write(&path, text + "\n").with_context(|| format!("cannot write {}", path.display()))?;
+    Ok(())
+}

@@ -1,0 +1,35 @@
+//! `lineao`: render tractography and streamlines with LineAO.
+//!
+//! Exit codes (CONTRACT.md): 0 success, 1 bad input or a failed operation (message on stderr),
+//! 2 bad command line. A panic is a bug; it is reported and exits 1, never 101.
+
+mod cli;
+mod dump;
+mod output;
+mod render;
+
+use std::process::ExitCode;
+
+use clap::Parser;
+
+fn main() -> ExitCode {
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        // SAFETY: single-threaded at this point; silences the Vulkan loader's warnings headless.
+        unsafe { std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir()) };
+    }
+    let cli = cli::Cli::parse();
+    let result = std::panic::catch_unwind(|| match cli.command {
+        cli::Command::Render(args) => render::run(&args),
+    });
+    match result {
+        Ok(Ok(())) => ExitCode::SUCCESS,
+        Ok(Err(error)) => {
+            eprintln!("lineao: error: {error:#}");
+            ExitCode::from(1)
+        }
+        Err(_) => {
+            eprintln!("lineao: internal error (a bug in lineao; please report it with the command line)");
+            ExitCode::from(1)
+        }
+    }
+}

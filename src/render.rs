@@ -1,0 +1,110 @@
+//! `lineao render`: a built-in scene through the pass chain into a PNG (and `--dump`).
+
+use anyhow::{Context, Result};
+use glam::Vec3;
+use lineao::camera::{Camera, Projection};
+use lineao::passes::lines::LineGeometry;
+use lineao::{AoChain, AoMethod, ChainSettings, Gpu, LineAoSettings, LineColor};
+
+use crate::cli::{ColorArg, Method, RenderArgs};
+
+/// The chain's settings from the command line.
+pub fn settings(args: &RenderArgs, zoom_unit: f32) -> ChainSettings {
+    ChainSettings {
+        method: match args.method {
+            Method::None => AoMethod::None,
+            Method::Lineao => AoMethod::LineAo,
+        },
+        line_ao: LineAoSettings {
+            s_r: args.s_r,
+            s_h: args.s_h,
+            r0_px: args.r0,
+            delta0: args.delta0,
+            epsilon: args.epsilon,
+            light_attenuation: !args.no_light_attenuation,
+            noise_seed: args.noise_seed,
+            guard_max_px: args.guard_max,
+        },
+        line_width_px: args.line_width,
+        line_color: match args.color {
+            ColorArg::Tangent => LineColor::Tangent,
+            ColorArg::Constant(rgb) => LineColor::Constant(rgb),
+        },
+        background: args.background,
+        strength: args.strength,
+        debug_view: args.debug_view,
+        zoom_unit: args.zoom_unit.unwrap_or(zoom_unit),
+        ..ChainSettings::default()
+    }
+}
+
+pub fn run(args: &RenderArgs) -> Result<()> {
+    let vertices = args.vertices.unwrap_or(args.scene.default_vertices());
+    let scene = args.scene.build(args.seed, vertices);
+    let hint = scene.view;
+    let settings = settings(args, hint.zoom_unit);
+    settings.validate()?;
+    let camera = Camera {
+        eye: Vec3::from_array(args.eye.unwrap_or(hint.eye)),
+        target: Vec3::from_array(args.target.unwrap_or(hint.target)),
+        up: Vec3::from_array(args.up.unwrap_or(hint.up)),
+        projection: match (args.ortho, args.fov) {
+            (Some(height), _) => Projection::Orthographic { height },
+            (None, fov) => Projection::Perspective { fov_y_deg: fov.unwrap_or(hint.fov_y_deg) },
+        },
+    };
+    validate_camera(&camera)?;
+
+    let gpu = Gpu::headless()?;
+    let tracts = &scene.tractogram;
+    let geometry = LineGeometry::new(&gpu.device, &tracts.positions, &tracts.offsets)?;
+    let bounds = geometry.bounds.context("the scene has no finite points")?;
+    let format = wgpu::TextureFormat::Rgba8UnormSrgb;
+    let mut chain = AoChain::new(&gpu.device, format, settings)?;
+    chain.resize(args.width, args.height)?;
+    chain.prepare(&gpu.device, &gpu.queue, &camera, &bounds);
+    let target = lineao::targets::Target::new(
+        &gpu.device,
+        "lineao::render::output",
+        (args.width, args.height),
+        format,
+        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+    );
+    let mut encoder =
+        gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::render") });
+    chain.encode(&mut encoder, &geometry, &target.view);
+    gpu.queue.submit([encoder.finish()]);
+    let image = lineao::readback::read_texture(&gpu.device, &gpu.queue, &target.texture)?;
+    crate::output::write_png(&args.output, args.width, args.height, &image.bytes)?;
+    if let Some(dir) = &args.dump {
+        crate::dump::write(dir, &gpu, &chain, &camera, args)?;
+    }
+    eprintln!(
+        "lineao: {} ({} streamlines, {} vertices) with {} on {} -> {}",
+        scene.kind.name(),
+        geometry.streamlines,
+        geometry.vertices,
+        chain.settings().method.name(),
+        gpu.describe(),
+        args.output.display()
+    );
+    Ok(())
+}
+
+fn validate_camera(camera: &Camera) -> Result<()> {
+    let forward = camera.target - camera.eye;
+    anyhow::ensure!(forward.length() > 0.0, "the camera's eye and target coincide");
+    anyhow::ensure!(
+        forward.cross(camera.up).length() > 1e-6 * forward.length() * camera.up.length(),
+        "the camera's up vector is parallel to its view direction (or zero)"
+    );
+    match camera.projection {
+        Projection::Perspective { fov_y_deg } => {
+            anyhow::ensure!(fov_y_deg > 0.0 && fov_y_deg < 180.0, "--fov must be in (0, 180) degrees, got {fov_y_deg}")
+        }
+        Projection::Orthographic { height } => {
+            anyhow::ensure!(height > 0.0 && height.is_finite(), "--ortho must be a positive height, got {height}")
+        }
+    }
+    Ok(())
+}
