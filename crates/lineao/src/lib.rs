@@ -48,6 +48,7 @@ pub mod reference;
 pub mod settings;
 pub mod shader;
 pub mod targets;
+pub mod verify;
 
 pub use chain::AoChain;
 pub use gpu::Gpu;

@@ -4,7 +4,7 @@
 //!
 //! | texture   | format        | content                                                    |
 //! |-----------|---------------|------------------------------------------------------------|
-//! | color     | Rgba16Float   | linear base color of the lines; background color elsewhere |
+//! | color     | Rgba32Float   | linear base color of the lines; background color elsewhere |
 //! | nd[j]     | Rgba32Float   | level j: view-space normal (xyz), normalized depth (w)     |
 //! | zoom      | R32Float      | z(P): pixels per `zoom_unit` at P; 0 on background          |
 //! | specular  | R32Float      | illuminated-lines specular, added in the composite         |
@@ -13,7 +13,7 @@
 //!
 //! All at the guard-banded size; level j is ⌈W_{j−1}/2⌉ × ⌈H_{j−1}/2⌉ (CONTRACT.md).
 
-pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub const ND_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub const ZOOM_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 pub const SPECULAR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
@@ -81,7 +81,8 @@ impl FrameTargets {
     pub fn new(device: &wgpu::Device, width: u32, height: u32, guard: u32, levels: u32) -> FrameTargets {
         use wgpu::TextureUsages as U;
         let size = (width + 2 * guard, height + 2 * guard);
-        let attachment = U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC;
+        // COPY_DST lets a host (or a test) write a G-buffer of its own into the targets.
+        let attachment = U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC | U::COPY_DST;
         let nd = level_sizes(size, levels.max(1))
             .into_iter()
             .enumerate()

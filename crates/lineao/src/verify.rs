@@ -1,0 +1,113 @@
+//! Proving the GPU against the CPU reference: read targets back as reference images, and the
+//! agreement check of CONTRACT.md ("GPU vs CPU agreement"): ≥ 99.5 % of geometry pixels within
+//! 1e-3, and every pixel within a bound of a few flipped samples.
+
+use crate::Error;
+use crate::readback::read_texture;
+use crate::reference::{Image, NdImage};
+use crate::targets::Target;
+
+/// A target of one f32 channel (zoom, specular, ao, depth) as an image.
+pub fn read_f32(device: &wgpu::Device, queue: &wgpu::Queue, target: &Target) -> Result<Image<f32>, Error> {
+    let data = read_texture(device, queue, &target.texture)?;
+    Ok(Image { width: data.width as usize, height: data.height as usize, data: data.to_f32() })
+}
+
+/// An Rgba32Float target (an ND level, color) as an image.
+pub fn read_rgba(device: &wgpu::Device, queue: &wgpu::Queue, target: &Target) -> Result<NdImage, Error> {
+    let data = read_texture(device, queue, &target.texture)?;
+    Ok(Image { width: data.width as usize, height: data.height as usize, data: data.to_vec4() })
+}
+
+/// Writes `image` into an Rgba32Float or R32Float target (a host's own G-buffer, or a test's).
+pub fn write_target<T: bytemuck::Pod>(queue: &wgpu::Queue, target: &Target, image: &Image<T>) {
+    let texel = std::mem::size_of::<T>() as u32;
+    queue.write_texture(
+        target.texture.as_image_copy(),
+        bytemuck::cast_slice(&image.data),
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(image.width as u32 * texel),
+            rows_per_image: Some(image.height as u32),
+        },
+        target.texture.size(),
+    );
+}
+
+/// How two images differ.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Agreement {
+    /// Pixels compared (the mask's).
+    pub pixels: usize,
+    /// Share of them within `tolerance`.
+    pub fraction_within: f64,
+    /// Largest absolute difference and where.
+    pub worst: f32,
+    pub worst_pixel: (usize, usize),
+    pub mean_abs: f64,
+}
+
+impl std::fmt::Display for Agreement {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} pixels, {:.4} % within tolerance, mean |Δ| {:.2e}, worst |Δ| {:.3e} at {:?}",
+            self.pixels,
+            100.0 * self.fraction_within,
+            self.mean_abs,
+            self.worst,
+            self.worst_pixel
+        )
+    }
+}
+
+/// Compares `a` and `b` on the pixels where `mask` holds.
+pub fn compare(a: &Image<f32>, b: &Image<f32>, tolerance: f32, mask: impl Fn(usize, usize) -> bool) -> Agreement {
+    assert_eq!((a.width, a.height), (b.width, b.height), "images differ in size");
+    let (mut pixels, mut within, mut sum) = (0usize, 0usize, 0.0f64);
+    let (mut worst, mut worst_pixel) = (0.0f32, (0, 0));
+    for y in 0..a.height {
+        for x in 0..a.width {
+            if !mask(x, y) {
+                continue;
+            }
+            let d = (a.get(x, y) - b.get(x, y)).abs();
+            let d = if d.is_nan() { f32::INFINITY } else { d };
+            pixels += 1;
+            sum += d as f64;
+            within += (d <= tolerance) as usize;
+            if d > worst {
+                (worst, worst_pixel) = (d, (x, y));
+            }
+        }
+    }
+    Agreement {
+        pixels,
+        fraction_within: if pixels == 0 { 1.0 } else { within as f64 / pixels as f64 },
+        worst,
+        worst_pixel,
+        mean_abs: if pixels == 0 { 0.0 } else { sum / pixels as f64 },
+    }
+}
+
+/// CONTRACT.md's bound for every pixel of LineAO: two flipped samples per hemisphere, Σ_j 2/n_j.
+pub fn line_ao_flip_bound(s_r: u32, s_h: u32) -> f32 {
+    (0..s_r).map(|j| 2.0 / crate::noise::samples_on_hemisphere(s_h, j) as f32).sum()
+}
+
+/// Checks the agreement policy on geometry pixels (non-background in `nd0`) and returns the
+/// statistics, or an error message that names the worst pixel and the fraction.
+pub fn check_policy(
+    gpu: &Image<f32>,
+    cpu: &Image<f32>,
+    nd0: &NdImage,
+    every_pixel_bound: f32,
+) -> Result<Agreement, String> {
+    let geometry = |x: usize, y: usize| nd0.get(x, y)[..3] != [0.0; 3];
+    let stats = compare(gpu, cpu, 1e-3, geometry);
+    let everywhere = compare(gpu, cpu, every_pixel_bound, |_, _| true);
+    if stats.fraction_within < 0.995 || everywhere.worst > every_pixel_bound {
+        return Err(format!("GPU vs CPU: {stats}; every-pixel bound {every_pixel_bound}: {everywhere}"));
+    }
+    Ok(stats)
+}

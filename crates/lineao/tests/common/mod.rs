@@ -1,0 +1,117 @@
+//! Shared by the GPU tests: a device on the default adapter (lavapipe on CI — a missing adapter
+//! fails the test, it never skips) and ways to run the chain or single passes and read back.
+#![allow(dead_code)]
+
+use lineao::camera::{Bounds, Camera, FrameView};
+use lineao::passes::line_ao::LineAo;
+use lineao::passes::lines::LineGeometry;
+use lineao::passes::nd_pyramid::NdPyramid;
+use lineao::reference::{Image, NdImage};
+use lineao::targets::{FrameTargets, Target};
+use lineao::verify::{read_f32, read_rgba, write_target};
+use lineao::{AoChain, ChainSettings, Gpu};
+
+pub fn gpu() -> Gpu {
+    if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
+        // SAFETY: set before any thread of ours reads the environment.
+        unsafe { std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir()) };
+    }
+    Gpu::headless().expect("a wgpu adapter (install mesa-vulkan-drivers for lavapipe)")
+}
+
+/// Everything a chain frame leaves in its targets, read back.
+pub struct Frame {
+    pub view: FrameView,
+    pub guard: usize,
+    pub color: NdImage,
+    pub nd: Vec<NdImage>,
+    pub zoom: Image<f32>,
+    pub specular: Image<f32>,
+    pub depth: Image<f32>,
+    pub ao: Image<f32>,
+    /// The composite's output (Rgba32Float, linear), visible size.
+    pub output: NdImage,
+}
+
+pub const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+
+/// Renders polylines through the whole chain and reads every target back.
+pub fn render(
+    gpu: &Gpu,
+    positions: &[[f32; 3]],
+    offsets: &[u64],
+    camera: &Camera,
+    bounds: Option<Bounds>,
+    settings: ChainSettings,
+    (width, height): (u32, u32),
+) -> Frame {
+    let geometry = LineGeometry::new(&gpu.device, positions, offsets).unwrap();
+    render_geometry(gpu, &geometry, camera, bounds.or(geometry.bounds).unwrap(), settings, (width, height))
+}
+
+pub fn render_geometry(
+    gpu: &Gpu,
+    geometry: &LineGeometry,
+    camera: &Camera,
+    bounds: Bounds,
+    settings: ChainSettings,
+    (width, height): (u32, u32),
+) -> Frame {
+    let mut chain = AoChain::new(&gpu.device, OUTPUT_FORMAT, settings).unwrap();
+    chain.resize(width, height).unwrap();
+    let view = chain.prepare(&gpu.device, &gpu.queue, camera, &bounds).unwrap();
+    let output = Target::new(
+        &gpu.device,
+        "test::output",
+        (width, height),
+        OUTPUT_FORMAT,
+        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+    );
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    chain.encode(&mut encoder, geometry, &output.view);
+    gpu.queue.submit([encoder.finish()]);
+    let t = chain.targets().unwrap();
+    let (d, q) = (&gpu.device, &gpu.queue);
+    Frame {
+        view,
+        guard: t.guard as usize,
+        color: read_rgba(d, q, &t.color).unwrap(),
+        nd: t.nd.iter().map(|level| read_rgba(d, q, level).unwrap()).collect(),
+        zoom: read_f32(d, q, &t.zoom).unwrap(),
+        specular: read_f32(d, q, &t.specular).unwrap(),
+        depth: read_f32(d, q, &t.depth).unwrap(),
+        ao: read_f32(d, q, &t.ao).unwrap(),
+        output: read_rgba(d, q, &output).unwrap(),
+    }
+}
+
+/// Runs the ND pyramid and LineAO passes alone on a G-buffer written from the CPU (as a host
+/// with its own geometry would), returning the GPU's pyramid and AO.
+pub fn line_ao_on(
+    gpu: &Gpu,
+    nd0: &NdImage,
+    zoom: &Image<f32>,
+    settings: &ChainSettings,
+    guard: u32,
+) -> (Vec<NdImage>, Image<f32>) {
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let (w, h) = (nd0.width as u32 - 2 * guard, nd0.height as u32 - 2 * guard);
+    let targets = FrameTargets::new(d, w, h, guard, settings.line_ao.s_r);
+    write_target(q, &targets.nd[0], nd0);
+    write_target(q, &targets.zoom, zoom);
+    let mut pyramid = NdPyramid::new(d);
+    pyramid.resize(d, &targets);
+    let mut line_ao = LineAo::new(d, &settings.line_ao);
+    line_ao.resize(d, &targets);
+    line_ao.prepare(q, &targets, &settings.line_ao, settings.r0_px(), &settings.lighting);
+    let mut encoder = d.create_command_encoder(&Default::default());
+    pyramid.encode(&mut encoder, &targets);
+    line_ao.encode(&mut encoder, &targets);
+    q.submit([encoder.finish()]);
+    let levels = targets.nd.iter().map(|level| read_rgba(d, q, level).unwrap()).collect();
+    (levels, read_f32(d, q, &targets.ao).unwrap())
+}
+
+pub fn is_geometry(nd: [f32; 4]) -> bool {
+    nd[..3] != [0.0; 3]
+}

@@ -1,0 +1,277 @@
+//! LineAO and the ND pyramid: closed-form cases worked out here, the passes run alone on
+//! G-buffers written from the CPU, and the GPU against the CPU reference on rendered lines.
+
+mod common;
+
+use common::{gpu, is_geometry, line_ao_on, render};
+use glam::Vec3;
+use lineao::camera::{Camera, Projection};
+use lineao::lighting::{Light, Lighting};
+use lineao::noise::{noise_tile, sample_table};
+use lineao::reference::{self, Image, LineAoParams, NdImage};
+use lineao::verify::{check_policy, compare, line_ao_flip_bound};
+use lineao::{ChainSettings, LineAoSettings};
+
+fn settings(s_r: u32, r0_px: f32, light_attenuation: bool) -> ChainSettings {
+    ChainSettings {
+        line_ao: LineAoSettings { s_r, r0_px: Some(r0_px), light_attenuation, ..LineAoSettings::default() },
+        ..ChainSettings::default()
+    }
+}
+
+#[test]
+fn delta_curve_and_depth_weight() {
+    // δ(l) = (1 − l/s_r)² (Eq. 11): 1, 4/9, 1/9 for s_r = 3.
+    for (j, expected) in [(0, 1.0), (1, 4.0 / 9.0), (2, 1.0 / 9.0)] {
+        assert!((reference::delta(j, 3) - expected).abs() < 1e-6);
+    }
+    let (d0, dj) = (1e-4, 4.0 / 9.0);
+    assert_eq!(reference::depth_weight(0.5 * d0, dj, d0), 1.0);
+    assert_eq!(reference::depth_weight(d0, dj, d0), 1.0); // continuous at δ0: 1 − h(0)
+    assert!(reference::depth_weight(dj, dj, d0).abs() < 1e-6); // and at δ(l): 1 − h(1)
+    assert!((reference::depth_weight(0.5 * (d0 + dj), dj, d0) - 0.5).abs() < 1e-6); // h(1/2) = 1/2
+    assert_eq!(reference::depth_weight(dj + 1e-3, dj, d0), 0.0);
+    // h(x) = 3x² − 2x³ at x = 1/4: 3/16 − 2/64 = 0.15625.
+    assert!((reference::hermite(0.25) - 0.15625).abs() < 1e-7);
+    let sweep: Vec<f32> = (0..=100).map(|k| reference::depth_weight(k as f32 / 200.0, dj, d0)).collect();
+    assert!(sweep.windows(2).all(|w| w[1] <= w[0]), "g_depth must not increase with Δd");
+}
+
+#[test]
+fn light_weight_closed_form() {
+    let params = |dir: Vec3| LineAoParams {
+        s_r: 3,
+        s_h: 32,
+        r0_px: 3.0,
+        delta0: 1e-4,
+        epsilon: 1e-6,
+        light_attenuation: true,
+        lights: vec![Light { dir, intensity: 1.0 }],
+        kd: 0.3,
+        ks: 0.4,
+        shininess: 32.0,
+        noise_origin: [0, 0],
+    };
+    let n = Vec3::Z;
+    // Light, normal and ω aligned: BRDF = kd + ks = 0.7.
+    assert!((reference::light_weight(&params(Vec3::Z), n, Vec3::Z) - 0.3).abs() < 1e-6);
+    // ω ⊥ n: h at 45°, (n·h)^32 = 2^-16.
+    let expected = 1.0 - (0.3 + 0.4 * 2f32.powi(-16));
+    assert!((reference::light_weight(&params(Vec3::Z), n, Vec3::X) - expected).abs() < 1e-6);
+    // Light behind the surface and ω opposite to it: nothing reflected.
+    assert_eq!(reference::light_weight(&params(-Vec3::Z), n, Vec3::Z), 1.0);
+    let off = LineAoParams { light_attenuation: false, ..params(Vec3::Z) };
+    assert_eq!(reference::light_weight(&off, n, Vec3::Z), 1.0);
+}
+
+/// A flat fronto-parallel ND map with the given per-pixel depth.
+fn nd_map(width: usize, height: usize, depth: impl Fn(usize, usize) -> f32) -> NdImage {
+    Image::from_fn(width, height, |x, y| [0.0, 0.0, 1.0, depth(x, y)])
+}
+
+fn cpu_line_ao(levels: &[NdImage], zoom: &Image<f32>, s: &ChainSettings, guard: u32) -> Image<f32> {
+    let ao = &s.line_ao;
+    reference::line_ao(
+        levels,
+        zoom,
+        &noise_tile(ao.noise_seed),
+        &sample_table(ao.noise_seed, ao.s_r, ao.s_h),
+        &LineAoParams::from_settings(s, guard),
+    )
+}
+
+#[test]
+fn flat_region_is_unoccluded_even_with_rounding_noise() {
+    let gpu = gpu();
+    let s = settings(3, 6.0, true);
+    // Depth noise below ε = 1e-6 (f32 rounding of a flat surface) must not occlude (CONTRACT.md
+    // departs from Eq. 8's Δd ≥ 0 for this reason).
+    let nd0 = nd_map(64, 48, |x, y| 0.5 + if (x * 7 + y * 3) % 5 == 0 { 4e-7 } else { 0.0 });
+    let zoom = Image::filled(64, 48, 4.0f32);
+    let (levels, ao) = line_ao_on(&gpu, &nd0, &zoom, &s, 0);
+    assert!(ao.data.iter().all(|&a| a == 0.0), "GPU occludes a flat region");
+    assert!(cpu_line_ao(&levels, &zoom, &s, 0).data.iter().all(|&a| a == 0.0), "CPU occludes a flat region");
+}
+
+/// Occlusion at pixel (x, y) of a step edge: the samples of hemisphere 0 that land at column
+/// `edge` or beyond, each weighted by `weight` — counted here from the noise tables alone.
+/// Pixels on the occluder's own side see only their own depth or farther: nothing.
+fn step_edge_expected(x: usize, y: usize, edge: usize, r0: f32, s_h: u32, weight: f32) -> f32 {
+    if x >= edge {
+        return 0.0;
+    }
+    let (noise, samples) = (noise_tile(1), sample_table(1, 1, s_h));
+    let r1 = Vec3::from_array(noise[(y % 64) * 64 + x % 64]);
+    let hits = samples
+        .iter()
+        .map(|r2| {
+            let r2 = Vec3::from_array(*r2);
+            let omega = r1 - 2.0 * r2.dot(r1) * r2;
+            if omega.z < 0.0 { -omega } else { omega }
+        })
+        .filter(|omega| (x as f32 + 0.5 + omega.x * r0).floor() >= edge as f32)
+        .count();
+    hits as f32 * weight / s_h as f32
+}
+
+#[test]
+fn step_edge_occludes_a_known_fraction_of_samples() {
+    let gpu = gpu();
+    let (w, h, edge, r0) = (64usize, 16usize, 32usize, 6.0f32);
+    let zoom = Image::filled(w, h, 4.0f32);
+    // An occluder closer by Δ < δ0 weighs 1; by Δ = 0.3 it weighs 1 − h((Δ − δ0)/(1 − δ0)).
+    let d0 = 1e-4f32;
+    for (step, weight) in [(5e-5f32, 1.0f32), (0.3, 1.0 - reference::hermite((0.3 - d0) / (1.0 - d0)))] {
+        let s = settings(1, r0, false);
+        let nd0 = nd_map(w, h, |x, _| if x >= edge { 0.5 - step } else { 0.5 });
+        let (levels, gpu_ao) = line_ao_on(&gpu, &nd0, &zoom, &s, 0);
+        let cpu_ao = cpu_line_ao(&levels, &zoom, &s, 0);
+        let mut occluded_pixels = 0;
+        for y in 0..h {
+            for x in 0..w {
+                let expected = step_edge_expected(x, y, edge, r0, 32, weight);
+                assert!(
+                    (cpu_ao.get(x, y) - expected).abs() < 1e-5,
+                    "CPU at ({x}, {y}): {} vs {expected}",
+                    cpu_ao.get(x, y)
+                );
+                // One sample may land on the other side of a texel border on the GPU (FMA).
+                assert!((gpu_ao.get(x, y) - expected).abs() <= weight / 32.0 + 1e-5, "GPU at ({x}, {y})");
+                if x + (r0 as usize) + 1 < edge {
+                    assert_eq!(expected, 0.0, "only pixels within r0 left of the edge are occluded");
+                }
+                occluded_pixels += (expected > 0.0) as usize;
+            }
+        }
+        assert!(occluded_pixels >= 4 * h, "{occluded_pixels}");
+    }
+}
+
+#[test]
+fn light_attenuation_scales_by_the_brdf() {
+    let gpu = gpu();
+    let (w, h) = (48usize, 16usize);
+    let nd0 = nd_map(w, h, |x, _| if x >= 24 { 0.49995 } else { 0.5 });
+    let zoom = Image::filled(w, h, 4.0f32);
+    let off = settings(1, 6.0, false);
+    // A purely diffuse light: g_light = 1 − kd · (n · L) = 1 − 0.3 · 0.8 for every sample.
+    let lighting = Lighting {
+        lights: vec![Light { dir: Vec3::new(0.0, 0.6, 0.8), intensity: 1.0 }],
+        ks: 0.0,
+        ..Lighting::default()
+    };
+    let on = ChainSettings { lighting, ..settings(1, 6.0, true) };
+    let (levels, ao_off) = line_ao_on(&gpu, &nd0, &zoom, &off, 0);
+    let (_, ao_on) = line_ao_on(&gpu, &nd0, &zoom, &on, 0);
+    let cpu_on = cpu_line_ao(&levels, &zoom, &on, 0);
+    let mut occluded = 0;
+    for i in 0..w * h {
+        assert!((ao_on.data[i] - 0.76 * ao_off.data[i]).abs() < 1e-5, "GPU pixel {i}");
+        assert!((cpu_on.data[i] - ao_on.data[i]).abs() < 1e-5, "CPU pixel {i}");
+        occluded += (ao_off.data[i] > 0.0) as usize;
+    }
+    assert!(occluded > 0);
+}
+
+fn polylines(count: usize, seed: f32) -> (Vec<[f32; 3]>, Vec<u64>) {
+    let mut positions = Vec::new();
+    let mut offsets = vec![0u64];
+    for k in 0..count {
+        let phase = seed + k as f32 * 0.61;
+        positions.extend((0..60).map(|i| {
+            let s = i as f32 / 59.0;
+            let r = 10.0 + 25.0 * (phase * 3.1).sin().abs();
+            [r * (phase + 3.0 * s).cos(), -40.0 + 80.0 * s + 5.0 * (phase * 5.0).sin(), r * (phase + 3.0 * s).sin()]
+        }));
+        offsets.push(positions.len() as u64);
+    }
+    (positions, offsets)
+}
+
+#[test]
+fn parallel_lines_occlude_within_r0_only() {
+    let gpu = gpu();
+    let cam = Camera {
+        eye: Vec3::new(0.0, 0.0, 100.0),
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        projection: Projection::Orthographic { height: 100.0 },
+    };
+    // Orthographic, 1 px per unit. The front line is 2 units closer (Δd = 0.02 of the depth range).
+    let r0 = 8.0;
+    for (gap, occludes) in [(5.0f32, true), (30.0, false)] {
+        let back = [[-40.0, 0.0, 0.0], [40.0, 0.0, 0.0]];
+        let front = [[-40.0, gap, 2.0], [40.0, gap, 2.0]];
+        let positions = [back, front].concat();
+        let bounds = lineao::camera::Bounds { center: Vec3::ZERO, radius: 50.0 };
+        let s = settings(1, r0, false);
+        let frame = render(&gpu, &positions, &[0, 2, 4], &cam, Some(bounds), s.clone(), (100, 100));
+        let g = frame.guard;
+        let row = |y: f32| (50.0 - y) as usize + g - 1..=(50.0 - y) as usize + g;
+        let back_ao: f32 =
+            (20 + g..80 + g).flat_map(|x| row(0.0).map(move |y| (x, y))).map(|(x, y)| frame.ao.get(x, y)).sum();
+        let front_ao: f32 =
+            (20 + g..80 + g).flat_map(|x| row(gap).map(move |y| (x, y))).map(|(x, y)| frame.ao.get(x, y)).sum();
+        assert_eq!(front_ao, 0.0, "nothing is in front of the front line");
+        assert_eq!(back_ao > 0.0, occludes, "gap {gap} px, r0 {r0} px: back line AO sum {back_ao}");
+        let cpu = cpu_line_ao(&frame.nd, &frame.zoom, &s, g as u32);
+        check_policy(&frame.ao, &cpu, &frame.nd[0], line_ao_flip_bound(1, 32)).unwrap();
+    }
+}
+
+#[test]
+fn gpu_matches_cpu_reference_on_rendered_lines() {
+    let gpu = gpu();
+    let (positions, offsets) = polylines(120, 0.3);
+    let perspective = Camera {
+        eye: Vec3::new(20.0, 30.0, 140.0),
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        projection: Projection::Perspective { fov_y_deg: 40.0 },
+    };
+    let ortho = Camera { projection: Projection::Orthographic { height: 110.0 }, ..perspective };
+    let cases = [
+        ("perspective, light", perspective, ChainSettings::default()),
+        (
+            "perspective, no light",
+            perspective,
+            ChainSettings {
+                line_ao: LineAoSettings { light_attenuation: false, ..Default::default() },
+                ..Default::default()
+            },
+        ),
+        ("orthographic, wide lines", ortho, ChainSettings { line_width_px: 4.0, ..Default::default() }),
+    ];
+    for (name, cam, s) in cases {
+        let frame = render(&gpu, &positions, &offsets, &cam, None, s.clone(), (240, 180));
+        assert!(frame.guard > 0);
+        // The pyramid from the GPU's own level 0.
+        let cpu_levels = reference::nd_pyramid(frame.nd[0].clone(), s.line_ao.s_r);
+        for (j, (g, c)) in frame.nd.iter().zip(&cpu_levels).enumerate().skip(1) {
+            for channel in 0..4 {
+                let a = Image { width: g.width, height: g.height, data: g.data.iter().map(|t| t[channel]).collect() };
+                let b = Image { width: c.width, height: c.height, data: c.data.iter().map(|t| t[channel]).collect() };
+                let stats = compare(&a, &b, 1e-5, |_, _| true);
+                assert!(
+                    stats.fraction_within > 0.999 && stats.worst < 1e-3,
+                    "{name}: level {j} channel {channel}: {stats}"
+                );
+            }
+        }
+        // LineAO on exactly the GPU's pyramid and zoom.
+        let cpu = cpu_line_ao(&frame.nd, &frame.zoom, &s, frame.guard as u32);
+        let stats = check_policy(&frame.ao, &cpu, &frame.nd[0], line_ao_flip_bound(3, 32))
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        println!("{name}: {stats}");
+        let occluded = frame.ao.data.iter().filter(|&&a| a > 0.05).count();
+        assert!(occluded > 500, "{name}: only {occluded} occluded pixels");
+        // The composite over the visible window.
+        let expected = reference::composite(&frame.color, &frame.specular, &frame.ao, frame.guard, s.strength);
+        for (i, (out, exp)) in frame.output.data.iter().zip(&expected.data).enumerate() {
+            for c in 0..3 {
+                assert!((out[c] - exp[c]).abs() < 1e-5, "{name}: composite pixel {i}: {out:?} vs {exp:?}");
+            }
+        }
+        assert!(frame.nd[0].data.iter().filter(|t| is_geometry(**t)).count() > 2000);
+    }
+}

@@ -1,0 +1,287 @@
+//! The line renderer against the G-buffer contract (CONTRACT.md), with expected values worked
+//! out here from the camera and the line: width in pixels, gap-free joins, separate streamlines,
+//! normals, normalized depth, zoom, hardware depth, colors, specular, chunked buffers.
+
+mod common;
+
+use common::{Frame, gpu, is_geometry, render};
+use glam::Vec3;
+use lineao::camera::{Bounds, Camera, Projection};
+use lineao::passes::lines::LineGeometry;
+use lineao::{AoMethod, ChainSettings, LineColor};
+
+const SIZE: (u32, u32) = (200, 100);
+
+fn camera(projection: Projection) -> Camera {
+    Camera { eye: Vec3::new(0.0, 0.0, 100.0), target: Vec3::ZERO, up: Vec3::Y, projection }
+}
+
+fn perspective() -> Camera {
+    camera(Projection::Perspective { fov_y_deg: 40.0 })
+}
+
+/// near = 50, far = 150 for the cameras above.
+fn bounds() -> Option<Bounds> {
+    Some(Bounds { center: Vec3::ZERO, radius: 50.0 })
+}
+
+fn plain(line_width_px: f32) -> ChainSettings {
+    ChainSettings { method: AoMethod::None, line_width_px, ..ChainSettings::default() }
+}
+
+fn lines(gpu: &lineao::Gpu, polylines: &[&[[f32; 3]]], cam: &Camera, settings: ChainSettings) -> Frame {
+    let mut positions = Vec::new();
+    let mut offsets = vec![0u64];
+    for line in polylines {
+        positions.extend_from_slice(line);
+        offsets.push(positions.len() as u64);
+    }
+    render(gpu, &positions, &offsets, cam, bounds(), settings, SIZE)
+}
+
+/// The pixel (column, row) a world point projects to.
+fn project(frame: &Frame, p: Vec3) -> (f32, f32) {
+    let c = frame.view.proj.project_point3(frame.view.view.transform_point3(p));
+    let (w, h) = frame.view.banded_size();
+    ((c.x + 1.0) * 0.5 * w as f32, (1.0 - c.y) * 0.5 * h as f32)
+}
+
+#[test]
+fn lines_are_exactly_their_width_in_pixels() {
+    let gpu = gpu();
+    for width in [1u32, 3, 4] {
+        let frame = lines(&gpu, &[&[[-40.0, 0.0, 0.0], [40.0, 0.0, 0.0]]], &perspective(), plain(width as f32));
+        // The line projects to the boundary between rows 49 and 50; columns 60..140 are well inside.
+        for x in 60..140 {
+            let covered = (0..SIZE.1 as usize).filter(|&y| is_geometry(frame.nd[0].get(x, y))).count();
+            assert_eq!(covered, width as usize, "column {x} at width {width}");
+        }
+    }
+}
+
+/// 8-connected components of the covered pixels.
+fn components(frame: &Frame) -> usize {
+    let (w, h) = (frame.nd[0].width, frame.nd[0].height);
+    let mut seen = vec![false; w * h];
+    let mut count = 0;
+    for start in 0..w * h {
+        if seen[start] || !is_geometry(frame.nd[0].data[start]) {
+            continue;
+        }
+        count += 1;
+        let mut stack = vec![start];
+        seen[start] = true;
+        while let Some(i) = stack.pop() {
+            let (x, y) = ((i % w) as i64, (i / w) as i64);
+            for (dx, dy) in [(-1, -1), (0, -1), (1, -1), (-1, 0), (1, 0), (-1, 1), (0, 1), (1, 1)] {
+                let (nx, ny) = (x + dx, y + dy);
+                if nx < 0 || ny < 0 || nx >= w as i64 || ny >= h as i64 {
+                    continue;
+                }
+                let j = ny as usize * w + nx as usize;
+                if !seen[j] && is_geometry(frame.nd[0].data[j]) {
+                    seen[j] = true;
+                    stack.push(j);
+                }
+            }
+        }
+    }
+    count
+}
+
+#[test]
+fn joins_have_no_gaps_and_streamlines_stay_apart() {
+    let gpu = gpu();
+    // Hairpin turns of up to 135°, with depth changes, stay one connected line. (Corners are
+    // offset along the vertex tangent, so a hairpin's outer tip is bevelled, never broken.)
+    let zigzag: Vec<[f32; 3]> = (0..9)
+        .map(|k| [-40.0 + 10.0 * k as f32, if k % 2 == 0 { -12.0 } else { 12.0 }, (k % 3) as f32 * 4.0])
+        .collect();
+    let frame = lines(&gpu, &[&zigzag], &perspective(), plain(3.0));
+    assert_eq!(components(&frame), 1, "the zigzag broke apart");
+    // Turns of 45° (sharper than tractography's usual angle thresholds): every pixel the centre
+    // line passes through is covered, joins included.
+    let mut polyline = vec![[-40.0f32, -20.0, 0.0]];
+    let mut direction = 0.0f32;
+    for k in 0..8 {
+        direction += if k % 4 < 2 { 45f32.to_radians() } else { -45f32.to_radians() };
+        let last = polyline[polyline.len() - 1];
+        polyline.push([last[0] + 9.0 * direction.cos(), last[1] + 9.0 * direction.sin(), last[2] + 2.0]);
+    }
+    let frame = lines(&gpu, &[&polyline], &perspective(), plain(3.0));
+    assert_eq!(components(&frame), 1);
+    for pair in polyline.windows(2) {
+        let (p0, p1) = (Vec3::from_array(pair[0]), Vec3::from_array(pair[1]));
+        for k in 0..=200 {
+            let (x, y) = project(&frame, p0.lerp(p1, k as f32 / 200.0));
+            let (x, y) = (x.floor() as usize, y.floor() as usize);
+            assert!(is_geometry(frame.nd[0].get(x, y)), "gap at pixel ({x}, {y}) between {p0} and {p1}");
+        }
+    }
+    // Two streamlines: no segment joins the end of `a` to the start of `b`.
+    let a = [[-40.0, 25.0, 0.0], [-6.0, 25.0, 0.0]];
+    let b = [[6.0, -25.0, 0.0], [40.0, -25.0, 0.0]];
+    let frame = lines(&gpu, &[&a, &b], &perspective(), plain(3.0));
+    assert_eq!(components(&frame), 2);
+    let (x, y) = project(&frame, Vec3::ZERO);
+    assert!(!is_geometry(frame.nd[0].get(x as usize, y as usize)));
+}
+
+#[test]
+fn normals_depth_zoom_and_hardware_depth_follow_the_contract() {
+    let gpu = gpu();
+    let (p0, p1) = (Vec3::new(-30.0, 5.0, -40.0), Vec3::new(30.0, -5.0, 40.0));
+    let frame = lines(&gpu, &[&[p0.to_array(), p1.to_array()]], &perspective(), plain(3.0));
+    let v = &frame.view;
+    assert_eq!((v.near, v.far), (50.0, 150.0));
+    let tangent = (p1 - p0).normalize(); // world = view rotation here (camera looks down −z)
+    let mut checked = 0;
+    for y in 0..SIZE.1 as usize {
+        for x in 0..SIZE.0 as usize {
+            let nd = frame.nd[0].get(x, y);
+            if !is_geometry(nd) {
+                assert_eq!(nd, [0.0, 0.0, 0.0, 1.0]);
+                assert_eq!(frame.zoom.get(x, y), 0.0);
+                assert_eq!(frame.depth.get(x, y), 1.0);
+                continue;
+            }
+            checked += 1;
+            // Depth → the point of the line at that view depth, which must project onto this pixel
+            // (within half the line width: the quad is pushed sideways from the centre line).
+            let depth = v.near + nd[3] * (v.far - v.near);
+            let t = ((100.0 - depth) - p0.z) / (p1.z - p0.z);
+            let p = p0.lerp(p1, t);
+            let (px, py) = project(&frame, p);
+            let distance = ((px - x as f32 - 0.5).powi(2) + (py - y as f32 - 0.5).powi(2)).sqrt();
+            assert!(distance < 2.2, "pixel ({x}, {y}): depth {depth} puts the line {distance} px away");
+            // n = normalize((T × C) × T), C = −p in view space.
+            let c = -(p - Vec3::new(0.0, 0.0, 100.0));
+            let expected = (c - c.dot(tangent) * tangent).normalize();
+            let n = Vec3::new(nd[0], nd[1], nd[2]);
+            assert!((n.length() - 1.0).abs() < 1e-4 && n.dot(c) > 0.0);
+            assert!(n.distance(expected) < 5e-3, "pixel ({x}, {y}): n {n} expected {expected}");
+            // z(P) = f_px · zoom_unit / (−z_view), f_px = proj[1][1] · H / 2.
+            let f_px = 1.0 / (20f32.to_radians().tan()) * SIZE.1 as f32 / 2.0;
+            let zoom = frame.zoom.get(x, y);
+            assert!((zoom - f_px / depth).abs() < 1e-4 * zoom, "zoom {zoom} vs {}", f_px / depth);
+            // Hardware depth is the projection's z/w of the same point.
+            let clip = v.proj * v.view.extend_point(p);
+            let hw = clip.z / clip.w;
+            assert!((frame.depth.get(x, y) - hw).abs() < 2e-5, "hardware depth {} vs {hw}", frame.depth.get(x, y));
+        }
+    }
+    assert!(checked > 150, "only {checked} line pixels");
+}
+
+trait ExtendPoint {
+    fn extend_point(&self, p: Vec3) -> glam::Vec4;
+}
+impl ExtendPoint for glam::Mat4 {
+    fn extend_point(&self, p: Vec3) -> glam::Vec4 {
+        *self * p.extend(1.0)
+    }
+}
+
+#[test]
+fn orthographic_zoom_is_constant_and_depth_is_linear() {
+    let gpu = gpu();
+    let cam = camera(Projection::Orthographic { height: 80.0 });
+    let settings = ChainSettings { zoom_unit: 2.0, ..plain(2.0) };
+    let frame = lines(&gpu, &[&[[-40.0, 0.0, 10.0], [40.0, 0.0, 10.0]]], &cam, settings);
+    let pixels: Vec<_> = frame.nd[0].data.iter().zip(&frame.zoom.data).filter(|(nd, _)| is_geometry(**nd)).collect();
+    assert!(pixels.len() > 100);
+    for (nd, zoom) in pixels {
+        // f_px = H / height = 100 / 80 px per world unit; zoom_unit 2 → 2.5 px.
+        assert!((zoom - 2.5).abs() < 1e-5, "{zoom}");
+        // −z_view = 90 → (90 − 50) / 100.
+        assert!((nd[3] - 0.4).abs() < 1e-5, "{}", nd[3]);
+        assert!(Vec3::new(nd[0], nd[1], nd[2]).distance(Vec3::Z) < 1e-4);
+    }
+}
+
+#[test]
+fn colors_and_specular() {
+    let gpu = gpu();
+    let s2 = std::f32::consts::FRAC_1_SQRT_2;
+    let diagonal: &[[f32; 3]] = &[[-30.0, -30.0, 0.0], [30.0, 30.0, 0.0]];
+    let frame = lines(&gpu, &[diagonal], &perspective(), plain(3.0));
+    let mut checked = 0;
+    for (i, nd) in frame.nd[0].data.iter().enumerate() {
+        let (x, y) = (i % SIZE.0 as usize, i / SIZE.0 as usize);
+        let color = frame.color.data[i];
+        if !is_geometry(*nd) {
+            assert_eq!(color, [1.0, 1.0, 1.0, 1.0], "background color at ({x}, {y})");
+            assert_eq!(frame.specular.data[i], 0.0);
+            continue;
+        }
+        checked += 1;
+        // |T| as RGB: x and y components of a 45° tangent.
+        assert!((color[0] - s2).abs() < 1e-3 && (color[1] - s2).abs() < 1e-3 && color[2].abs() < 1e-3, "{color:?}");
+        // Illuminated lines: ks · I · (√(1−(L·T)²)·√(1−(V·T)²) − (L·T)(V·T))^α, V toward the eye.
+        let depth = frame.view.near + nd[3] * (frame.view.far - frame.view.near);
+        let (px, py) = (x as f32 + 0.5 - 100.0, 50.0 - (y as f32 + 0.5));
+        let f_px = 50.0 / 20f32.to_radians().tan();
+        let p = Vec3::new(px / f_px * depth, py / f_px * depth, -depth);
+        let t = Vec3::new(s2, s2, 0.0);
+        let (v, l) = (-p.normalize(), Vec3::new(-0.4, 0.6, 0.7).normalize());
+        let (lt, vt) = (l.dot(t), v.dot(t));
+        let cos = (1.0 - lt * lt).sqrt() * (1.0 - vt * vt).sqrt() - lt * vt;
+        let expected = 0.4 * cos.max(0.0).powf(32.0);
+        assert!(
+            (frame.specular.data[i] - expected).abs() < 2e-3,
+            "({x}, {y}): {} vs {expected}",
+            frame.specular.data[i]
+        );
+    }
+    assert!(checked > 100);
+    let constant = ChainSettings { line_color: LineColor::Constant([0.2, 0.4, 0.6]), ..plain(3.0) };
+    let frame = lines(&gpu, &[diagonal], &perspective(), constant);
+    let line_colors: Vec<_> =
+        frame.color.data.iter().zip(&frame.nd[0].data).filter(|(_, nd)| is_geometry(**nd)).collect();
+    assert!(line_colors.iter().all(|(c, _)| c.xyz() == [0.2, 0.4, 0.6]));
+}
+
+trait Rgb {
+    fn xyz(&self) -> [f32; 3];
+}
+impl Rgb for [f32; 4] {
+    fn xyz(&self) -> [f32; 3] {
+        [self[0], self[1], self[2]]
+    }
+}
+
+#[test]
+fn chunked_buffers_render_identically() {
+    let gpu = gpu();
+    let mut positions = Vec::new();
+    let mut offsets = vec![0u64];
+    for k in 0..40 {
+        let phase = k as f32 * 0.37;
+        positions.extend((0..30).map(|i| {
+            let s = i as f32 / 29.0;
+            [-45.0 + 90.0 * s, 30.0 * (phase + 4.0 * s).sin(), 20.0 * (phase * 2.0 + 3.0 * s).cos()]
+        }));
+        offsets.push(positions.len() as u64);
+    }
+    let whole = LineGeometry::new(&gpu.device, &positions, &offsets).unwrap();
+    // 97 points per buffer: chunk borders fall inside streamlines and between them.
+    let chunked = LineGeometry::with_chunk_bytes(&gpu.device, &positions, &offsets, 97 * 20).unwrap();
+    assert_eq!((whole.chunk_count(), chunked.chunk_count()), (1, 13));
+    let cam = perspective();
+    let a = common::render_geometry(&gpu, &whole, &cam, bounds().unwrap(), plain(2.0), SIZE);
+    let b = common::render_geometry(&gpu, &chunked, &cam, bounds().unwrap(), plain(2.0), SIZE);
+    assert_eq!(a.nd[0], b.nd[0]);
+    assert_eq!(a.color, b.color);
+}
+
+#[test]
+fn bad_offsets_are_clear_errors() {
+    let gpu = gpu();
+    let p = [[0.0f32; 3]; 4];
+    for (offsets, needle) in
+        [(&[][..], "none"), (&[1, 4][..], "start at 0"), (&[0, 3][..], "end at"), (&[0, 3, 2, 4][..], "decrease")]
+    {
+        let error = LineGeometry::new(&gpu.device, &p, offsets).err().expect("an error").to_string();
+        assert!(error.contains(needle), "{error}");
+    }
+}
