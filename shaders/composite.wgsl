@@ -5,8 +5,7 @@
 
 // Keep in sync with `lineao::passes::composite::CompositeUniform`.
 struct CompositeUniform {
-    level_scale: array<vec4<f32>, 5>,
-    level_size: array<vec4<u32>, 5>,
+    levels: Levels,
     guard: vec2<u32>,
     strength: f32,
     // 0 final, 1 AO only, 2 normals, 3 depth, 4 zoom, 5 pyramid level `debug_level`.
@@ -39,7 +38,7 @@ fn show_normal(nd: vec4<f32>) -> vec3<f32> {
 }
 
 fn pyramid_level(k: u32, pixel: vec2<u32>) -> vec4<f32> {
-    let texel = level_texel(pixel, vec2<f32>(0.0), params.level_scale[k].xy, params.level_size[k].xy);
+    let texel = level_texel(pixel, vec2<f32>(0.0), params.levels.scale[k].xy, params.levels.size[k].xy);
     switch k {
         case 0u: { return textureLoad(nd0, texel, 0); }
         case 1u: { return textureLoad(nd1, texel, 0); }

@@ -17,10 +17,7 @@ override S_H: u32 = 32u;
 
 // Keep in sync with `lineao::passes::line_ao::LineAoUniform`.
 struct LineAoUniform {
-    // xy: size_j / size_0 for level j.
-    level_scale: array<vec4<f32>, 5>,
-    // xy: size of level j in texels.
-    level_size: array<vec4<u32>, 5>,
+    levels: Levels,
     // Pixel coordinate of the visible viewport's top-left corner (the guard band's width).
     noise_origin: vec2<i32>,
     r0_px: f32,
@@ -81,8 +78,8 @@ fn light_weight(n: vec3<f32>, omega: vec3<f32>) -> f32 {
 
 // AO_j(P, r0 + j z(P)) of Eq. 6 on pyramid level `nd`.
 fn hemisphere(nd: texture_2d<f32>, j: u32, pixel: vec2<u32>, r1: vec3<f32>, zoom: f32) -> f32 {
-    let scale = params.level_scale[j].xy;
-    let size = params.level_size[j].xy;
+    let scale = params.levels.scale[j].xy;
+    let size = params.levels.size[j].xy;
     let centre = textureLoad(nd, level_texel(pixel, vec2<f32>(0.0), scale, size), 0);
     let n = centre.xyz;
     let radius = params.r0_px + f32(j) * zoom;

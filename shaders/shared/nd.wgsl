@@ -8,6 +8,15 @@ fn nd_is_background(nd: vec4<f32>) -> bool {
     return all(nd.xyz == vec3<f32>(0.0));
 }
 
+// Size of each pyramid level, padded to MAX_LEVELS with the last level.
+// Keep in sync with `lineao::targets::LevelsUniform`.
+struct Levels {
+    // xy: size_j / size_0.
+    scale: array<vec4<f32>, 5>,
+    // xy: size of level j in texels.
+    size: array<vec4<u32>, 5>,
+}
+
 // Nearest texel of a pyramid level for full-resolution pixel `pixel` displaced by `offset` pixels:
 // floor((P + 0.5 + offset) * size_j / size_0), clamped to the level (CONTRACT.md "Addressing").
 // `scale` is size_j / size_0, computed once on the CPU so that both sides use the same f32.

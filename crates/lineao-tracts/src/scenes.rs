@@ -124,7 +124,7 @@ impl Bundle<'_> {
         let lines = ((vertices as f32 * self.share / (0.92 * per_line)).ceil() as usize).max(8);
         for _ in 0..lines {
             let (u, v) = disk(rng);
-            let (wu, wv) = (uniform(rng) * 6.28, uniform(rng) * 6.28);
+            let (wu, wv) = (uniform(rng) * std::f32::consts::TAU, uniform(rng) * std::f32::consts::TAU);
             let t0 = 0.08 * uniform(rng);
             let t1 = 1.0 - 0.08 * uniform(rng);
             let steps = ((t1 - t0) * per_line) as usize;

@@ -79,6 +79,26 @@ pub fn uniform_buffer<T: bytemuck::Pod>(device: &wgpu::Device, label: &str) -> w
     })
 }
 
+/// A compute pipeline over one bind group, with WGSL `override` constants.
+pub fn compute_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    group: &wgpu::BindGroupLayout,
+    shader: &str,
+    entry_point: &str,
+    constants: &[(&str, f64)],
+) -> wgpu::ComputePipeline {
+    let module = crate::shader::module(device, shader);
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(label),
+        layout: Some(&pipeline_layout(device, label, group)),
+        module: &module,
+        entry_point: Some(entry_point),
+        compilation_options: wgpu::PipelineCompilationOptions { constants, ..Default::default() },
+        cache: None,
+    })
+}
+
 /// A pipeline layout with one bind group.
 pub fn pipeline_layout(device: &wgpu::Device, label: &str, group: &wgpu::BindGroupLayout) -> wgpu::PipelineLayout {
     device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {

@@ -60,6 +60,14 @@ pub fn level_sizes((width, height): (u32, u32), levels: u32) -> Vec<(u32, u32)> 
         .collect()
 }
 
+/// Keep in sync with `Levels` in `shaders/shared/nd.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct LevelsUniform {
+    pub scale: [[f32; 4]; 5],
+    pub size: [[u32; 4]; 5],
+}
+
 /// Every size-dependent texture of the chain.
 pub struct FrameTargets {
     /// Guard-banded size.
@@ -116,7 +124,7 @@ impl FrameTargets {
 
     /// Per-level (size_j / size_0, size_j) as the shaders' uniforms carry them, padded to
     /// [`crate::MAX_LEVELS`] with the last level.
-    pub fn level_uniforms(&self) -> ([[f32; 4]; 5], [[u32; 4]; 5]) {
+    pub fn levels_uniform(&self) -> LevelsUniform {
         let (w0, h0) = self.size;
         let mut scale = [[0.0; 4]; 5];
         let mut size = [[0; 4]; 5];
@@ -125,7 +133,7 @@ impl FrameTargets {
             scale[k] = [w as f32 / w0 as f32, h as f32 / h0 as f32, 0.0, 0.0];
             size[k] = [w, h, 0, 0];
         }
-        (scale, size)
+        LevelsUniform { scale, size }
     }
 
     /// Views of the pyramid levels padded to [`crate::MAX_LEVELS`] with the last level, for the

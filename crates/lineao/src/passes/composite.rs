@@ -12,14 +12,13 @@
 
 use crate::binding::{self, Slot};
 use crate::settings::DebugView;
-use crate::targets::FrameTargets;
+use crate::targets::{FrameTargets, LevelsUniform};
 
 /// Keep in sync with `CompositeUniform` in `shaders/composite.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct CompositeUniform {
-    pub level_scale: [[f32; 4]; 5],
-    pub level_size: [[u32; 4]; 5],
+    pub levels: LevelsUniform,
     pub guard: [u32; 2],
     pub strength: f32,
     pub debug_view: u32,
@@ -91,11 +90,9 @@ impl Composite {
         debug_view: DebugView,
         zoom_max: f32,
     ) {
-        let (level_scale, level_size) = targets.level_uniforms();
         let (debug_view, debug_level) = debug_view.code();
         let uniform = CompositeUniform {
-            level_scale,
-            level_size,
+            levels: targets.levels_uniform(),
             guard: [targets.guard; 2],
             strength,
             debug_view,

@@ -24,14 +24,13 @@ use crate::lighting::{Lighting, LightingUniform};
 use crate::noise;
 use crate::passes::dispatch_size;
 use crate::settings::LineAoSettings;
-use crate::targets::{AO_FORMAT, FrameTargets};
+use crate::targets::{AO_FORMAT, FrameTargets, LevelsUniform};
 
 /// Keep in sync with `LineAoUniform` in `shaders/line_ao.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct LineAoUniform {
-    pub level_scale: [[f32; 4]; 5],
-    pub level_size: [[u32; 4]; 5],
+    pub levels: LevelsUniform,
     pub noise_origin: [i32; 2],
     pub r0_px: f32,
     pub delta0: f32,
@@ -83,18 +82,15 @@ impl LineAo {
             slots
         });
         let shape = Shape { s_r: settings.s_r, s_h: settings.s_h, noise_seed: settings.noise_seed };
-        let module = crate::shader::module(device, "line_ao.wgsl");
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("lineao::LineAo::pipeline"),
-            layout: Some(&binding::pipeline_layout(device, "lineao::LineAo::pipeline_layout", &layout)),
-            module: &module,
-            entry_point: Some("line_ao"),
-            compilation_options: wgpu::PipelineCompilationOptions {
-                constants: &[("S_R", shape.s_r as f64), ("S_H", shape.s_h as f64)],
-                ..Default::default()
-            },
-            cache: None,
-        });
+        let constants = [("S_R", shape.s_r as f64), ("S_H", shape.s_h as f64)];
+        let pipeline = binding::compute_pipeline(
+            device,
+            "lineao::LineAo::pipeline",
+            &layout,
+            "line_ao.wgsl",
+            "line_ao",
+            &constants,
+        );
         LineAo {
             shape,
             pipeline,
@@ -137,11 +133,9 @@ impl LineAo {
         r0_px: f32,
         lighting: &Lighting,
     ) {
-        let (level_scale, level_size) = targets.level_uniforms();
         let guard = targets.guard as i32;
         let uniform = LineAoUniform {
-            level_scale,
-            level_size,
+            levels: targets.levels_uniform(),
             noise_origin: [guard, guard],
             r0_px,
             delta0: settings.delta0,

@@ -26,15 +26,14 @@ impl NdPyramid {
             wgpu::ShaderStages::COMPUTE,
             &[Slot::Texture, Slot::StorageTexture(ND_FORMAT)],
         );
-        let module = crate::shader::module(device, "nd_pyramid.wgsl");
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("lineao::NdPyramid::pipeline"),
-            layout: Some(&binding::pipeline_layout(device, "lineao::NdPyramid::pipeline_layout", &layout)),
-            module: &module,
-            entry_point: Some("downsample"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+        let pipeline = binding::compute_pipeline(
+            device,
+            "lineao::NdPyramid::pipeline",
+            &layout,
+            "nd_pyramid.wgsl",
+            "downsample",
+            &[],
+        );
         NdPyramid { pipeline, layout, groups: Vec::new() }
     }
 

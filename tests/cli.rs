@@ -1,0 +1,186 @@
+//! `lineao render` end to end: exit codes, the PNG, and `--dump` read back the way an outside
+//! tool would, recomputing LineAO from the dumped files alone.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use lineao::lighting::Light;
+use lineao::reference::{self, Image, LineAoParams};
+use lineao::verify::{check_policy, line_ao_flip_bound};
+use serde_json::Value;
+
+fn lineao(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_lineao")).args(args).env("XDG_RUNTIME_DIR", std::env::temp_dir()).output().unwrap()
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn stderr(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+#[test]
+fn exit_codes() {
+    assert_eq!(lineao(&["--help"]).status.code(), Some(0));
+    assert_eq!(lineao(&["render", "--help"]).status.code(), Some(0));
+    for bad in [
+        &["render", "--no-such-flag"][..],
+        &["render", "--scene", "brain"],
+        &["render", "--method", "magic"],
+        &["render", "--width", "0"],
+        &["render", "--eye", "1,2"],
+        &["render", "--debug-view", "level:x"],
+        &["frobnicate"],
+    ] {
+        let out = lineao(bad);
+        assert_eq!(out.status.code(), Some(2), "{bad:?}: {}", stderr(&out));
+    }
+    let dir = scratch("exit_codes");
+    let png = dir.join("x.png");
+    let png = png.to_str().unwrap();
+    for (bad, needle) in [
+        (&["render", "--s-r", "9", "-o", png][..], "s_r"),
+        (&["render", "--line-width", "0", "-o", png], "line width"),
+        (&["render", "--debug-view", "level:3", "-o", png], "debug level 3"),
+        (&["render", "--eye", "0,0,0", "--target", "0,0,0", "-o", png], "coincide"),
+        (
+            &["render", "--vertices", "2000", "--width", "64", "--height", "64", "-o", "/nonexistent/dir/x.png"],
+            "/nonexistent/dir/x.png",
+        ),
+    ] {
+        let out = lineao(bad);
+        assert_eq!(out.status.code(), Some(1), "{bad:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains(needle), "{bad:?}: {}", stderr(&out));
+    }
+}
+
+fn read_npy(path: &Path) -> (Vec<u64>, Vec<f32>) {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let npy = npyz::NpyFile::new(&bytes[..]).unwrap();
+    let shape = npy.shape().to_vec();
+    (shape, npy.into_vec::<f32>().unwrap())
+}
+
+fn vec3(v: &Value) -> [f32; 3] {
+    let a: Vec<f32> = v.as_array().unwrap().iter().map(|x| x.as_f64().unwrap() as f32).collect();
+    [a[0], a[1], a[2]]
+}
+
+#[test]
+fn render_and_dump_let_an_outside_tool_recompute_lineao() {
+    let dir = scratch("dump");
+    let png = dir.join("out.png");
+    let dump = dir.join("dump");
+    let out = lineao(&[
+        "render",
+        "--scene",
+        "spiral",
+        "--vertices",
+        "60000",
+        "--width",
+        "200",
+        "--height",
+        "150",
+        "-o",
+        png.to_str().unwrap(),
+        "--dump",
+        dump.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&png).unwrap()));
+    let reader = decoder.read_info().unwrap();
+    assert_eq!((reader.info().width, reader.info().height), (200, 150));
+
+    let params: Value = serde_json::from_str(&std::fs::read_to_string(dump.join("params.json")).unwrap()).unwrap();
+    for key in [
+        "method",
+        "variant",
+        "geometry",
+        "line_width_px",
+        "s_r",
+        "s_h",
+        "r0_px",
+        "delta0",
+        "epsilon",
+        "strength",
+        "light_attenuation",
+        "lights",
+        "kd",
+        "ks",
+        "shininess",
+        "zoom_unit",
+        "guard_px",
+        "noise_seed",
+        "outer",
+        "depth_near",
+        "depth_far",
+        "width",
+        "height",
+        "camera",
+    ] {
+        assert!(params.get(key).is_some(), "params.json lacks {key}");
+    }
+    assert_eq!(params["method"], "lineao");
+    assert_eq!((params["width"].as_u64(), params["height"].as_u64()), (Some(200), Some(150)));
+    assert!(params["camera"]["fov_y_deg"].is_number());
+    let guard = params["guard_px"].as_u64().unwrap();
+    let s_r = params["s_r"].as_u64().unwrap() as u32;
+    let s_h = params["s_h"].as_u64().unwrap() as u32;
+    assert!(guard > 0 && guard.is_multiple_of(1 << (s_r - 1)));
+    let (w, h) = (200 + 2 * guard, 150 + 2 * guard);
+
+    let mut levels = Vec::new();
+    let (mut lw, mut lh) = (w, h);
+    for j in 0..s_r {
+        let (shape, data) = read_npy(&dump.join(format!("nd_{j}.npy")));
+        assert_eq!(shape, [lh, lw, 4], "nd_{j}.npy");
+        levels.push(Image {
+            width: lw as usize,
+            height: lh as usize,
+            data: data.chunks(4).map(|c| [c[0], c[1], c[2], c[3]]).collect(),
+        });
+        (lw, lh) = (lw.div_ceil(2), lh.div_ceil(2));
+    }
+    let (shape, zoom) = read_npy(&dump.join("zoom.npy"));
+    assert_eq!(shape, [h, w]);
+    let (shape, ao) = read_npy(&dump.join("ao.npy"));
+    assert_eq!(shape, [h, w]);
+    let (shape, noise) = read_npy(&dump.join("noise.npy"));
+    assert_eq!(shape, [64, 64, 3]);
+    let (shape, samples) = read_npy(&dump.join("samples.npy"));
+    assert_eq!(shape, [s_r as u64, s_h as u64, 3]);
+
+    let f = |k: &str| params[k].as_f64().unwrap() as f32;
+    let lights = params["lights"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|l| Light { dir: vec3(&l["dir"]).into(), intensity: l["intensity"].as_f64().unwrap() as f32 })
+        .collect();
+    let p = LineAoParams {
+        s_r,
+        s_h,
+        r0_px: f("r0_px"),
+        delta0: f("delta0"),
+        epsilon: f("epsilon"),
+        light_attenuation: params["light_attenuation"].as_bool().unwrap(),
+        lights,
+        kd: f("kd"),
+        ks: f("ks"),
+        shininess: f("shininess"),
+        noise_origin: [guard as i32; 2],
+    };
+    let triples = |v: &[f32]| v.chunks(3).map(|c| [c[0], c[1], c[2]]).collect::<Vec<_>>();
+    let zoom = Image { width: w as usize, height: h as usize, data: zoom };
+    let gpu_ao = Image { width: w as usize, height: h as usize, data: ao };
+    let cpu_ao = reference::line_ao(&levels, &zoom, &triples(&noise), &triples(&samples), &p);
+    let stats = check_policy(&gpu_ao, &cpu_ao, &levels[0], line_ao_flip_bound(s_r, s_h)).unwrap();
+    println!("recomputed from the dump: {stats}");
+    assert!(gpu_ao.data.iter().filter(|&&a| a > 0.1).count() > 1000);
+}

@@ -1,0 +1,123 @@
+//! Snapshot images of every pass on the built-in scenes, to catch regressions (correctness comes
+//! from the CPU reference and the closed-form tests). `UPDATE_SNAPSHOTS=1 cargo test` rewrites
+//! them; a failure leaves `*.actual.png` and `*.diff.png` beside the snapshot (ignored by git).
+
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+use lineao::camera::{Camera, Projection};
+use lineao::passes::lines::LineGeometry;
+use lineao::readback::read_texture;
+use lineao::targets::Target;
+use lineao::{AoChain, ChainSettings, DebugView, Gpu};
+use lineao_tracts::SceneKind;
+
+const SIZE: (u32, u32) = (160, 128);
+/// Per-channel difference that counts as a changed pixel (lavapipe is deterministic; this
+/// absorbs rounding from another LLVM version), and the share of changed pixels allowed.
+const CHANNEL_TOLERANCE: u8 = 3;
+const MAX_CHANGED: f64 = 0.005;
+
+fn snapshot_path(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/snapshots").join(format!("{name}.png"))
+}
+
+fn write_png(path: &Path, rgba: &[u8]) {
+    let file = std::fs::File::create(path).unwrap();
+    let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), SIZE.0, SIZE.1);
+    encoder.set_color(png::ColorType::Rgba);
+    encoder.set_depth(png::BitDepth::Eight);
+    encoder.write_header().unwrap().write_image_data(rgba).unwrap();
+}
+
+fn read_png(path: &Path) -> Vec<u8> {
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let mut buffer = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut buffer).unwrap();
+    assert_eq!((info.width, info.height), SIZE, "{}", path.display());
+    buffer.truncate(info.buffer_size());
+    buffer
+}
+
+/// Compares against the stored snapshot; returns a description of the failure.
+fn check(name: &str, rgba: &[u8]) -> Option<String> {
+    let path = snapshot_path(name);
+    if std::env::var_os("UPDATE_SNAPSHOTS").is_some() {
+        write_png(&path, rgba);
+        return None;
+    }
+    if !path.exists() {
+        return Some(format!("{name}: no snapshot at {} (run with UPDATE_SNAPSHOTS=1)", path.display()));
+    }
+    let expected = read_png(&path);
+    let mut diff = vec![0u8; rgba.len()];
+    let mut changed = 0usize;
+    for (i, (a, b)) in rgba.chunks(4).zip(expected.chunks(4)).enumerate() {
+        let worst = (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap();
+        if worst > CHANNEL_TOLERANCE {
+            changed += 1;
+        }
+        diff[4 * i..4 * i + 4].copy_from_slice(&[worst.saturating_mul(8), 0, 0, 255]);
+    }
+    let share = changed as f64 / (SIZE.0 * SIZE.1) as f64;
+    if share > MAX_CHANGED {
+        write_png(&path.with_extension("actual.png"), rgba);
+        write_png(&path.with_extension("diff.png"), &diff);
+        return Some(format!(
+            "{name}: {:.2} % of pixels changed (allowed {:.2} %)",
+            100.0 * share,
+            100.0 * MAX_CHANGED
+        ));
+    }
+    None
+}
+
+#[test]
+fn every_pass_on_every_scene() {
+    // SAFETY: set before any thread of ours reads the environment.
+    unsafe { std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir()) };
+    let gpu = Gpu::headless().expect("a wgpu adapter (install mesa-vulkan-drivers for lavapipe)");
+    let format = wgpu::TextureFormat::Rgba8UnormSrgb;
+    let target = Target::new(
+        &gpu.device,
+        "snapshot",
+        SIZE,
+        format,
+        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+    );
+    let mut chain = AoChain::new(&gpu.device, format, ChainSettings::default()).unwrap();
+    chain.resize(SIZE.0, SIZE.1).unwrap();
+    let views = [
+        ("final", DebugView::Final),
+        ("ao", DebugView::Ao),
+        ("normals", DebugView::Normals),
+        ("depth", DebugView::Depth),
+        ("zoom", DebugView::Zoom),
+        ("level1", DebugView::Level(1)),
+        ("level2", DebugView::Level(2)),
+    ];
+    let mut failures = Vec::new();
+    for kind in SceneKind::ALL {
+        let scene = kind.build(1, 40_000);
+        let t = &scene.tractogram;
+        let geometry = LineGeometry::new(&gpu.device, &t.positions, &t.offsets).unwrap();
+        let camera = Camera {
+            eye: Vec3::from_array(scene.view.eye),
+            target: Vec3::from_array(scene.view.target),
+            up: Vec3::from_array(scene.view.up),
+            projection: Projection::Perspective { fov_y_deg: scene.view.fov_y_deg },
+        };
+        for (view_name, view) in views {
+            let settings = ChainSettings { debug_view: view, ..ChainSettings::default() };
+            chain.set_settings(&gpu.device, settings).unwrap();
+            chain.prepare(&gpu.device, &gpu.queue, &camera, &geometry.bounds.unwrap()).unwrap();
+            let mut encoder = gpu.device.create_command_encoder(&Default::default());
+            chain.encode(&mut encoder, &geometry, &target.view);
+            gpu.queue.submit([encoder.finish()]);
+            let image = read_texture(&gpu.device, &gpu.queue, &target.texture).unwrap();
+            failures.extend(check(&format!("{}_{view_name}", kind.name()), &image.bytes));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
