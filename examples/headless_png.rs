@@ -30,13 +30,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     chain.prepare(&gpu.device, &gpu.queue, &camera, &geometry.bounds.ok_or("no points")?);
 
-    let target = lineao::targets::Target::new(
-        &gpu.device,
-        "example::target",
-        (width, height),
-        format,
-        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-    );
+    let target = lineao::targets::Target::output(&gpu.device, "example::target", (width, height), format);
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     chain.encode(&mut encoder, &geometry, &target.view);
     gpu.queue.submit([encoder.finish()]);

@@ -63,13 +63,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut chain = AoChain::new(&gpu.device, format, settings)?;
     chain.resize(args.width, args.height)?;
     chain.prepare(&gpu.device, &gpu.queue, &camera, &bounds);
-    let target = lineao::targets::Target::new(
-        &gpu.device,
-        "lineao::render::output",
-        (args.width, args.height),
-        format,
-        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-    );
+    let target =
+        lineao::targets::Target::output(&gpu.device, "lineao::render::output", (args.width, args.height), format);
     let mut encoder =
         gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::render") });
     chain.encode(&mut encoder, &geometry, &target.view);

@@ -79,13 +79,7 @@ fn every_pass_on_every_scene() {
     unsafe { std::env::set_var("XDG_RUNTIME_DIR", std::env::temp_dir()) };
     let gpu = Gpu::headless().expect("a wgpu adapter (install mesa-vulkan-drivers for lavapipe)");
     let format = wgpu::TextureFormat::Rgba8UnormSrgb;
-    let target = Target::new(
-        &gpu.device,
-        "snapshot",
-        SIZE,
-        format,
-        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-    );
+    let target = Target::output(&gpu.device, "snapshot", SIZE, format);
     let mut chain = AoChain::new(&gpu.device, format, ChainSettings::default()).unwrap();
     chain.resize(SIZE.0, SIZE.1).unwrap();
     let views = [

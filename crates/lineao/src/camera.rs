@@ -48,26 +48,16 @@ pub struct Bounds {
 
 impl Bounds {
     /// The sphere around the axis-aligned box of `points` that contains them all; `None` when
-    /// there are no finite points.
-    pub fn of_points<'a>(points: impl IntoIterator<Item = &'a [f32; 3]>) -> Option<Bounds> {
-        let mut lo = Vec3::splat(f32::INFINITY);
-        let mut hi = Vec3::splat(f32::NEG_INFINITY);
-        let mut any = false;
-        let finite: Vec<Vec3> = points
-            .into_iter()
-            .map(|p| Vec3::from_array(*p))
-            .filter(|p| p.is_finite())
-            .inspect(|p| {
-                lo = lo.min(*p);
-                hi = hi.max(*p);
-                any = true;
-            })
-            .collect();
-        if !any {
+    /// there are no finite points. Two passes over the slice, no copy.
+    pub fn of_points(points: &[[f32; 3]]) -> Option<Bounds> {
+        let finite = || points.iter().map(|p| Vec3::from_array(*p)).filter(|p| p.is_finite());
+        let (lo, hi) = finite()
+            .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(p), hi.max(p)));
+        if !lo.is_finite() {
             return None;
         }
         let center = (lo + hi) * 0.5;
-        let radius = finite.iter().map(|p| p.distance(center)).fold(0.0f32, f32::max);
+        let radius = finite().map(|p| p.distance(center)).fold(0.0f32, f32::max);
         Some(Bounds { center, radius: radius.max(1e-6) })
     }
 }

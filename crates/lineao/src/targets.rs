@@ -48,6 +48,11 @@ impl Target {
         Target { texture, view }
     }
 
+    /// An offscreen texture to composite into and read back (PNG output, tests, examples).
+    pub fn output(device: &wgpu::Device, label: &str, size: (u32, u32), format: wgpu::TextureFormat) -> Target {
+        Target::new(device, label, size, format, wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC)
+    }
+
     pub fn size(&self) -> (u32, u32) {
         (self.texture.width(), self.texture.height())
     }

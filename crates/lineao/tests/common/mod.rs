@@ -60,13 +60,7 @@ pub fn render_geometry(
     let mut chain = AoChain::new(&gpu.device, OUTPUT_FORMAT, settings).unwrap();
     chain.resize(width, height).unwrap();
     let view = chain.prepare(&gpu.device, &gpu.queue, camera, &bounds).unwrap();
-    let output = Target::new(
-        &gpu.device,
-        "test::output",
-        (width, height),
-        OUTPUT_FORMAT,
-        wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-    );
+    let output = Target::output(&gpu.device, "test::output", (width, height), OUTPUT_FORMAT);
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     chain.encode(&mut encoder, geometry, &output.view);
     gpu.queue.submit([encoder.finish()]);
