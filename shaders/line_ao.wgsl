@@ -8,12 +8,24 @@
 //   ω_i = reflect(R1(P), R2[j][i]), flipped into n_j(P)'s hemisphere
 //
 // The occlusion test departs from Eq. 8 on purpose (Δd > ε, not Δd >= 0): see CONTRACT.md.
+//
+// With REFERENCE the pass computes variant `reference` instead, the authors' own shader
+// (`lineao::passes::line_ao` documents it): `reference_ao` below.
 #import shared/nd.wgsl
 #import shared/lighting.wgsl
 
 // Compile-time sample counts so that the loops can unroll (paper §3.4).
 override S_R: u32 = 3u;
 override S_H: u32 = 32u;
+// Benchmark only (`lineao-tap-floor`): fetch every sample as LineAO does, but only sum the depths.
+override TAP_FLOOR: bool = false;
+// Eq. 15 on or off (`--no-light-attenuation`): a constant, so the off case costs nothing per sample.
+override LIGHT_ATTENUATION: bool = true;
+// Variant `reference` instead of `paper`.
+override REFERENCE: bool = false;
+
+// The authors' falloff: occluded iff Δd >= 1e-5, also the lower edge of their smoothstep.
+const REFERENCE_FALLOFF: f32 = 1e-5;
 
 // Keep in sync with `lineao::passes::line_ao::LineAoUniform`.
 struct LineAoUniform {
@@ -22,10 +34,10 @@ struct LineAoUniform {
     noise_origin: vec2<i32>,
     r0_px: f32,
     delta0: f32,
+    // Variant `reference`: radius_px / z_fit * (W, H) / max(W, H).
+    reference_scale: vec2<f32>,
     epsilon: f32,
-    light_attenuation: u32,
-    _pad0: u32,
-    _pad1: u32,
+    _pad: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: LineAoUniform;
@@ -42,36 +54,20 @@ struct LineAoUniform {
 @group(0) @binding(9) var nd3: texture_2d<f32>;
 @group(0) @binding(10) var nd4: texture_2d<f32>;
 
-// Hermite smoothstep h(x) = 3x^2 - 2x^3 (Eq. 13).
-fn hermite(x: f32) -> f32 {
-    return x * x * (3.0 - 2.0 * x);
-}
-
-// Depth-based attenuation (Eq. 11-12; its third case reads Δd where the paper prints d_l).
-fn depth_weight(dd: f32, delta_j: f32) -> f32 {
-    if (dd > delta_j) {
-        return 0.0;
-    }
-    if (dd < params.delta0) {
-        return 1.0;
-    }
-    return 1.0 - hermite((dd - params.delta0) / (delta_j - params.delta0));
-}
-
 // Illumination-based attenuation (Eq. 14-15): 1 - min(sum over lights of the Blinn-Phong BRDF
-// lit from L_s and seen from ω, 1).
-fn light_weight(n: vec3<f32>, omega: vec3<f32>) -> f32 {
-    if (params.light_attenuation == 0u) {
+// lit from L_s and seen from ω, 1). `n_omega` = n · ω. For unit L and ω, |L + ω|² = 2 + 2 L·ω,
+// so n · normalize(L + ω) needs no normalize (this loop runs once per sample).
+fn light_weight(n: vec3<f32>, omega: vec3<f32>, n_omega: f32) -> f32 {
+    if (!LIGHT_ATTENUATION) {
         return 1.0;
     }
     var reflected = 0.0;
     for (var s = 0u; s < lighting.count; s++) {
         let light = lighting.lights[s];
-        let half_sum = light.xyz + omega;
-        let half_len = length(half_sum);
-        let n_h = select(0.0, dot(n, half_sum) / half_len, half_len > 1e-12);
-        reflected += light.w * (lighting.kd * max(dot(n, light.xyz), 0.0)
-            + lighting.ks * clamped_pow(n_h, lighting.shininess));
+        let n_l = dot(n, light.xyz);
+        let sum_sq = 2.0 + 2.0 * dot(light.xyz, omega);
+        let n_h = select(0.0, min((n_l + n_omega) * inverseSqrt(sum_sq), 1.0), sum_sq > 1e-12);
+        reflected += light.w * (lighting.kd * max(n_l, 0.0) + lighting.ks * clamped_pow(n_h, lighting.shininess));
     }
     return 1.0 - min(reflected, 1.0);
 }
@@ -85,19 +81,85 @@ fn hemisphere(nd: texture_2d<f32>, j: u32, pixel: vec2<u32>, r1: vec3<f32>, zoom
     let radius = params.r0_px + f32(j) * zoom;
     let falloff = 1.0 - f32(j) / f32(S_R);
     let delta_j = falloff * falloff;
+    let inv_range = 1.0 / (delta_j - params.delta0);
     let count = (S_H + j) / (j + 1u);
     var occlusion = 0.0;
     for (var i = 0u; i < count; i++) {
-        var omega = reflect(r1, samples[j * S_H + i].xyz);
-        omega = select(omega, -omega, dot(omega, n) < 0.0);
+        let reflected = reflect(r1, samples[j * S_H + i].xyz);
+        let n_reflected = dot(reflected, n);
+        let omega = select(reflected, -reflected, n_reflected < 0.0);
         let offset = vec2<f32>(omega.x, -omega.y) * radius;
         let sample = textureLoad(nd, level_texel(pixel, offset, scale, size), 0);
-        let dd = centre.w - sample.w;
-        if (dd > params.epsilon) {
-            occlusion += depth_weight(dd, delta_j) * light_weight(n, omega);
+        if (TAP_FLOOR) {
+            occlusion += sample.w;
+            continue;
         }
+        let dd = centre.w - sample.w;
+        // g_depth (Eq. 11-13) without branches: t = 0 below δ0 (weight 1), t = 1 above δ(j)
+        // (weight 0), the Hermite h(t) = 3t² - 2t³ between.
+        let t = saturate((dd - params.delta0) * inv_range);
+        let depth_weight = 1.0 - t * t * (3.0 - 2.0 * t);
+        let weight = depth_weight * light_weight(n, omega, abs(n_reflected));
+        occlusion += select(0.0, weight, dd > params.epsilon);
     }
     return occlusion / f32(count);
+}
+
+// Σ over lights of the light an occluder with normal `n_o` reflects toward ω: the authors'
+// diffuse plus specular with exponent 100 (unweighted by kd, ks).
+fn occluder_light(n_o: vec3<f32>, omega: vec3<f32>) -> f32 {
+    var reflected = 0.0;
+    for (var s = 0u; s < lighting.count; s++) {
+        let light = lighting.lights[s];
+        let half_sum = light.xyz + omega;
+        let half_len = length(half_sum);
+        let n_h = select(0.0, dot(n_o, half_sum) / half_len, half_len > 1e-12);
+        reflected += light.w * (max(dot(n_o, light.xyz), 0.0) + clamped_pow(n_h, 100.0));
+    }
+    return reflected;
+}
+
+// Variant `reference` at a geometry pixel: every hemisphere on level 0 with s_h samples.
+fn reference_ao(pixel: vec2<u32>, r1: vec3<f32>, zoom: f32) -> f32 {
+    let size = vec2<f32>(params.levels.size[0].xy);
+    let centre = textureLoad(nd0, pixel, 0);
+    let n = centre.xyz;
+    let base = params.reference_scale * (zoom / max(1.0 - centre.w, 1e-6));
+    var total = 0.0;
+    var scaler = 0.0;
+    for (var l = 0u; l < S_R; l++) {
+        scaler += 1.5 + f32(l);
+        let falloff = select(1.0, 1.0 - f32(l) / f32(max(S_R, 2u) - 1u), S_R > 1u);
+        let density = falloff * falloff;
+        var occlusion = 0.0;
+        var used = 0u;
+        for (var i = 0u; i < S_H; i++) {
+            let omega = reflect(samples[l * S_H + i].xyz, r1);
+            let n_omega = dot(omega, n);
+            let ray = sign(n_omega) * omega;
+            let at = vec2<f32>(pixel) + 0.5 + vec2<f32>(ray.x, -ray.y) * (scaler * base);
+            if (any(at < vec2<f32>(0.0)) || any(at > size)) {
+                continue;
+            }
+            used += 1u;
+            let sample = textureLoad(nd0, min(vec2<i32>(floor(at)), vec2<i32>(size) - 1), 0);
+            if (TAP_FLOOR) {
+                occlusion += sample.w;
+                continue;
+            }
+            let dd = centre.w - sample.w;
+            let t = saturate((dd - REFERENCE_FALLOFF) / (density - REFERENCE_FALLOFF));
+            var weight = 1.0 - t * t * (3.0 - 2.0 * t);
+            if (LIGHT_ATTENUATION) {
+                weight *= 1.5 - max(n_omega, 0.0) * occluder_light(sample.xyz, omega);
+            } else {
+                weight *= 1.5;
+            }
+            occlusion += select(0.0, weight, dd >= REFERENCE_FALLOFF);
+        }
+        total += select(0.0, occlusion / f32(used), used > 0u);
+    }
+    return max(total / f32(S_R), 0.0);
 }
 
 @compute @workgroup_size(8, 8, 1)
@@ -113,6 +175,10 @@ fn line_ao(@builtin(global_invocation_id) id: vec3<u32>) {
     let zoom = textureLoad(zoom_map, pixel, 0).r;
     let tile = ((vec2<i32>(pixel) - params.noise_origin) % 64 + 64) % 64;
     let r1 = noise[tile.y * 64 + tile.x].xyz;
+    if (REFERENCE) {
+        textureStore(ao_out, pixel, vec4<f32>(reference_ao(pixel, r1, zoom)));
+        return;
+    }
 
     var ao = hemisphere(nd0, 0u, pixel, r1, zoom);
     if (S_R > 1u) {

@@ -52,16 +52,14 @@ fn screen_direction(clip: vec4<f32>, dclip: vec4<f32>) -> vec2<f32> {
     return (dclip.xy * clip.w - clip.xy * dclip.w) * frame.viewport;
 }
 
-@vertex
-fn vs_main(@builtin(vertex_index) vertex_index: u32, seg: SegmentIn) -> VsOut {
+// Vertex `at_end` of the segment, pushed `side` half line widths to its left (−1 right, 0 on it).
+fn segment_vertex(seg: SegmentIn, at_end: bool, side: f32) -> VsOut {
     var out: VsOut;
     if (seg.t0.w < 0.5) {
-        // No segment starts at p0: a degenerate quad outside the clip volume.
+        // No segment starts at p0: a degenerate primitive outside the clip volume.
         out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
         return out;
     }
-    let at_end = (vertex_index >> 1u) == 1u;
-    let side = f32(vertex_index & 1u) * 2.0 - 1.0;
     let p = select(seg.p0, seg.p1, at_end);
     let t_world = select(seg.t0.xyz, seg.t1.xyz, at_end);
 
@@ -89,6 +87,19 @@ fn vs_main(@builtin(vertex_index) vertex_index: u32, seg: SegmentIn) -> VsOut {
         out.color = frame.constant_color.rgb;
     }
     return out;
+}
+
+// Quads: vertices 0..4 of a triangle strip, (start, right), (start, left), (end, right), (end, left).
+@vertex
+fn vs_main(@builtin(vertex_index) vertex_index: u32, seg: SegmentIn) -> VsOut {
+    return segment_vertex(seg, (vertex_index >> 1u) == 1u, f32(vertex_index & 1u) * 2.0 - 1.0);
+}
+
+// Native 1-px lines (`LineList`, vertices 0..2): the rasterizer's own thin lines, the baseline the
+// quads are measured against (`lineao bench`, pass `lines-native-1px`).
+@vertex
+fn vs_native(@builtin(vertex_index) vertex_index: u32, seg: SegmentIn) -> VsOut {
+    return segment_vertex(seg, vertex_index == 1u, 0.0);
 }
 
 struct GBuffer {

@@ -16,6 +16,37 @@ pub struct Cli {
 pub enum Command {
     /// Render a built-in scene to a PNG.
     Render(RenderArgs),
+    /// Time every pass on a built-in scene (CONTRACT.md `lineao bench --json`).
+    Bench(BenchArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Built-in scene.
+    #[arg(long, default_value = "bundles", value_parser = parse_scene)]
+    pub scene: SceneKind,
+    /// Approximate vertex count of the scene.
+    #[arg(long, default_value_t = 1_000_000)]
+    pub vertices: usize,
+    /// Seed of the built-in scene.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    #[arg(long, default_value_t = 1280, value_parser = clap::value_parser!(u32).range(1..=8192))]
+    pub width: u32,
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=8192))]
+    pub height: u32,
+    /// Timed frames per pass (after the warm-up).
+    #[arg(long, default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..))]
+    pub frames: u32,
+    /// Untimed frames first (pipeline compilation, caches).
+    #[arg(long, default_value_t = 3)]
+    pub warmup: u32,
+    /// Disable LineAO's light attenuation (g_light = 1).
+    #[arg(long)]
+    pub no_light_attenuation: bool,
+    /// Print CONTRACT.md's JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -28,6 +59,8 @@ pub enum Method {
 pub enum Variant {
     /// The paper's equations with CONTRACT.md's conventions.
     Paper,
+    /// What the authors' OpenWalnut shader does (no pyramid, growing radii, `1.5 − …` weights).
+    Reference,
 }
 
 #[derive(Args, Debug)]
@@ -84,6 +117,9 @@ pub struct RenderArgs {
     /// LineAO r0 in pixels [default: 1.5 × line width].
     #[arg(long)]
     pub r0: Option<f32>,
+    /// Variant `reference`: base radius in pixels at the home zoom (the authors' u_lineAORadius).
+    #[arg(long, default_value_t = 2.0)]
+    pub reference_radius: f32,
     /// LineAO δ0.
     #[arg(long, default_value_t = 1e-4)]
     pub delta0: f32,

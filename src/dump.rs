@@ -9,11 +9,9 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use lineao::camera::{Camera, Projection};
 use lineao::readback::read_texture;
-use lineao::{AoChain, AoMethod, Gpu, noise};
+use lineao::{AoChain, AoMethod, Gpu, LineAoVariant, noise};
 use npyz::WriterBuilder;
 use serde_json::json;
-
-use crate::cli::RenderArgs;
 
 fn write_npy(dir: &Path, name: &str, shape: &[u64], data: &[f32]) -> Result<()> {
     let path = dir.join(name);
@@ -33,7 +31,7 @@ fn flat3(vectors: &[[f32; 3]]) -> Vec<f32> {
     vectors.iter().flatten().copied().collect()
 }
 
-pub fn write(dir: &Path, gpu: &Gpu, chain: &AoChain, camera: &Camera, args: &RenderArgs) -> Result<()> {
+pub fn write(dir: &Path, gpu: &Gpu, chain: &AoChain, camera: &Camera) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let (targets, view) = chain.targets().zip(chain.frame_view()).context("nothing was rendered")?;
     let s = chain.settings();
@@ -75,24 +73,34 @@ pub fn write(dir: &Path, gpu: &Gpu, chain: &AoChain, camera: &Camera, args: &Ren
             .iter()
             .map(|l| json!({"dir": l.dir.to_array(), "intensity": l.intensity}))
             .collect();
-        let extra = json!({
-            "variant": format!("{:?}", args.variant).to_lowercase(),
+        let mut extra = json!({
+            "variant": ao.variant.name(),
             "s_r": ao.s_r,
             "s_h": ao.s_h,
-            "r0_px": s.r0_px(),
-            "delta0": ao.delta0,
-            "epsilon": ao.epsilon,
             "light_attenuation": ao.light_attenuation,
             "lights": lights,
-            "kd": s.lighting.kd,
-            "ks": s.lighting.ks,
-            "shininess": s.lighting.shininess,
             "noise_seed": ao.noise_seed,
             "outer": "full",
         });
+        let variant_keys = match ao.variant {
+            LineAoVariant::Paper => json!({
+                "r0_px": s.r0_px(),
+                "delta0": ao.delta0,
+                "epsilon": ao.epsilon,
+                "kd": s.lighting.kd,
+                "ks": s.lighting.ks,
+                "shininess": s.lighting.shininess,
+            }),
+            // Our extension of CONTRACT.md: what the authors' radius needs.
+            LineAoVariant::Reference => json!({
+                "reference_radius_px": ao.reference_radius_px,
+                "zoom_fit": view.zoom_fit(),
+            }),
+        };
+        extra.as_object_mut().expect("object").extend(variant_keys.as_object().expect("object").clone());
         params.as_object_mut().expect("object").extend(extra.as_object().expect("object").clone());
         write_npy(dir, "noise.npy", &[64, 64, 3], &flat3(&noise::noise_tile(ao.noise_seed)))?;
-        let samples = noise::sample_table(ao.noise_seed, ao.s_r, ao.s_h);
+        let samples = lineao::passes::line_ao::sample_table(ao);
         write_npy(dir, "samples.npy", &[ao.s_r as u64, ao.s_h as u64, 3], &flat3(&samples))?;
     }
     let path = dir.join("params.json");

@@ -3,6 +3,7 @@
 //! Exit codes (CONTRACT.md): 0 success, 1 bad input or a failed operation (message on stderr),
 //! 2 bad command line. A panic is a bug; it is reported and exits 1, never 101.
 
+mod bench;
 mod cli;
 mod dump;
 mod output;
@@ -20,6 +21,7 @@ fn main() -> ExitCode {
     let cli = cli::Cli::parse();
     let result = std::panic::catch_unwind(|| match cli.command {
         cli::Command::Render(args) => render::run(&args),
+        cli::Command::Bench(args) => bench::run(&args),
     });
     match result {
         Ok(Ok(())) => ExitCode::SUCCESS,

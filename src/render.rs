@@ -4,9 +4,10 @@ use anyhow::{Context, Result};
 use glam::Vec3;
 use lineao::camera::{Camera, Projection};
 use lineao::passes::lines::LineGeometry;
-use lineao::{AoChain, AoMethod, ChainSettings, Gpu, LineAoSettings, LineColor};
+use lineao::{AoChain, AoMethod, ChainSettings, Gpu, LineAoSettings, LineAoVariant, LineColor};
+use lineao_tracts::scenes::ViewHint;
 
-use crate::cli::{ColorArg, Method, RenderArgs};
+use crate::cli::{ColorArg, Method, RenderArgs, Variant};
 
 /// The chain's settings from the command line.
 pub fn settings(args: &RenderArgs, zoom_unit: f32) -> ChainSettings {
@@ -24,6 +25,11 @@ pub fn settings(args: &RenderArgs, zoom_unit: f32) -> ChainSettings {
             light_attenuation: !args.no_light_attenuation,
             noise_seed: args.noise_seed,
             guard_max_px: args.guard_max,
+            variant: match args.variant {
+                Variant::Paper => LineAoVariant::Paper,
+                Variant::Reference => LineAoVariant::Reference,
+            },
+            reference_radius_px: args.reference_radius,
         },
         line_width_px: args.line_width,
         line_color: match args.color {
@@ -72,7 +78,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let image = lineao::readback::read_texture(&gpu.device, &gpu.queue, &target.texture)?;
     crate::output::write_png(&args.output, args.width, args.height, &image.bytes)?;
     if let Some(dir) = &args.dump {
-        crate::dump::write(dir, &gpu, &chain, &camera, args)?;
+        crate::dump::write(dir, &gpu, &chain, &camera)?;
     }
     eprintln!(
         "lineao: {} ({} streamlines, {} vertices) with {} on {} -> {}",
@@ -84,6 +90,16 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         args.output.display()
     );
     Ok(())
+}
+
+/// The camera a built-in scene suggests.
+pub fn camera_from_hint(hint: &ViewHint) -> Camera {
+    Camera {
+        eye: Vec3::from_array(hint.eye),
+        target: Vec3::from_array(hint.target),
+        up: Vec3::from_array(hint.up),
+        projection: Projection::Perspective { fov_y_deg: hint.fov_y_deg },
+    }
 }
 
 fn validate_camera(camera: &Camera) -> Result<()> {

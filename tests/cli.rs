@@ -4,9 +4,10 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+use lineao::LineAoVariant;
 use lineao::lighting::Light;
 use lineao::reference::{self, Image, LineAoParams};
-use lineao::verify::{check_policy, line_ao_flip_bound};
+use lineao::verify::{check_policy, line_ao_flip_bound, line_ao_reference_flip_bound};
 use serde_json::Value;
 
 fn lineao(args: &[&str]) -> Output {
@@ -73,7 +74,18 @@ fn vec3(v: &Value) -> [f32; 3] {
 
 #[test]
 fn render_and_dump_let_an_outside_tool_recompute_lineao() {
-    let dir = scratch("dump");
+    recompute_from_dump("paper");
+}
+
+#[test]
+fn render_and_dump_let_an_outside_tool_recompute_the_reference_variant() {
+    recompute_from_dump("reference");
+}
+
+/// Renders with `--variant variant --dump`, then recomputes LineAO from the dumped files and
+/// `params.json` alone, as an outside implementation would.
+fn recompute_from_dump(variant: &str) {
+    let dir = scratch(&format!("dump-{variant}"));
     let png = dir.join("out.png");
     let dump = dir.join("dump");
     let out = lineao(&[
@@ -86,6 +98,10 @@ fn render_and_dump_let_an_outside_tool_recompute_lineao() {
         "200",
         "--height",
         "150",
+        "--variant",
+        variant,
+        "--guard-max",
+        "48",
         "-o",
         png.to_str().unwrap(),
         "--dump",
@@ -98,22 +114,20 @@ fn render_and_dump_let_an_outside_tool_recompute_lineao() {
     assert_eq!((reader.info().width, reader.info().height), (200, 150));
 
     let params: Value = serde_json::from_str(&std::fs::read_to_string(dump.join("params.json")).unwrap()).unwrap();
-    for key in [
+    let variant_keys: &[&str] = match variant {
+        "paper" => &["r0_px", "delta0", "epsilon", "kd", "ks", "shininess"],
+        _ => &["reference_radius_px", "zoom_fit"],
+    };
+    let common = [
         "method",
         "variant",
         "geometry",
         "line_width_px",
         "s_r",
         "s_h",
-        "r0_px",
-        "delta0",
-        "epsilon",
         "strength",
         "light_attenuation",
         "lights",
-        "kd",
-        "ks",
-        "shininess",
         "zoom_unit",
         "guard_px",
         "noise_seed",
@@ -123,9 +137,11 @@ fn render_and_dump_let_an_outside_tool_recompute_lineao() {
         "width",
         "height",
         "camera",
-    ] {
+    ];
+    for key in common.iter().chain(variant_keys) {
         assert!(params.get(key).is_some(), "params.json lacks {key}");
     }
+    assert_eq!(params["variant"], variant);
     assert_eq!(params["method"], "lineao");
     assert_eq!((params["width"].as_u64(), params["height"].as_u64()), (Some(200), Some(150)));
     assert!(params["camera"]["fov_y_deg"].is_number());
@@ -137,7 +153,8 @@ fn render_and_dump_let_an_outside_tool_recompute_lineao() {
 
     let mut levels = Vec::new();
     let (mut lw, mut lh) = (w, h);
-    for j in 0..s_r {
+    let pyramid_levels = if variant == "paper" { s_r } else { 1 };
+    for j in 0..pyramid_levels {
         let (shape, data) = read_npy(&dump.join(format!("nd_{j}.npy")));
         assert_eq!(shape, [lh, lw, 4], "nd_{j}.npy");
         levels.push(Image {
@@ -156,31 +173,81 @@ fn render_and_dump_let_an_outside_tool_recompute_lineao() {
     let (shape, samples) = read_npy(&dump.join("samples.npy"));
     assert_eq!(shape, [s_r as u64, s_h as u64, 3]);
 
-    let f = |k: &str| params[k].as_f64().unwrap() as f32;
     let lights = params["lights"]
         .as_array()
         .unwrap()
         .iter()
         .map(|l| Light { dir: vec3(&l["dir"]).into(), intensity: l["intensity"].as_f64().unwrap() as f32 })
         .collect();
+    let get = |k: &str| params.get(k).and_then(Value::as_f64).unwrap_or(0.0) as f32;
+    let reference_scale = if variant == "paper" {
+        [0.0; 2]
+    } else {
+        let (vw, vh) = (get("width"), get("height"));
+        let k = get("reference_radius_px") / get("zoom_fit") / vw.max(vh);
+        [k * vw, k * vh]
+    };
     let p = LineAoParams {
+        variant: if variant == "paper" { LineAoVariant::Paper } else { LineAoVariant::Reference },
+        reference_scale,
         s_r,
         s_h,
-        r0_px: f("r0_px"),
-        delta0: f("delta0"),
-        epsilon: f("epsilon"),
+        r0_px: get("r0_px"),
+        delta0: get("delta0"),
+        epsilon: get("epsilon"),
         light_attenuation: params["light_attenuation"].as_bool().unwrap(),
         lights,
-        kd: f("kd"),
-        ks: f("ks"),
-        shininess: f("shininess"),
+        kd: get("kd"),
+        ks: get("ks"),
+        shininess: get("shininess"),
         noise_origin: [guard as i32; 2],
     };
     let triples = |v: &[f32]| v.chunks(3).map(|c| [c[0], c[1], c[2]]).collect::<Vec<_>>();
     let zoom = Image { width: w as usize, height: h as usize, data: zoom };
     let gpu_ao = Image { width: w as usize, height: h as usize, data: ao };
     let cpu_ao = reference::line_ao(&levels, &zoom, &triples(&noise), &triples(&samples), &p);
-    let stats = check_policy(&gpu_ao, &cpu_ao, &levels[0], line_ao_flip_bound(s_r, s_h)).unwrap();
-    println!("recomputed from the dump: {stats}");
+    let bound = if variant == "paper" { line_ao_flip_bound(s_r, s_h) } else { line_ao_reference_flip_bound(s_h) };
+    let stats = check_policy(&gpu_ao, &cpu_ao, &levels[0], bound).unwrap();
+    println!("{variant} recomputed from the dump: {stats}");
     assert!(gpu_ao.data.iter().filter(|&&a| a > 0.1).count() > 1000);
+}
+
+#[test]
+fn bench_json_is_the_contract() {
+    let out = lineao(&[
+        "bench",
+        "--json",
+        "--vertices",
+        "3000",
+        "--width",
+        "96",
+        "--height",
+        "64",
+        "--frames",
+        "3",
+        "--warmup",
+        "1",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let report: Value = serde_json::from_slice(&out.stdout).expect("stdout is JSON");
+    for key in ["adapter", "backend", "width", "height", "scene", "vertices", "frames", "timestamps", "passes"] {
+        assert!(report.get(key).is_some(), "bench JSON lacks {key}");
+    }
+    assert_eq!((report["width"].as_u64(), report["height"].as_u64()), (Some(96), Some(64)));
+    assert_eq!((report["scene"].as_str(), report["frames"].as_u64()), (Some("bundles"), Some(3)));
+    assert!(report["vertices"].as_u64().unwrap() > 1000);
+    let on = if report["timestamps"] == true { "gpu" } else { "cpu" };
+    let passes = report["passes"].as_array().unwrap();
+    let names: Vec<&str> = passes.iter().map(|p| p["name"].as_str().unwrap()).collect();
+    assert_eq!(
+        names,
+        ["lines", "lines-native-1px", "nd-pyramid", "lineao", "lineao-tap-floor", "composite", "lineao-chain"]
+    );
+    for p in passes {
+        assert_eq!(p["on"], on);
+        let ms = |k: &str| p[k].as_f64().unwrap();
+        assert!(0.0 <= ms("ms_min") && ms("ms_min") <= ms("ms_median") && ms("ms_median") <= ms("ms_max"), "{p}");
+        assert!(ms("ms_max") < 60_000.0, "{p}");
+    }
+    assert_eq!(lineao(&["bench", "--frames", "0"]).status.code(), Some(2));
 }

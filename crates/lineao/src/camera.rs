@@ -81,6 +81,8 @@ pub struct FrameView {
     pub f_px: f32,
     pub zoom_unit: f32,
     pub orthographic: bool,
+    /// Radius of the scene's bounding sphere, world units.
+    pub scene_radius: f32,
 }
 
 impl FrameView {
@@ -117,6 +119,7 @@ impl FrameView {
             f_px,
             zoom_unit,
             orthographic: matches!(camera.projection, Projection::Orthographic { .. }),
+            scene_radius: r,
         }
     }
 
@@ -128,6 +131,12 @@ impl FrameView {
     /// The largest zoom anywhere in the image: at the nearest geometry for perspective.
     pub fn zoom_max(&self) -> f32 {
         if self.orthographic { self.f_px * self.zoom_unit } else { self.f_px * self.zoom_unit / self.near }
+    }
+
+    /// The zoom at which the scene's bounding sphere just fills the shorter side of the view:
+    /// the "home view" that the authors' zoom factor of 1 stands for (variant `reference`).
+    pub fn zoom_fit(&self) -> f32 {
+        self.width.min(self.height).max(1) as f32 * self.zoom_unit / (2.0 * self.scene_radius)
     }
 
     /// Normalized linear depth of a view-space z (CONTRACT.md).

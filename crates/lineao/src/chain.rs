@@ -12,6 +12,10 @@
 //!                                       │
 //!   target view ◀─ Composite ◀──────────┘ color · (1 − strength · ao) + specular
 //! ```
+//!
+//! Every pass is labelled and the frame sits in a `lineao` debug group, so GPU debuggers show
+//! the chain by name. With [`AoChain::set_timing`] each pass also records timestamp queries under
+//! the names `lineao bench` uses (CONTRACT.md): `lines`, `nd-pyramid`, `lineao`, `composite`.
 
 use crate::Error;
 use crate::camera::{self, Bounds, Camera, FrameView};
@@ -19,8 +23,12 @@ use crate::passes::composite::Composite;
 use crate::passes::line_ao::LineAo;
 use crate::passes::lines::{LineGeometry, LineRenderer};
 use crate::passes::nd_pyramid::NdPyramid;
-use crate::settings::{AoMethod, ChainSettings};
+use crate::settings::{AoMethod, ChainSettings, LineAoVariant};
 use crate::targets::FrameTargets;
+use crate::timing::{PassTime, PassTimer};
+
+/// The spans of a timed frame, in chain order.
+pub const PASS_NAMES: [&str; 4] = ["lines", "nd-pyramid", "lineao", "composite"];
 
 pub struct AoChain {
     settings: ChainSettings,
@@ -32,6 +40,7 @@ pub struct AoChain {
     max_texture: u32,
     targets: Option<FrameTargets>,
     view: Option<FrameView>,
+    timer: Option<PassTimer>,
 }
 
 impl AoChain {
@@ -48,6 +57,7 @@ impl AoChain {
             max_texture: device.limits().max_texture_dimension_2d,
             targets: None,
             view: None,
+            timer: None,
         })
     }
 
@@ -67,6 +77,25 @@ impl AoChain {
         }
         self.settings = settings;
         Ok(())
+    }
+
+    /// Turns per-pass GPU timing on or off. Returns whether timing is on: it stays off on
+    /// adapters without timestamp queries.
+    pub fn set_timing(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, enabled: bool) -> bool {
+        self.timer = if enabled { PassTimer::new(device, queue, &PASS_NAMES) } else { None };
+        self.timer.is_some()
+    }
+
+    /// GPU time of each pass of the last submitted frame (waits for it), or `None` when timing
+    /// is off. Passes the method skips are left out.
+    pub fn pass_times(&self, device: &wgpu::Device) -> Result<Option<Vec<PassTime>>, Error> {
+        let Some(timer) = &self.timer else { return Ok(None) };
+        let used: &[&str] = match (self.settings.method, self.settings.levels()) {
+            (AoMethod::LineAo, 2..) => &PASS_NAMES,
+            (AoMethod::LineAo, _) => &["lines", "lineao", "composite"],
+            (AoMethod::None, _) => &["lines", "composite"],
+        };
+        timer.read(device, used).map(Some)
     }
 
     /// Sets the visible size. 0 × 0 (a minimized window) is allowed: nothing is rendered until a
@@ -89,9 +118,11 @@ impl AoChain {
     /// The guard band for this view: the largest sampling radius over the image (CONTRACT.md).
     pub fn guard_for(&self, camera: &Camera, bounds: &Bounds) -> u32 {
         let s = &self.settings;
-        match s.method {
-            AoMethod::None => 0,
-            AoMethod::LineAo => {
+        match (s.method, s.line_ao.variant) {
+            (AoMethod::None, _) => 0,
+            // Its radius grows as 1/(1 − d), without bound toward the far plane.
+            (AoMethod::LineAo, LineAoVariant::Reference) => s.line_ao.guard_max_px,
+            (AoMethod::LineAo, LineAoVariant::Paper) => {
                 let unguarded = FrameView::new(camera, bounds, self.size.0, self.size.1, 0, s.zoom_unit);
                 let radius = s.r0_px() + (s.line_ao.s_r - 1) as f32 * unguarded.zoom_max();
                 camera::guard_band(radius, s.line_ao.s_r, s.line_ao.guard_max_px)
@@ -128,7 +159,7 @@ impl AoChain {
         let targets = self.targets.as_ref()?;
         let view = FrameView::new(camera, bounds, width, height, guard, s.zoom_unit);
         self.lines.prepare(queue, &view, s.line_width_px, s.line_color, &s.lighting);
-        self.line_ao.prepare(queue, targets, &s.line_ao, s.r0_px(), &s.lighting);
+        self.line_ao.prepare(queue, targets, &view, &s.line_ao, s.r0_px(), &s.lighting);
         let strength = if s.method == AoMethod::None { 0.0 } else { s.strength };
         self.composite.prepare(queue, targets, strength, s.debug_view, view.zoom_max());
         self.view = Some(view);
@@ -142,13 +173,19 @@ impl AoChain {
         if self.view.is_none() {
             return;
         }
+        let span = |name| self.timer.as_ref().and_then(|t| t.span(name));
         encoder.push_debug_group("lineao");
-        self.lines.encode(encoder, targets, geometry, self.settings.background);
+        self.lines.encode(encoder, targets, geometry, self.settings.background, span("lines"));
         if self.settings.method == AoMethod::LineAo {
-            self.pyramid.encode(encoder, targets);
-            self.line_ao.encode(encoder, targets);
+            if self.settings.levels() > 1 {
+                self.pyramid.encode(encoder, targets, span("nd-pyramid"));
+            }
+            self.line_ao.encode(encoder, targets, span("lineao"));
         }
-        self.composite.encode(encoder, target);
+        self.composite.encode(encoder, target, span("composite"));
+        if let Some(timer) = &self.timer {
+            timer.resolve(encoder);
+        }
         encoder.pop_debug_group();
     }
 

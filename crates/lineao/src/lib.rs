@@ -48,11 +48,12 @@ pub mod reference;
 pub mod settings;
 pub mod shader;
 pub mod targets;
+pub mod timing;
 pub mod verify;
 
 pub use chain::AoChain;
 pub use gpu::Gpu;
-pub use settings::{AoMethod, ChainSettings, DebugView, LineAoSettings, LineColor};
+pub use settings::{AoMethod, ChainSettings, DebugView, LineAoSettings, LineAoVariant, LineColor};
 
 /// Pyramid levels (and so LineAO hemispheres) the shaders can bind.
 pub const MAX_LEVELS: u32 = 5;

@@ -41,12 +41,13 @@ pub fn noise_tile(seed: u32) -> Vec<[f32; 3]> {
     (0..(NOISE_SIZE * NOISE_SIZE) as u32).map(|i| unit_vector(seed, STREAM_R1, i)).collect()
 }
 
-/// R2: `samples[j * s_h + i]` for j < s_r, i < s_h. Only i < ⌈s_h/(j+1)⌉ is used; the rest are
-/// zero so that the table reads the same as CONTRACT.md's zero-padded `samples.npy`.
-pub fn sample_table(seed: u32, s_r: u32, s_h: u32) -> Vec<[f32; 3]> {
+/// R2: `samples[j * s_h + i]` for j < s_r, i < s_h. Only i < `count(j)` is used (⌈s_h/(j+1)⌉ for
+/// the paper, s_h for the authors' code); the rest are zero so that the table reads the same as
+/// CONTRACT.md's zero-padded `samples.npy`.
+pub fn sample_table(seed: u32, s_r: u32, s_h: u32, count: impl Fn(u32) -> u32) -> Vec<[f32; 3]> {
     let mut table = vec![[0.0; 3]; (s_r * s_h) as usize];
     for j in 0..s_r {
-        for i in 0..samples_on_hemisphere(s_h, j) {
+        for i in 0..count(j).min(s_h) {
             let index = j * s_h + i;
             table[index as usize] = unit_vector(seed, STREAM_R2, index);
         }
@@ -82,9 +83,12 @@ mod tests {
     fn default_counts_are_the_papers_59_samples() {
         let total: u32 = (0..3).map(|j| samples_on_hemisphere(32, j)).sum();
         assert_eq!(total, 32 + 16 + 11);
-        let table = sample_table(1, 3, 32);
+        let table = sample_table(1, 3, 32, |j| samples_on_hemisphere(32, j));
         assert_eq!(table[32 + 15], unit_vector(1, STREAM_R2, 32 + 15));
         assert_eq!(table[32 + 16], [0.0; 3]);
+        let full = sample_table(1, 3, 32, |_| 32);
+        assert_eq!(full[..32 + 16], table[..32 + 16]);
+        assert_eq!(full[32 + 16], unit_vector(1, STREAM_R2, 32 + 16));
     }
 
     #[test]

@@ -22,9 +22,32 @@ impl AoMethod {
     }
 }
 
+/// Which LineAO: the paper's equations, or what the authors' own code does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum LineAoVariant {
+    /// Eq. 4–15 with CONTRACT.md's conventions.
+    #[default]
+    Paper,
+    /// The authors' OpenWalnut shader (DESIGN.md): no pyramid, radii growing 1.5, 4, 7.5 times a
+    /// depth-scaled base radius, s_h samples per hemisphere skipping off-screen ones, the
+    /// `1.5 − …` light weight, ao = max(0, Σ occ_l / s_r). See [`crate::passes::line_ao`].
+    Reference,
+}
+
+impl LineAoVariant {
+    /// The name used on the command line and in `params.json`.
+    pub fn name(self) -> &'static str {
+        match self {
+            LineAoVariant::Paper => "paper",
+            LineAoVariant::Reference => "reference",
+        }
+    }
+}
+
 /// The LineAO parameters of Eq. 7–15 (CONTRACT.md "LineAO").
 #[derive(Clone, Debug, PartialEq)]
 pub struct LineAoSettings {
+    pub variant: LineAoVariant,
     /// s_r: number of hemispheres and pyramid levels, 1..=5; the paper uses 3 (and needs > 1
     /// for δ(l) to fall off).
     pub s_r: u32,
@@ -42,6 +65,9 @@ pub struct LineAoSettings {
     pub noise_seed: u32,
     /// Upper bound of the guard band in pixels. Default 128.
     pub guard_max_px: u32,
+    /// Variant `reference`: the base radius in pixels at the home zoom (the authors'
+    /// `u_lineAORadius`). Default 2.
+    pub reference_radius_px: f32,
 }
 
 impl Default for LineAoSettings {
@@ -55,6 +81,8 @@ impl Default for LineAoSettings {
             light_attenuation: true,
             noise_seed: 1,
             guard_max_px: 128,
+            variant: LineAoVariant::Paper,
+            reference_radius_px: 2.0,
         }
     }
 }
@@ -140,11 +168,12 @@ impl ChainSettings {
         self.line_ao.r0_px.unwrap_or(1.5 * self.line_width_px)
     }
 
-    /// Pyramid levels the chain needs: s_r for LineAO; one for plain lines.
+    /// Pyramid levels the chain needs: s_r for LineAO; one for plain lines and for the
+    /// `reference` variant (the authors' pyramid is off by default).
     pub fn levels(&self) -> u32 {
-        match self.method {
-            AoMethod::LineAo => self.line_ao.s_r,
-            AoMethod::None => 1,
+        match (self.method, self.line_ao.variant) {
+            (AoMethod::LineAo, LineAoVariant::Paper) => self.line_ao.s_r,
+            (AoMethod::LineAo, LineAoVariant::Reference) | (AoMethod::None, _) => 1,
         }
     }
 
@@ -166,6 +195,9 @@ impl ChainSettings {
         }
         if !(ao.delta0.is_finite() && ao.delta0 >= 0.0 && ao.delta0 < (1.0 / ao.s_r as f32).powi(2)) {
             return bad(format!("delta0 must be in [0, (1/s_r)^2), got {}", ao.delta0));
+        }
+        if !(ao.reference_radius_px.is_finite() && ao.reference_radius_px >= 0.0) {
+            return bad(format!("the reference radius must be >= 0 px, got {}", ao.reference_radius_px));
         }
         if !(ao.epsilon.is_finite() && ao.epsilon >= 0.0) {
             return bad(format!("epsilon must be >= 0, got {}", ao.epsilon));

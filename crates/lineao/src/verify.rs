@@ -95,6 +95,12 @@ pub fn line_ao_flip_bound(s_r: u32, s_h: u32) -> f32 {
     (0..s_r).map(|j| 2.0 / crate::noise::samples_on_hemisphere(s_h, j) as f32).sum()
 }
 
+/// The same bound for variant `reference`: two flipped samples per hemisphere, each weighing up
+/// to 1.5/s_h, averaged over the s_r hemispheres: 3/s_h.
+pub fn line_ao_reference_flip_bound(s_h: u32) -> f32 {
+    3.0 / s_h as f32
+}
+
 /// Checks the agreement policy on geometry pixels (non-background in `nd0`) and returns the
 /// statistics, or an error message that names the worst pixel and the fraction.
 pub fn check_policy(

@@ -3,14 +3,16 @@
 
 mod common;
 
-use common::{gpu, is_geometry, line_ao_on, render};
+use common::{flat_view, gpu, is_geometry, line_ao_on, render};
 use glam::Vec3;
+use lineao::camera::FrameView;
 use lineao::camera::{Camera, Projection};
 use lineao::lighting::{Light, Lighting};
-use lineao::noise::{noise_tile, sample_table};
+use lineao::noise::noise_tile;
+use lineao::passes::line_ao::sample_table;
 use lineao::reference::{self, Image, LineAoParams, NdImage};
-use lineao::verify::{check_policy, compare, line_ao_flip_bound};
-use lineao::{ChainSettings, LineAoSettings};
+use lineao::verify::{check_policy, compare, line_ao_flip_bound, line_ao_reference_flip_bound};
+use lineao::{ChainSettings, LineAoSettings, LineAoVariant};
 
 fn settings(s_r: u32, r0_px: f32, light_attenuation: bool) -> ChainSettings {
     ChainSettings {
@@ -40,6 +42,8 @@ fn delta_curve_and_depth_weight() {
 #[test]
 fn light_weight_closed_form() {
     let params = |dir: Vec3| LineAoParams {
+        variant: LineAoVariant::Paper,
+        reference_scale: [0.0; 2],
         s_r: 3,
         s_h: 32,
         r0_px: 3.0,
@@ -69,15 +73,14 @@ fn nd_map(width: usize, height: usize, depth: impl Fn(usize, usize) -> f32) -> N
     Image::from_fn(width, height, |x, y| [0.0, 0.0, 1.0, depth(x, y)])
 }
 
-fn cpu_line_ao(levels: &[NdImage], zoom: &Image<f32>, s: &ChainSettings, guard: u32) -> Image<f32> {
+fn cpu_line_ao(levels: &[NdImage], zoom: &Image<f32>, s: &ChainSettings, view: &FrameView) -> Image<f32> {
     let ao = &s.line_ao;
-    reference::line_ao(
-        levels,
-        zoom,
-        &noise_tile(ao.noise_seed),
-        &sample_table(ao.noise_seed, ao.s_r, ao.s_h),
-        &LineAoParams::from_settings(s, guard),
-    )
+    reference::line_ao(levels, zoom, &noise_tile(ao.noise_seed), &sample_table(ao), &LineAoParams::new(s, view))
+}
+
+/// The view `line_ao_on` uses for a CPU-written G-buffer of `levels[0]`'s size.
+fn view_of(level0: &NdImage, guard: u32) -> FrameView {
+    flat_view(level0.width as u32 - 2 * guard, level0.height as u32 - 2 * guard, guard)
 }
 
 #[test]
@@ -90,7 +93,10 @@ fn flat_region_is_unoccluded_even_with_rounding_noise() {
     let zoom = Image::filled(64, 48, 4.0f32);
     let (levels, ao) = line_ao_on(&gpu, &nd0, &zoom, &s, 0);
     assert!(ao.data.iter().all(|&a| a == 0.0), "GPU occludes a flat region");
-    assert!(cpu_line_ao(&levels, &zoom, &s, 0).data.iter().all(|&a| a == 0.0), "CPU occludes a flat region");
+    assert!(
+        cpu_line_ao(&levels, &zoom, &s, &view_of(&levels[0], 0)).data.iter().all(|&a| a == 0.0),
+        "CPU occludes a flat region"
+    );
 }
 
 /// Occlusion at pixel (x, y) of a step edge: the samples of hemisphere 0 that land at column
@@ -100,7 +106,7 @@ fn step_edge_expected(x: usize, y: usize, edge: usize, r0: f32, s_h: u32, weight
     if x >= edge {
         return 0.0;
     }
-    let (noise, samples) = (noise_tile(1), sample_table(1, 1, s_h));
+    let (noise, samples) = (noise_tile(1), lineao::noise::sample_table(1, 1, s_h, |_| s_h));
     let r1 = Vec3::from_array(noise[(y % 64) * 64 + x % 64]);
     let hits = samples
         .iter()
@@ -125,7 +131,7 @@ fn step_edge_occludes_a_known_fraction_of_samples() {
         let s = settings(1, r0, false);
         let nd0 = nd_map(w, h, |x, _| if x >= edge { 0.5 - step } else { 0.5 });
         let (levels, gpu_ao) = line_ao_on(&gpu, &nd0, &zoom, &s, 0);
-        let cpu_ao = cpu_line_ao(&levels, &zoom, &s, 0);
+        let cpu_ao = cpu_line_ao(&levels, &zoom, &s, &view_of(&levels[0], 0));
         let mut occluded_pixels = 0;
         for y in 0..h {
             for x in 0..w {
@@ -163,7 +169,7 @@ fn light_attenuation_scales_by_the_brdf() {
     let on = ChainSettings { lighting, ..settings(1, 6.0, true) };
     let (levels, ao_off) = line_ao_on(&gpu, &nd0, &zoom, &off, 0);
     let (_, ao_on) = line_ao_on(&gpu, &nd0, &zoom, &on, 0);
-    let cpu_on = cpu_line_ao(&levels, &zoom, &on, 0);
+    let cpu_on = cpu_line_ao(&levels, &zoom, &on, &view_of(&levels[0], 0));
     let mut occluded = 0;
     for i in 0..w * h {
         assert!((ao_on.data[i] - 0.76 * ao_off.data[i]).abs() < 1e-5, "GPU pixel {i}");
@@ -186,6 +192,17 @@ fn polylines(count: usize, seed: f32) -> (Vec<[f32; 3]>, Vec<u64>) {
         offsets.push(positions.len() as u64);
     }
     (positions, offsets)
+}
+
+/// A perspective and an orthographic camera framing [`polylines`].
+fn cameras_for_polylines() -> (Camera, Camera) {
+    let perspective = Camera {
+        eye: Vec3::new(20.0, 30.0, 140.0),
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        projection: Projection::Perspective { fov_y_deg: 40.0 },
+    };
+    (perspective, Camera { projection: Projection::Orthographic { height: 110.0 }, ..perspective })
 }
 
 #[test]
@@ -214,7 +231,7 @@ fn parallel_lines_occlude_within_r0_only() {
             (20 + g..80 + g).flat_map(|x| row(gap).map(move |y| (x, y))).map(|(x, y)| frame.ao.get(x, y)).sum();
         assert_eq!(front_ao, 0.0, "nothing is in front of the front line");
         assert_eq!(back_ao > 0.0, occludes, "gap {gap} px, r0 {r0} px: back line AO sum {back_ao}");
-        let cpu = cpu_line_ao(&frame.nd, &frame.zoom, &s, g as u32);
+        let cpu = cpu_line_ao(&frame.nd, &frame.zoom, &s, &frame.view);
         check_policy(&frame.ao, &cpu, &frame.nd[0], line_ao_flip_bound(1, 32)).unwrap();
     }
 }
@@ -223,13 +240,7 @@ fn parallel_lines_occlude_within_r0_only() {
 fn gpu_matches_cpu_reference_on_rendered_lines() {
     let gpu = gpu();
     let (positions, offsets) = polylines(120, 0.3);
-    let perspective = Camera {
-        eye: Vec3::new(20.0, 30.0, 140.0),
-        target: Vec3::ZERO,
-        up: Vec3::Y,
-        projection: Projection::Perspective { fov_y_deg: 40.0 },
-    };
-    let ortho = Camera { projection: Projection::Orthographic { height: 110.0 }, ..perspective };
+    let (perspective, ortho) = cameras_for_polylines();
     let cases = [
         ("perspective, light", perspective, ChainSettings::default()),
         (
@@ -259,7 +270,7 @@ fn gpu_matches_cpu_reference_on_rendered_lines() {
             }
         }
         // LineAO on exactly the GPU's pyramid and zoom.
-        let cpu = cpu_line_ao(&frame.nd, &frame.zoom, &s, frame.guard as u32);
+        let cpu = cpu_line_ao(&frame.nd, &frame.zoom, &s, &frame.view);
         let stats = check_policy(&frame.ao, &cpu, &frame.nd[0], line_ao_flip_bound(3, 32))
             .unwrap_or_else(|e| panic!("{name}: {e}"));
         println!("{name}: {stats}");
@@ -273,5 +284,96 @@ fn gpu_matches_cpu_reference_on_rendered_lines() {
             }
         }
         assert!(frame.nd[0].data.iter().filter(|t| is_geometry(**t)).count() > 2000);
+    }
+}
+
+/// Variant `reference` on a step edge, counted from the noise tables alone: the authors'
+/// ω = ±reflect(R2, R1), the first radius 1.5 · base, every hit weighing
+/// 1.5 · (1 − smoothstep(1e−5, 1, Δ)), normalized by the samples that stay on the texture.
+#[test]
+fn reference_variant_on_a_step_edge() {
+    let gpu = gpu();
+    let (w, h, edge) = (64usize, 16usize, 32usize);
+    let step = 0.2f32;
+    let s = ChainSettings {
+        line_ao: LineAoSettings {
+            variant: LineAoVariant::Reference,
+            s_r: 1,
+            light_attenuation: false,
+            // flat_view(64, 16): z_fit = 8 px per unit, so base = 4 · z / 8 / (1 − d) = 4 px along x
+            // at z = 4, d = 0.5; along y a quarter of that (the authors' UV radius is anisotropic).
+            reference_radius_px: 4.0,
+            ..LineAoSettings::default()
+        },
+        ..ChainSettings::default()
+    };
+    let nd0 = nd_map(w, h, |x, _| if x >= edge { 0.5 - step } else { 0.5 });
+    let zoom = Image::filled(w, h, 4.0f32);
+    let (levels, gpu_ao) = line_ao_on(&gpu, &nd0, &zoom, &s, 0);
+    assert_eq!(levels.len(), 1, "the reference variant needs no pyramid");
+    let cpu_ao = cpu_line_ao(&levels, &zoom, &s, &view_of(&levels[0], 0));
+    let (noise, samples) = (noise_tile(1), lineao::noise::sample_table(1, 1, 32, |_| 32));
+    let weight = 1.5 * (1.0 - reference::hermite((step - 1e-5) / (1.0 - 1e-5)));
+    let (base_x, base_y) = (1.5 * 4.0, 1.5 * 1.0);
+    for y in 0..h {
+        for x in 0..w {
+            let r1 = Vec3::from_array(noise[(y % 64) * 64 + x % 64]);
+            let (mut used, mut hits) = (0, 0);
+            for r2 in &samples {
+                let r2 = Vec3::from_array(*r2);
+                let omega = r2 - 2.0 * r1.dot(r2) * r1;
+                let ray = if omega.z > 0.0 { omega } else { -omega };
+                let (at_x, at_y) = (x as f32 + 0.5 + ray.x * base_x, y as f32 + 0.5 - ray.y * base_y);
+                if (0.0..=w as f32).contains(&at_x) && (0.0..=h as f32).contains(&at_y) {
+                    used += 1;
+                    hits += (x < edge && at_x.floor() >= edge as f32) as u32;
+                }
+            }
+            let expected = weight * hits as f32 / used as f32;
+            assert!(
+                (cpu_ao.get(x, y) - expected).abs() < 1e-5,
+                "CPU at ({x}, {y}): {} vs {expected}",
+                cpu_ao.get(x, y)
+            );
+            let bound = weight / used as f32 + 1e-5;
+            assert!((gpu_ao.get(x, y) - expected).abs() <= bound, "GPU at ({x}, {y}): {}", gpu_ao.get(x, y));
+        }
+    }
+    assert!(cpu_ao.data.iter().any(|&a| a > 0.1), "the step must occlude");
+}
+
+#[test]
+fn reference_variant_matches_its_cpu_reference_on_rendered_lines() {
+    let gpu = gpu();
+    let (positions, offsets) = polylines(120, 0.3);
+    let (perspective, ortho) = cameras_for_polylines();
+    let reference = |light_attenuation| LineAoSettings {
+        variant: LineAoVariant::Reference,
+        light_attenuation,
+        guard_max_px: 32,
+        ..LineAoSettings::default()
+    };
+    let cases = [
+        // The authors' brain-lines strength: the composite's clamp(2.5 · ao) is their
+        // clamp(1 − 2.5/s_r · Σ occ_l).
+        (
+            "perspective, light",
+            perspective,
+            ChainSettings { line_ao: reference(true), strength: 2.5, ..Default::default() },
+        ),
+        ("orthographic, no light", ortho, ChainSettings { line_ao: reference(false), ..Default::default() }),
+    ];
+    for (name, cam, s) in cases {
+        let frame = render(&gpu, &positions, &offsets, &cam, None, s.clone(), (240, 180));
+        assert_eq!((frame.nd.len(), frame.guard), (1, 32), "{name}: no pyramid, the guard band is the cap");
+        let cpu = cpu_line_ao(&frame.nd, &frame.zoom, &s, &frame.view);
+        let stats = check_policy(&frame.ao, &cpu, &frame.nd[0], line_ao_reference_flip_bound(32))
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        println!("reference variant, {name}: {stats}");
+        assert!(frame.ao.data.iter().filter(|&&a| a > 0.05).count() > 500, "{name}: too little occlusion");
+        let expected = reference::composite(&frame.color, &frame.specular, &frame.ao, frame.guard, s.strength);
+        for (out, exp) in frame.output.data.iter().zip(&expected.data) {
+            assert!((0..3).all(|c| (out[c] - exp[c]).abs() < 1e-5), "{name}: composite {out:?} vs {exp:?}");
+        }
     }
 }

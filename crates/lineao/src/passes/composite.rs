@@ -13,6 +13,7 @@
 use crate::binding::{self, Slot};
 use crate::settings::DebugView;
 use crate::targets::{FrameTargets, LevelsUniform};
+use crate::timing::{self, Span};
 
 /// Keep in sync with `CompositeUniform` in `shaders/composite.wgsl`.
 #[repr(C)]
@@ -104,7 +105,8 @@ impl Composite {
     }
 
     /// Draws the visible window into `target` (the visible size).
-    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, target: &wgpu::TextureView) {
+    /// Records the composite into `target`, timed into `span` when given.
+    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, target: &wgpu::TextureView, span: Option<Span>) {
         let Some(group) = &self.group else { return };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("lineao::Composite"),
@@ -115,7 +117,7 @@ impl Composite {
                 ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store },
             })],
             depth_stencil_attachment: None,
-            timestamp_writes: None,
+            timestamp_writes: timing::render_writes(span),
             occlusion_query_set: None,
             multiview_mask: None,
         });

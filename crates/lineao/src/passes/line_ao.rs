@@ -16,15 +16,41 @@
 //! ω_i = reflect(R1(P), R2[j][i]) flipped into the hemisphere of n_j(P) (§3.4, [`crate::noise`]).
 //! Where we depart from the paper (the ε test, the third case of Eq. 12) is in CONTRACT.md.
 //! The CPU reference is [`crate::reference::line_ao`]; `shaders/line_ao.wgsl` is the shader.
+//!
+//! # Variant `reference`: what the authors' code does
+//!
+//! The authors' OpenWalnut shader (`WGEPostprocessorLineAO`) differs from the paper in ways
+//! that change the picture; [`LineAoVariant::Reference`] reproduces it on our G-buffer so the
+//! two can be compared:
+//!
+//! ```text
+//!   base(P)  = z(P)/z_fit · radius_px · (W, H)/max(W, H) / (1 − d(P))   pixels per axis
+//!   offset   = (1.5 + 4.0 + … : Σ_{k≤l} (1.5 + k)) · base(P) ⊙ (ω.x, −ω.y),  ω = ±reflect(R2, R1)
+//!   occ_l    = 1/used Σ_i [Δd ≥ 1e−5] · (1 − smoothstep(1e−5, (1 − l/(s_r−1))², Δd))
+//!                       · (1.5 − max(ω·n, 0) · Σ_lights I (max(n_o·L, 0) + max(n_o·h, 0)^100))
+//!   ao       = max(0, Σ_l occ_l / s_r)        (not clamped above: the weights reach 1.5)
+//! ```
+//!
+//! All hemispheres read level 0 (the authors' pyramid is off by default), each takes s_h
+//! samples, samples falling outside the texture are skipped and each hemisphere is normalized
+//! by the samples it used. The last hemisphere's falloff is 0, which makes every occluder count
+//! fully there. Where our G-buffer differs: the authors' zoom factor is the camera's scale
+//! relative to the home view; ours is z(P)/z_fit with z_fit the zoom at which the scene's
+//! bounding sphere fills the view's shorter side ([`FrameView::zoom_fit`]); the occluder's
+//! normal n_o is its ND normal (their G-buffer has tangents, ours does not); the light is the
+//! scene's. 1 − d is kept above 1e−6. The radius grows without bound as d → 1, so the guard
+//! band of this variant is the cap.
 
 use wgpu::util::DeviceExt;
 
 use crate::binding::{self, Slot};
+use crate::camera::FrameView;
 use crate::lighting::{Lighting, LightingUniform};
 use crate::noise;
 use crate::passes::dispatch_size;
-use crate::settings::LineAoSettings;
+use crate::settings::{LineAoSettings, LineAoVariant};
 use crate::targets::{AO_FORMAT, FrameTargets, LevelsUniform};
+use crate::timing::{self, Span};
 
 /// Keep in sync with `LineAoUniform` in `shaders/line_ao.wgsl`.
 #[repr(C)]
@@ -34,17 +60,61 @@ pub struct LineAoUniform {
     pub noise_origin: [i32; 2],
     pub r0_px: f32,
     pub delta0: f32,
+    /// Variant `reference`: radius_px / z_fit · (W, H) / max(W, H).
+    pub reference_scale: [f32; 2],
     pub epsilon: f32,
-    pub light_attenuation: u32,
-    pub _pad: [u32; 2],
+    pub _pad: u32,
+}
+
+/// The `reference` variant's base radius per axis, in pixels per unit of zoom z(P) at d = 0.
+pub fn reference_scale(view: &FrameView, radius_px: f32) -> [f32; 2] {
+    let (w, h) = (view.width.max(1) as f32, view.height.max(1) as f32);
+    let k = radius_px / view.zoom_fit() / w.max(h);
+    [k * w, k * h]
+}
+
+/// What the shader does with the samples it fetches.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Evaluation {
+    /// LineAO.
+    #[default]
+    Occlusion,
+    /// The same sample addresses (noise, ω, levels, early exits) that only sum the fetched
+    /// depths: the cost of the memory traffic alone, which `lineao bench` reports as
+    /// `lineao-tap-floor` so that LineAO's arithmetic can be judged against it.
+    TapFloor,
 }
 
 /// The compile-time shape of the pass: sample counts and the noise they index.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct Shape {
+    variant: LineAoVariant,
     s_r: u32,
     s_h: u32,
     noise_seed: u32,
+    light_attenuation: bool,
+}
+
+impl Shape {
+    fn of(settings: &LineAoSettings) -> Shape {
+        Shape {
+            variant: settings.variant,
+            s_r: settings.s_r,
+            s_h: settings.s_h,
+            noise_seed: settings.noise_seed,
+            light_attenuation: settings.light_attenuation,
+        }
+    }
+}
+
+/// R2 as the variant uses it: ⌈s_h/(j+1)⌉ samples on hemisphere j (`paper`), or s_h on each
+/// (`reference`); zero-padded to `s_r × s_h`.
+pub fn sample_table(settings: &LineAoSettings) -> Vec<[f32; 3]> {
+    let (seed, s_r, s_h) = (settings.noise_seed, settings.s_r, settings.s_h);
+    match settings.variant {
+        LineAoVariant::Paper => noise::sample_table(seed, s_r, s_h, |j| noise::samples_on_hemisphere(s_h, j)),
+        LineAoVariant::Reference => noise::sample_table(seed, s_r, s_h, |_| s_h),
+    }
 }
 
 pub struct LineAo {
@@ -69,6 +139,10 @@ fn vec4_buffer(device: &wgpu::Device, label: &str, vectors: &[[f32; 3]]) -> wgpu
 
 impl LineAo {
     pub fn new(device: &wgpu::Device, settings: &LineAoSettings) -> LineAo {
+        Self::with_evaluation(device, settings, Evaluation::Occlusion)
+    }
+
+    pub fn with_evaluation(device: &wgpu::Device, settings: &LineAoSettings, evaluation: Evaluation) -> LineAo {
         let layout = binding::layout(device, "lineao::LineAo::layout", wgpu::ShaderStages::COMPUTE, &{
             let mut slots = vec![
                 Slot::Uniform,
@@ -81,8 +155,14 @@ impl LineAo {
             slots.extend([Slot::Texture; crate::MAX_LEVELS as usize]);
             slots
         });
-        let shape = Shape { s_r: settings.s_r, s_h: settings.s_h, noise_seed: settings.noise_seed };
-        let constants = [("S_R", shape.s_r as f64), ("S_H", shape.s_h as f64)];
+        let shape = Shape::of(settings);
+        let constants = [
+            ("S_R", shape.s_r as f64),
+            ("S_H", shape.s_h as f64),
+            ("TAP_FLOOR", (evaluation == Evaluation::TapFloor) as u32 as f64),
+            ("LIGHT_ATTENUATION", shape.light_attenuation as u32 as f64),
+            ("REFERENCE", (shape.variant == LineAoVariant::Reference) as u32 as f64),
+        ];
         let pipeline = binding::compute_pipeline(
             device,
             "lineao::LineAo::pipeline",
@@ -97,11 +177,7 @@ impl LineAo {
             uniform: binding::uniform_buffer::<LineAoUniform>(device, "lineao::LineAo::uniform"),
             lighting: binding::uniform_buffer::<LightingUniform>(device, "lineao::LineAo::lighting"),
             noise: vec4_buffer(device, "lineao::LineAo::noise", &noise::noise_tile(shape.noise_seed)),
-            samples: vec4_buffer(
-                device,
-                "lineao::LineAo::samples",
-                &noise::sample_table(shape.noise_seed, shape.s_r, shape.s_h),
-            ),
+            samples: vec4_buffer(device, "lineao::LineAo::samples", &sample_table(settings)),
             layout,
             group: None,
         }
@@ -109,7 +185,7 @@ impl LineAo {
 
     /// Whether `settings` need a new pipeline or noise (then make a new pass and `resize` it).
     pub fn matches(&self, settings: &LineAoSettings) -> bool {
-        self.shape == Shape { s_r: settings.s_r, s_h: settings.s_h, noise_seed: settings.noise_seed }
+        self.shape == Shape::of(settings)
     }
 
     pub fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets) {
@@ -129,6 +205,7 @@ impl LineAo {
         &self,
         queue: &wgpu::Queue,
         targets: &FrameTargets,
+        view: &FrameView,
         settings: &LineAoSettings,
         r0_px: f32,
         lighting: &Lighting,
@@ -139,18 +216,21 @@ impl LineAo {
             noise_origin: [guard, guard],
             r0_px,
             delta0: settings.delta0,
+            reference_scale: reference_scale(view, settings.reference_radius_px),
             epsilon: settings.epsilon,
-            light_attenuation: settings.light_attenuation as u32,
-            _pad: [0; 2],
+            _pad: 0,
         };
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
         queue.write_buffer(&self.lighting, 0, bytemuck::bytes_of(&lighting.uniform()));
     }
 
-    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, targets: &FrameTargets) {
+    /// Records the pass, timed into `span` when given.
+    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, targets: &FrameTargets, span: Option<Span>) {
         let Some(group) = &self.group else { return };
-        let mut pass = encoder
-            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("lineao::LineAo"), timestamp_writes: None });
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("lineao::LineAo"),
+            timestamp_writes: timing::compute_writes(span),
+        });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, group, &[]);
         let (x, y) = dispatch_size(targets.size);

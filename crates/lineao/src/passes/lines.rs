@@ -20,6 +20,7 @@ use crate::camera::{Bounds, FrameView};
 use crate::lighting::{Lighting, LightingUniform};
 use crate::settings::LineColor;
 use crate::targets::{self, FrameTargets};
+use crate::timing::{self, Span};
 
 /// One vertex of the point buffer. Keep in sync with `SegmentIn` in `shaders/lines.wgsl`.
 #[repr(C)]
@@ -156,8 +157,20 @@ pub struct LineUniform {
     pub _pad: [u32; 3],
 }
 
+/// How segments are rasterized.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum LineStyle {
+    /// Screen-aligned quads of the chain's line width (the paper's fixed-width lines).
+    #[default]
+    Quads,
+    /// The rasterizer's native 1-pixel lines (`LineList`), ignoring the line width: the cheapest
+    /// way to put segments on screen, and the baseline `lineao bench` measures quads against.
+    Native1px,
+}
+
 /// Renders [`LineGeometry`] into the G-buffer of [`FrameTargets`].
 pub struct LineRenderer {
+    style: LineStyle,
     pipeline: wgpu::RenderPipeline,
     uniform: wgpu::Buffer,
     lighting: wgpu::Buffer,
@@ -165,7 +178,12 @@ pub struct LineRenderer {
 }
 
 impl LineRenderer {
+    /// The renderer of fixed-width lines.
     pub fn new(device: &wgpu::Device) -> LineRenderer {
+        Self::with_style(device, LineStyle::Quads)
+    }
+
+    pub fn with_style(device: &wgpu::Device, style: LineStyle) -> LineRenderer {
         let layout = binding::layout(
             device,
             "lineao::LineRenderer::layout",
@@ -198,11 +216,20 @@ impl LineRenderer {
             layout: Some(&binding::pipeline_layout(device, "lineao::LineRenderer::pipeline_layout", &layout)),
             vertex: wgpu::VertexState {
                 module: &module,
-                entry_point: Some("vs_main"),
+                entry_point: Some(match style {
+                    LineStyle::Quads => "vs_main",
+                    LineStyle::Native1px => "vs_native",
+                }),
                 compilation_options: Default::default(),
                 buffers: &buffers,
             },
-            primitive: wgpu::PrimitiveState { topology: wgpu::PrimitiveTopology::TriangleStrip, ..Default::default() },
+            primitive: wgpu::PrimitiveState {
+                topology: match style {
+                    LineStyle::Quads => wgpu::PrimitiveTopology::TriangleStrip,
+                    LineStyle::Native1px => wgpu::PrimitiveTopology::LineList,
+                },
+                ..Default::default()
+            },
             depth_stencil: Some(wgpu::DepthStencilState {
                 format: targets::DEPTH_FORMAT,
                 depth_write_enabled: Some(true),
@@ -225,7 +252,7 @@ impl LineRenderer {
             multiview_mask: None,
             cache: None,
         });
-        LineRenderer { pipeline, uniform, lighting, group }
+        LineRenderer { style, pipeline, uniform, lighting, group }
     }
 
     pub fn prepare(
@@ -260,13 +287,14 @@ impl LineRenderer {
     }
 
     /// Clears the G-buffer (color to `background`, ND to background, zoom and specular to 0,
-    /// depth to 1) and draws `geometry`.
+    /// depth to 1) and draws `geometry`, timed into `span` when given.
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         targets: &FrameTargets,
         geometry: &LineGeometry,
         background: [f32; 3],
+        span: Option<Span>,
     ) {
         let clear = |r: f64, g: f64, b: f64, a: f64| wgpu::Operations {
             load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a }),
@@ -288,16 +316,20 @@ impl LineRenderer {
                 depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
                 stencil_ops: None,
             }),
-            timestamp_writes: None,
+            timestamp_writes: timing::render_writes(span),
             occlusion_query_set: None,
             multiview_mask: None,
         });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &self.group, &[]);
+        let corners = match self.style {
+            LineStyle::Quads => 4,
+            LineStyle::Native1px => 2,
+        };
         for (buffer, points) in &geometry.chunks {
             pass.set_vertex_buffer(0, buffer.slice(..));
             pass.set_vertex_buffer(1, buffer.slice(POINT_SIZE..));
-            pass.draw(0..4, 0..points - 1);
+            pass.draw(0..corners, 0..points - 1);
         }
     }
 }

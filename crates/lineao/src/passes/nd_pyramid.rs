@@ -10,6 +10,7 @@
 use crate::binding::{self, Slot};
 use crate::passes::dispatch_size;
 use crate::targets::{FrameTargets, ND_FORMAT};
+use crate::timing::{self, Span};
 
 pub struct NdPyramid {
     pipeline: wgpu::ComputePipeline,
@@ -56,10 +57,11 @@ impl NdPyramid {
             .collect();
     }
 
-    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, targets: &FrameTargets) {
+    /// Records levels 1.. from level 0, timed into `span` when given.
+    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, targets: &FrameTargets, span: Option<Span>) {
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("lineao::NdPyramid"),
-            timestamp_writes: None,
+            timestamp_writes: timing::compute_writes(span),
         });
         pass.set_pipeline(&self.pipeline);
         for (group, level) in self.groups.iter().zip(&targets.nd[1..]) {

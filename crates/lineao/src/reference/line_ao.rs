@@ -1,14 +1,18 @@
-//! CPU reference of LineAO, variant `paper` (`shaders/line_ao.wgsl`, CONTRACT.md "LineAO").
+//! CPU reference of LineAO, variants `paper` (CONTRACT.md "LineAO") and `reference` (the
+//! authors' shader, [`crate::passes::line_ao`]), written plainly from the equations: the shader
+//! `shaders/line_ao.wgsl` is optimized differently and the tests compare the two.
 
 use glam::Vec3;
 
 use super::{Image, NdImage, level_texel};
+use crate::camera::FrameView;
 use crate::lighting::Light;
-use crate::settings::ChainSettings;
+use crate::settings::{ChainSettings, LineAoVariant};
 
 /// Every number LineAO reads besides the images and the noise.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LineAoParams {
+    pub variant: LineAoVariant,
     pub s_r: u32,
     pub s_h: u32,
     pub r0_px: f32,
@@ -22,13 +26,18 @@ pub struct LineAoParams {
     pub shininess: f32,
     /// Pixel coordinate of the visible viewport's top-left corner (the guard band).
     pub noise_origin: [i32; 2],
+    /// Variant `reference`: base radius per axis in pixels per unit of zoom at d = 0
+    /// ([`crate::passes::line_ao::reference_scale`]).
+    pub reference_scale: [f32; 2],
 }
 
 impl LineAoParams {
-    /// The parameters a chain with `settings` uses at guard band `guard`.
-    pub fn from_settings(settings: &ChainSettings, guard: u32) -> LineAoParams {
+    /// The parameters a chain with `settings` uses for `view`.
+    pub fn new(settings: &ChainSettings, view: &FrameView) -> LineAoParams {
         let ao = &settings.line_ao;
         LineAoParams {
+            variant: ao.variant,
+            reference_scale: crate::passes::line_ao::reference_scale(view, ao.reference_radius_px),
             s_r: ao.s_r,
             s_h: ao.s_h,
             r0_px: settings.r0_px(),
@@ -39,7 +48,7 @@ impl LineAoParams {
             kd: settings.lighting.kd,
             ks: settings.lighting.ks,
             shininess: settings.lighting.shininess,
-            noise_origin: [guard as i32; 2],
+            noise_origin: [view.guard as i32; 2],
         }
     }
 }
@@ -94,9 +103,9 @@ fn vec3(v: [f32; 3]) -> Vec3 {
     Vec3::from_array(v)
 }
 
-/// LineAO at full-resolution pixel (x, y): the sum over hemispheres, clamped to [0, 1].
-/// `levels` is the ND pyramid, `zoom` the zoom map (level-0 size), `noise` R1 (64 × 64) and
-/// `samples` R2 (`s_r × s_h`).
+/// LineAO at full-resolution pixel (x, y) in the variant `p.variant`. `levels` is the ND pyramid
+/// (only level 0 is read by `reference`), `zoom` the zoom map (level-0 size), `noise` R1
+/// (64 × 64) and `samples` R2 (`s_r × s_h`, zero-padded).
 pub fn line_ao_pixel(
     levels: &[NdImage],
     zoom: &Image<f32>,
@@ -106,14 +115,36 @@ pub fn line_ao_pixel(
     x: usize,
     y: usize,
 ) -> f32 {
+    let inputs = Inputs { levels, zoom, noise, samples };
+    match p.variant {
+        LineAoVariant::Paper => paper_pixel(&inputs, p, x, y),
+        LineAoVariant::Reference => reference_pixel(&inputs, p, x, y),
+    }
+}
+
+/// What both variants read besides their parameters.
+struct Inputs<'a> {
+    levels: &'a [NdImage],
+    zoom: &'a Image<f32>,
+    noise: &'a [[f32; 3]],
+    samples: &'a [[f32; 3]],
+}
+
+/// R1 at pixel (x, y): the tile indexed relative to the visible viewport's corner.
+fn r1_at(noise: &[[f32; 3]], p: &LineAoParams, x: usize, y: usize) -> Vec3 {
+    let tile_x = (x as i32 - p.noise_origin[0]).rem_euclid(64) as usize;
+    let tile_y = (y as i32 - p.noise_origin[1]).rem_euclid(64) as usize;
+    vec3(noise[tile_y * 64 + tile_x])
+}
+
+/// Variant `paper`: the sum over hemispheres, clamped to [0, 1].
+fn paper_pixel(&Inputs { levels, zoom, noise, samples }: &Inputs, p: &LineAoParams, x: usize, y: usize) -> f32 {
     let centre0 = levels[0].get(x, y);
     if centre0[0] == 0.0 && centre0[1] == 0.0 && centre0[2] == 0.0 {
         return 0.0;
     }
     let (w0, h0) = (levels[0].width, levels[0].height);
-    let tile_x = (x as i32 - p.noise_origin[0]).rem_euclid(64) as usize;
-    let tile_y = (y as i32 - p.noise_origin[1]).rem_euclid(64) as usize;
-    let r1 = vec3(noise[tile_y * 64 + tile_x]);
+    let r1 = r1_at(noise, p, x, y);
     let z = zoom.get(x, y);
     let pixel = [x as u32, y as u32];
     let mut ao = 0.0f32;
@@ -142,6 +173,77 @@ pub fn line_ao_pixel(
         ao += occlusion / count as f32;
     }
     ao.clamp(0.0, 1.0)
+}
+
+/// The authors' falloff: occluded iff Δd ≥ 1e−5, also the lower edge of their smoothstep.
+pub const REFERENCE_FALLOFF: f32 = 1e-5;
+
+/// GLSL `smoothstep(e0, e1, x)` as written in its specification, also for e0 > e1 (the
+/// authors' last hemisphere has e1 = 0 < e0).
+pub fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
+    hermite(((x - e0) / (e1 - e0)).clamp(0.0, 1.0))
+}
+
+/// Light an occluder with normal `n_o` reflects toward ω in the authors' weight: Σ over lights
+/// of I · (max(n_o·L, 0) + max(n_o·normalize(L + ω), 0)^100).
+pub fn occluder_light(p: &LineAoParams, n_o: Vec3, omega: Vec3) -> f32 {
+    p.lights
+        .iter()
+        .map(|light| {
+            let half_sum = light.dir + omega;
+            let half_len = half_sum.length();
+            let n_h = if half_len > 1e-12 { n_o.dot(half_sum) / half_len } else { 0.0 };
+            light.intensity * (n_o.dot(light.dir).max(0.0) + clamped_pow(n_h, 100.0))
+        })
+        .sum()
+}
+
+/// Variant `reference` at pixel (x, y) of level 0: the authors' shader.
+fn reference_pixel(&Inputs { levels, zoom, noise, samples }: &Inputs, p: &LineAoParams, x: usize, y: usize) -> f32 {
+    let nd = &levels[0];
+    let centre = nd.get(x, y);
+    let n = Vec3::new(centre[0], centre[1], centre[2]);
+    if n == Vec3::ZERO {
+        return 0.0;
+    }
+    let r1 = r1_at(noise, p, x, y);
+    let (w, h) = (nd.width as f32, nd.height as f32);
+    let depth_scale = zoom.get(x, y) / (1.0 - centre[3]).max(1e-6);
+    let base = [p.reference_scale[0] * depth_scale, p.reference_scale[1] * depth_scale];
+    let mut total = 0.0f32;
+    let mut scaler = 0.0f32;
+    for l in 0..p.s_r {
+        // Radii 1.5, 4.0, 7.5, …: the scaler grows by 1.5 + l each hemisphere.
+        scaler += 1.5 + l as f32;
+        let falloff = if p.s_r > 1 { 1.0 - l as f32 / (p.s_r - 1) as f32 } else { 1.0 };
+        let density = falloff * falloff;
+        let (mut occlusion, mut used) = (0.0f32, 0u32);
+        for i in 0..p.s_h {
+            let omega = reflect(vec3(samples[(l * p.s_h + i) as usize]), r1);
+            let n_omega = omega.dot(n);
+            let ray = n_omega.signum() * omega * (n_omega != 0.0) as u32 as f32;
+            let at_x = x as f32 + 0.5 + ray.x * (scaler * base[0]);
+            let at_y = y as f32 + 0.5 - ray.y * (scaler * base[1]);
+            if at_x < 0.0 || at_y < 0.0 || at_x > w || at_y > h {
+                continue;
+            }
+            used += 1;
+            let sample = nd.get((at_x.floor() as usize).min(nd.width - 1), (at_y.floor() as usize).min(nd.height - 1));
+            let dd = centre[3] - sample[3];
+            if dd >= REFERENCE_FALLOFF {
+                let light = if p.light_attenuation {
+                    n_omega.max(0.0) * occluder_light(p, Vec3::new(sample[0], sample[1], sample[2]), omega)
+                } else {
+                    0.0
+                };
+                occlusion += (1.0 - smoothstep(REFERENCE_FALLOFF, density, dd)) * (1.5 - light);
+            }
+        }
+        if used > 0 {
+            total += occlusion / used as f32;
+        }
+    }
+    (total / p.s_r as f32).max(0.0)
 }
 
 /// LineAO over the whole (guard-banded) image.

@@ -79,6 +79,18 @@ pub fn render_geometry(
     }
 }
 
+/// A view for G-buffers written from the CPU: `width` × `height` visible, `guard` around, the
+/// scene a unit sphere 10 units in front of the camera (only the reference variant reads it).
+pub fn flat_view(width: u32, height: u32, guard: u32) -> FrameView {
+    let camera = Camera {
+        eye: glam::Vec3::new(0.0, 0.0, 10.0),
+        target: glam::Vec3::ZERO,
+        up: glam::Vec3::Y,
+        projection: lineao::camera::Projection::Perspective { fov_y_deg: 45.0 },
+    };
+    FrameView::new(&camera, &Bounds { center: glam::Vec3::ZERO, radius: 1.0 }, width, height, guard, 1.0)
+}
+
 /// Runs the ND pyramid and LineAO passes alone on a G-buffer written from the CPU (as a host
 /// with its own geometry would), returning the GPU's pyramid and AO.
 pub fn line_ao_on(
@@ -90,17 +102,17 @@ pub fn line_ao_on(
 ) -> (Vec<NdImage>, Image<f32>) {
     let (d, q) = (&gpu.device, &gpu.queue);
     let (w, h) = (nd0.width as u32 - 2 * guard, nd0.height as u32 - 2 * guard);
-    let targets = FrameTargets::new(d, w, h, guard, settings.line_ao.s_r);
+    let targets = FrameTargets::new(d, w, h, guard, settings.levels());
     write_target(q, &targets.nd[0], nd0);
     write_target(q, &targets.zoom, zoom);
     let mut pyramid = NdPyramid::new(d);
     pyramid.resize(d, &targets);
     let mut line_ao = LineAo::new(d, &settings.line_ao);
     line_ao.resize(d, &targets);
-    line_ao.prepare(q, &targets, &settings.line_ao, settings.r0_px(), &settings.lighting);
+    line_ao.prepare(q, &targets, &flat_view(w, h, guard), &settings.line_ao, settings.r0_px(), &settings.lighting);
     let mut encoder = d.create_command_encoder(&Default::default());
-    pyramid.encode(&mut encoder, &targets);
-    line_ao.encode(&mut encoder, &targets);
+    pyramid.encode(&mut encoder, &targets, None);
+    line_ao.encode(&mut encoder, &targets, None);
     q.submit([encoder.finish()]);
     let levels = targets.nd.iter().map(|level| read_rgba(d, q, level).unwrap()).collect();
     (levels, read_f32(d, q, &targets.ao).unwrap())

@@ -1,0 +1,207 @@
+//! `lineao bench`: GPU time per pass on a built-in scene, as CONTRACT.md's `lineao bench --json`.
+//!
+//! Every pass runs in its own submission, `--frames` times after `--warmup` frames, on the same
+//! G-buffer. With timestamp queries the time is the GPU's (`"on": "gpu"`); without, CPU wall time
+//! around submit + wait (`"on": "cpu"`, `"timestamps": false`). Baselines measured in the same
+//! run give the ratios the numbers are judged by:
+//!
+//! - `lines-native-1px`: the same segments as the rasterizer's native 1-px `LineList`;
+//! - `lineao-tap-floor`: the LineAO shader with the same sample addresses that only sums the
+//!   fetched depths ([`Evaluation::TapFloor`]);
+//! - `lineao-chain`: pyramid + LineAO in one span (what a frame pays for the occlusion).
+
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use lineao::camera::FrameView;
+use lineao::passes::composite::Composite;
+use lineao::passes::line_ao::{Evaluation, LineAo};
+use lineao::passes::lines::{LineGeometry, LineRenderer, LineStyle};
+use lineao::passes::nd_pyramid::NdPyramid;
+use lineao::targets::{FrameTargets, Target};
+use lineao::timing::{PassTimer, Span};
+use lineao::{AoChain, ChainSettings, Gpu, LineAoSettings};
+use serde_json::json;
+
+use crate::cli::BenchArgs;
+
+/// The passes of one run, in CONTRACT.md's order.
+const PASSES: [&str; 7] =
+    ["lines", "lines-native-1px", "nd-pyramid", "lineao", "lineao-tap-floor", "composite", "lineao-chain"];
+
+/// Every pass of the benchmark, prepared for one view over one G-buffer.
+struct Passes {
+    lines: LineRenderer,
+    lines_native: LineRenderer,
+    pyramid: NdPyramid,
+    line_ao: LineAo,
+    tap_floor: LineAo,
+    composite: Composite,
+    output: Target,
+}
+
+impl Passes {
+    fn new(gpu: &Gpu, settings: &ChainSettings, targets: &FrameTargets, view: &FrameView) -> Passes {
+        let (device, queue) = (&gpu.device, &gpu.queue);
+        let format = wgpu::TextureFormat::Rgba8UnormSrgb;
+        let mut passes = Passes {
+            lines: LineRenderer::new(device),
+            lines_native: LineRenderer::with_style(device, LineStyle::Native1px),
+            pyramid: NdPyramid::new(device),
+            line_ao: LineAo::new(device, &settings.line_ao),
+            tap_floor: LineAo::with_evaluation(device, &settings.line_ao, Evaluation::TapFloor),
+            composite: Composite::new(device, format),
+            output: Target::output(device, "lineao::bench::output", (view.width, view.height), format),
+        };
+        for renderer in [&passes.lines, &passes.lines_native] {
+            renderer.prepare(queue, view, settings.line_width_px, settings.line_color, &settings.lighting);
+        }
+        passes.pyramid.resize(device, targets);
+        for pass in [&mut passes.line_ao, &mut passes.tap_floor] {
+            pass.resize(device, targets);
+            pass.prepare(queue, targets, view, &settings.line_ao, settings.r0_px(), &settings.lighting);
+        }
+        passes.composite.resize(device, targets);
+        passes.composite.prepare(queue, targets, settings.strength, settings.debug_view, view.zoom_max());
+        passes
+    }
+
+    /// Records pass `name` timed into `span`.
+    fn encode(
+        &self,
+        name: &str,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &FrameTargets,
+        geometry: &LineGeometry,
+        background: [f32; 3],
+        span: Option<Span>,
+    ) {
+        match name {
+            "lines" => self.lines.encode(encoder, targets, geometry, background, span),
+            "lines-native-1px" => self.lines_native.encode(encoder, targets, geometry, background, span),
+            "nd-pyramid" => self.pyramid.encode(encoder, targets, span),
+            "lineao" => self.line_ao.encode(encoder, targets, span),
+            "lineao-tap-floor" => self.tap_floor.encode(encoder, targets, span),
+            "composite" => self.composite.encode(encoder, &self.output.view, span),
+            "lineao-chain" => {
+                self.pyramid.encode(encoder, targets, span.map(Span::begin_only));
+                self.line_ao.encode(encoder, targets, span.map(Span::end_only));
+            }
+            _ => unreachable!("unknown bench pass {name}"),
+        }
+    }
+}
+
+fn summary(name: &str, on: &str, mut ms: Vec<f64>) -> serde_json::Value {
+    ms.sort_by(f64::total_cmp);
+    let median = if ms.len() % 2 == 1 { ms[ms.len() / 2] } else { (ms[ms.len() / 2 - 1] + ms[ms.len() / 2]) / 2.0 };
+    json!({"name": name, "on": on, "ms_median": median, "ms_min": ms[0], "ms_max": ms[ms.len() - 1]})
+}
+
+pub fn run(args: &BenchArgs) -> Result<()> {
+    let scene = args.scene.build(args.seed, args.vertices);
+    let settings = ChainSettings {
+        line_ao: LineAoSettings { light_attenuation: !args.no_light_attenuation, ..LineAoSettings::default() },
+        zoom_unit: scene.view.zoom_unit,
+        ..ChainSettings::default()
+    };
+    let camera = crate::render::camera_from_hint(&scene.view);
+    let gpu = Gpu::headless()?;
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let geometry = LineGeometry::new(device, &scene.tractogram.positions, &scene.tractogram.offsets)?;
+    let bounds = geometry.bounds.context("the scene has no finite points")?;
+
+    // The chain decides the guard band and allocates the G-buffer; the passes below share it.
+    let mut chain = AoChain::new(device, wgpu::TextureFormat::Rgba8UnormSrgb, settings.clone())?;
+    chain.resize(args.width, args.height)?;
+    let view = chain.prepare(device, queue, &camera, &bounds).context("nothing to render at this size")?;
+    let targets = chain.targets().context("the chain allocated no targets")?;
+    let passes = Passes::new(&gpu, &settings, targets, &view);
+    let timer = PassTimer::new(device, queue, &PASSES);
+
+    let mut times: Vec<Vec<f64>> = vec![Vec::new(); PASSES.len()];
+    // Quads last among the line passes, so the G-buffer the later passes read is the chain's.
+    let order = ["lines-native-1px", "lines", "nd-pyramid", "lineao", "lineao-tap-floor", "composite", "lineao-chain"];
+    for frame in 0..args.warmup + args.frames {
+        for name in order {
+            let mut encoder =
+                device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::bench") });
+            encoder.push_debug_group(name);
+            passes.encode(
+                name,
+                &mut encoder,
+                targets,
+                &geometry,
+                settings.background,
+                timer.as_ref().and_then(|t| t.span(name)),
+            );
+            encoder.pop_debug_group();
+            if let Some(timer) = &timer {
+                timer.resolve(&mut encoder);
+            }
+            let start = Instant::now();
+            queue.submit([encoder.finish()]);
+            gpu.wait()?;
+            let wall_ms = start.elapsed().as_secs_f64() * 1e3;
+            let ms = match &timer {
+                Some(timer) => timer.read(device, &[name])?[0].ms,
+                None => wall_ms,
+            };
+            if frame >= args.warmup {
+                times[PASSES.iter().position(|p| *p == name).expect("every pass is listed")].push(ms);
+            }
+        }
+    }
+
+    let on = if timer.is_some() { "gpu" } else { "cpu" };
+    let passes: Vec<_> = PASSES.iter().zip(times).map(|(name, ms)| summary(name, on, ms)).collect();
+    let info = gpu.adapter.get_info();
+    let report = json!({
+        "adapter": info.name,
+        "backend": info.backend.to_str(),
+        "width": args.width,
+        "height": args.height,
+        "scene": scene.kind.name(),
+        "vertices": geometry.vertices,
+        "frames": args.frames,
+        "timestamps": timer.is_some(),
+        "passes": passes,
+    });
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        print_table(&report, &passes);
+    }
+    Ok(())
+}
+
+fn print_table(report: &serde_json::Value, passes: &[serde_json::Value]) {
+    println!(
+        "{} ({}), {}x{}, {} with {} vertices, {} frames, {} time",
+        report["adapter"].as_str().unwrap_or_default(),
+        report["backend"].as_str().unwrap_or_default(),
+        report["width"],
+        report["height"],
+        report["scene"].as_str().unwrap_or_default(),
+        report["vertices"],
+        report["frames"],
+        if report["timestamps"] == true { "GPU timestamp" } else { "CPU wall" },
+    );
+    println!("{:<20} {:>10} {:>10} {:>10}", "pass", "median ms", "min ms", "max ms");
+    let median = |name: &str| passes.iter().find(|p| p["name"] == name).and_then(|p| p["ms_median"].as_f64());
+    for p in passes {
+        let f = |k: &str| p[k].as_f64().unwrap_or(f64::NAN);
+        println!(
+            "{:<20} {:>10.2} {:>10.2} {:>10.2}",
+            p["name"].as_str().unwrap_or_default(),
+            f("ms_median"),
+            f("ms_min"),
+            f("ms_max")
+        );
+    }
+    for (a, b) in [("lineao", "lineao-tap-floor"), ("lines", "lines-native-1px")] {
+        if let (Some(x), Some(y)) = (median(a), median(b)) {
+            println!("{a} / {b}: {:.2}x", x / y);
+        }
+    }
+}
