@@ -145,6 +145,13 @@ impl FrameView {
     }
 }
 
+/// How far, in full-resolution pixels, a nearest-texel read of pyramid level `level` reaches
+/// beyond the sample point: the texel spans 2^j − 1 more pixels, and the binomial [1 4 6 4 1]
+/// of each level reaches two texels further, 2 (2^j − 1) pixels over j levels.
+pub fn pyramid_reach(level: u32) -> f32 {
+    3.0 * ((1u32 << level.min(16)) - 1) as f32
+}
+
 /// The guard band of CONTRACT.md: `radius_px` rounded up to a multiple of 2^(s_r−1), capped.
 pub fn guard_band(radius_px: f32, s_r: u32, cap: u32) -> u32 {
     let step = 1u32 << s_r.saturating_sub(1).min(16);

@@ -124,7 +124,10 @@ impl AoChain {
             (AoMethod::LineAo, LineAoVariant::Reference) => s.line_ao.guard_max_px,
             (AoMethod::LineAo, LineAoVariant::Paper) => {
                 let unguarded = FrameView::new(camera, bounds, self.size.0, self.size.1, 0, s.zoom_unit);
-                let radius = s.r0_px() + (s.line_ao.s_r - 1) as f32 * unguarded.zoom_max();
+                // The widest hemisphere reads the deepest level, whose texels near the band's
+                // edge are filtered with clamp-to-edge: the band covers that reach too.
+                let deepest = s.line_ao.s_r - 1;
+                let radius = s.r0_px() + deepest as f32 * unguarded.zoom_max() + camera::pyramid_reach(deepest);
                 camera::guard_band(radius, s.line_ao.s_r, s.line_ao.guard_max_px)
             }
         }
