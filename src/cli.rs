@@ -150,6 +150,9 @@ pub struct RenderArgs {
     /// Write the method's inputs and output as .npy files and params.json into this folder.
     #[arg(long)]
     pub dump: Option<PathBuf>,
+    /// Print the time of each pass (GPU timestamps, or the frame's CPU wall time without them).
+    #[arg(long)]
+    pub timings: bool,
 }
 
 #[derive(Clone, Copy, Debug)]

@@ -67,6 +67,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let bounds = geometry.bounds.context("the scene has no finite points")?;
     let format = wgpu::TextureFormat::Rgba8UnormSrgb;
     let mut chain = AoChain::new(&gpu.device, format, settings)?;
+    let timed = args.timings && chain.set_timing(&gpu.device, &gpu.queue, true);
     chain.resize(args.width, args.height)?;
     chain.prepare(&gpu.device, &gpu.queue, &camera, &bounds);
     let target =
@@ -74,7 +75,21 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut encoder =
         gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::render") });
     chain.encode(&mut encoder, &geometry, &target.view);
+    let start = std::time::Instant::now();
     gpu.queue.submit([encoder.finish()]);
+    if args.timings {
+        gpu.wait()?;
+        let wall_ms = start.elapsed().as_secs_f64() * 1e3;
+        match chain.pass_times(&gpu.device)?.filter(|_| timed) {
+            Some(times) => {
+                for t in &times {
+                    eprintln!("lineao: {:<12} {:9.2} ms (GPU)", t.name, t.ms);
+                }
+                eprintln!("lineao: {:<12} {:9.2} ms (GPU, sum)", "frame", times.iter().map(|t| t.ms).sum::<f64>());
+            }
+            None => eprintln!("lineao: frame {wall_ms:.2} ms (CPU wall time: the adapter has no timestamp queries)"),
+        }
+    }
     let image = lineao::readback::read_texture(&gpu.device, &gpu.queue, &target.texture)?;
     crate::output::write_png(&args.output, args.width, args.height, &image.bytes)?;
     if let Some(dir) = &args.dump {

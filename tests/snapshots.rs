@@ -9,7 +9,7 @@ use lineao::camera::{Camera, Projection};
 use lineao::passes::lines::LineGeometry;
 use lineao::readback::read_texture;
 use lineao::targets::Target;
-use lineao::{AoChain, ChainSettings, DebugView, Gpu};
+use lineao::{AoChain, ChainSettings, DebugView, Gpu, LineAoSettings, LineAoVariant};
 use lineao_tracts::SceneKind;
 
 const SIZE: (u32, u32) = (160, 128);
@@ -82,14 +82,21 @@ fn every_pass_on_every_scene() {
     let target = Target::output(&gpu.device, "snapshot", SIZE, format);
     let mut chain = AoChain::new(&gpu.device, format, ChainSettings::default()).unwrap();
     chain.resize(SIZE.0, SIZE.1).unwrap();
+    let debug = |debug_view| ChainSettings { debug_view, ..ChainSettings::default() };
+    let reference = ChainSettings {
+        line_ao: LineAoSettings { variant: LineAoVariant::Reference, ..Default::default() },
+        debug_view: DebugView::Ao,
+        ..ChainSettings::default()
+    };
     let views = [
-        ("final", DebugView::Final),
-        ("ao", DebugView::Ao),
-        ("normals", DebugView::Normals),
-        ("depth", DebugView::Depth),
-        ("zoom", DebugView::Zoom),
-        ("level1", DebugView::Level(1)),
-        ("level2", DebugView::Level(2)),
+        ("final", debug(DebugView::Final)),
+        ("ao", debug(DebugView::Ao)),
+        ("normals", debug(DebugView::Normals)),
+        ("depth", debug(DebugView::Depth)),
+        ("zoom", debug(DebugView::Zoom)),
+        ("level1", debug(DebugView::Level(1))),
+        ("level2", debug(DebugView::Level(2))),
+        ("reference_ao", reference),
     ];
     let mut failures = Vec::new();
     for kind in SceneKind::ALL {
@@ -102,8 +109,7 @@ fn every_pass_on_every_scene() {
             up: Vec3::from_array(scene.view.up),
             projection: Projection::Perspective { fov_y_deg: scene.view.fov_y_deg },
         };
-        for (view_name, view) in views {
-            let settings = ChainSettings { debug_view: view, ..ChainSettings::default() };
+        for (view_name, settings) in views.clone() {
             chain.set_settings(&gpu.device, settings).unwrap();
             chain.prepare(&gpu.device, &gpu.queue, &camera, &geometry.bounds.unwrap()).unwrap();
             let mut encoder = gpu.device.create_command_encoder(&Default::default());

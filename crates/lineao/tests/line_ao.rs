@@ -377,3 +377,31 @@ fn reference_variant_matches_its_cpu_reference_on_rendered_lines() {
         }
     }
 }
+
+#[test]
+fn chain_reports_gpu_time_per_pass() {
+    let gpu = gpu();
+    let (positions, offsets) = polylines(40, 0.7);
+    let geometry = lineao::passes::lines::LineGeometry::new(&gpu.device, &positions, &offsets).unwrap();
+    let (camera, _) = cameras_for_polylines();
+    let has_timestamps = gpu.device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+    let variants = [(LineAoVariant::Paper, 4), (LineAoVariant::Reference, 3)];
+    for (variant, passes) in variants {
+        let s = ChainSettings { line_ao: LineAoSettings { variant, ..Default::default() }, ..Default::default() };
+        let mut chain = lineao::AoChain::new(&gpu.device, common::OUTPUT_FORMAT, s).unwrap();
+        assert_eq!(chain.set_timing(&gpu.device, &gpu.queue, true), has_timestamps);
+        chain.resize(64, 48).unwrap();
+        chain.prepare(&gpu.device, &gpu.queue, &camera, &geometry.bounds.unwrap()).unwrap();
+        let output = lineao::targets::Target::output(&gpu.device, "test::output", (64, 48), common::OUTPUT_FORMAT);
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        chain.encode(&mut encoder, &geometry, &output.view);
+        gpu.queue.submit([encoder.finish()]);
+        let Some(times) = chain.pass_times(&gpu.device).unwrap() else {
+            assert!(!has_timestamps);
+            continue;
+        };
+        let names: Vec<_> = times.iter().map(|t| t.name).collect();
+        assert_eq!(names.len(), passes, "{variant:?}: {names:?}");
+        assert!(times.iter().all(|t| t.ms > 0.0 && t.ms < 10_000.0), "{variant:?}: {times:?}");
+    }
+}
