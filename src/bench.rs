@@ -26,7 +26,7 @@ use serde_json::json;
 use crate::cli::BenchArgs;
 
 /// The passes of one run, in CONTRACT.md's order.
-const PASSES: [&str; 7] =
+pub const PASSES: [&str; 7] =
     ["lines", "lines-native-1px", "nd-pyramid", "lineao", "lineao-tap-floor", "composite", "lineao-chain"];
 
 /// Every pass of the benchmark, prepared for one view over one G-buffer.
@@ -122,8 +122,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let mut times: Vec<Vec<f64>> = vec![Vec::new(); PASSES.len()];
     // Quads last among the line passes, so the G-buffer the later passes read is the chain's.
     let order = ["lines-native-1px", "lines", "nd-pyramid", "lineao", "lineao-tap-floor", "composite", "lineao-chain"];
+    let selected = |name: &str| args.passes.is_empty() || args.passes.iter().any(|p| p == name);
     for frame in 0..args.warmup + args.frames {
-        for name in order {
+        for name in order.into_iter().filter(|name| selected(name)) {
             let mut encoder =
                 device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::bench") });
             encoder.push_debug_group(name);
@@ -154,7 +155,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     }
 
     let on = if timer.is_some() { "gpu" } else { "cpu" };
-    let passes: Vec<_> = PASSES.iter().zip(times).map(|(name, ms)| summary(name, on, ms)).collect();
+    let passes: Vec<_> =
+        PASSES.iter().zip(times).filter(|(name, _)| selected(name)).map(|(name, ms)| summary(name, on, ms)).collect();
     let info = gpu.adapter.get_info();
     let report = json!({
         "adapter": info.name,

@@ -47,6 +47,17 @@ pub struct BenchArgs {
     /// Print CONTRACT.md's JSON instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// Only these passes, comma-separated (default: all of them).
+    #[arg(long, value_delimiter = ',', value_parser = parse_bench_pass)]
+    pub passes: Vec<String>,
+}
+
+fn parse_bench_pass(s: &str) -> Result<String, String> {
+    if crate::bench::PASSES.contains(&s) {
+        Ok(s.to_string())
+    } else {
+        Err(format!("unknown pass '{s}' (one of {})", crate::bench::PASSES.join(", ")))
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
