@@ -1,12 +1,10 @@
-// Line renderer: polylines at a fixed pixel width, expanded to screen-aligned quads in the vertex
-// shader, writing the G-buffer of CONTRACT.md (color, ND map, zoom map, specular, hardware depth).
+// Line renderer: polylines at a fixed pixel width as triangle strips, writing the G-buffer of
+// CONTRACT.md (color, ND map, zoom map, specular, hardware depth).
 //
-// Each instance is one segment (p0, p1). The same point buffer is bound twice, the second time one
-// point further on, so instance k reads points k and k + 1 without duplicating data. A point's
-// tangent.w says whether a segment starts there (0 at a streamline's last point: the instance
-// becomes a degenerate, culled quad). Each quad corner is pushed sideways perpendicular to the
-// *vertex* tangent's screen direction, so consecutive segments share their join corners exactly:
-// joins without gaps or overlaps.
+// Every point comes twice (left, right; the sign of tangent.w); the vertex shader pushes it half
+// a line width sideways, perpendicular to the screen direction of its *vertex* tangent, so
+// consecutive segments share their join corners exactly: joins without gaps or overlaps.
+// `lineao::passes::lines` builds the strip.
 #import shared/lighting.wgsl
 
 // Keep in sync with `lineao::passes::lines::LineUniform`.
@@ -32,11 +30,10 @@ struct LineUniform {
 @group(0) @binding(0) var<uniform> frame: LineUniform;
 @group(0) @binding(1) var<uniform> lighting: Lighting;
 
-struct SegmentIn {
-    @location(0) p0: vec3<f32>,
-    @location(1) t0: vec4<f32>,
-    @location(2) p1: vec3<f32>,
-    @location(3) t1: vec4<f32>,
+struct StripVertex {
+    @location(0) p: vec3<f32>,
+    // xyz: unit world-space tangent; w: side, > 0 left, < 0 right.
+    @location(1) t: vec4<f32>,
 }
 
 struct VsOut {
@@ -52,31 +49,18 @@ fn screen_direction(clip: vec4<f32>, dclip: vec4<f32>) -> vec2<f32> {
     return (dclip.xy * clip.w - clip.xy * dclip.w) * frame.viewport;
 }
 
-// Vertex `at_end` of the segment, pushed `side` half line widths to its left (−1 right, 0 on it).
-fn segment_vertex(seg: SegmentIn, at_end: bool, side: f32) -> VsOut {
+// Point `p` with tangent `t_world`, pushed `side` half line widths to its left (−1 right, 0 on it).
+fn line_vertex(p: vec3<f32>, t_world: vec3<f32>, side: f32) -> VsOut {
     var out: VsOut;
-    if (seg.t0.w < 0.5) {
-        // No segment starts at p0: a degenerate primitive outside the clip volume.
-        out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
-        return out;
-    }
-    let p = select(seg.p0, seg.p1, at_end);
-    let t_world = select(seg.t0.xyz, seg.t1.xyz, at_end);
-
     let view_pos = frame.view * vec4<f32>(p, 1.0);
     let view_tangent = (frame.view * vec4<f32>(t_world, 0.0)).xyz;
     let clip = frame.proj * view_pos;
 
-    var dir = screen_direction(clip, frame.proj * vec4<f32>(view_tangent, 0.0));
-    if (dot(dir, dir) < 1e-12) {
-        // Tangent along the view ray: fall back to the segment's own screen direction.
-        let c0 = frame.proj * frame.view * vec4<f32>(seg.p0, 1.0);
-        let c1 = frame.proj * frame.view * vec4<f32>(seg.p1, 1.0);
-        dir = (c1.xy / c1.w - c0.xy / c0.w) * frame.viewport;
-    }
-    dir = select(vec2<f32>(1.0, 0.0), normalize(dir), dot(dir, dir) >= 1e-12);
+    let dir = screen_direction(clip, frame.proj * vec4<f32>(view_tangent, 0.0));
+    // A tangent along the view ray has no screen direction: any sideways offset will do.
+    let sideways = select(vec2<f32>(0.0, 1.0), normalize(vec2<f32>(-dir.y, dir.x)), dot(dir, dir) >= 1e-12);
     // Half the width in pixels is w/2 * 2/viewport in NDC.
-    let offset_ndc = vec2<f32>(-dir.y, dir.x) * side * frame.line_width_px / frame.viewport;
+    let offset_ndc = sideways * side * frame.line_width_px / frame.viewport;
 
     out.clip = vec4<f32>(clip.xy + offset_ndc * clip.w, clip.zw);
     out.view_pos = view_pos.xyz;
@@ -89,17 +73,17 @@ fn segment_vertex(seg: SegmentIn, at_end: bool, side: f32) -> VsOut {
     return out;
 }
 
-// Quads: vertices 0..4 of a triangle strip, (start, right), (start, left), (end, right), (end, left).
+// Fixed-width lines: the triangle strip.
 @vertex
-fn vs_main(@builtin(vertex_index) vertex_index: u32, seg: SegmentIn) -> VsOut {
-    return segment_vertex(seg, (vertex_index >> 1u) == 1u, f32(vertex_index & 1u) * 2.0 - 1.0);
+fn vs_main(v: StripVertex) -> VsOut {
+    return line_vertex(v.p, v.t.xyz, sign(v.t.w));
 }
 
-// Native 1-px lines (`LineList`, vertices 0..2): the rasterizer's own thin lines, the baseline the
-// quads are measured against (`lineao bench`, pass `lines-native-1px`).
+// Native 1-px lines (an indexed `LineList` over the same vertices): the rasterizer's own thin
+// lines, the baseline the strip is measured against (`lineao bench`, pass `lines-native-1px`).
 @vertex
-fn vs_native(@builtin(vertex_index) vertex_index: u32, seg: SegmentIn) -> VsOut {
-    return segment_vertex(seg, vertex_index == 1u, 0.0);
+fn vs_native(v: StripVertex) -> VsOut {
+    return line_vertex(v.p, v.t.xyz, 0.0);
 }
 
 struct GBuffer {

@@ -16,7 +16,7 @@ use anyhow::{Context, Result};
 use lineao::camera::FrameView;
 use lineao::passes::composite::Composite;
 use lineao::passes::line_ao::{Evaluation, LineAo};
-use lineao::passes::lines::{LineGeometry, LineRenderer, LineStyle};
+use lineao::passes::lines::{GeometryOptions, LineGeometry, LineRenderer, LineStyle};
 use lineao::passes::nd_pyramid::NdPyramid;
 use lineao::targets::{FrameTargets, Target};
 use lineao::timing::{PassTimer, Span};
@@ -108,7 +108,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let camera = crate::render::camera_from_hint(&scene.view);
     let gpu = Gpu::headless()?;
     let (device, queue) = (&gpu.device, &gpu.queue);
-    let geometry = LineGeometry::new(device, &scene.tractogram.positions, &scene.tractogram.offsets)?;
+    let options = GeometryOptions { native_lines: true, ..Default::default() };
+    let geometry = LineGeometry::with_options(device, &scene.tractogram.positions, &scene.tractogram.offsets, options)?;
     let bounds = geometry.bounds.context("the scene has no finite points")?;
 
     // The chain decides the guard band and allocates the G-buffer; the passes below share it.

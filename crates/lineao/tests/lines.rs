@@ -6,8 +6,10 @@ mod common;
 
 use common::{Frame, gpu, is_geometry, render};
 use glam::Vec3;
+use lineao::camera::FrameView;
 use lineao::camera::{Bounds, Camera, Projection};
-use lineao::passes::lines::LineGeometry;
+use lineao::passes::lines::{GeometryOptions, LineGeometry, LineRenderer, LineStyle};
+use lineao::targets::FrameTargets;
 use lineao::{AoMethod, ChainSettings, LineColor};
 
 const SIZE: (u32, u32) = (200, 100);
@@ -264,14 +266,21 @@ fn chunked_buffers_render_identically() {
         offsets.push(positions.len() as u64);
     }
     let whole = LineGeometry::new(&gpu.device, &positions, &offsets).unwrap();
-    // 97 points per buffer: chunk borders fall inside streamlines and between them.
-    let chunked = LineGeometry::with_chunk_bytes(&gpu.device, &positions, &offsets, 97 * 20).unwrap();
-    assert_eq!((whole.chunk_count(), chunked.chunk_count()), (1, 13));
+    // 97 × 20 bytes hold 96 strip vertices (chunks keep an even length): chunk borders fall
+    // inside streamlines and between them.
+    let options = GeometryOptions { chunk_bytes: 97 * 20, ..Default::default() };
+    let chunked = LineGeometry::with_options(&gpu.device, &positions, &offsets, options).unwrap();
+    // 40 × 30 points, twice each, plus two joining vertices between streamlines; each further
+    // chunk repeats the last two vertices of the one before.
+    let strip = 2 * 40 * 30 + 2 * 39;
+    assert_eq!((whole.chunk_count(), chunked.chunk_count()), (1, 1 + (strip - 96usize).div_ceil(94)));
     let cam = perspective();
     let a = common::render_geometry(&gpu, &whole, &cam, bounds().unwrap(), plain(2.0), SIZE);
     let b = common::render_geometry(&gpu, &chunked, &cam, bounds().unwrap(), plain(2.0), SIZE);
-    assert_eq!(a.nd[0], b.nd[0]);
-    assert_eq!(a.color, b.color);
+    let differ = |x: &lineao::reference::NdImage, y: &lineao::reference::NdImage| {
+        x.data.iter().zip(&y.data).filter(|(p, q)| p != q).count()
+    };
+    assert_eq!((differ(&a.nd[0], &b.nd[0]), differ(&a.color, &b.color)), (0, 0), "pixels that differ (ND, color)");
 }
 
 #[test]
@@ -284,4 +293,29 @@ fn bad_offsets_are_clear_errors() {
         let error = LineGeometry::new(&gpu.device, &p, offsets).err().expect("an error").to_string();
         assert!(error.contains(needle), "{error}");
     }
+}
+
+#[test]
+fn native_lines_are_one_pixel_and_need_their_segments() {
+    let gpu = gpu();
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let positions = [[-40.0, 0.0, 0.0], [40.0, 0.0, 0.0], [-40.0, 20.0, 0.0], [0.0, 20.0, 0.0], [40.0, 20.0, 0.0]];
+    let offsets = [0, 2, 5];
+    let view = FrameView::new(&perspective(), &bounds().unwrap(), SIZE.0, SIZE.1, 0, 1.0);
+    let targets = FrameTargets::new(d, SIZE.0, SIZE.1, 0, 1);
+    let renderer = LineRenderer::with_style(d, LineStyle::Native1px);
+    let s = plain(4.0);
+    renderer.prepare(q, &view, s.line_width_px, s.line_color, &s.lighting);
+    let covered = |native_lines| {
+        let options = GeometryOptions { native_lines, ..Default::default() };
+        let geometry = LineGeometry::with_options(d, &positions, &offsets, options).unwrap();
+        let mut encoder = d.create_command_encoder(&Default::default());
+        renderer.encode(&mut encoder, &targets, &geometry, s.background, None);
+        q.submit([encoder.finish()]);
+        let nd = lineao::verify::read_rgba(d, q, &targets.nd[0]).unwrap();
+        (60..140).map(|x| (0..SIZE.1 as usize).filter(|&y| is_geometry(nd.get(x, y))).count()).collect::<Vec<_>>()
+    };
+    // Two horizontal polylines, one pixel high each whatever the line width.
+    assert!(covered(true).iter().all(|&n| n == 2), "{:?}", covered(true));
+    assert!(covered(false).iter().all(|&n| n == 0), "without native segments nothing is drawn");
 }
