@@ -76,35 +76,29 @@ pub fn validate_offsets(offsets: &[u64], vertices: usize) -> Result<(), Error> {
     Ok(())
 }
 
-/// Every point with its tangent, w = 32767 where a segment to the next point starts (both
-/// finite, same polyline), for polylines `positions[offsets[i]..offsets[i + 1]]`.
-pub fn line_points(positions: &[[f32; 3]], offsets: &[u64]) -> Result<Vec<LinePoint>, Error> {
-    validate_offsets(offsets, positions.len())?;
-    let mut points = Vec::with_capacity(positions.len());
-    for range in offsets.windows(2) {
-        let line = &positions[range[0] as usize..range[1] as usize];
-        let at = |k: usize| Vec3::from_array(line[k]);
-        for k in 0..line.len() {
-            let prev = at(k.saturating_sub(1));
-            let next = at((k + 1).min(line.len() - 1));
-            let tangent = [next - prev, next - at(k), at(k) - prev]
-                .into_iter()
-                .map(|t| t.normalize_or_zero())
-                .find(|t| t != &Vec3::ZERO && t.is_finite())
-                .unwrap_or(Vec3::X);
-            let starts_segment = k + 1 < line.len() && at(k).is_finite() && at(k + 1).is_finite();
-            points.push(LinePoint {
-                position: line[k],
-                tangent: [
-                    snorm16(tangent.x),
-                    snorm16(tangent.y),
-                    snorm16(tangent.z),
-                    if starts_segment { 32767 } else { 0 },
-                ],
-            });
-        }
+/// The points of one polyline with their tangents (central differences), w = 32767 where a
+/// segment to the next point starts (both finite), appended to `out`.
+fn polyline_points(line: &[[f32; 3]], out: &mut Vec<LinePoint>) {
+    let at = |k: usize| Vec3::from_array(line[k]);
+    for k in 0..line.len() {
+        let prev = at(k.saturating_sub(1));
+        let next = at((k + 1).min(line.len() - 1));
+        let tangent = [next - prev, next - at(k), at(k) - prev]
+            .into_iter()
+            .map(|t| t.normalize_or_zero())
+            .find(|t| t != &Vec3::ZERO && t.is_finite())
+            .unwrap_or(Vec3::X);
+        let starts_segment = k + 1 < line.len() && at(k).is_finite() && at(k + 1).is_finite();
+        out.push(LinePoint {
+            position: line[k],
+            tangent: [
+                snorm16(tangent.x),
+                snorm16(tangent.y),
+                snorm16(tangent.z),
+                if starts_segment { SEGMENT_STARTS } else { 0 },
+            ],
+        });
     }
-    Ok(points)
 }
 
 /// How [`LineGeometry`] is uploaded.
@@ -138,30 +132,29 @@ pub struct LineGeometry {
     pub streamlines: usize,
 }
 
-/// The strip vertices of `points` (see the module documentation), streamed to `emit`.
-fn strip_vertices(points: &[LinePoint], mut emit: impl FnMut(LinePoint)) {
+/// The strip vertices of polylines `positions[offsets[i]..offsets[i + 1]]` (see the module
+/// documentation), streamed to `emit`; memory beyond the longest polyline is never held.
+fn strip_vertices(positions: &[[f32; 3]], offsets: &[u64], mut emit: impl FnMut(LinePoint)) {
+    let mut points = Vec::new();
     let mut previous: Option<LinePoint> = None;
-    let mut start = 0;
-    while start < points.len() {
-        // A run: points joined by segments (w = 32767 on all but its last point).
-        let end = start
-            + points[start..].iter().position(|p| p.tangent[3] != SEGMENT_STARTS).unwrap_or(points.len() - start - 1)
-            + 1;
-        let run = &points[start..end.min(points.len())];
-        start = end;
-        if run.len() < 2 {
-            continue;
+    for range in offsets.windows(2) {
+        points.clear();
+        polyline_points(&positions[range[0] as usize..range[1] as usize], &mut points);
+        // Runs of points joined by segments (w = 32767 on all but a run's last point).
+        for run in points.split_inclusive(|p| p.tangent[3] != SEGMENT_STARTS) {
+            if run.len() < 2 {
+                continue;
+            }
+            if let Some(last) = previous {
+                emit(last);
+                emit(run[0].with_side(NO_SEGMENT));
+            }
+            for (k, p) in run.iter().enumerate() {
+                emit(p.with_side(if k + 1 < run.len() { SEGMENT_STARTS } else { NO_SEGMENT }));
+                emit(p.with_side(-NO_SEGMENT));
+            }
+            previous = run.last().map(|p| p.with_side(-NO_SEGMENT));
         }
-        if let Some(last) = previous {
-            emit(last);
-            emit(run[0].with_side(NO_SEGMENT));
-        }
-        for (k, p) in run.iter().enumerate() {
-            let left = if k + 1 < run.len() { SEGMENT_STARTS } else { NO_SEGMENT };
-            emit(p.with_side(left));
-            emit(p.with_side(-NO_SEGMENT));
-        }
-        previous = run.last().map(|p| p.with_side(-NO_SEGMENT));
     }
 }
 
@@ -177,13 +170,13 @@ impl LineGeometry {
         offsets: &[u64],
         options: GeometryOptions,
     ) -> Result<LineGeometry, Error> {
-        let points = line_points(positions, offsets)?;
+        validate_offsets(offsets, positions.len())?;
         let limit = options.chunk_bytes.min(device.limits().max_buffer_size);
         // Even, so that every chunk starts at an even strip position: a triangle then keeps the
         // vertex order (and so the exact interpolation) it has in one long strip.
         let per_chunk = (limit / POINT_SIZE).max(4) as usize & !1;
         let mut chunks = Vec::new();
-        let mut current: Vec<LinePoint> = Vec::with_capacity(per_chunk.min(2 * points.len() + 2));
+        let mut current: Vec<LinePoint> = Vec::with_capacity(per_chunk.min(2 * positions.len() + 2 * offsets.len()));
         let upload = |vertices: &[LinePoint], chunks: &mut Vec<Chunk>| {
             chunks.push(Chunk {
                 vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
@@ -195,7 +188,7 @@ impl LineGeometry {
                 segments: options.native_lines.then(|| native_segments(device, vertices)),
             })
         };
-        strip_vertices(&points, |v| {
+        strip_vertices(positions, offsets, |v| {
             if current.len() == per_chunk {
                 upload(&current, &mut chunks);
                 current.drain(..per_chunk - 2);
