@@ -118,7 +118,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let view = chain.prepare(device, queue, &camera, &bounds).context("nothing to render at this size")?;
     let targets = chain.targets().context("the chain allocated no targets")?;
     let passes = Passes::new(&gpu, &settings, targets, &view);
-    let timer = PassTimer::new(device, queue, &PASSES);
+    let timer = if args.no_timestamps { None } else { PassTimer::new(device, queue, &PASSES) };
 
     let mut times: Vec<Vec<f64>> = vec![Vec::new(); PASSES.len()];
     // Quads last among the line passes, so the G-buffer the later passes read is the chain's.

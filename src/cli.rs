@@ -47,6 +47,9 @@ pub struct BenchArgs {
     /// Print CONTRACT.md's JSON instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// Time with CPU wall clocks around submit + wait even where timestamp queries exist.
+    #[arg(long)]
+    pub no_timestamps: bool,
     /// Only these passes, comma-separated (default: all of them).
     #[arg(long, value_delimiter = ',', value_parser = parse_bench_pass)]
     pub passes: Vec<String>,

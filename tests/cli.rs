@@ -250,4 +250,30 @@ fn bench_json_is_the_contract() {
         assert!(ms("ms_max") < 60_000.0, "{p}");
     }
     assert_eq!(lineao(&["bench", "--frames", "0"]).status.code(), Some(2));
+    assert_eq!(lineao(&["bench", "--passes", "lines,warp-drive"]).status.code(), Some(2));
+
+    // The CPU fallback (adapters without timestamp queries), on a subset of the passes.
+    let out = lineao(&[
+        "bench",
+        "--json",
+        "--no-timestamps",
+        "--vertices",
+        "3000",
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--frames",
+        "2",
+        "--warmup",
+        "0",
+        "--passes",
+        "lines,lineao",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let report: Value = serde_json::from_slice(&out.stdout).expect("stdout is JSON");
+    assert_eq!(report["timestamps"], false);
+    let passes = report["passes"].as_array().unwrap();
+    assert_eq!(passes.iter().map(|p| p["name"].as_str().unwrap()).collect::<Vec<_>>(), ["lines", "lineao"]);
+    assert!(passes.iter().all(|p| p["on"] == "cpu" && p["ms_median"].as_f64().unwrap() > 0.0));
 }
