@@ -5,7 +5,7 @@
 //! ND map's linear depth comes from the bounding sphere (c, r) of all geometry:
 //! near = max(−c_z − r, 1e-3 r), far = −c_z + r. The zoom z(P) is how many pixels `zoom_unit`
 //! world units span at P's depth: f_px · zoom_unit / (−z_view) (perspective) or f_px · zoom_unit
-//! (orthographic), with f_px = proj[1][1] · H / 2.
+//! (orthographic), with f_px = `proj[1][1]` · H / 2.
 //!
 //! The G-buffer is rendered `guard` pixels larger on every side (paper §3.4); the projection is
 //! widened so that the visible W × H window shows exactly what the camera frames, and f_px is the

@@ -12,7 +12,7 @@
 //! - [`passes`]: [`LineRenderer`](passes::lines::LineRenderer) (fixed-width lines writing the
 //!   G-buffer), [`NdPyramid`](passes::nd_pyramid::NdPyramid), [`LineAo`](passes::line_ao::LineAo),
 //!   [`Composite`](passes::composite::Composite) — each usable alone.
-//! - [`reference`]: the CPU reference of each pass.
+//! - [`mod@reference`]: the CPU reference of each pass.
 //!
 //! The G-buffer contract (the ND map, the zoom map, normalized depth) is in [`targets`] and
 //! [`camera`]; CONTRACT.md in the repository is the full specification.

@@ -2,7 +2,7 @@
 //!
 //! R1 is a 64 × 64 tile of unit vectors repeated over the image (indexed by the pixel's position
 //! relative to the visible viewport's top-left corner), R2 a table `samples[j][i]` of unit vectors
-//! per hemisphere j and sample i. The sampling direction is ω = reflect(R1(P), R2[j][i]), so
+//! per hemisphere j and sample i. The sampling direction is ω = reflect(R1(P), `R2[j][i]`), so
 //! neighbouring pixels and different hemispheres never share a direction.
 //!
 //! Both come from a PCG hash of (seed, stream, index) in our own code, never from an RNG crate's

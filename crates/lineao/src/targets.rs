@@ -5,7 +5,7 @@
 //! | texture   | format        | content                                                    |
 //! |-----------|---------------|------------------------------------------------------------|
 //! | color     | Rgba32Float   | linear base color of the lines; background color elsewhere |
-//! | nd[j]     | Rgba32Float   | level j: view-space normal (xyz), normalized depth (w)     |
+//! | `nd[j]`   | Rgba32Float   | level j: view-space normal (xyz), normalized depth (w)     |
 //! | zoom      | R32Float      | z(P): pixels per `zoom_unit` at P; 0 on background          |
 //! | specular  | R32Float      | illuminated-lines specular, added in the composite         |
 //! | depth     | Depth32Float  | hardware depth                                             |
