@@ -17,7 +17,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     let scene = SceneKind::Spiral.build(1, 200_000);
     let gpu = Gpu::headless()?;
-    let geometry = LineGeometry::new(&gpu.device, &scene.tractogram.positions, &scene.tractogram.offsets)?;
+    let geometry = LineGeometry::new(&gpu.device, &gpu.queue, &scene.tractogram.positions, &scene.tractogram.offsets)?;
 
     let format = wgpu::TextureFormat::Rgba8UnormSrgb;
     let mut chain = AoChain::new(&gpu.device, format, ChainSettings::default())?;

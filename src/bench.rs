@@ -109,7 +109,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let gpu = Gpu::headless()?;
     let (device, queue) = (&gpu.device, &gpu.queue);
     let options = GeometryOptions { native_lines: true, ..Default::default() };
-    let geometry = LineGeometry::with_options(device, &scene.tractogram.positions, &scene.tractogram.offsets, options)?;
+    let geometry =
+        LineGeometry::with_options(device, queue, &scene.tractogram.positions, &scene.tractogram.offsets, options)?;
     let bounds = geometry.bounds.context("the scene has no finite points")?;
 
     // The chain decides the guard band and allocates the G-buffer; the passes below share it.

@@ -63,7 +63,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 
     let gpu = Gpu::headless()?;
     let tracts = &scene.tractogram;
-    let geometry = LineGeometry::new(&gpu.device, &tracts.positions, &tracts.offsets)?;
+    let geometry = LineGeometry::new(&gpu.device, &gpu.queue, &tracts.positions, &tracts.offsets)?;
     let bounds = geometry.bounds.context("the scene has no finite points")?;
     let format = wgpu::TextureFormat::Rgba8UnormSrgb;
     let mut chain = AoChain::new(&gpu.device, format, settings)?;

@@ -102,7 +102,7 @@ fn every_pass_on_every_scene() {
     for kind in SceneKind::ALL {
         let scene = kind.build(1, 40_000);
         let t = &scene.tractogram;
-        let geometry = LineGeometry::new(&gpu.device, &t.positions, &t.offsets).unwrap();
+        let geometry = LineGeometry::new(&gpu.device, &gpu.queue, &t.positions, &t.offsets).unwrap();
         let camera = Camera {
             eye: Vec3::from_array(scene.view.eye),
             target: Vec3::from_array(scene.view.target),

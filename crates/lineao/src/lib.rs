@@ -22,7 +22,7 @@
 //! # fn main() -> Result<(), lineao::Error> {
 //! let gpu = Gpu::headless()?;
 //! let positions = [[0.0, 0.0, 0.0], [10.0, 0.0, 0.0], [10.0, 10.0, 0.0]];
-//! let geometry = LineGeometry::new(&gpu.device, &positions, &[0, 3])?;
+//! let geometry = LineGeometry::new(&gpu.device, &gpu.queue, &positions, &[0, 3])?;
 //! let format = wgpu::TextureFormat::Rgba8UnormSrgb;
 //! let mut chain = AoChain::new(&gpu.device, format, ChainSettings::default())?;
 //! chain.resize(640, 480)?;

@@ -76,7 +76,7 @@ fn edge_band(small: &Frame, small_ao: &Image<f32>, large: &Frame, (w, h): (usize
 fn edge_pixels_see_what_a_larger_render_sees() {
     let gpu = gpu();
     let (positions, offsets) = dense_lines();
-    let geometry = LineGeometry::new(&gpu.device, &positions, &offsets).unwrap();
+    let geometry = LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap();
     let (w, h) = (96u32, 80u32);
     let fov = 30.0f32;
     // The larger render: the same focal length in pixels over a larger image.

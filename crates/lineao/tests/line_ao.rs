@@ -382,7 +382,7 @@ fn reference_variant_matches_its_cpu_reference_on_rendered_lines() {
 fn chain_reports_gpu_time_per_pass() {
     let gpu = gpu();
     let (positions, offsets) = polylines(40, 0.7);
-    let geometry = lineao::passes::lines::LineGeometry::new(&gpu.device, &positions, &offsets).unwrap();
+    let geometry = lineao::passes::lines::LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap();
     let (camera, _) = cameras_for_polylines();
     let has_timestamps = gpu.device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
     let variants = [(LineAoVariant::Paper, 4), (LineAoVariant::Reference, 3)];

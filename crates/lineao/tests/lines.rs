@@ -265,11 +265,11 @@ fn chunked_buffers_render_identically() {
         }));
         offsets.push(positions.len() as u64);
     }
-    let whole = LineGeometry::new(&gpu.device, &positions, &offsets).unwrap();
+    let whole = LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap();
     // 97 × 20 bytes hold 96 strip vertices (chunks keep an even length): chunk borders fall
     // inside streamlines and between them.
     let options = GeometryOptions { chunk_bytes: 97 * 20, ..Default::default() };
-    let chunked = LineGeometry::with_options(&gpu.device, &positions, &offsets, options).unwrap();
+    let chunked = LineGeometry::with_options(&gpu.device, &gpu.queue, &positions, &offsets, options).unwrap();
     // 40 × 30 points, twice each, plus two joining vertices between streamlines; each further
     // chunk repeats the last two vertices of the one before.
     let strip = 2 * 40 * 30 + 2 * 39;
@@ -290,7 +290,7 @@ fn bad_offsets_are_clear_errors() {
     for (offsets, needle) in
         [(&[][..], "none"), (&[1, 4][..], "start at 0"), (&[0, 3][..], "end at"), (&[0, 3, 2, 4][..], "decrease")]
     {
-        let error = LineGeometry::new(&gpu.device, &p, offsets).err().expect("an error").to_string();
+        let error = LineGeometry::new(&gpu.device, &gpu.queue, &p, offsets).err().expect("an error").to_string();
         assert!(error.contains(needle), "{error}");
     }
 }
@@ -308,7 +308,7 @@ fn native_lines_are_one_pixel_and_need_their_segments() {
     renderer.prepare(q, &view, s.line_width_px, s.line_color, &s.lighting);
     let covered = |native_lines| {
         let options = GeometryOptions { native_lines, ..Default::default() };
-        let geometry = LineGeometry::with_options(d, &positions, &offsets, options).unwrap();
+        let geometry = LineGeometry::with_options(d, q, &positions, &offsets, options).unwrap();
         let mut encoder = d.create_command_encoder(&Default::default());
         renderer.encode(&mut encoder, &targets, &geometry, s.background, None);
         q.submit([encoder.finish()]);

@@ -19,7 +19,6 @@
 //! specular and hardware depth.
 
 use glam::Vec3;
-use wgpu::util::DeviceExt;
 
 use crate::Error;
 use crate::binding::{self, Slot};
@@ -159,13 +158,21 @@ fn strip_vertices(positions: &[[f32; 3]], offsets: &[u64], mut emit: impl FnMut(
 }
 
 impl LineGeometry {
-    /// Uploads polylines `positions[offsets[i]..offsets[i + 1]]` (world units).
-    pub fn new(device: &wgpu::Device, positions: &[[f32; 3]], offsets: &[u64]) -> Result<LineGeometry, Error> {
-        Self::with_options(device, positions, offsets, GeometryOptions::default())
+    /// Uploads polylines `positions[offsets[i]..offsets[i + 1]]` (world units). Waits for the
+    /// queue after each buffer so that its staging memory is freed before the next one is made:
+    /// peak memory is the strip plus one buffer, not twice the strip.
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        positions: &[[f32; 3]],
+        offsets: &[u64],
+    ) -> Result<LineGeometry, Error> {
+        Self::with_options(device, queue, positions, offsets, GeometryOptions::default())
     }
 
     pub fn with_options(
         device: &wgpu::Device,
+        queue: &wgpu::Queue,
         positions: &[[f32; 3]],
         offsets: &[u64],
         options: GeometryOptions,
@@ -177,16 +184,23 @@ impl LineGeometry {
         let per_chunk = (limit / POINT_SIZE).max(4) as usize & !1;
         let mut chunks = Vec::new();
         let mut current: Vec<LinePoint> = Vec::with_capacity(per_chunk.min(2 * positions.len() + 2 * offsets.len()));
-        let upload = |vertices: &[LinePoint], chunks: &mut Vec<Chunk>| {
-            chunks.push(Chunk {
-                vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some("lineao::LineGeometry::strip"),
-                    contents: bytemuck::cast_slice(vertices),
-                    usage: wgpu::BufferUsages::VERTEX,
-                }),
+        let mut failed = None;
+        let mut upload = |vertices: &[LinePoint], chunks: &mut Vec<Chunk>| {
+            let chunk = Chunk {
+                vertices: upload_buffer(
+                    device,
+                    queue,
+                    "lineao::LineGeometry::strip",
+                    wgpu::BufferUsages::VERTEX,
+                    vertices,
+                ),
                 count: vertices.len() as u32,
-                segments: options.native_lines.then(|| native_segments(device, vertices)),
-            })
+                segments: options.native_lines.then(|| native_segments(device, queue, vertices)),
+            };
+            if let Err(e) = device.poll(wgpu::PollType::wait_indefinitely()) {
+                failed.get_or_insert(Error::Gpu(e.to_string()));
+            }
+            chunks.push(chunk);
         };
         strip_vertices(positions, offsets, |v| {
             if current.len() == per_chunk {
@@ -197,6 +211,9 @@ impl LineGeometry {
         });
         if current.len() >= 3 {
             upload(&current, &mut chunks);
+        }
+        if let Some(error) = failed {
+            return Err(error);
         }
         Ok(LineGeometry {
             chunks,
@@ -215,17 +232,34 @@ impl LineGeometry {
 /// Index pairs (left vertex of a point, left vertex of the next) of the segments that lie
 /// within `vertices`: a segment across a chunk border is in the next chunk, which repeats the
 /// last two vertices.
-fn native_segments(device: &wgpu::Device, vertices: &[LinePoint]) -> (wgpu::Buffer, u32) {
+fn native_segments(device: &wgpu::Device, queue: &wgpu::Queue, vertices: &[LinePoint]) -> (wgpu::Buffer, u32) {
     let indices: Vec<u32> = (0..vertices.len().saturating_sub(2))
         .filter(|&i| vertices[i].tangent[3] == SEGMENT_STARTS)
         .flat_map(|i| [i as u32, i as u32 + 2])
         .collect();
-    let buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("lineao::LineGeometry::segments"),
-        contents: bytemuck::cast_slice(if indices.is_empty() { &[0u32, 0] } else { &indices }),
-        usage: wgpu::BufferUsages::INDEX,
-    });
+    let contents = if indices.is_empty() { &[0u32, 0][..] } else { &indices };
+    let buffer = upload_buffer(device, queue, "lineao::LineGeometry::segments", wgpu::BufferUsages::INDEX, contents);
     (buffer, indices.len() as u32)
+}
+
+/// A buffer of `usage` holding `contents`, written through the queue and submitted.
+fn upload_buffer<T: bytemuck::Pod>(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    label: &str,
+    usage: wgpu::BufferUsages,
+    contents: &[T],
+) -> wgpu::Buffer {
+    let bytes: &[u8] = bytemuck::cast_slice(contents);
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: bytes.len() as u64,
+        usage: usage | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    queue.write_buffer(&buffer, 0, bytes);
+    queue.submit([]);
+    buffer
 }
 
 /// Keep in sync with `LineUniform` in `shaders/lines.wgsl`.

@@ -45,7 +45,7 @@ pub fn render(
     settings: ChainSettings,
     (width, height): (u32, u32),
 ) -> Frame {
-    let geometry = LineGeometry::new(&gpu.device, positions, offsets).unwrap();
+    let geometry = LineGeometry::new(&gpu.device, &gpu.queue, positions, offsets).unwrap();
     render_geometry(gpu, &geometry, camera, bounds.or(geometry.bounds).unwrap(), settings, (width, height))
 }
 
