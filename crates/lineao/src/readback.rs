@@ -22,7 +22,8 @@ impl TextureData {
     }
 }
 
-/// Copies `texture` (mip 0) to the CPU and waits for it.
+/// Copies `texture` (mip 0) to the CPU and waits for it, in bands of rows that fit the
+/// device's largest buffer.
 pub fn read_texture(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::Texture) -> Result<TextureData, Error> {
     let format = texture.format();
     let (width, height) = (texture.width(), texture.height());
@@ -32,36 +33,52 @@ pub fn read_texture(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::
         format.block_copy_size(Some(aspect)).ok_or_else(|| Error::Gpu(format!("cannot read back {format:?}")))?;
     let row = width * texel;
     let padded_row = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("lineao::readback"),
-        size: padded_row as u64 * height as u64,
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
-    let mut encoder =
-        device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::readback") });
-    encoder.copy_texture_to_buffer(
-        wgpu::TexelCopyTextureInfo { texture, mip_level: 0, origin: wgpu::Origin3d::ZERO, aspect },
-        wgpu::TexelCopyBufferInfo {
-            buffer: &buffer,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(padded_row),
-                rows_per_image: Some(height),
-            },
-        },
-        wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-    );
-    queue.submit([encoder.finish()]);
-    buffer.slice(..).map_async(wgpu::MapMode::Read, |_| {});
-    device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| Error::Gpu(e.to_string()))?;
-    let mapped = buffer.slice(..).get_mapped_range().map_err(|e| Error::Gpu(e.to_string()))?;
-    let mut bytes = Vec::with_capacity((row * height) as usize);
-    for r in 0..height as usize {
-        let start = r * padded_row as usize;
-        bytes.extend_from_slice(&mapped[start..start + row as usize]);
+    let band = (device.limits().max_buffer_size / padded_row as u64).min(height as u64) as u32;
+    // Depth can only be copied whole.
+    if band == 0 || (format.is_depth_stencil_format() && band < height) {
+        return Err(Error::TooLarge(format!(
+            "reading {width} x {height} {format:?} needs a larger buffer than the device's {} bytes",
+            device.limits().max_buffer_size
+        )));
     }
-    drop(mapped);
-    buffer.unmap();
+    let mut bytes = Vec::with_capacity((row * height) as usize);
+    for first in (0..height).step_by(band as usize) {
+        let rows = band.min(height - first);
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("lineao::readback"),
+            size: padded_row as u64 * rows as u64,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        let mut encoder =
+            device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::readback") });
+        encoder.copy_texture_to_buffer(
+            wgpu::TexelCopyTextureInfo {
+                texture,
+                mip_level: 0,
+                origin: wgpu::Origin3d { x: 0, y: first, z: 0 },
+                aspect,
+            },
+            wgpu::TexelCopyBufferInfo {
+                buffer: &buffer,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(padded_row),
+                    rows_per_image: Some(rows),
+                },
+            },
+            wgpu::Extent3d { width, height: rows, depth_or_array_layers: 1 },
+        );
+        queue.submit([encoder.finish()]);
+        buffer.slice(..).map_async(wgpu::MapMode::Read, |_| {});
+        device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| Error::Gpu(e.to_string()))?;
+        let mapped = buffer.slice(..).get_mapped_range().map_err(|e| Error::Gpu(e.to_string()))?;
+        for r in 0..rows as usize {
+            let start = r * padded_row as usize;
+            bytes.extend_from_slice(&mapped[start..start + row as usize]);
+        }
+        drop(mapped);
+        buffer.unmap();
+    }
     Ok(TextureData { width, height, format, bytes })
 }

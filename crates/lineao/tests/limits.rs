@@ -1,0 +1,85 @@
+//! Size limits: geometry larger than the device's buffers is split, images larger than its
+//! textures are a clear error, and empty sizes or empty geometry draw nothing.
+
+mod common;
+
+use common::{gpu, render_geometry};
+use glam::Vec3;
+use lineao::camera::{Bounds, Camera, Projection};
+use lineao::passes::lines::LineGeometry;
+use lineao::{AoChain, ChainSettings, Error, Gpu};
+
+fn spiral_bundle(lines: usize, points: usize) -> (Vec<[f32; 3]>, Vec<u64>) {
+    let mut positions = Vec::with_capacity(lines * points);
+    let mut offsets = vec![0u64];
+    for k in 0..lines {
+        let phase = k as f32 * 0.05;
+        positions.extend((0..points).map(|i| {
+            let s = i as f32 / (points - 1) as f32;
+            [(20.0 + 10.0 * phase.sin()) * (6.0 * s + phase).cos(), -40.0 + 80.0 * s, 20.0 * (6.0 * s + phase).sin()]
+        }));
+        offsets.push(positions.len() as u64);
+    }
+    (positions, offsets)
+}
+
+fn camera() -> Camera {
+    Camera {
+        eye: Vec3::new(0.0, 10.0, 150.0),
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        projection: Projection::Perspective { fov_y_deg: 45.0 },
+    }
+}
+
+#[test]
+fn a_device_with_small_buffers_gets_more_of_them_and_the_same_image() {
+    let gpu = gpu();
+    // The same adapter, as a host might open it: buffers of at most 256 KiB.
+    let limits = wgpu::Limits { max_buffer_size: 256 << 10, ..gpu.adapter.limits() };
+    let descriptor = wgpu::DeviceDescriptor { required_limits: limits, ..Gpu::device_descriptor(&gpu.adapter) };
+    let (device, queue) = pollster::block_on(gpu.adapter.request_device(&descriptor)).unwrap();
+    let small = Gpu { instance: gpu.instance.clone(), adapter: gpu.adapter.clone(), device, queue };
+
+    let (positions, offsets) = spiral_bundle(100, 200);
+    let big = LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap();
+    let split = LineGeometry::new(&small.device, &small.queue, &positions, &offsets).unwrap();
+    // 20 000 points, twice each, 20 bytes a vertex: 800 KB in 256 KiB buffers. (Readback
+    // splits textures into bands of rows the same way; depth only fits whole.)
+    assert_eq!(big.chunk_count(), 1);
+    assert!(split.chunk_count() >= 4, "{} buffers", split.chunk_count());
+
+    let bounds = big.bounds.unwrap();
+    let settings = ChainSettings::default();
+    let a = render_geometry(&gpu, &big, &camera(), bounds, settings.clone(), (160, 120));
+    let b = render_geometry(&small, &split, &camera(), bounds, settings, (160, 120));
+    assert_eq!(a.nd[0], b.nd[0]);
+    assert_eq!(a.ao, b.ao);
+    assert!(a.ao.data.iter().any(|&v| v > 0.1));
+}
+
+#[test]
+fn sizes_beyond_the_adapter_are_errors_and_zero_draws_nothing() {
+    let gpu = gpu();
+    let mut chain = AoChain::new(&gpu.device, common::OUTPUT_FORMAT, ChainSettings::default()).unwrap();
+    let max = gpu.device.limits().max_texture_dimension_2d;
+    match chain.resize(max, 16) {
+        Err(Error::TooLarge(message)) => assert!(message.contains(&max.to_string()), "{message}"),
+        other => panic!("expected TooLarge, got {other:?}"),
+    }
+    // A minimized window: no targets, no view, encoding records nothing.
+    chain.resize(0, 0).unwrap();
+    let bounds = Bounds { center: Vec3::ZERO, radius: 50.0 };
+    assert!(chain.prepare(&gpu.device, &gpu.queue, &camera(), &bounds).is_none());
+    let empty = LineGeometry::new(&gpu.device, &gpu.queue, &[], &[0]).unwrap();
+    assert_eq!((empty.chunk_count(), empty.bounds), (0, None));
+    let output = lineao::targets::Target::output(&gpu.device, "test::output", (8, 8), common::OUTPUT_FORMAT);
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    chain.encode(&mut encoder, &empty, &output.view);
+    gpu.queue.submit([encoder.finish()]);
+
+    // Back to a real size, empty geometry renders background only.
+    let frame = render_geometry(&gpu, &empty, &camera(), bounds, ChainSettings::default(), (32, 24));
+    assert!(frame.nd[0].data.iter().all(|t| *t == [0.0, 0.0, 0.0, 1.0]));
+    assert!(frame.ao.data.iter().all(|&a| a == 0.0));
+}
