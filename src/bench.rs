@@ -124,6 +124,11 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let mut times: Vec<Vec<f64>> = vec![Vec::new(); PASSES.len()];
     // Quads last among the line passes, so the G-buffer the later passes read is the chain's.
     let order = ["lines-native-1px", "lines", "nd-pyramid", "lineao", "lineao-tap-floor", "composite", "lineao-chain"];
+    // The G-buffer and pyramid every later pass reads, also when `--passes` leaves them out.
+    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::bench") });
+    passes.encode("lines", &mut encoder, targets, &geometry, settings.background, None);
+    passes.encode("nd-pyramid", &mut encoder, targets, &geometry, settings.background, None);
+    queue.submit([encoder.finish()]);
     let selected = |name: &str| args.passes.is_empty() || args.passes.iter().any(|p| p == name);
     for frame in 0..args.warmup + args.frames {
         for name in order.into_iter().filter(|name| selected(name)) {
