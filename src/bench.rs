@@ -48,8 +48,8 @@ impl Passes {
             lines: LineRenderer::new(device),
             lines_native: LineRenderer::with_style(device, LineStyle::Native1px),
             pyramid: NdPyramid::new(device),
-            line_ao: LineAo::new(device, &settings.line_ao),
-            tap_floor: LineAo::with_evaluation(device, &settings.line_ao, Evaluation::TapFloor),
+            line_ao: LineAo::new(device, &settings.line_ao, &settings.lighting),
+            tap_floor: LineAo::with_evaluation(device, &settings.line_ao, &settings.lighting, Evaluation::TapFloor),
             composite: Composite::new(device, format),
             output: Target::output(device, "lineao::bench::output", (view.width, view.height), format),
         };

@@ -50,7 +50,7 @@ impl AoChain {
         Ok(AoChain {
             lines: LineRenderer::new(device),
             pyramid: NdPyramid::new(device),
-            line_ao: LineAo::new(device, &settings.line_ao),
+            line_ao: LineAo::new(device, &settings.line_ao, &settings.lighting),
             composite: Composite::new(device, format),
             settings,
             size: (0, 0),
@@ -68,8 +68,8 @@ impl AoChain {
     /// Changes settings; pipelines and targets are rebuilt only where needed.
     pub fn set_settings(&mut self, device: &wgpu::Device, settings: ChainSettings) -> Result<(), Error> {
         settings.validate()?;
-        if !self.line_ao.matches(&settings.line_ao) {
-            self.line_ao = LineAo::new(device, &settings.line_ao);
+        if !self.line_ao.matches(&settings.line_ao, &settings.lighting) {
+            self.line_ao = LineAo::new(device, &settings.line_ao, &settings.lighting);
             self.targets = None;
         }
         if settings.levels() != self.settings.levels() {

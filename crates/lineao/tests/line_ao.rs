@@ -252,6 +252,26 @@ fn gpu_matches_cpu_reference_on_rendered_lines() {
             },
         ),
         ("orthographic, wide lines", ortho, ChainSettings { line_width_px: 4.0, ..Default::default() }),
+        (
+            // The light count is compiled into the pipeline: two lights, and none at all.
+            "perspective, two lights",
+            perspective,
+            ChainSettings {
+                lighting: Lighting {
+                    lights: vec![
+                        Light { dir: Vec3::new(-0.4, 0.6, 0.7), intensity: 0.7 },
+                        Light { dir: Vec3::new(0.5, -0.2, 0.8), intensity: 0.6 },
+                    ],
+                    ..Lighting::default()
+                },
+                ..Default::default()
+            },
+        ),
+        (
+            "perspective, no lights",
+            perspective,
+            ChainSettings { lighting: Lighting { lights: vec![], ..Lighting::default() }, ..Default::default() },
+        ),
     ];
     for (name, cam, s) in cases {
         let frame = render(&gpu, &positions, &offsets, &cam, None, s.clone(), (240, 180));

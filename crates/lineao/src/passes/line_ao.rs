@@ -93,16 +93,18 @@ struct Shape {
     s_h: u32,
     noise_seed: u32,
     light_attenuation: bool,
+    lights: u32,
 }
 
 impl Shape {
-    fn of(settings: &LineAoSettings) -> Shape {
+    fn of(settings: &LineAoSettings, lighting: &Lighting) -> Shape {
         Shape {
             variant: settings.variant,
             s_r: settings.s_r,
             s_h: settings.s_h,
             noise_seed: settings.noise_seed,
             light_attenuation: settings.light_attenuation,
+            lights: lighting.lights.len().min(crate::lighting::MAX_LIGHTS) as u32,
         }
     }
 }
@@ -128,40 +130,58 @@ pub struct LineAo {
     group: Option<wgpu::BindGroup>,
 }
 
-fn vec4_buffer(device: &wgpu::Device, label: &str, vectors: &[[f32; 3]]) -> wgpu::Buffer {
-    let padded: Vec<[f32; 4]> = vectors.iter().map(|v| [v[0], v[1], v[2], 0.0]).collect();
+/// Entries of the uniform sample table (`samples` in `shaders/line_ao.wgsl`): s_r ≤ 5, s_h ≤ 256.
+const SAMPLE_TABLE_LEN: usize = crate::MAX_LEVELS as usize * 256;
+
+/// `vectors` as vec4s, zero-padded to `len` entries.
+fn vec4_buffer(
+    device: &wgpu::Device,
+    label: &str,
+    vectors: &[[f32; 3]],
+    len: usize,
+    usage: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    let mut padded: Vec<[f32; 4]> = vectors.iter().map(|v| [v[0], v[1], v[2], 0.0]).collect();
+    padded.resize(padded.len().max(len), [0.0; 4]);
     device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some(label),
         contents: bytemuck::cast_slice(&padded),
-        usage: wgpu::BufferUsages::STORAGE,
+        usage,
     })
 }
 
 impl LineAo {
-    pub fn new(device: &wgpu::Device, settings: &LineAoSettings) -> LineAo {
-        Self::with_evaluation(device, settings, Evaluation::Occlusion)
+    /// The pass for `settings` lit by `lighting` (the number of lights is compiled in).
+    pub fn new(device: &wgpu::Device, settings: &LineAoSettings, lighting: &Lighting) -> LineAo {
+        Self::with_evaluation(device, settings, lighting, Evaluation::Occlusion)
     }
 
-    pub fn with_evaluation(device: &wgpu::Device, settings: &LineAoSettings, evaluation: Evaluation) -> LineAo {
+    pub fn with_evaluation(
+        device: &wgpu::Device,
+        settings: &LineAoSettings,
+        lighting: &Lighting,
+        evaluation: Evaluation,
+    ) -> LineAo {
         let layout = binding::layout(device, "lineao::LineAo::layout", wgpu::ShaderStages::COMPUTE, &{
             let mut slots = vec![
                 Slot::Uniform,
                 Slot::Uniform,
                 Slot::Storage,
-                Slot::Storage,
+                Slot::Uniform,
                 Slot::Texture,
                 Slot::StorageTexture(AO_FORMAT),
             ];
             slots.extend([Slot::Texture; crate::MAX_LEVELS as usize]);
             slots
         });
-        let shape = Shape::of(settings);
+        let shape = Shape::of(settings, lighting);
         let constants = [
             ("S_R", shape.s_r as f64),
             ("S_H", shape.s_h as f64),
             ("TAP_FLOOR", (evaluation == Evaluation::TapFloor) as u32 as f64),
             ("LIGHT_ATTENUATION", shape.light_attenuation as u32 as f64),
             ("REFERENCE", (shape.variant == LineAoVariant::Reference) as u32 as f64),
+            ("LIGHTS", shape.lights as f64),
         ];
         let pipeline = binding::compute_pipeline(
             device,
@@ -176,16 +196,29 @@ impl LineAo {
             pipeline,
             uniform: binding::uniform_buffer::<LineAoUniform>(device, "lineao::LineAo::uniform"),
             lighting: binding::uniform_buffer::<LightingUniform>(device, "lineao::LineAo::lighting"),
-            noise: vec4_buffer(device, "lineao::LineAo::noise", &noise::noise_tile(shape.noise_seed)),
-            samples: vec4_buffer(device, "lineao::LineAo::samples", &sample_table(settings)),
+            noise: vec4_buffer(
+                device,
+                "lineao::LineAo::noise",
+                &noise::noise_tile(shape.noise_seed),
+                0,
+                wgpu::BufferUsages::STORAGE,
+            ),
+            samples: vec4_buffer(
+                device,
+                "lineao::LineAo::samples",
+                &sample_table(settings),
+                SAMPLE_TABLE_LEN,
+                wgpu::BufferUsages::UNIFORM,
+            ),
             layout,
             group: None,
         }
     }
 
-    /// Whether `settings` need a new pipeline or noise (then make a new pass and `resize` it).
-    pub fn matches(&self, settings: &LineAoSettings) -> bool {
-        self.shape == Shape::of(settings)
+    /// Whether `settings` and `lighting` need a new pipeline or noise (then make a new pass and
+    /// `resize` it).
+    pub fn matches(&self, settings: &LineAoSettings, lighting: &Lighting) -> bool {
+        self.shape == Shape::of(settings, lighting)
     }
 
     pub fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets) {

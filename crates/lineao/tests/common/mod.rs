@@ -107,7 +107,7 @@ pub fn line_ao_on(
     write_target(q, &targets.zoom, zoom);
     let mut pyramid = NdPyramid::new(d);
     pyramid.resize(d, &targets);
-    let mut line_ao = LineAo::new(d, &settings.line_ao);
+    let mut line_ao = LineAo::new(d, &settings.line_ao, &settings.lighting);
     line_ao.resize(d, &targets);
     line_ao.prepare(q, &targets, &flat_view(w, h, guard), &settings.line_ao, settings.r0_px(), &settings.lighting);
     let mut encoder = d.create_command_encoder(&Default::default());
