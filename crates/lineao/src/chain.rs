@@ -69,8 +69,11 @@ impl AoChain {
     pub fn set_settings(&mut self, device: &wgpu::Device, settings: ChainSettings) -> Result<(), Error> {
         settings.validate()?;
         if !self.line_ao.matches(&settings.line_ao, &settings.lighting) {
+            // A new pipeline (sample counts, variant, lights): the targets stay.
             self.line_ao = LineAo::new(device, &settings.line_ao, &settings.lighting);
-            self.targets = None;
+            if let Some(targets) = &self.targets {
+                self.line_ao.resize(device, targets);
+            }
         }
         if settings.levels() != self.settings.levels() {
             self.targets = None;
