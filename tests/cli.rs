@@ -212,24 +212,18 @@ fn recompute_from_dump(variant: &str) {
     assert!(gpu_ao.data.iter().filter(|&&a| a > 0.1).count() > 1000);
 }
 
+/// `lineao bench --json` on a small scene with `extra` options; the report.
+fn bench_report(extra: &[&str]) -> Value {
+    let mut args = vec!["bench", "--json", "--vertices", "3000"];
+    args.extend(extra);
+    let out = lineao(&args);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    serde_json::from_slice(&out.stdout).expect("stdout is JSON")
+}
+
 #[test]
 fn bench_json_is_the_contract() {
-    let out = lineao(&[
-        "bench",
-        "--json",
-        "--vertices",
-        "3000",
-        "--width",
-        "96",
-        "--height",
-        "64",
-        "--frames",
-        "3",
-        "--warmup",
-        "1",
-    ]);
-    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
-    let report: Value = serde_json::from_slice(&out.stdout).expect("stdout is JSON");
+    let report = bench_report(&["--width", "96", "--height", "64", "--frames", "3", "--warmup", "1"]);
     for key in ["adapter", "backend", "width", "height", "scene", "vertices", "frames", "timestamps", "passes"] {
         assert!(report.get(key).is_some(), "bench JSON lacks {key}");
     }
@@ -253,12 +247,8 @@ fn bench_json_is_the_contract() {
     assert_eq!(lineao(&["bench", "--passes", "lines,warp-drive"]).status.code(), Some(2));
 
     // The CPU fallback (adapters without timestamp queries), on a subset of the passes.
-    let out = lineao(&[
-        "bench",
-        "--json",
+    let report = bench_report(&[
         "--no-timestamps",
-        "--vertices",
-        "3000",
         "--width",
         "64",
         "--height",
@@ -270,8 +260,6 @@ fn bench_json_is_the_contract() {
         "--passes",
         "lines,lineao",
     ]);
-    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
-    let report: Value = serde_json::from_slice(&out.stdout).expect("stdout is JSON");
     assert_eq!(report["timestamps"], false);
     let passes = report["passes"].as_array().unwrap();
     assert_eq!(passes.iter().map(|p| p["name"].as_str().unwrap()).collect::<Vec<_>>(), ["lines", "lineao"]);
