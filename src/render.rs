@@ -67,7 +67,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let bounds = geometry.bounds.context("the scene has no finite points")?;
     let format = wgpu::TextureFormat::Rgba8UnormSrgb;
     let mut chain = AoChain::new(&gpu.device, format, settings)?;
-    let timed = args.timings && chain.set_timing(&gpu.device, &gpu.queue, true);
+    if args.timings {
+        chain.set_timing(&gpu.device, &gpu.queue, true);
+    }
     chain.resize(args.width, args.height)?;
     chain.prepare(&gpu.device, &gpu.queue, &camera, &bounds);
     let target =
@@ -80,7 +82,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     if args.timings {
         gpu.wait()?;
         let wall_ms = start.elapsed().as_secs_f64() * 1e3;
-        match chain.pass_times(&gpu.device)?.filter(|_| timed) {
+        match chain.pass_times(&gpu.device)? {
             Some(times) => {
                 for t in &times {
                     eprintln!("lineao: {:<12} {:9.2} ms (GPU)", t.name, t.ms);
