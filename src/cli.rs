@@ -14,8 +14,12 @@ pub struct Cli {
 
 #[derive(Subcommand, Debug)]
 pub enum Command {
-    /// Render a built-in scene to a PNG.
+    /// Render a tractography file or a built-in scene to a PNG.
     Render(RenderArgs),
+    /// Describe a tractography file (CONTRACT.md `lineao info --json`).
+    Info(InfoArgs),
+    /// Convert between formats: reads any, writes .tck, .trk or .trx (by OUT's extension).
+    Convert(ConvertArgs),
     /// Time every pass on a built-in scene (CONTRACT.md `lineao bench --json`).
     Bench(BenchArgs),
 }
@@ -78,7 +82,26 @@ pub enum Variant {
 }
 
 #[derive(Args, Debug)]
+pub struct InfoArgs {
+    /// A .trk, .tck, .tsf, .trx (zip or directory), .vtk, .vtp, .tt.gz, .gltf/.glb or .obj file,
+    /// optionally gzip-wrapped.
+    pub file: PathBuf,
+    /// Print CONTRACT.md's JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct ConvertArgs {
+    pub input: PathBuf,
+    /// .tck, .trk or .trx.
+    pub output: PathBuf,
+}
+
+#[derive(Args, Debug)]
 pub struct RenderArgs {
+    /// Tractography file to render (any format `lineao info` reads) instead of a built-in scene.
+    pub file: Option<PathBuf>,
     /// Built-in scene.
     #[arg(long, default_value = "bundles", value_parser = parse_scene)]
     pub scene: SceneKind,

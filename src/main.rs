@@ -6,6 +6,7 @@
 mod bench;
 mod cli;
 mod dump;
+mod info;
 mod output;
 mod render;
 
@@ -22,6 +23,8 @@ fn main() -> ExitCode {
     let result = std::panic::catch_unwind(|| match cli.command {
         cli::Command::Render(args) => render::run(&args),
         cli::Command::Bench(args) => bench::run(&args),
+        cli::Command::Info(args) => info::run(&args),
+        cli::Command::Convert(args) => info::convert(&args),
     });
     match result {
         Ok(Ok(())) => ExitCode::SUCCESS,

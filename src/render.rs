@@ -1,4 +1,4 @@
-//! `lineao render`: a built-in scene through the pass chain into a PNG (and `--dump`).
+//! `lineao render`: a tractography file or a built-in scene through the pass chain into a PNG (and `--dump`).
 
 use anyhow::{Context, Result};
 use glam::Vec3;
@@ -45,9 +45,25 @@ pub fn settings(args: &RenderArgs, zoom_unit: f32) -> ChainSettings {
 }
 
 pub fn run(args: &RenderArgs) -> Result<()> {
-    let vertices = args.vertices.unwrap_or(args.scene.default_vertices());
-    let scene = args.scene.build(args.seed, vertices);
-    let hint = scene.view;
+    let (name, tracts, hint) = match &args.file {
+        Some(path) => {
+            let loaded = crate::info::load(path)?;
+            if !loaded.tractogram.has_points() {
+                anyhow::bail!(
+                    "{}: a .{} holds values without points; render its .tck",
+                    path.display(),
+                    loaded.format.name()
+                );
+            }
+            let hint = ViewHint::for_tractogram(&loaded.tractogram);
+            (path.display().to_string(), loaded.tractogram, hint)
+        }
+        None => {
+            let vertices = args.vertices.unwrap_or(args.scene.default_vertices());
+            let scene = args.scene.build(args.seed, vertices);
+            (scene.kind.name().to_string(), scene.tractogram, scene.view)
+        }
+    };
     let settings = settings(args, hint.zoom_unit);
     settings.validate()?;
     let camera = Camera {
@@ -62,9 +78,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     validate_camera(&camera)?;
 
     let gpu = Gpu::headless()?;
-    let tracts = &scene.tractogram;
     let geometry = LineGeometry::new(&gpu.device, &gpu.queue, &tracts.positions, &tracts.offsets)?;
-    let bounds = geometry.bounds.context("the scene has no finite points")?;
+    let bounds = geometry.bounds.with_context(|| format!("{name} has no finite points"))?;
     let format = wgpu::TextureFormat::Rgba8UnormSrgb;
     let mut chain = AoChain::new(&gpu.device, format, settings)?;
     if args.timings {
@@ -99,7 +114,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     eprintln!(
         "lineao: {} ({} streamlines, {} vertices) with {} on {} -> {}",
-        scene.kind.name(),
+        name,
         geometry.streamlines,
         geometry.vertices,
         chain.settings().method.name(),

@@ -142,13 +142,15 @@ impl Bundle<'_> {
 }
 
 /// Camera looking at the tractogram's bounding sphere from direction `from`, filling the frame.
+/// Non-finite points are ignored.
 fn framed(tractogram: &Tractogram, from: Vec3, up: Vec3, fov_y_deg: f32) -> ViewHint {
-    let (lo, hi) = tractogram.positions.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), p| {
-        let p = Vec3::from_array(*p);
-        (lo.min(p), hi.max(p))
-    });
-    let centre = (lo + hi) * 0.5;
-    let radius = tractogram.positions.iter().map(|p| Vec3::from_array(*p).distance(centre)).fold(1.0f32, f32::max);
+    let centre = tractogram.bounds().map_or(Vec3::ZERO, |b| (Vec3::from_array(b.min) + Vec3::from_array(b.max)) * 0.5);
+    let radius = tractogram
+        .positions
+        .iter()
+        .map(|p| Vec3::from_array(*p).distance(centre))
+        .filter(|d| d.is_finite())
+        .fold(1.0f32, f32::max);
     let distance = 0.9 * radius / (fov_y_deg.to_radians() * 0.5).tan();
     ViewHint {
         eye: (centre + from.normalize() * distance).to_array(),
@@ -156,6 +158,15 @@ fn framed(tractogram: &Tractogram, from: Vec3, up: Vec3, fov_y_deg: f32) -> View
         up: up.to_array(),
         fov_y_deg,
         zoom_unit: 1.0,
+    }
+}
+
+impl ViewHint {
+    /// The default view of a loaded tractogram in RAS+ mm: from the left, a little anterior and
+    /// superior (most association bundles run anterior–posterior and show best sagittally),
+    /// superior up, 1 mm per zoom unit.
+    pub fn for_tractogram(tractogram: &Tractogram) -> ViewHint {
+        framed(tractogram, Vec3::new(-1.0, 0.35, 0.3), Vec3::Z, 35.0)
     }
 }
 

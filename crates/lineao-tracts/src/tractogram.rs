@@ -1,16 +1,68 @@
+//! The one in-memory representation every loader produces and every writer consumes.
+
 /// Streamlines as one flat array of points: streamline i is
 /// `positions[offsets[i] as usize..offsets[i + 1] as usize]`.
+///
+/// Positions are RAS+ millimetres (or a built-in scene's world units). Data attached to vertices
+/// or streamlines is kept by name, as `f32` columns; groups are lists of streamline indices.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Tractogram {
-    /// Points in RAS+ millimetres (or the scene's world units).
+    /// Points in RAS+ millimetres.
     pub positions: Vec<[f32; 3]>,
-    /// N + 1 entries, first 0, last `positions.len()`.
+    /// N + 1 entries, first 0, last `positions.len()`, never decreasing.
     pub offsets: Vec<u64>,
+    /// Per-vertex data (`values.len() == vertices() * columns`): TrackVis scalars, TRX dpv,
+    /// VTK POINT_DATA, the values of a `.tsf`.
+    pub vertex_fields: Vec<Field>,
+    /// Per-streamline data (`values.len() == streamlines() * columns`): TrackVis properties,
+    /// TRX dps, VTK CELL_DATA.
+    pub streamline_fields: Vec<Field>,
+    /// Named subsets of streamlines (TRX groups, DSI Studio clusters).
+    pub groups: Vec<Group>,
+    /// The voxel grid the streamlines were tracked in, where the format records one.
+    pub space: Option<VoxelSpace>,
 }
+
+/// Named data with `columns` values per vertex or per streamline, row-major.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Field {
+    pub name: String,
+    pub columns: usize,
+    pub values: Vec<f32>,
+}
+
+/// A named set of streamline indices, with optional data per group (TRX dpg).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Group {
+    pub name: String,
+    pub streamlines: Vec<u32>,
+    /// TRX `dpg/<group>/<name>`: `columns` values for the whole group.
+    pub data: Vec<Field>,
+}
+
+/// The reference image of a tractogram.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VoxelSpace {
+    /// Voxel indices to RAS+ mm, row-major 4 × 4.
+    pub affine: [[f64; 4]; 4],
+    pub dimensions: [u32; 3],
+    /// Absent where the format records only the affine (TRX).
+    pub voxel_sizes: Option<[f32; 3]>,
+}
+
+/// Axis-aligned bounds of all points.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bounds {
+    pub min: [f32; 3],
+    pub max: [f32; 3],
+}
+
+pub const IDENTITY: [[f64; 4]; 4] =
+    [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]];
 
 impl Tractogram {
     pub fn new() -> Tractogram {
-        Tractogram { positions: Vec::new(), offsets: vec![0] }
+        Tractogram { offsets: vec![0], ..Tractogram::default() }
     }
 
     /// Appends one streamline.
@@ -26,12 +78,114 @@ impl Tractogram {
         self.offsets.len().saturating_sub(1)
     }
 
+    /// Vertices described by the offsets; equals `positions.len()` except for value-only
+    /// files (a `.tsf`), whose values sit in a vertex field without points.
     pub fn vertices(&self) -> usize {
-        self.positions.len()
+        self.offsets.last().map_or(self.positions.len(), |&n| n as usize)
+    }
+
+    /// False for value-only files such as a `.tsf`.
+    pub fn has_points(&self) -> bool {
+        self.positions.len() == self.vertices() && (self.vertices() > 0 || self.vertex_fields.is_empty())
     }
 
     /// The points of streamline `i`.
     pub fn streamline(&self, i: usize) -> &[[f32; 3]] {
         &self.positions[self.offsets[i] as usize..self.offsets[i + 1] as usize]
     }
+
+    /// Bounds of every point that is finite; `None` when there is none.
+    pub fn bounds(&self) -> Option<Bounds> {
+        let mut min = [f32::INFINITY; 3];
+        let mut max = [f32::NEG_INFINITY; 3];
+        for p in &self.positions {
+            for a in 0..3 {
+                if p[a].is_finite() {
+                    min[a] = min[a].min(p[a]);
+                    max[a] = max[a].max(p[a]);
+                }
+            }
+        }
+        (min[0] <= max[0] && min[1] <= max[1] && min[2] <= max[2]).then_some(Bounds { min, max })
+    }
+
+    /// The per-vertex field called `name`.
+    pub fn vertex_field(&self, name: &str) -> Option<&Field> {
+        self.vertex_fields.iter().find(|f| f.name == name)
+    }
+
+    /// The per-streamline field called `name`.
+    pub fn streamline_field(&self, name: &str) -> Option<&Field> {
+        self.streamline_fields.iter().find(|f| f.name == name)
+    }
+
+    /// Checks the invariants every loader guarantees: offsets start at 0, never decrease and end
+    /// at the vertex count; every field and group fits.
+    pub fn validate(&self) -> Result<(), String> {
+        if self.offsets.first() != Some(&0) {
+            return Err("offsets must start with 0".into());
+        }
+        if self.offsets.windows(2).any(|w| w[1] < w[0]) {
+            return Err("offsets must not decrease".into());
+        }
+        let last = *self.offsets.last().unwrap();
+        let value_only = self.positions.is_empty() && !self.vertex_fields.is_empty();
+        if last != self.positions.len() as u64 && !value_only {
+            return Err(format!(
+                "the last offset {} is not the vertex count {}",
+                self.offsets.last().unwrap(),
+                self.positions.len()
+            ));
+        }
+        let check = |fields: &[Field], rows: usize, what: &str| {
+            fields.iter().try_for_each(|f| {
+                if f.values.len() != rows * f.columns {
+                    Err(format!(
+                        "{what} field '{}' holds {} values, expected {rows} × {}",
+                        f.name,
+                        f.values.len(),
+                        f.columns
+                    ))
+                } else {
+                    Ok(())
+                }
+            })
+        };
+        check(&self.vertex_fields, self.vertices(), "vertex")?;
+        check(&self.streamline_fields, self.streamlines(), "streamline")?;
+        for g in &self.groups {
+            if let Some(&i) = g.streamlines.iter().find(|&&i| i as usize >= self.streamlines()) {
+                return Err(format!("group '{}' names streamline {i} of {}", g.name, self.streamlines()));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Applies a row-major 4 × 4 affine to a point, in f64.
+pub fn apply_affine(m: &[[f64; 4]; 4], p: [f64; 3]) -> [f64; 3] {
+    std::array::from_fn(|r| m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + m[r][3])
+}
+
+/// The inverse of an affine map (rotation/scale part must be invertible).
+pub fn invert_affine(m: &[[f64; 4]; 4]) -> Option<[[f64; 4]; 4]> {
+    let a = [[m[0][0], m[0][1], m[0][2]], [m[1][0], m[1][1], m[1][2]], [m[2][0], m[2][1], m[2][2]]];
+    let det = a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+        + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+    if !det.is_finite() || det.abs() < 1e-12 {
+        return None;
+    }
+    let cof = |r0: usize, r1: usize, c0: usize, c1: usize| a[r0][c0] * a[r1][c1] - a[r0][c1] * a[r1][c0];
+    let inv = [
+        [cof(1, 2, 1, 2) / det, -cof(0, 2, 1, 2) / det, cof(0, 1, 1, 2) / det],
+        [-cof(1, 2, 0, 2) / det, cof(0, 2, 0, 2) / det, -cof(0, 1, 0, 2) / det],
+        [cof(1, 2, 0, 1) / det, -cof(0, 2, 0, 1) / det, cof(0, 1, 0, 1) / det],
+    ];
+    let t = [m[0][3], m[1][3], m[2][3]];
+    let mut out = IDENTITY;
+    for r in 0..3 {
+        out[r][..3].copy_from_slice(&inv[r]);
+        out[r][3] = -(inv[r][0] * t[0] + inv[r][1] * t[1] + inv[r][2] * t[2]);
+    }
+    Some(out)
 }

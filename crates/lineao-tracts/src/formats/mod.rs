@@ -1,0 +1,11 @@
+//! One module per file format family; each parses from bytes or a [`crate::input::Reader`] and
+//! knows nothing about files, compression or progress (that is [`crate::load`]'s job).
+
+pub mod gltf;
+pub mod mrtrix;
+pub mod obj;
+pub mod trk;
+pub mod trx;
+pub mod tt;
+pub mod vtk;
+pub mod vtp;

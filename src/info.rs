@@ -1,0 +1,98 @@
+//! `lineao info` and `lineao convert`, and the progress bar every file-loading command shares.
+
+use std::io::IsTerminal;
+use std::path::Path;
+
+use anyhow::Result;
+use lineao_tracts::{LoadOptions, Loaded, Tractogram};
+use serde_json::{Value, json};
+
+use crate::cli::{ConvertArgs, InfoArgs};
+
+/// Loads a file, with a progress bar on a terminal for files over 32 MiB.
+pub fn load(path: &Path) -> Result<Loaded> {
+    let size = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
+    if !std::io::stderr().is_terminal() || size < 32 << 20 {
+        return Ok(lineao_tracts::load(path)?);
+    }
+    let bar = indicatif::ProgressBar::new(size).with_style(
+        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {bytes}/{total_bytes} {bytes_per_sec}")
+            .expect("a valid template")
+            .progress_chars("=> "),
+    );
+    bar.set_message(format!("loading {}", path.display()));
+    let mut report = |p: lineao_tracts::Progress| bar.set_position(p.bytes);
+    let loaded = lineao_tracts::load_with(path, &LoadOptions::default(), Some(&mut report));
+    bar.finish_and_clear();
+    Ok(loaded?)
+}
+
+/// CONTRACT.md's `lineao info --json` object.
+pub fn describe(loaded: &Loaded) -> Value {
+    let t = &loaded.tractogram;
+    let point = |p: Option<&[f32; 3]>| p.map_or(Value::Null, |p| json!(p));
+    let (first, last) = if t.has_points() { (t.positions.first(), t.positions.last()) } else { (None, None) };
+    let fields = |fields: &[lineao_tracts::Field]| {
+        Value::Object(fields.iter().map(|f| (trimmed(&f.name), json!(f.columns))).collect())
+    };
+    json!({
+        "format": loaded.format.name(),
+        "compression": loaded.compression.name(),
+        "streamlines": t.streamlines(),
+        "vertices": t.vertices(),
+        "first_point": point(first),
+        "last_point": point(last),
+        "bounds": t.bounds().map_or(Value::Null, |b| json!({"min": b.min, "max": b.max})),
+        "vertex_fields": fields(&t.vertex_fields),
+        "streamline_fields": fields(&t.streamline_fields),
+        "groups": Value::Object(t.groups.iter().map(|g| (trimmed(&g.name), json!(g.streamlines.len()))).collect()),
+        "affine": t.space.map_or(Value::Null, |s| json!(s.affine)),
+        "dimensions": t.space.map_or(Value::Null, |s| json!(s.dimensions)),
+        "voxel_sizes": t.space.and_then(|s| s.voxel_sizes).map_or(Value::Null, |v| json!(v)),
+    })
+}
+
+fn trimmed(name: &str) -> String {
+    name.trim_end_matches([' ', '\0']).to_string()
+}
+
+pub fn run(args: &InfoArgs) -> Result<()> {
+    let loaded = load(&args.file)?;
+    let info = describe(&loaded);
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&info)?);
+        return Ok(());
+    }
+    let t: &Tractogram = &loaded.tractogram;
+    println!("file         {}", args.file.display());
+    println!("format       {} ({})", loaded.format.name(), loaded.compression.name());
+    println!("streamlines  {}", t.streamlines());
+    println!("vertices     {}", t.vertices());
+    for key in ["first_point", "last_point", "bounds", "affine", "dimensions", "voxel_sizes"] {
+        println!("{key:<12} {}", info[key]);
+    }
+    for key in ["vertex_fields", "streamline_fields", "groups"] {
+        println!("{key:<12} {}", info[key]);
+    }
+    Ok(())
+}
+
+pub fn convert(args: &ConvertArgs) -> Result<()> {
+    let loaded = load(&args.input)?;
+    let dropped = lineao_tracts::save(&loaded.tractogram, &args.output)?;
+    if !dropped.is_empty() {
+        eprintln!(
+            "lineao: warning: {} cannot hold these fields, left out: {}",
+            args.output.display(),
+            dropped.join(", ")
+        );
+    }
+    eprintln!(
+        "lineao: {} ({} streamlines, {} vertices) -> {}",
+        args.input.display(),
+        loaded.tractogram.streamlines(),
+        loaded.tractogram.vertices(),
+        args.output.display()
+    );
+    Ok(())
+}
