@@ -32,6 +32,6 @@ mod tractogram;
 
 pub use error::{Error, ErrorKind};
 pub use input::{Progress, ProgressFn};
-pub use load::{Compression, Format, LoadOptions, Loaded, load, load_with, save};
+pub use load::{Compression, Format, LoadOptions, Loaded, load, load_from_bytes, load_with, parse_as, save};
 pub use scenes::{Scene, SceneKind, ViewHint};
 pub use tractogram::{Bounds, Field, Group, IDENTITY, Tractogram, VoxelSpace};

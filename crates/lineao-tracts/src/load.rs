@@ -127,50 +127,77 @@ fn load_inner(path: &Path, options: &LoadOptions, progress: Option<ProgressFn<'_
             compression: Compression::None,
         });
     }
-    let mut file = File::open(path)?;
+    let file = File::open(path)?;
     let len = file.metadata()?.len();
+    let mut file = ProgressRead::new(file, Some(len), progress);
+    let loaded = load_from(&mut file, len, path, path.parent(), None, options)?;
+    file.finish();
+    Ok(loaded)
+}
+
+/// Loads from bytes in memory (a download, an upload, a fuzzer's input). `name` only breaks
+/// ties between formats as a file name would; glTF external buffers are refused.
+pub fn load_from_bytes(bytes: &[u8], name: &str, options: &LoadOptions) -> Result<Loaded, Error> {
+    load_from(std::io::Cursor::new(bytes), bytes.len() as u64, Path::new(name), None, None, options)
+        .map_err(|k| k.at(name))
+}
+
+/// Parses bytes in memory as `format` (gzip-wrapped or not), skipping detection: one parser,
+/// directly — what the fuzz targets drive.
+pub fn parse_as(bytes: &[u8], format: Format, options: &LoadOptions) -> Result<Tractogram, ErrorKind> {
+    let name = format!("memory.{}", format.name());
+    load_from(std::io::Cursor::new(bytes), bytes.len() as u64, Path::new(&name), None, Some(format), options)
+        .map(|l| l.tractogram)
+}
+
+/// The one loading path: zip → TRX; gzip → decompress (capped) and look again; then by content.
+fn load_from<R: Read + Seek>(
+    mut src: R,
+    len: u64,
+    name: &Path,
+    dir: Option<&Path>,
+    forced: Option<Format>,
+    options: &LoadOptions,
+) -> Parse<Loaded> {
     let limit = options.limit(len);
     let mut magic = [0u8; 4];
-    let got = read_up_to(&mut file, &mut magic)?;
-    file.seek(SeekFrom::Start(0))?;
-    let mut file = ProgressRead::new(file, Some(len), progress);
-    if trx::sniff(&magic[..got]) {
-        let t = trx::read_zip(file, len, limit)?;
+    let got = read_up_to(&mut src, &mut magic)?;
+    src.seek(SeekFrom::Start(0))?;
+    if forced.map_or(trx::sniff(&magic[..got]), |f| f == Format::Trx) {
+        let t = trx::read_zip(src, len, limit)?;
         return Ok(Loaded { tractogram: checked(t)?, format: Format::Trx, compression: Compression::Zip });
     }
     let gzip = magic[..got].starts_with(&[0x1f, 0x8b]);
     let compression = if gzip { Compression::Gzip } else { Compression::None };
-    let loaded = {
-        let stream: Box<dyn Read + '_> = if gzip {
-            let decoder = flate2::read::MultiGzDecoder::new(BufReader::with_capacity(1 << 16, &mut file));
-            Box::new(Limited { inner: decoder, left: limit, limit })
-        } else {
-            Box::new(&mut file)
-        };
-        let mut r = Reader::new(stream);
-        let size_hint = (!gzip).then_some(len);
-        let head = r.peek(4096)?.to_vec();
-        let format = detect(&head, path)?;
-        let tractogram = match format {
-            Format::Trk => trk::read(&mut r, size_hint)?,
-            Format::Tck | Format::Tsf => mrtrix::read(&mut r, size_hint)?.0,
-            Format::Trx if gzip => return Err(ErrorKind::Unsupported("a TRX zip inside gzip".into())),
-            Format::Trx => unreachable!("zip TRX is detected before"),
-            other => {
-                let bytes = r.read_to_end()?;
-                match other {
-                    Format::Vtk => vtk::read(&bytes)?,
-                    Format::Vtp => vtp::read(&bytes, limit)?,
-                    Format::Tt => tt::read(&bytes)?,
-                    Format::Gltf => gltf::read(&bytes, path, limit)?,
-                    _ => obj::read(&bytes)?,
-                }
-            }
-        };
-        Loaded { tractogram: checked(tractogram)?, format, compression }
+    let stream: Box<dyn Read + '_> = if gzip {
+        let decoder = flate2::read::MultiGzDecoder::new(BufReader::with_capacity(1 << 16, src));
+        Box::new(Limited { inner: decoder, left: limit, limit })
+    } else {
+        Box::new(src)
     };
-    file.finish();
-    Ok(loaded)
+    let mut r = Reader::new(stream);
+    let size_hint = (!gzip).then_some(len);
+    let head = r.peek(4096)?.to_vec();
+    let format = match forced {
+        Some(f) => f,
+        None => detect(&head, name)?,
+    };
+    let tractogram = match format {
+        Format::Trk => trk::read(&mut r, size_hint)?,
+        Format::Tck | Format::Tsf => mrtrix::read(&mut r, size_hint)?.0,
+        Format::Trx => return Err(ErrorKind::Unsupported("a TRX zip inside gzip".into())),
+        other => {
+            let bytes = r.read_to_end()?;
+            match other {
+                Format::Vtk => vtk::read(&bytes)?,
+                Format::Vtp => vtp::read(&bytes, limit)?,
+                Format::Tt => tt::read(&bytes)?,
+                Format::Gltf => gltf::read(&bytes, dir, limit)?,
+                _ => obj::read(&bytes)?,
+            }
+        }
+    };
+    Ok(Loaded { tractogram: checked(tractogram)?, format, compression })
 }
 
 /// Content first; the name only decides between text formats that look alike.
@@ -196,14 +223,18 @@ fn detect(head: &[u8], path: &Path) -> Parse<Format> {
     if tt::sniff(head) {
         return Ok(Format::Tt);
     }
-    if obj::sniff(head) || Format::from_path(path) == Some(Format::Obj) {
+    if obj::sniff(head) {
         return Ok(Format::Obj);
+    }
+    // Nothing matched: let the parser the name asks for say precisely what is wrong.
+    if let Some(format) = Format::from_path(path).filter(|f| *f != Format::Trx) {
+        return Ok(format);
     }
     let shown: String = head.iter().take(16).map(|&b| if b.is_ascii_graphic() { b as char } else { '.' }).collect();
     Err(ErrorKind::UnknownFormat(format!("the file starts with '{shown}'")))
 }
 
-fn read_up_to(f: &mut File, buf: &mut [u8]) -> std::io::Result<usize> {
+fn read_up_to(f: &mut impl Read, buf: &mut [u8]) -> std::io::Result<usize> {
     let mut n = 0;
     while n < buf.len() {
         match f.read(&mut buf[n..])? {

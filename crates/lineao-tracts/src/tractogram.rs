@@ -96,16 +96,26 @@ impl Tractogram {
 
     /// Bounds of every point that is finite; `None` when there is none.
     pub fn bounds(&self) -> Option<Bounds> {
-        let mut min = [f32::INFINITY; 3];
-        let mut max = [f32::NEG_INFINITY; 3];
-        for p in &self.positions {
-            for a in 0..3 {
-                if p[a].is_finite() {
-                    min[a] = min[a].min(p[a]);
-                    max[a] = max[a].max(p[a]);
-                }
+        // Four points (12 lanes) at a time with selects rather than f32::min/max, whose NaN
+        // rules block vectorising; NaN and ±Inf fail `finite`, so they never move a bound.
+        let flat: &[f32] = bytemuck::cast_slice(&self.positions);
+        let mut lo = [f32::INFINITY; 12];
+        let mut hi = [f32::NEG_INFINITY; 12];
+        let mut fold = |chunk: &[f32; 12]| {
+            for i in 0..12 {
+                let finite = chunk[i].abs() < f32::INFINITY;
+                let (a, b) = if finite { (chunk[i], chunk[i]) } else { (f32::INFINITY, f32::NEG_INFINITY) };
+                lo[i] = if a < lo[i] { a } else { lo[i] };
+                hi[i] = if b > hi[i] { b } else { hi[i] };
             }
-        }
+        };
+        let chunks = flat.chunks_exact(12);
+        let mut rest = [f32::NAN; 12];
+        rest[..chunks.remainder().len()].copy_from_slice(chunks.remainder());
+        chunks.for_each(|c| fold(c.try_into().unwrap()));
+        fold(&rest);
+        let min: [f32; 3] = std::array::from_fn(|a| (0..4).map(|k| lo[3 * k + a]).fold(f32::INFINITY, f32::min));
+        let max: [f32; 3] = std::array::from_fn(|a| (0..4).map(|k| hi[3 * k + a]).fold(f32::NEG_INFINITY, f32::max));
         (min[0] <= max[0] && min[1] <= max[1] && min[2] <= max[2]).then_some(Bounds { min, max })
     }
 

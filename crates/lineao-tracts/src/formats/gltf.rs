@@ -15,6 +15,37 @@ use glam::{Mat4, Vec3};
 use crate::error::{ErrorKind, Parse, bad};
 use crate::tractogram::Tractogram;
 
+/// Checks what the gltf crate (1.4) trusts before it validates, both found by our fuzzer: a GLB
+/// header length below 12 (an integer underflow, a panic with overflow checks), and
+/// `accessors[POSITION]` indexed before the index is checked.
+fn precheck(bytes: &[u8]) -> Parse<()> {
+    let json = if bytes.starts_with(b"glTF") {
+        let word = |at: usize| bytes.get(at..at + 4).map_or(0, |b| u32::from_le_bytes(b.try_into().unwrap()) as usize);
+        if !(20..=bytes.len()).contains(&word(8)) {
+            return bad(8, format!("a GLB length between 20 and the file's {} bytes, found {}", bytes.len(), word(8)));
+        }
+        let Some(json) = bytes.get(20..20usize.saturating_add(word(12))) else {
+            return bad(12, "a GLB JSON chunk inside the file");
+        };
+        json
+    } else {
+        bytes
+    };
+    let doc = serde_json::from_slice::<serde_json::Value>(json)
+        .or_else(|e| bad(e.column() as u64, format!("glTF JSON (line {}: {e})", e.line())))?;
+    let accessors = doc.get("accessors").and_then(|a| a.as_array()).map_or(0, Vec::len) as u64;
+    let meshes = doc.get("meshes").and_then(|m| m.as_array()).into_iter().flatten();
+    for prim in meshes.filter_map(|m| m.get("primitives")?.as_array()).flatten() {
+        let attributes = prim.get("attributes").and_then(|a| a.as_object()).into_iter().flat_map(|a| a.values());
+        for index in attributes.chain(prim.get("indices")) {
+            if index.as_u64().is_none_or(|i| i >= accessors) {
+                return bad(0, format!("primitive accessor indices below {accessors}, found {index}"));
+            }
+        }
+    }
+    Ok(())
+}
+
 pub(crate) fn sniff(head: &[u8]) -> bool {
     if head.starts_with(b"glTF") {
         return true;
@@ -23,9 +54,14 @@ pub(crate) fn sniff(head: &[u8]) -> bool {
     text.trim_start().starts_with('{') && text.contains("\"asset\"")
 }
 
-pub(crate) fn read(bytes: &[u8], path: &Path, limit: u64) -> Parse<Tractogram> {
-    let gltf = gltf::Gltf::from_slice(bytes).or_else(|e| bad(0, format!("a valid glTF document ({e})")))?;
-    let dir = path.parent().unwrap_or(Path::new("."));
+/// `dir` is where external buffer files are looked up; `None` (bytes in memory) refuses them.
+pub(crate) fn read(bytes: &[u8], dir: Option<&Path>, limit: u64) -> Parse<Tractogram> {
+    precheck(bytes)?;
+    // The gltf crate has panicked on malformed input its validation should reject (found by our
+    // fuzzer, see `precheck`); a panic there must not take the caller down.
+    let parsed = std::panic::catch_unwind(|| gltf::Gltf::from_slice(bytes))
+        .or_else(|_| bad(0, "a glTF document the gltf crate can validate"))?;
+    let gltf = parsed.or_else(|e| bad(0, format!("a valid glTF document ({e})")))?;
     let mut buffers = Vec::new();
     for buffer in gltf.document.buffers() {
         let data = match buffer.source() {
@@ -42,6 +78,11 @@ pub(crate) fn read(bytes: &[u8], path: &Path, limit: u64) -> Parse<Tractogram> {
                     .or_else(|e| bad(0, format!("base64 in the buffer's data: URI ({e})")))?
             }
             gltf::buffer::Source::Uri(uri) => {
+                let Some(dir) = dir else {
+                    return Err(ErrorKind::Unsupported(format!(
+                        "the external buffer '{uri}' of a glTF read from memory"
+                    )));
+                };
                 let file = dir.join(uri);
                 let len = std::fs::metadata(&file).map_err(|e| ErrorKind::Format {
                     offset: 0,
@@ -83,6 +124,24 @@ pub(crate) fn read(bytes: &[u8], path: &Path, limit: u64) -> Parse<Tractogram> {
                 triangles += 1;
                 continue;
             }
+            // The gltf crate's readers panic on accessors its validation lets through (wrong
+            // component types, views past the buffer): check the two we read.
+            let position = prim.get(&gltf::Semantic::Positions);
+            check_accessor(
+                position.as_ref(),
+                &buffers,
+                &[gltf::accessor::DataType::F32],
+                gltf::accessor::Dimensions::Vec3,
+            )?;
+            use gltf::accessor::DataType as D;
+            if prim.indices().is_some() {
+                check_accessor(
+                    prim.indices().as_ref(),
+                    &buffers,
+                    &[D::U8, D::U16, D::U32],
+                    gltf::accessor::Dimensions::Scalar,
+                )?;
+            }
             let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
             let Some(positions) = reader.read_positions() else {
                 return bad(0, format!("POSITION data for a line primitive of mesh {}", mesh.index()));
@@ -118,4 +177,38 @@ pub(crate) fn read(bytes: &[u8], path: &Path, limit: u64) -> Parse<Tractogram> {
         return Err(ErrorKind::NoLines(format!("glTF with {triangles} non-line primitives and no line primitive")));
     }
     Ok(t)
+}
+
+/// An accessor we read must exist, have the expected type and lie inside its buffer.
+fn check_accessor(
+    accessor: Option<&gltf::Accessor>,
+    buffers: &[Vec<u8>],
+    types: &[gltf::accessor::DataType],
+    dims: gltf::accessor::Dimensions,
+) -> Parse<()> {
+    let Some(a) = accessor else { return bad(0, "a POSITION accessor on every line primitive") };
+    if !types.contains(&a.data_type()) || a.dimensions() != dims {
+        return bad(
+            0,
+            format!(
+                "accessor {} of type {types:?} {dims:?}, found {:?} {:?}",
+                a.index(),
+                a.data_type(),
+                a.dimensions()
+            ),
+        );
+    }
+    let Some(view) = a.view() else { return bad(0, format!("a buffer view for accessor {}", a.index())) };
+    let element = a.size();
+    let stride = view.stride().unwrap_or(element);
+    let end = (a.count() as u64).checked_sub(1).map_or(0, |n| n * stride as u64 + element as u64);
+    let start = view.offset() as u64 + a.offset() as u64;
+    let buffer_len = buffers.get(view.buffer().index()).map_or(0, Vec::len) as u64;
+    if a.offset() as u64 + end > view.length() as u64
+        || start + end > buffer_len
+        || view.offset() as u64 + view.length() as u64 > buffer_len
+    {
+        return bad(0, format!("accessor {} inside its view and buffer ({buffer_len} bytes)", a.index()));
+    }
+    Ok(())
 }

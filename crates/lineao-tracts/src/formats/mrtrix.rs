@@ -11,7 +11,7 @@
 use std::io::{self, Write};
 
 use crate::error::{Parse, bad};
-use crate::input::{Endian, Reader};
+use crate::input::{Endian, Reader, read_rest_as_points};
 use crate::tractogram::{Field, Tractogram};
 
 /// The header: keys in file order, repeated keys joined by `\n`.
@@ -136,33 +136,90 @@ pub(crate) fn read(r: &mut Reader, size_hint: Option<u64>) -> Parse<(Tractogram,
     };
     r.skip(data_at - header_end, "the padding before the data offset")?;
 
-    let per_element = if header.scalars { 1 } else { 3 };
-    let element = width * per_element;
     let layout = (width, header.scalars);
-    let capacity = size_hint.map_or(0, |s| s.saturating_sub(data_at) / element as u64) as usize;
     let mut t = Tractogram::new();
     let mut values = Vec::new();
-    if header.scalars {
-        values.reserve(capacity);
-    } else {
-        t.positions.reserve(capacity);
+    match (size_hint, header.scalars) {
+        // A plain .tck: read the data into the points' storage and decode it in place.
+        (Some(len), false) => {
+            let data_at = r.offset();
+            let (mut points, got) = read_rest_as_points(r, len)?;
+            let bytes = bytemuck::cast_slice_mut::<[f32; 3], u8>(&mut points);
+            let kept = match (width, endian) {
+                (4, Endian::Little) => {
+                    in_place(bytes, got, data_at, 4, &mut t.offsets, |b| f32::from_le_bytes(b[..4].try_into().unwrap()))
+                }
+                (4, Endian::Big) => {
+                    in_place(bytes, got, data_at, 4, &mut t.offsets, |b| f32::from_be_bytes(b[..4].try_into().unwrap()))
+                }
+                (_, Endian::Little) => in_place(bytes, got, data_at, 8, &mut t.offsets, |b| {
+                    f64::from_le_bytes(b[..8].try_into().unwrap()) as f32
+                }),
+                (_, Endian::Big) => in_place(bytes, got, data_at, 8, &mut t.offsets, |b| {
+                    f64::from_be_bytes(b[..8].try_into().unwrap()) as f32
+                }),
+            }?;
+            points.truncate(kept);
+            points.shrink_to_fit();
+            t.positions = points;
+        }
+        _ => match (width, endian) {
+            (4, Endian::Little) => {
+                stream(r, layout, &mut t, &mut values, |b| f32::from_le_bytes(b[..4].try_into().unwrap()))
+            }
+            (4, Endian::Big) => {
+                stream(r, layout, &mut t, &mut values, |b| f32::from_be_bytes(b[..4].try_into().unwrap()))
+            }
+            (_, Endian::Little) => {
+                stream(r, layout, &mut t, &mut values, |b| f64::from_le_bytes(b[..8].try_into().unwrap()) as f32)
+            }
+            (_, Endian::Big) => {
+                stream(r, layout, &mut t, &mut values, |b| f64::from_be_bytes(b[..8].try_into().unwrap()) as f32)
+            }
+        }?,
     }
-    match (width, endian) {
-        (4, Endian::Little) => {
-            stream(r, layout, &mut t, &mut values, |b| f32::from_le_bytes(b[..4].try_into().unwrap()))
-        }
-        (4, Endian::Big) => stream(r, layout, &mut t, &mut values, |b| f32::from_be_bytes(b[..4].try_into().unwrap())),
-        (_, Endian::Little) => {
-            stream(r, layout, &mut t, &mut values, |b| f64::from_le_bytes(b[..8].try_into().unwrap()) as f32)
-        }
-        (_, Endian::Big) => {
-            stream(r, layout, &mut t, &mut values, |b| f64::from_be_bytes(b[..8].try_into().unwrap()) as f32)
-        }
-    }?;
     if header.scalars {
         t.vertex_fields.push(Field { name: "tsf".into(), columns: 1, values });
     }
     Ok((t, header.scalars))
+}
+
+/// Decodes the triplets in `bytes[..got]` in place (point w goes to bytes 12w..12w + 12, never
+/// ahead of the triplet being read) until an Inf or the end; returns the number of points.
+/// `data_at` is the file offset of `bytes[0]`, for errors.
+fn in_place(
+    bytes: &mut [u8],
+    got: usize,
+    data_at: u64,
+    width: usize,
+    offsets: &mut Vec<u64>,
+    decode: impl Fn(&[u8]) -> f32,
+) -> Parse<usize> {
+    let element = 3 * width;
+    let mut kept = 0usize;
+    let mut at = 0usize;
+    while at + element <= got {
+        let e = &bytes[at..at + element];
+        let x = decode(e);
+        if x.is_nan() {
+            offsets.push(kept as u64);
+        } else if x.is_infinite() {
+            at = got; // the terminator: ignore whatever follows
+            break;
+        } else {
+            let p = [x, decode(&e[width..]), decode(&e[2 * width..])];
+            bytes[12 * kept..12 * kept + 12].copy_from_slice(bytemuck::bytes_of(&p));
+            kept += 1;
+        }
+        at += element;
+    }
+    if at < got {
+        return bad(data_at + at as u64, format!("a whole {element}-byte point (the file ends inside one)"));
+    }
+    if *offsets.last().unwrap() != kept as u64 {
+        offsets.push(kept as u64);
+    }
+    Ok(kept)
 }
 
 /// Decodes elements until an Inf or the end of the file. Monomorphised per datatype so the

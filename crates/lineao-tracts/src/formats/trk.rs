@@ -16,7 +16,7 @@
 use std::io::{self, Write};
 
 use crate::error::{Parse, bad};
-use crate::input::{Endian, Reader};
+use crate::input::{Endian, Reader, read_rest_as_points};
 use crate::tractogram::{Field, IDENTITY, Tractogram, VoxelSpace, apply_affine, invert_affine};
 
 pub(crate) const HEADER_SIZE: usize = 1000;
@@ -227,58 +227,171 @@ fn mul(a: &[[f64; 4]; 4], b: &[[f64; 4]; 4]) -> [[f64; 4]; 4] {
 
 pub(crate) fn read(r: &mut Reader, size_hint: Option<u64>) -> Parse<Tractogram> {
     let h = parse_header(r.take(HEADER_SIZE, "a 1000-byte TrackVis header")?)?;
-    let to_ras = voxmm_to_ras(&h);
-    let e = h.endian;
-    let record = 4 * (3 + h.n_scalars);
     let mut t = Tractogram::new();
-    if let Some(size) = size_hint {
-        // Upper bound from the file's size, not from a header field.
-        t.positions.reserve((size.saturating_sub(HEADER_SIZE as u64) / record as u64) as usize);
-    }
     let mut scalar_fields: Vec<Field> =
         h.scalars.iter().map(|(n, c)| Field { name: n.clone(), columns: *c, values: Vec::new() }).collect();
     let mut property_fields: Vec<Field> =
         h.properties.iter().map(|(n, c)| Field { name: n.clone(), columns: *c, values: Vec::new() }).collect();
-    let mut row = vec![0f32; h.n_scalars.max(h.n_properties)];
-    let mut streamlines = 0u64;
-    while (h.n_count == 0 || streamlines < h.n_count) && !r.at_end()? {
-        let at = r.offset();
-        let n = e.i32(r.take(4, "a streamline's point count")?);
-        if n < 0 {
-            return bad(at, format!("a non-negative point count, found {n}"));
-        }
-        let mut left = n as usize;
-        let per_piece = (Reader::CHUNK / record).max(1);
-        while left > 0 {
-            let k = left.min(per_piece);
-            let piece = r.take(k * record, &format!("{n} points of {record} bytes"))?;
-            for p in piece.chunks_exact(record) {
-                let v = [e.f32(p) as f64, e.f32(&p[4..]) as f64, e.f32(&p[8..]) as f64];
-                let w = apply_affine(&to_ras, v);
-                t.positions.push([w[0] as f32, w[1] as f32, w[2] as f32]);
-                if h.n_scalars > 0 {
-                    for (s, v) in row[..h.n_scalars].iter_mut().enumerate() {
-                        *v = e.f32(&p[12 + 4 * s..]);
-                    }
-                    split_row(&row[..h.n_scalars], &mut scalar_fields);
+    let mut decoder = Decoder::new(&h, &mut scalar_fields, &mut property_fields);
+    match size_hint {
+        // A plain file: read the body into the points' storage and decode in place (a point's
+        // 12 bytes never overtake the 4 + 12 n bytes of its streamline's record).
+        Some(len) => {
+            let (mut points, got) = read_rest_as_points(r, len)?;
+            let bytes = bytemuck::cast_slice_mut::<[f32; 3], u8>(&mut points);
+            let mut at = 0usize;
+            let mut kept = 0usize;
+            while (h.n_count == 0 || (t.streamlines() as u64) < h.n_count) && at < got {
+                let offset = (HEADER_SIZE + at) as u64;
+                let Some(n) = bytes.get(at..(at + 4).min(got)).filter(|b| b.len() == 4).map(|b| h.endian.i32(b)) else {
+                    return bad(offset, "a streamline's point count (4 bytes)");
+                };
+                let need = decoder.record_bytes(n, offset)?;
+                if need > got - at - 4 {
+                    return bad(offset + 4, format!("{n} points of {} bytes and the properties", decoder.record));
                 }
+                at += 4;
+                if decoder.n_scalars == 0 {
+                    kept = decoder.points_in_place(bytes, at, n as usize, kept);
+                } else {
+                    for p in 0..n as usize {
+                        let s = at + p * decoder.record;
+                        let xyz: [u8; 12] = bytes[s..s + 12].try_into().unwrap();
+                        decoder.scalars(&bytes[s + 12..s + decoder.record]);
+                        let point = decoder.point(&xyz);
+                        bytes[12 * kept..12 * kept + 12].copy_from_slice(bytemuck::bytes_of(&point));
+                        kept += 1;
+                    }
+                }
+                at += n as usize * decoder.record;
+                decoder.properties(&bytes[at..]);
+                at += 4 * h.n_properties;
+                t.offsets.push(kept as u64);
             }
-            left -= k;
+            points.truncate(kept);
+            points.shrink_to_fit();
+            t.positions = points;
         }
-        if h.n_properties > 0 {
-            let p = r.take(4 * h.n_properties, "the streamline's properties")?;
-            for (s, v) in row[..h.n_properties].iter_mut().enumerate() {
-                *v = e.f32(&p[4 * s..]);
+        // A stream (gzip): the same records, piece by piece.
+        None => {
+            while (h.n_count == 0 || (t.streamlines() as u64) < h.n_count) && !r.at_end()? {
+                let offset = r.offset();
+                let n = h.endian.i32(r.take(4, "a streamline's point count")?);
+                decoder.record_bytes(n, offset)?;
+                let mut left = n as usize;
+                let per_piece = (Reader::CHUNK / decoder.record).max(1);
+                while left > 0 {
+                    let k = left.min(per_piece);
+                    let piece = r.take(k * decoder.record, &format!("{n} points of {} bytes", decoder.record))?;
+                    for p in piece.chunks_exact(decoder.record) {
+                        decoder.scalars(&p[12..]);
+                        t.positions.push(decoder.point(p[..12].try_into().unwrap()));
+                    }
+                    left -= k;
+                }
+                decoder.properties(r.take(4 * h.n_properties, "the streamline's properties")?);
+                t.offsets.push(t.positions.len() as u64);
             }
-            split_row(&row[..h.n_properties], &mut property_fields);
         }
-        t.offsets.push(t.positions.len() as u64);
-        streamlines += 1;
     }
     t.vertex_fields = scalar_fields;
     t.streamline_fields = property_fields;
     t.space = Some(VoxelSpace { affine: h.vox_to_ras, dimensions: h.dims, voxel_sizes: Some(h.voxel_sizes) });
     Ok(t)
+}
+
+/// Turns point records into RAS+ points (and scalar rows), property records into rows.
+struct Decoder<'a> {
+    endian: Endian,
+    to_ras: [[f32; 4]; 3],
+    record: usize,
+    n_scalars: usize,
+    n_properties: usize,
+    row: Vec<f32>,
+    scalars: &'a mut [Field],
+    properties: &'a mut [Field],
+}
+
+impl<'a> Decoder<'a> {
+    fn new(h: &Header, scalars: &'a mut [Field], properties: &'a mut [Field]) -> Decoder<'a> {
+        let m = voxmm_to_ras(h);
+        Decoder {
+            endian: h.endian,
+            // f32 like nibabel's float32 points; the affine itself was composed in f64.
+            to_ras: std::array::from_fn(|r| std::array::from_fn(|c| m[r][c] as f32)),
+            record: 4 * (3 + h.n_scalars),
+            n_scalars: h.n_scalars,
+            n_properties: h.n_properties,
+            row: vec![0.0; h.n_scalars.max(h.n_properties)],
+            scalars,
+            properties,
+        }
+    }
+
+    /// Bytes a streamline of `n` points needs after its count; rejects negative counts.
+    fn record_bytes(&self, n: i32, offset: u64) -> Parse<usize> {
+        if n < 0 {
+            return bad(offset, format!("a non-negative point count, found {n}"));
+        }
+        Ok((n as usize).saturating_mul(self.record).saturating_add(4 * self.n_properties))
+    }
+
+    /// voxmm → RAS+ for one point record's first 12 bytes.
+    #[inline(always)]
+    fn point(&self, p: &[u8; 12]) -> [f32; 3] {
+        let word = |i: usize| {
+            let w = u32::from_le_bytes([p[4 * i], p[4 * i + 1], p[4 * i + 2], p[4 * i + 3]]);
+            f32::from_bits(if self.endian == Endian::Big { w.swap_bytes() } else { w })
+        };
+        let v = [word(0), word(1), word(2)];
+        let m = &self.to_ras;
+        std::array::from_fn(|r| m[r][0] * v[0] + m[r][1] * v[1] + m[r][2] * v[2] + m[r][3])
+    }
+
+    /// `n` bare points (no scalars) from `bytes[at..]` to points `kept..` of the same buffer; the
+    /// tight loop of the common case, with the matrix in registers and the diagonal case (no
+    /// rotation: every TrackVis voxel order with an axis-aligned vox_to_ras) apart.
+    fn points_in_place(&self, bytes: &mut [u8], at: usize, n: usize, mut kept: usize) -> usize {
+        let m = self.to_ras;
+        let big = self.endian == Endian::Big;
+        let diagonal = (0..3).all(|r| (0..3).all(|c| r == c || m[r][c] == 0.0));
+        let (scale, shift) = ([m[0][0], m[1][1], m[2][2]], [m[0][3], m[1][3], m[2][3]]);
+        for p in 0..n {
+            let s = at + 12 * p;
+            let raw: [u8; 12] = bytes[s..s + 12].try_into().unwrap();
+            let mut v: [f32; 3] = bytemuck::cast(raw);
+            if big {
+                v = v.map(|x| f32::from_bits(x.to_bits().swap_bytes()));
+            }
+            let w: [f32; 3] = if diagonal {
+                std::array::from_fn(|a| v[a] * scale[a] + shift[a])
+            } else {
+                std::array::from_fn(|r| m[r][0] * v[0] + m[r][1] * v[1] + m[r][2] * v[2] + m[r][3])
+            };
+            bytes[12 * kept..12 * kept + 12].copy_from_slice(bytemuck::bytes_of(&w));
+            kept += 1;
+        }
+        kept
+    }
+
+    /// The scalars that follow a point's coordinates.
+    fn scalars(&mut self, p: &[u8]) {
+        if self.n_scalars > 0 {
+            for (s, x) in self.row[..self.n_scalars].iter_mut().enumerate() {
+                *x = self.endian.f32(&p[4 * s..]);
+            }
+            split_row(&self.row[..self.n_scalars], self.scalars);
+        }
+    }
+
+    fn properties(&mut self, p: &[u8]) {
+        if self.n_properties > 0 {
+            for (s, x) in self.row[..self.n_properties].iter_mut().enumerate() {
+                *x = self.endian.f32(&p[4 * s..]);
+            }
+            split_row(&self.row[..self.n_properties], self.properties);
+        }
+    }
 }
 
 /// Appends one row of values to the fields that share it, in order.

@@ -7,12 +7,14 @@
 //! equals the vertex count) or, in older files, only N, and the header's counts may be stale.
 //! Members are found relative to `header.json`, so an archive made by zipping a folder works too.
 
+use std::cell::RefCell;
 use std::fs::File;
 use std::io::{self, Read, Seek, Write};
 use std::path::Path;
+use std::rc::Rc;
 
 use crate::error::{ErrorKind, Parse, bad};
-use crate::input::{Limited, ProgressRead, Reader, io_error};
+use crate::input::{Limited, Reader, advise_huge_pages, io_error};
 use crate::tractogram::{Field, Group, IDENTITY, Tractogram, VoxelSpace};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -108,17 +110,37 @@ trait Members {
     fn names(&self) -> Vec<String>;
     /// A reader for one member and its size, if known and trustworthy.
     fn open(&mut self, name: &str) -> Parse<(Box<dyn Read + '_>, Option<u64>)>;
+    /// Reads an uncompressed member's bytes straight into `out` (its exact size), bypassing
+    /// the zip reader's buffering and CRC pass (TRX readers map these bytes directly; so do we,
+    /// in effect). False when the member is compressed.
+    fn read_stored(&mut self, name: &str, out: &mut [u8]) -> Parse<bool>;
 }
 
-struct Zip<'p> {
-    archive: zip::ZipArchive<ProgressRead<'p, File>>,
+/// One reader shared by the zip index and our direct reads of stored members.
+struct Shared<R>(Rc<RefCell<R>>);
+
+impl<R: Read> Read for Shared<R> {
+    fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        self.0.borrow_mut().read(buf)
+    }
+}
+
+impl<R: Seek> Seek for Shared<R> {
+    fn seek(&mut self, pos: io::SeekFrom) -> io::Result<u64> {
+        self.0.borrow_mut().seek(pos)
+    }
+}
+
+struct Zip<R> {
+    archive: zip::ZipArchive<Shared<R>>,
+    raw: Rc<RefCell<R>>,
     /// Inflated bytes left for the whole archive (bomb guard).
     budget: u64,
     limit: u64,
     file_len: u64,
 }
 
-impl Members for Zip<'_> {
+impl<R: Read + Seek> Members for Zip<R> {
     fn names(&self) -> Vec<String> {
         self.archive.file_names().filter(|n| !n.ends_with('/')).map(str::to_string).collect()
     }
@@ -132,6 +154,21 @@ impl Members for Zip<'_> {
         let budget = self.budget;
         self.budget = self.budget.saturating_sub(entry.size());
         Ok((Box::new(Limited { inner: entry, left: budget, limit: self.limit }), size))
+    }
+
+    fn read_stored(&mut self, name: &str, out: &mut [u8]) -> Parse<bool> {
+        let entry = self.archive.by_name(name).map_err(|e| zip_error(e, name))?;
+        let (Some(start), zip::CompressionMethod::Stored) = (entry.data_start(), entry.compression()) else {
+            return Ok(false);
+        };
+        if entry.size() != out.len() as u64 {
+            return Ok(false);
+        }
+        drop(entry);
+        let mut raw = self.raw.borrow_mut();
+        raw.seek(io::SeekFrom::Start(start))?;
+        raw.read_exact(out).map_err(|e| io_error(e, start, &format!("the {} bytes of '{name}'", out.len())))?;
+        Ok(true)
     }
 }
 
@@ -169,6 +206,15 @@ impl Members for Directory<'_> {
         let size = f.metadata()?.len();
         Ok((Box::new(f), Some(size)))
     }
+
+    fn read_stored(&mut self, name: &str, out: &mut [u8]) -> Parse<bool> {
+        let mut f = File::open(self.root.join(name))?;
+        if f.metadata()?.len() != out.len() as u64 {
+            return Ok(false);
+        }
+        f.read_exact(out).map_err(|e| io_error(e, 0, name))?;
+        Ok(true)
+    }
 }
 
 pub(crate) fn sniff(head: &[u8]) -> bool {
@@ -176,9 +222,10 @@ pub(crate) fn sniff(head: &[u8]) -> bool {
 }
 
 /// Reads a zipped TRX.
-pub(crate) fn read_zip(file: ProgressRead<'_, File>, file_len: u64, limit: u64) -> Parse<Tractogram> {
-    let archive = zip::ZipArchive::new(file).map_err(|e| zip_error(e, "the zip directory"))?;
-    read(&mut Zip { archive, budget: limit, limit, file_len })
+pub(crate) fn read_zip(file: impl Read + Seek, file_len: u64, limit: u64) -> Parse<Tractogram> {
+    let raw = Rc::new(RefCell::new(file));
+    let archive = zip::ZipArchive::new(Shared(raw.clone())).map_err(|e| zip_error(e, "the zip directory"))?;
+    read(&mut Zip { archive, raw, budget: limit, limit, file_len })
 }
 
 /// Reads a TRX directory.
@@ -217,7 +264,23 @@ fn read(m: &mut dyn Members) -> Parse<Tractogram> {
     let (_, size) = m.open(&full(positions_name))?;
     // A stored member's size is bounded by the file; reserve it (untouched pages cost nothing).
     positions.reserve(size.unwrap_or(0) as usize / (3 * dtype.size()));
-    if dtype == Dtype::F32 {
+    // Stored float32: the member's bytes are the points (little-endian), read straight in.
+    let direct = dtype == Dtype::F32 && size.is_some_and(|s| s % 12 == 0) && {
+        // vec! of zeros is calloc: fresh pages, no memset, so huge pages can still back them.
+        positions = vec![[0.0; 3]; size.unwrap() as usize / 12];
+        advise_huge_pages(bytemuck::cast_slice_mut(&mut positions));
+        let done = m.read_stored(&full(positions_name), bytemuck::cast_slice_mut(&mut positions))?;
+        if !done {
+            positions.clear();
+        }
+        done
+    };
+    if direct {
+        #[cfg(target_endian = "big")]
+        for c in positions.iter_mut().flatten() {
+            *c = f32::from_bits(c.to_bits().swap_bytes());
+        }
+    } else if dtype == Dtype::F32 {
         // The common case, decoded without going through f64 rows.
         let f = |b: &[u8]| f32::from_le_bytes(b[..4].try_into().unwrap());
         raw_values(m, &full(positions_name), 12, |b| positions.push([f(b), f(&b[4..]), f(&b[8..])]))?;
