@@ -18,6 +18,8 @@ pub enum Command {
     Render(RenderArgs),
     /// Describe a tractography file (CONTRACT.md `lineao info --json`).
     Info(InfoArgs),
+    /// Time loading .tck, .trk and .trx files against reading their bytes and against nibabel.
+    BenchLoad(BenchLoadArgs),
     /// Convert between formats: reads any, writes .tck, .trk or .trx (by OUT's extension).
     Convert(ConvertArgs),
     /// Time every pass on a built-in scene (CONTRACT.md `lineao bench --json`).
@@ -87,6 +89,29 @@ pub struct InfoArgs {
     /// optionally gzip-wrapped.
     pub file: PathBuf,
     /// Print CONTRACT.md's JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct BenchLoadArgs {
+    /// Approximate vertex count of the synthetic tractogram.
+    #[arg(long, default_value_t = 10_000_000)]
+    pub vertices: usize,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Formats to write and load, comma-separated.
+    #[arg(long, value_delimiter = ',', default_value = "tck,trk,trx", value_parser = ["tck", "trk", "trx"])]
+    pub formats: Vec<String>,
+    /// Runs per measurement (the median is reported).
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..))]
+    pub repeat: u32,
+    /// Where to write the files (kept); default a temporary folder that is removed.
+    #[arg(long)]
+    pub dir: Option<PathBuf>,
+    /// Skip the nibabel comparison.
+    #[arg(long)]
+    pub no_nibabel: bool,
     #[arg(long)]
     pub json: bool,
 }

@@ -4,6 +4,7 @@
 //! 2 bad command line. A panic is a bug; it is reported and exits 1, never 101.
 
 mod bench;
+mod bench_load;
 mod cli;
 mod dump;
 mod info;
@@ -25,6 +26,7 @@ fn main() -> ExitCode {
         cli::Command::Bench(args) => bench::run(&args),
         cli::Command::Info(args) => info::run(&args),
         cli::Command::Convert(args) => info::convert(&args),
+        cli::Command::BenchLoad(args) => bench_load::run(&args),
     });
     match result {
         Ok(Ok(())) => ExitCode::SUCCESS,

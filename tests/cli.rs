@@ -1,25 +1,17 @@
 //! `lineao render` end to end: exit codes, the PNG, and `--dump` read back the way an outside
 //! tool would, recomputing LineAO from the dumped files alone.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
+use std::process::Output;
+
+mod common;
+use common::{lineao, scratch};
 
 use lineao::LineAoVariant;
 use lineao::lighting::Light;
 use lineao::reference::{self, Image, LineAoParams};
 use lineao::verify::{check_policy, line_ao_flip_bound, line_ao_reference_flip_bound};
 use serde_json::Value;
-
-fn lineao(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_lineao")).args(args).env("XDG_RUNTIME_DIR", std::env::temp_dir()).output().unwrap()
-}
-
-fn scratch(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 fn stderr(output: &Output) -> String {
     String::from_utf8_lossy(&output.stderr).into_owned()

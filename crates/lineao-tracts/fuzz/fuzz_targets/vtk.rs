@@ -1,0 +1,3 @@
+#![no_main]
+include!("common.rs");
+fuzz_format!(lineao_tracts::Format::Vtk);

@@ -1,0 +1,17 @@
+//! Helpers the end-to-end tests share: running the `lineao` binary and scratch folders.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// Runs the `lineao` binary under test.
+pub fn lineao(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_lineao")).args(args).env("XDG_RUNTIME_DIR", std::env::temp_dir()).output().unwrap()
+}
+
+/// An empty folder under cargo's test scratch space.
+pub fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
