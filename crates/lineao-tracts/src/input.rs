@@ -20,8 +20,11 @@ pub struct Progress {
 pub type ProgressFn<'a> = &'a mut dyn FnMut(Progress);
 
 /// Counts the bytes read from the file and reports them, every `STEP` bytes and at the end.
+/// Seeks (a zip's directory first, then its members) do not move the count: it is the bytes
+/// read so far, capped at the file's size, so a progress bar only moves forward.
 pub(crate) struct ProgressRead<'p, R> {
     inner: R,
+    /// Bytes read so far.
     position: u64,
     total: Option<u64>,
     reported: u64,
@@ -40,7 +43,8 @@ impl<'p, R> ProgressRead<'p, R> {
             && (force || self.position >= self.reported + Self::STEP)
         {
             self.reported = self.position;
-            cb(Progress { bytes: self.position, total: self.total });
+            let bytes = self.total.map_or(self.position, |t| self.position.min(t));
+            cb(Progress { bytes, total: self.total });
         }
     }
 
@@ -61,8 +65,7 @@ impl<R: Read> Read for ProgressRead<'_, R> {
 
 impl<R: Seek> Seek for ProgressRead<'_, R> {
     fn seek(&mut self, pos: SeekFrom) -> io::Result<u64> {
-        self.position = self.inner.seek(pos)?;
-        Ok(self.position)
+        self.inner.seek(pos)
     }
 }
 

@@ -346,3 +346,27 @@ fn unwritable_formats_and_value_only_files_are_clear_errors() {
     assert!(matches!(save(&tsf, dir.path().join("x.tck")).unwrap_err().kind, ErrorKind::Unsupported(_)));
     assert!(!dir.path().join("x.tck").exists(), "nothing half-written");
 }
+
+#[test]
+fn progress_reports_bytes_of_the_file_up_to_its_size() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut t = Tractogram::new();
+    for i in 0..5000 {
+        t.push((0..100).map(|k| [i as f32, k as f32, 0.5]));
+    }
+    for ext in ["tck", "trk", "trx"] {
+        let p = dir.path().join(format!("big.{ext}"));
+        save(&t, &p).unwrap();
+        let len = std::fs::metadata(&p).unwrap().len();
+        let mut seen = Vec::new();
+        let mut report = |p: lineao_tracts::Progress| seen.push(p);
+        let loaded = lineao_tracts::load_with(&p, &lineao_tracts::LoadOptions::default(), Some(&mut report)).unwrap();
+        assert_eq!(loaded.tractogram.vertices(), 500_000);
+        assert!(seen.len() >= 2, "{ext}: {} reports for {len} bytes", seen.len());
+        assert!(seen.iter().all(|p| p.total == Some(len) && p.bytes <= len), "{ext}");
+        assert!(seen.windows(2).all(|w| w[0].bytes <= w[1].bytes), "{ext}: only forward");
+        // A zip's members are most of it; its directory and local headers are read by the zip
+        // crate in small pieces.
+        assert!(seen.last().unwrap().bytes as f64 >= 0.99 * len as f64, "{ext}: {:?} of {len}", seen.last());
+    }
+}
