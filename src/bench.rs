@@ -8,7 +8,10 @@
 //! - `lines-native-1px`: the same segments as the rasterizer's native 1-px `LineList`;
 //! - `lineao-tap-floor`: the LineAO shader with the same sample addresses that only sums the
 //!   fetched depths ([`Evaluation::TapFloor`]);
-//! - `lineao-chain`: pyramid + LineAO in one span (what a frame pays for the occlusion).
+//! - `lineao-chain`: pyramid + LineAO in one span (what a frame pays for the occlusion);
+//! - `ssao-12`: Crytek SSAO with 12 point samples (the VO paper's comparison);
+//! - `ssao-16-chain`: SSAO with 16 samples and its 4 × 4 blur in one span (the LineAO paper's
+//!   baseline frame, against `lineao-chain`).
 
 use std::time::Instant;
 
@@ -18,16 +21,27 @@ use lineao::passes::composite::Composite;
 use lineao::passes::line_ao::{Evaluation, LineAo};
 use lineao::passes::lines::{GeometryOptions, LineGeometry, LineRenderer, LineStyle};
 use lineao::passes::nd_pyramid::NdPyramid;
+use lineao::passes::ssao::Ssao;
+use lineao::passes::ssao_blur::SsaoBlur;
 use lineao::targets::{FrameTargets, Target};
 use lineao::timing::{PassTimer, Span};
-use lineao::{AoChain, ChainSettings, Gpu, LineAoSettings};
+use lineao::{AoChain, ChainSettings, Gpu, LineAoSettings, SsaoSettings};
 use serde_json::json;
 
 use crate::cli::BenchArgs;
 
 /// The passes of one run, in CONTRACT.md's order.
-pub const PASSES: [&str; 7] =
-    ["lines", "lines-native-1px", "nd-pyramid", "lineao", "lineao-tap-floor", "composite", "lineao-chain"];
+pub const PASSES: [&str; 9] = [
+    "lines",
+    "lines-native-1px",
+    "nd-pyramid",
+    "lineao",
+    "lineao-tap-floor",
+    "composite",
+    "lineao-chain",
+    "ssao-12",
+    "ssao-16-chain",
+];
 
 /// Every pass of the benchmark, prepared for one view over one G-buffer.
 struct Passes {
@@ -37,6 +51,9 @@ struct Passes {
     line_ao: LineAo,
     tap_floor: LineAo,
     composite: Composite,
+    ssao_12: Ssao,
+    ssao_16: Ssao,
+    ssao_blur: SsaoBlur,
     output: Target,
 }
 
@@ -51,6 +68,9 @@ impl Passes {
             line_ao: LineAo::new(device, &settings.line_ao, &settings.lighting),
             tap_floor: LineAo::with_evaluation(device, &settings.line_ao, &settings.lighting, Evaluation::TapFloor),
             composite: Composite::new(device, format),
+            ssao_12: Ssao::new(device, &SsaoSettings { samples: 12, ..settings.ssao.clone() }),
+            ssao_16: Ssao::new(device, &SsaoSettings { samples: 16, ..settings.ssao.clone() }),
+            ssao_blur: SsaoBlur::new(device),
             output: Target::output(device, "lineao::bench::output", (view.width, view.height), format),
         };
         for renderer in [&passes.lines, &passes.lines_native] {
@@ -61,6 +81,11 @@ impl Passes {
             pass.resize(device, targets);
             pass.prepare(queue, targets, view, &settings.line_ao, settings.r0_px(), &settings.lighting);
         }
+        for (pass, samples) in [(&mut passes.ssao_12, 12), (&mut passes.ssao_16, 16)] {
+            pass.resize(device, targets);
+            pass.prepare(queue, targets, view, &SsaoSettings { samples, ..settings.ssao.clone() });
+        }
+        passes.ssao_blur.resize(device, targets);
         passes.composite.resize(device, targets);
         passes.composite.prepare(queue, targets, settings.strength, settings.debug_view, view.zoom_max());
         passes
@@ -86,6 +111,11 @@ impl Passes {
             "lineao-chain" => {
                 self.pyramid.encode(encoder, targets, span.map(Span::begin_only));
                 self.line_ao.encode(encoder, targets, span.map(Span::end_only));
+            }
+            "ssao-12" => self.ssao_12.encode(encoder, targets, span),
+            "ssao-16-chain" => {
+                self.ssao_16.encode(encoder, targets, span.map(Span::begin_only));
+                self.ssao_blur.encode(encoder, targets, span.map(Span::end_only));
             }
             _ => unreachable!("unknown bench pass {name}"),
         }
@@ -123,7 +153,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
 
     let mut times: Vec<Vec<f64>> = vec![Vec::new(); PASSES.len()];
     // Quads last among the line passes, so the G-buffer the later passes read is the chain's.
-    let order = ["lines-native-1px", "lines", "nd-pyramid", "lineao", "lineao-tap-floor", "composite", "lineao-chain"];
+    let order = std::iter::once("lines-native-1px").chain(PASSES.into_iter().filter(|p| *p != "lines-native-1px"));
     // The G-buffer and pyramid every later pass reads, also when `--passes` leaves them out.
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::bench") });
     passes.encode("lines", &mut encoder, targets, &geometry, settings.background, None);
@@ -131,7 +161,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     queue.submit([encoder.finish()]);
     let selected = |name: &str| args.passes.is_empty() || args.passes.iter().any(|p| p == name);
     for frame in 0..args.warmup + args.frames {
-        for name in order.into_iter().filter(|name| selected(name)) {
+        for name in order.clone().filter(|name| selected(name)) {
             let mut encoder =
                 device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::bench") });
             encoder.push_debug_group(name);
@@ -208,7 +238,7 @@ fn print_table(report: &serde_json::Value, passes: &[serde_json::Value]) {
             f("ms_max")
         );
     }
-    for (a, b) in [("lineao", "lineao-tap-floor"), ("lines", "lines-native-1px")] {
+    for (a, b) in [("lineao", "lineao-tap-floor"), ("lines", "lines-native-1px"), ("lineao-chain", "ssao-16-chain")] {
         if let (Some(x), Some(y)) = (median(a), median(b)) {
             println!("{a} / {b}: {:.2}x", x / y);
         }

@@ -15,7 +15,7 @@ pub struct Cli {
 #[derive(Subcommand, Debug)]
 pub enum Command {
     /// Render a tractography file or a built-in scene to a PNG.
-    Render(RenderArgs),
+    Render(Box<RenderArgs>),
     /// Describe a tractography file (CONTRACT.md `lineao info --json`).
     Info(InfoArgs),
     /// Time loading .tck, .trk and .trx files against reading their bytes and against nibabel.
@@ -73,6 +73,8 @@ fn parse_bench_pass(s: &str) -> Result<String, String> {
 pub enum Method {
     None,
     Lineao,
+    /// Crytek SSAO with its 4 × 4 blur (the LineAO paper's baseline).
+    Ssao,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -182,6 +184,15 @@ pub struct RenderArgs {
     /// Variant `reference`: base radius in pixels at the home zoom (the authors' u_lineAORadius).
     #[arg(long, default_value_t = 2.0)]
     pub reference_radius: f32,
+    /// SSAO: point samples in the sphere (8..=32).
+    #[arg(long, default_value_t = 16)]
+    pub samples: u32,
+    /// SSAO: sphere radius in world units (mm for tractograms).
+    #[arg(long, default_value_t = 2.0)]
+    pub radius: f32,
+    /// SSAO: range check in world units [default: the radius].
+    #[arg(long)]
+    pub ssao_range: Option<f32>,
     /// LineAO δ0.
     #[arg(long, default_value_t = 1e-4)]
     pub delta0: f32,

@@ -1,6 +1,7 @@
 //! `--dump DIR` (CONTRACT.md): the method's inputs and raw output at the guard-banded size, so an
 //! outside implementation can recompute the result: `nd_<j>.npy`, `zoom.npy`, `ao.npy`,
-//! `noise.npy`, `samples.npy` and `params.json`.
+//! `noise.npy`, `samples.npy` (LineAO) or `ssao_kernel.npy`, `ssao_noise.npy` (SSAO), and
+//! `params.json`. `ao.npy` is the method's raw occlusion, before SSAO's blur.
 
 use std::fs::File;
 use std::io::BufWriter;
@@ -43,7 +44,8 @@ pub fn write(dir: &Path, gpu: &Gpu, chain: &AoChain, camera: &Camera) -> Result<
     }
     let (w, h) = (targets.size.0 as u64, targets.size.1 as u64);
     write_npy(dir, "zoom.npy", &[h, w], &read(&targets.zoom.texture)?.to_f32())?;
-    write_npy(dir, "ao.npy", &[h, w], &read(&targets.ao.texture)?.to_f32())?;
+    let raw = if s.method == AoMethod::Ssao { &targets.ao_raw } else { &targets.ao };
+    write_npy(dir, "ao.npy", &[h, w], &read(&raw.texture)?.to_f32())?;
 
     let mut params = json!({
         "method": s.method.name(),
@@ -102,6 +104,19 @@ pub fn write(dir: &Path, gpu: &Gpu, chain: &AoChain, camera: &Camera) -> Result<
         write_npy(dir, "noise.npy", &[64, 64, 3], &flat3(&noise::noise_tile(ao.noise_seed)))?;
         let samples = lineao::passes::line_ao::sample_table(ao);
         write_npy(dir, "samples.npy", &[ao.s_r as u64, ao.s_h as u64, 3], &flat3(&samples))?;
+    }
+    if s.method == AoMethod::Ssao {
+        let ssao = &s.ssao;
+        let extra = json!({
+            "samples": ssao.samples,
+            "radius_world": ssao.radius_world,
+            "ssao_range": ssao.range_world,
+            "noise_seed": ssao.noise_seed,
+        });
+        params.as_object_mut().expect("object").extend(extra.as_object().expect("object").clone());
+        let kernel = noise::ssao_kernel(ssao.noise_seed, ssao.samples);
+        write_npy(dir, "ssao_kernel.npy", &[ssao.samples as u64, 3], &flat3(&kernel))?;
+        write_npy(dir, "ssao_noise.npy", &[4, 4, 3], &flat3(&noise::ssao_noise(ssao.noise_seed)))?;
     }
     let path = dir.join("params.json");
     let text = serde_json::to_string_pretty(&params)?;

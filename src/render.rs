@@ -4,7 +4,7 @@ use anyhow::{Context, Result};
 use glam::Vec3;
 use lineao::camera::{Camera, Projection};
 use lineao::passes::lines::LineGeometry;
-use lineao::{AoChain, AoMethod, ChainSettings, Gpu, LineAoSettings, LineAoVariant, LineColor};
+use lineao::{AoChain, AoMethod, ChainSettings, Gpu, LineAoSettings, LineAoVariant, LineColor, SsaoSettings};
 use lineao_tracts::scenes::ViewHint;
 
 use crate::cli::{ColorArg, Method, RenderArgs, Variant};
@@ -15,6 +15,13 @@ pub fn settings(args: &RenderArgs, zoom_unit: f32) -> ChainSettings {
         method: match args.method {
             Method::None => AoMethod::None,
             Method::Lineao => AoMethod::LineAo,
+            Method::Ssao => AoMethod::Ssao,
+        },
+        ssao: SsaoSettings {
+            samples: args.samples,
+            radius_world: args.radius,
+            range_world: args.ssao_range.unwrap_or(args.radius),
+            noise_seed: args.noise_seed,
         },
         line_ao: LineAoSettings {
             s_r: args.s_r,

@@ -1,7 +1,7 @@
 //! `lineao render` end to end: exit codes, the PNG, and `--dump` read back the way an outside
 //! tool would, recomputing LineAO from the dumped files alone.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Output;
 
 mod common;
@@ -9,7 +9,7 @@ use common::{lineao, scratch};
 
 use lineao::LineAoVariant;
 use lineao::lighting::Light;
-use lineao::reference::{self, Image, LineAoParams};
+use lineao::reference::{self, Image, LineAoParams, SsaoParams, ViewParams};
 use lineao::verify::{check_policy, line_ao_flip_bound, line_ao_reference_flip_bound};
 use serde_json::Value;
 
@@ -74,32 +74,24 @@ fn render_and_dump_let_an_outside_tool_recompute_the_reference_variant() {
     recompute_from_dump("reference");
 }
 
+/// `lineao render` at 200 × 150 on 60 000 vertices with `extra` options and `--dump`; returns
+/// the PNG's and the dump folder's paths.
+fn render_with_dump(name: &str, extra: &[&str]) -> (PathBuf, PathBuf) {
+    let dir = scratch(name);
+    let (png, dump) = (dir.join("out.png"), dir.join("dump"));
+    let mut args = vec!["render", "--vertices", "60000", "--width", "200", "--height", "150"];
+    args.extend(extra);
+    args.extend(["-o", png.to_str().unwrap(), "--dump", dump.to_str().unwrap()]);
+    let out = lineao(&args);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    (png, dump)
+}
+
 /// Renders with `--variant variant --dump`, then recomputes LineAO from the dumped files and
 /// `params.json` alone, as an outside implementation would.
 fn recompute_from_dump(variant: &str) {
-    let dir = scratch(&format!("dump-{variant}"));
-    let png = dir.join("out.png");
-    let dump = dir.join("dump");
-    let out = lineao(&[
-        "render",
-        "--scene",
-        "spiral",
-        "--vertices",
-        "60000",
-        "--width",
-        "200",
-        "--height",
-        "150",
-        "--variant",
-        variant,
-        "--guard-max",
-        "48",
-        "-o",
-        png.to_str().unwrap(),
-        "--dump",
-        dump.to_str().unwrap(),
-    ]);
-    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let (png, dump) =
+        render_with_dump(&format!("dump-{variant}"), &["--scene", "spiral", "--variant", variant, "--guard-max", "48"]);
 
     let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&png).unwrap()));
     let reader = decoder.read_info().unwrap();
@@ -227,7 +219,17 @@ fn bench_json_is_the_contract() {
     let names: Vec<&str> = passes.iter().map(|p| p["name"].as_str().unwrap()).collect();
     assert_eq!(
         names,
-        ["lines", "lines-native-1px", "nd-pyramid", "lineao", "lineao-tap-floor", "composite", "lineao-chain"]
+        [
+            "lines",
+            "lines-native-1px",
+            "nd-pyramid",
+            "lineao",
+            "lineao-tap-floor",
+            "composite",
+            "lineao-chain",
+            "ssao-12",
+            "ssao-16-chain"
+        ]
     );
     for p in passes {
         assert_eq!(p["on"], on);
@@ -256,4 +258,52 @@ fn bench_json_is_the_contract() {
     let passes = report["passes"].as_array().unwrap();
     assert_eq!(passes.iter().map(|p| p["name"].as_str().unwrap()).collect::<Vec<_>>(), ["lines", "lineao"]);
     assert!(passes.iter().all(|p| p["on"] == "cpu" && p["ms_median"].as_f64().unwrap() > 0.0));
+}
+
+/// `--method ssao --dump`: Crytek SSAO recomputed from the dumped files and `params.json` alone
+/// (the projection from the camera's field of view and the image height, as an outside tool
+/// would), against the dumped raw `ao.npy`.
+#[test]
+fn render_and_dump_let_an_outside_tool_recompute_ssao() {
+    let extra = ["--scene", "vortex", "--method", "ssao", "--samples", "12", "--radius", "3"];
+    let (_, dump) = render_with_dump("dump-ssao", &extra);
+    let params: Value = serde_json::from_str(&std::fs::read_to_string(dump.join("params.json")).unwrap()).unwrap();
+    assert_eq!(params["method"], "ssao");
+    assert_eq!(
+        (params["samples"].as_u64(), params["radius_world"].as_f64(), params["ssao_range"].as_f64()),
+        (Some(12), Some(3.0), Some(3.0))
+    );
+    assert!(params.get("s_r").is_none(), "LineAO keys are omitted for SSAO");
+    let f = |k: &str| params[k].as_f64().unwrap() as f32;
+    let guard = params["guard_px"].as_u64().unwrap() as usize;
+    let (w, h) = (
+        params["width"].as_u64().unwrap() as usize + 2 * guard,
+        params["height"].as_u64().unwrap() as usize + 2 * guard,
+    );
+    let f_px = match params["camera"]["fov_y_deg"].as_f64() {
+        Some(fov) => f("height") / (2.0 * ((fov as f32).to_radians() * 0.5).tan()),
+        None => f("height") / params["camera"]["ortho_height"].as_f64().unwrap() as f32,
+    };
+    let view = ViewParams {
+        near: f("depth_near"),
+        far: f("depth_far"),
+        f_px,
+        orthographic: params["camera"]["fov_y_deg"].is_null(),
+        center: [w as f32 * 0.5, h as f32 * 0.5],
+    };
+    let (shape, nd) = read_npy(&dump.join("nd_0.npy"));
+    assert_eq!(shape, [h as u64, w as u64, 4]);
+    let nd0 = Image { width: w, height: h, data: nd.chunks_exact(4).map(|t| [t[0], t[1], t[2], t[3]]).collect() };
+    let (_, ao) = read_npy(&dump.join("ao.npy"));
+    let ao = Image { width: w, height: h, data: ao };
+    let (kshape, kernel) = read_npy(&dump.join("ssao_kernel.npy"));
+    assert_eq!(kshape, [12, 3]);
+    let (nshape, tile) = read_npy(&dump.join("ssao_noise.npy"));
+    assert_eq!(nshape, [4, 4, 3]);
+    let triples = |v: &[f32]| v.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect::<Vec<_>>();
+    let p = SsaoParams { view, radius: f("radius_world"), range: f("ssao_range"), noise_origin: [guard as i32; 2] };
+    let cpu = reference::ssao(&nd0, &triples(&kernel), &triples(&tile), &p);
+    let stats = check_policy(&ao, &cpu, &nd0, 2.0 / 12.0).unwrap_or_else(|e| panic!("{e}"));
+    println!("ssao from --dump: {stats}");
+    assert!(ao.data.iter().filter(|&&a| a > 0.05).count() > 200, "SSAO occludes something");
 }

@@ -9,7 +9,7 @@ use lineao::camera::{Camera, Projection};
 use lineao::passes::lines::LineGeometry;
 use lineao::readback::read_texture;
 use lineao::targets::Target;
-use lineao::{AoChain, ChainSettings, DebugView, Gpu, LineAoSettings, LineAoVariant};
+use lineao::{AoChain, AoMethod, ChainSettings, DebugView, Gpu, LineAoSettings, LineAoVariant};
 use lineao_tracts::SceneKind;
 
 const SIZE: (u32, u32) = (160, 128);
@@ -97,6 +97,8 @@ fn every_pass_on_every_scene() {
         ("level1", debug(DebugView::Level(1))),
         ("level2", debug(DebugView::Level(2))),
         ("reference_ao", reference),
+        ("ssao_ao", ChainSettings { method: AoMethod::Ssao, debug_view: DebugView::Ao, ..ChainSettings::default() }),
+        ("ssao_final", ChainSettings { method: AoMethod::Ssao, ..ChainSettings::default() }),
     ];
     let mut failures = Vec::new();
     for kind in SceneKind::ALL {

@@ -13,9 +13,13 @@
 //!   target view ◀─ Composite ◀──────────┘ color · (1 − strength · ao) + specular
 //! ```
 //!
+//! With [`AoMethod::Ssao`] the pyramid and LineAO give way to Crytek SSAO (`nd[0]` → `ao_raw`)
+//! and its 4 × 4 blur (`ao_raw` → `ao`).
+//!
 //! Every pass is labelled and the frame sits in a `lineao` debug group, so GPU debuggers show
 //! the chain by name. With [`AoChain::set_timing`] each pass also records timestamp queries under
-//! the names `lineao bench` uses (CONTRACT.md): `lines`, `nd-pyramid`, `lineao`, `composite`.
+//! the names `lineao bench` uses (CONTRACT.md): `lines`, `nd-pyramid`, `lineao`, `ssao`,
+//! `ssao-blur`, `composite`.
 
 use crate::Error;
 use crate::camera::{self, Bounds, Camera, FrameView};
@@ -23,18 +27,22 @@ use crate::passes::composite::Composite;
 use crate::passes::line_ao::LineAo;
 use crate::passes::lines::{LineGeometry, LineRenderer};
 use crate::passes::nd_pyramid::NdPyramid;
+use crate::passes::ssao::Ssao;
+use crate::passes::ssao_blur::SsaoBlur;
 use crate::settings::{AoMethod, ChainSettings, LineAoVariant};
 use crate::targets::FrameTargets;
 use crate::timing::{PassTime, PassTimer};
 
 /// The spans of a timed frame, in chain order.
-pub const PASS_NAMES: [&str; 4] = ["lines", "nd-pyramid", "lineao", "composite"];
+pub const PASS_NAMES: [&str; 6] = ["lines", "nd-pyramid", "lineao", "ssao", "ssao-blur", "composite"];
 
 pub struct AoChain {
     settings: ChainSettings,
     lines: LineRenderer,
     pyramid: NdPyramid,
     line_ao: LineAo,
+    ssao: Ssao,
+    ssao_blur: SsaoBlur,
     composite: Composite,
     size: (u32, u32),
     max_texture: u32,
@@ -51,6 +59,8 @@ impl AoChain {
             lines: LineRenderer::new(device),
             pyramid: NdPyramid::new(device),
             line_ao: LineAo::new(device, &settings.line_ao, &settings.lighting),
+            ssao: Ssao::new(device, &settings.ssao),
+            ssao_blur: SsaoBlur::new(device),
             composite: Composite::new(device, format),
             settings,
             size: (0, 0),
@@ -75,6 +85,12 @@ impl AoChain {
                 self.line_ao.resize(device, targets);
             }
         }
+        if !self.ssao.matches(&settings.ssao) {
+            self.ssao = Ssao::new(device, &settings.ssao);
+            if let Some(targets) = &self.targets {
+                self.ssao.resize(device, targets);
+            }
+        }
         if settings.levels() != self.settings.levels() {
             self.targets = None;
         }
@@ -94,8 +110,9 @@ impl AoChain {
     pub fn pass_times(&self, device: &wgpu::Device) -> Result<Option<Vec<PassTime>>, Error> {
         let Some(timer) = &self.timer else { return Ok(None) };
         let used: &[&str] = match (self.settings.method, self.settings.levels()) {
-            (AoMethod::LineAo, 2..) => &PASS_NAMES,
+            (AoMethod::LineAo, 2..) => &["lines", "nd-pyramid", "lineao", "composite"],
             (AoMethod::LineAo, _) => &["lines", "lineao", "composite"],
+            (AoMethod::Ssao, _) => &["lines", "ssao", "ssao-blur", "composite"],
             (AoMethod::None, _) => &["lines", "composite"],
         };
         timer.read(device, used).map(Some)
@@ -123,6 +140,13 @@ impl AoChain {
         let s = &self.settings;
         match (s.method, s.line_ao.variant) {
             (AoMethod::None, _) => 0,
+            // The sphere's radius in pixels where it is largest (at the near plane), plus the
+            // blur's 2 px.
+            (AoMethod::Ssao, _) => {
+                let unguarded = FrameView::new(camera, bounds, self.size.0, self.size.1, 0, s.zoom_unit);
+                let radius = s.ssao.radius_world * unguarded.zoom_max() / s.zoom_unit + 2.0;
+                camera::guard_band(radius, 1, s.line_ao.guard_max_px)
+            }
             // Its radius grows as 1/(1 − d), without bound toward the far plane.
             (AoMethod::LineAo, LineAoVariant::Reference) => s.line_ao.guard_max_px,
             (AoMethod::LineAo, LineAoVariant::Paper) => {
@@ -159,13 +183,19 @@ impl AoChain {
             let targets = FrameTargets::new(device, width, height, guard, levels);
             self.pyramid.resize(device, &targets);
             self.line_ao.resize(device, &targets);
+            self.ssao.resize(device, &targets);
+            self.ssao_blur.resize(device, &targets);
             self.composite.resize(device, &targets);
             self.targets = Some(targets);
         }
         let targets = self.targets.as_ref()?;
         let view = FrameView::new(camera, bounds, width, height, guard, s.zoom_unit);
         self.lines.prepare(queue, &view, s.line_width_px, s.line_color, &s.lighting);
-        self.line_ao.prepare(queue, targets, &view, &s.line_ao, s.r0_px(), &s.lighting);
+        match s.method {
+            AoMethod::LineAo => self.line_ao.prepare(queue, targets, &view, &s.line_ao, s.r0_px(), &s.lighting),
+            AoMethod::Ssao => self.ssao.prepare(queue, targets, &view, &s.ssao),
+            AoMethod::None => {}
+        }
         let strength = if s.method == AoMethod::None { 0.0 } else { s.strength };
         self.composite.prepare(queue, targets, strength, s.debug_view, view.zoom_max());
         self.view = Some(view);
@@ -182,11 +212,18 @@ impl AoChain {
         let span = |name| self.timer.as_ref().and_then(|t| t.span(name));
         encoder.push_debug_group("lineao");
         self.lines.encode(encoder, targets, geometry, self.settings.background, span("lines"));
-        if self.settings.method == AoMethod::LineAo {
-            if self.settings.levels() > 1 {
-                self.pyramid.encode(encoder, targets, span("nd-pyramid"));
+        match self.settings.method {
+            AoMethod::LineAo => {
+                if self.settings.levels() > 1 {
+                    self.pyramid.encode(encoder, targets, span("nd-pyramid"));
+                }
+                self.line_ao.encode(encoder, targets, span("lineao"));
             }
-            self.line_ao.encode(encoder, targets, span("lineao"));
+            AoMethod::Ssao => {
+                self.ssao.encode(encoder, targets, span("ssao"));
+                self.ssao_blur.encode(encoder, targets, span("ssao-blur"));
+            }
+            AoMethod::None => {}
         }
         self.composite.encode(encoder, target, span("composite"));
         if let Some(timer) = &self.timer {

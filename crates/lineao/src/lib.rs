@@ -53,7 +53,7 @@ pub mod verify;
 
 pub use chain::AoChain;
 pub use gpu::Gpu;
-pub use settings::{AoMethod, ChainSettings, DebugView, LineAoSettings, LineAoVariant, LineColor};
+pub use settings::{AoMethod, ChainSettings, DebugView, LineAoSettings, LineAoVariant, LineColor, SsaoSettings};
 
 /// Pyramid levels (and so LineAO hemispheres) the shaders can bind.
 pub const MAX_LEVELS: u32 = 5;

@@ -55,6 +55,28 @@ pub fn sample_table(seed: u32, s_r: u32, s_h: u32, count: impl Fn(u32) -> u32) -
     table
 }
 
+const STREAM_SSAO_KERNEL: u32 = 3;
+const STREAM_SSAO_NOISE: u32 = 4;
+/// Side of the SSAO rotation tile (Crytek's 4 × 4, matched by its 4 × 4 blur).
+pub const SSAO_NOISE_SIZE: usize = 4;
+
+/// The SSAO kernel: `n` points inside the unit sphere, directions uniform, lengths
+/// 0.1 + 0.9 (i/n)² so that more samples sit near the centre, where occluders matter most.
+pub fn ssao_kernel(seed: u32, n: u32) -> Vec<[f32; 3]> {
+    (0..n)
+        .map(|i| {
+            let t = (i + 1) as f32 / n as f32;
+            let scale = 0.1 + 0.9 * t * t;
+            unit_vector(seed, STREAM_SSAO_KERNEL, i).map(|c| c * scale)
+        })
+        .collect()
+}
+
+/// The 4 × 4 rotation tile, `noise[y * 4 + x]`: unit vectors the kernel is reflected about.
+pub fn ssao_noise(seed: u32) -> Vec<[f32; 3]> {
+    (0..(SSAO_NOISE_SIZE * SSAO_NOISE_SIZE) as u32).map(|i| unit_vector(seed, STREAM_SSAO_NOISE, i)).collect()
+}
+
 /// n_j = ⌈s_h / (j + 1)⌉ (Eq. 7): the harmonic series of samples per hemisphere.
 pub fn samples_on_hemisphere(s_h: u32, j: u32) -> u32 {
     s_h.div_ceil(j + 1)

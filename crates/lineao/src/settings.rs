@@ -10,6 +10,8 @@ pub enum AoMethod {
     /// LineAO (Eichelbaum et al. 2013).
     #[default]
     LineAo,
+    /// Crytek SSAO (Mittring 2007), the LineAO paper's baseline, with its 4 × 4 blur.
+    Ssao,
 }
 
 impl AoMethod {
@@ -18,6 +20,7 @@ impl AoMethod {
         match self {
             AoMethod::None => "none",
             AoMethod::LineAo => "lineao",
+            AoMethod::Ssao => "ssao",
         }
     }
 }
@@ -88,6 +91,26 @@ impl Default for LineAoSettings {
 }
 
 /// What the composite shows.
+/// Crytek SSAO (`lineao::passes::ssao`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SsaoSettings {
+    /// Point samples in the sphere (8..=32).
+    pub samples: u32,
+    /// Radius of the sampling sphere in world units.
+    pub radius_world: f32,
+    /// Range check: a sample counts as occluded only when the visible surface is in front of it
+    /// by less than this (world units), so far-away foreground does not darken the background.
+    pub range_world: f32,
+    /// Seed of the kernel and the 4 × 4 rotation tile.
+    pub noise_seed: u32,
+}
+
+impl Default for SsaoSettings {
+    fn default() -> Self {
+        SsaoSettings { samples: 16, radius_world: 2.0, range_world: 2.0, noise_seed: 1 }
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum DebugView {
     /// color · (1 − strength · ao) + specular.
@@ -133,6 +156,7 @@ pub enum LineColor {
 pub struct ChainSettings {
     pub method: AoMethod,
     pub line_ao: LineAoSettings,
+    pub ssao: SsaoSettings,
     pub lighting: Lighting,
     /// Line width in pixels, > 0. Default 2.
     pub line_width_px: f32,
@@ -151,6 +175,7 @@ impl Default for ChainSettings {
         ChainSettings {
             method: AoMethod::LineAo,
             line_ao: LineAoSettings::default(),
+            ssao: SsaoSettings::default(),
             lighting: Lighting::default(),
             line_width_px: 2.0,
             line_color: LineColor::Tangent,
@@ -173,7 +198,7 @@ impl ChainSettings {
     pub fn levels(&self) -> u32 {
         match (self.method, self.line_ao.variant) {
             (AoMethod::LineAo, LineAoVariant::Paper) => self.line_ao.s_r,
-            (AoMethod::LineAo, LineAoVariant::Reference) | (AoMethod::None, _) => 1,
+            (AoMethod::LineAo, LineAoVariant::Reference) | (AoMethod::None | AoMethod::Ssao, _) => 1,
         }
     }
 
@@ -201,6 +226,16 @@ impl ChainSettings {
         }
         if !(ao.epsilon.is_finite() && ao.epsilon >= 0.0) {
             return bad(format!("epsilon must be >= 0, got {}", ao.epsilon));
+        }
+        let ssao = &self.ssao;
+        if !(8..=32).contains(&ssao.samples) {
+            return bad(format!("SSAO samples must be in 8..=32, got {}", ssao.samples));
+        }
+        if !(ssao.radius_world.is_finite() && ssao.radius_world > 0.0) {
+            return bad(format!("the SSAO radius must be > 0 world units, got {}", ssao.radius_world));
+        }
+        if !(ssao.range_world.is_finite() && ssao.range_world > 0.0) {
+            return bad(format!("the SSAO range must be > 0 world units, got {}", ssao.range_world));
         }
         if !(self.strength.is_finite() && self.strength >= 0.0) {
             return bad(format!("strength must be >= 0, got {}", self.strength));

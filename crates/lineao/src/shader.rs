@@ -11,10 +11,13 @@ pub const FILES: &[(&str, &str)] = &[
     ("shared/fullscreen.wgsl", include_str!("../shaders/shared/fullscreen.wgsl")),
     ("shared/lighting.wgsl", include_str!("../shaders/shared/lighting.wgsl")),
     ("shared/nd.wgsl", include_str!("../shaders/shared/nd.wgsl")),
+    ("shared/view.wgsl", include_str!("../shaders/shared/view.wgsl")),
     ("composite.wgsl", include_str!("../shaders/composite.wgsl")),
     ("line_ao.wgsl", include_str!("../shaders/line_ao.wgsl")),
     ("lines.wgsl", include_str!("../shaders/lines.wgsl")),
     ("nd_pyramid.wgsl", include_str!("../shaders/nd_pyramid.wgsl")),
+    ("ssao.wgsl", include_str!("../shaders/ssao.wgsl")),
+    ("ssao_blur.wgsl", include_str!("../shaders/ssao_blur.wgsl")),
 ];
 
 /// The embedded source of `path` (relative to `shaders/`), without imports resolved.

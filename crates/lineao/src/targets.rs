@@ -85,7 +85,10 @@ pub struct FrameTargets {
     pub zoom: Target,
     pub specular: Target,
     pub depth: Target,
+    /// What the composite shows: the method's occlusion, after its blur if it has one.
     pub ao: Target,
+    /// A method's occlusion before its blur (SSAO); the blur writes `ao`.
+    pub ao_raw: Target,
 }
 
 impl FrameTargets {
@@ -96,6 +99,7 @@ impl FrameTargets {
         let size = (width + 2 * guard, height + 2 * guard);
         // COPY_DST lets a host (or a test) write a G-buffer of its own into the targets.
         let attachment = U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC | U::COPY_DST;
+        let ao_usage = U::STORAGE_BINDING | U::TEXTURE_BINDING | U::COPY_SRC | U::COPY_DST;
         let nd = level_sizes(size, levels.max(1))
             .into_iter()
             .enumerate()
@@ -112,13 +116,8 @@ impl FrameTargets {
             zoom: Target::new(device, "lineao::FrameTargets::zoom", size, ZOOM_FORMAT, attachment),
             specular: Target::new(device, "lineao::FrameTargets::specular", size, SPECULAR_FORMAT, attachment),
             depth: Target::new(device, "lineao::FrameTargets::depth", size, DEPTH_FORMAT, attachment),
-            ao: Target::new(
-                device,
-                "lineao::FrameTargets::ao",
-                size,
-                AO_FORMAT,
-                U::STORAGE_BINDING | U::TEXTURE_BINDING | U::COPY_SRC | U::COPY_DST,
-            ),
+            ao: Target::new(device, "lineao::FrameTargets::ao", size, AO_FORMAT, ao_usage),
+            ao_raw: Target::new(device, "lineao::FrameTargets::ao_raw", size, AO_FORMAT, ao_usage),
         }
     }
 

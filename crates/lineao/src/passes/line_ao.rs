@@ -47,10 +47,10 @@ use crate::binding::{self, Slot};
 use crate::camera::FrameView;
 use crate::lighting::{Lighting, LightingUniform};
 use crate::noise;
-use crate::passes::dispatch_size;
+use crate::passes::dispatch_full_screen;
 use crate::settings::{LineAoSettings, LineAoVariant};
 use crate::targets::{AO_FORMAT, FrameTargets, LevelsUniform};
-use crate::timing::{self, Span};
+use crate::timing::Span;
 
 /// Keep in sync with `LineAoUniform` in `shaders/line_ao.wgsl`.
 #[repr(C)]
@@ -260,13 +260,6 @@ impl LineAo {
     /// Records the pass, timed into `span` when given.
     pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, targets: &FrameTargets, span: Option<Span>) {
         let Some(group) = &self.group else { return };
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("lineao::LineAo"),
-            timestamp_writes: timing::compute_writes(span),
-        });
-        pass.set_pipeline(&self.pipeline);
-        pass.set_bind_group(0, group, &[]);
-        let (x, y) = dispatch_size(targets.size);
-        pass.dispatch_workgroups(x, y, 1);
+        dispatch_full_screen(encoder, "lineao::LineAo", &self.pipeline, group, targets.size, span);
     }
 }

@@ -6,10 +6,32 @@ pub mod composite;
 pub mod line_ao;
 pub mod lines;
 pub mod nd_pyramid;
+pub mod ssao;
+pub mod ssao_blur;
 
 /// Workgroup size of the compute passes (8 × 8, as in the WGSL files).
 pub(crate) const WORKGROUP: u32 = 8;
 
 pub(crate) fn dispatch_size((width, height): (u32, u32)) -> (u32, u32) {
     (width.div_ceil(WORKGROUP), height.div_ceil(WORKGROUP))
+}
+
+/// Records one compute pass over every pixel of `targets` (8 × 8 workgroups), timed into
+/// `span` when given: the whole `encode` of a full-screen compute pass.
+pub(crate) fn dispatch_full_screen(
+    encoder: &mut wgpu::CommandEncoder,
+    label: &str,
+    pipeline: &wgpu::ComputePipeline,
+    group: &wgpu::BindGroup,
+    size: (u32, u32),
+    span: Option<crate::timing::Span>,
+) {
+    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        label: Some(label),
+        timestamp_writes: crate::timing::compute_writes(span),
+    });
+    pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, group, &[]);
+    let (x, y) = dispatch_size(size);
+    pass.dispatch_workgroups(x, y, 1);
 }

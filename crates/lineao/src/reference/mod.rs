@@ -6,8 +6,10 @@
 //! the two differ only by rounding inside the GPU (fused multiply-adds, `pow`, `sqrt`).
 
 mod line_ao;
+mod ssao;
 
 pub use line_ao::{LineAoParams, delta, depth_weight, hermite, light_weight, line_ao, line_ao_pixel};
+pub use ssao::{SSAO_EPSILON, SsaoParams, ViewParams, ssao, ssao_blur, ssao_pixel};
 
 /// A row-major image, `data[y * width + x]`.
 #[derive(Clone, Debug, PartialEq)]

@@ -29,6 +29,8 @@ pub struct Frame {
     pub specular: Image<f32>,
     pub depth: Image<f32>,
     pub ao: Image<f32>,
+    /// A method's occlusion before its blur (SSAO).
+    pub ao_raw: Image<f32>,
     /// The composite's output (Rgba32Float, linear), visible size.
     pub output: NdImage,
 }
@@ -75,6 +77,7 @@ pub fn render_geometry(
         specular: read_f32(d, q, &t.specular).unwrap(),
         depth: read_f32(d, q, &t.depth).unwrap(),
         ao: read_f32(d, q, &t.ao).unwrap(),
+        ao_raw: read_f32(d, q, &t.ao_raw).unwrap(),
         output: read_rgba(d, q, &output).unwrap(),
     }
 }

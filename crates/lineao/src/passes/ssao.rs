@@ -1,0 +1,154 @@
+//! Crytek SSAO (Mittring 2007, "Finding next gen: CryEngine 2", §8.5.4.3): the screen-space
+//! ambient occlusion the LineAO paper compares against.
+//!
+//! For the view-space position P of each pixel, N points q_i = P + R · reflect(k_i, r(P)) of a
+//! kernel inside the sphere of radius R are projected back into the image; q_i counts as
+//! occluded when the visible surface at its pixel lies in front of it — by more than ε (flat
+//! surfaces stay clean of f32 noise) and less than the *range* (a far foreground does not
+//! darken what lies behind it):
+//!
+//! ```text
+//!   ao(P) = 1/N Σ_i [ε < depth(q_i) − surface(pixel(q_i)) < range]
+//! ```
+//!
+//! r(P) comes from a 4 × 4 tile of unit vectors, so 16 neighbouring pixels see 16 rotations of
+//! the kernel, and [`crate::passes::ssao_blur`] averages exactly that 4 × 4 window. Nothing here
+//! knows about lines: a surface facing the camera is half occluded by itself (the samples behind
+//! it), the grey look that LineAO's hemispheres avoid. The radius is in world units, so thin
+//! lines far away get a sphere of a pixel or two — the paper's point about screen-space AO on
+//! lines. The CPU reference is [`crate::reference::ssao`].
+
+use wgpu::util::DeviceExt;
+
+use crate::binding::{self, Slot};
+use crate::camera::FrameView;
+use crate::noise;
+use crate::passes::dispatch_full_screen;
+use crate::reference::ViewParams;
+use crate::settings::SsaoSettings;
+use crate::targets::{AO_FORMAT, FrameTargets};
+use crate::timing::Span;
+
+/// `ViewParams` in `shaders/shared/view.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct ViewUniform {
+    pub near: f32,
+    pub far: f32,
+    pub f_px: f32,
+    pub orthographic: u32,
+    pub center: [f32; 2],
+    pub _pad: [f32; 2],
+}
+
+impl From<ViewParams> for ViewUniform {
+    fn from(v: ViewParams) -> Self {
+        ViewUniform {
+            near: v.near,
+            far: v.far,
+            f_px: v.f_px,
+            orthographic: v.orthographic as u32,
+            center: v.center,
+            _pad: [0.0; 2],
+        }
+    }
+}
+
+/// Keep in sync with `SsaoUniform` in `shaders/ssao.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct SsaoUniform {
+    pub view: ViewUniform,
+    pub noise_origin: [i32; 2],
+    pub radius: f32,
+    pub range: f32,
+}
+
+/// The kernel and the tile as the shader reads them: kernel in 0..32, tile in 32..48.
+const TABLES: usize = 48;
+
+pub struct Ssao {
+    samples: u32,
+    noise_seed: u32,
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    uniform: wgpu::Buffer,
+    tables: wgpu::Buffer,
+    group: Option<wgpu::BindGroup>,
+}
+
+impl Ssao {
+    pub fn new(device: &wgpu::Device, settings: &SsaoSettings) -> Ssao {
+        let layout = binding::layout(
+            device,
+            "lineao::Ssao::layout",
+            wgpu::ShaderStages::COMPUTE,
+            &[Slot::Uniform, Slot::Uniform, Slot::Texture, Slot::StorageTexture(AO_FORMAT)],
+        );
+        let pipeline = binding::compute_pipeline(
+            device,
+            "lineao::Ssao::pipeline",
+            &layout,
+            "ssao.wgsl",
+            "ssao",
+            &[("SAMPLES", settings.samples as f64)],
+        );
+        let mut tables = [[0.0f32; 4]; TABLES];
+        for (slot, k) in tables.iter_mut().zip(noise::ssao_kernel(settings.noise_seed, settings.samples)) {
+            *slot = [k[0], k[1], k[2], 0.0];
+        }
+        for (slot, r) in tables[32..].iter_mut().zip(noise::ssao_noise(settings.noise_seed)) {
+            *slot = [r[0], r[1], r[2], 0.0];
+        }
+        Ssao {
+            samples: settings.samples,
+            noise_seed: settings.noise_seed,
+            pipeline,
+            layout,
+            uniform: binding::uniform_buffer::<SsaoUniform>(device, "lineao::Ssao::uniform"),
+            tables: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("lineao::Ssao::tables"),
+                contents: bytemuck::cast_slice(&tables),
+                usage: wgpu::BufferUsages::UNIFORM,
+            }),
+            group: None,
+        }
+    }
+
+    /// Whether `settings` can reuse this pipeline and its tables.
+    pub fn matches(&self, settings: &SsaoSettings) -> bool {
+        (self.samples, self.noise_seed) == (settings.samples, settings.noise_seed)
+    }
+
+    /// Reads `nd[0]`, writes `ao_raw`.
+    pub fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets) {
+        self.group = Some(binding::group(
+            device,
+            "lineao::Ssao::group",
+            &self.layout,
+            &[
+                self.uniform.as_entire_binding(),
+                self.tables.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&targets.nd[0].view),
+                wgpu::BindingResource::TextureView(&targets.ao_raw.view),
+            ],
+        ));
+    }
+
+    pub fn prepare(&self, queue: &wgpu::Queue, targets: &FrameTargets, view: &FrameView, settings: &SsaoSettings) {
+        let guard = targets.guard as i32;
+        let uniform = SsaoUniform {
+            view: ViewParams::of(view).into(),
+            noise_origin: [guard, guard],
+            radius: settings.radius_world,
+            range: settings.range_world,
+        };
+        queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
+    }
+
+    /// Records the pass, timed into `span` when given.
+    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, targets: &FrameTargets, span: Option<Span>) {
+        let Some(group) = &self.group else { return };
+        dispatch_full_screen(encoder, "lineao::Ssao", &self.pipeline, group, targets.size, span);
+    }
+}

@@ -1,0 +1,134 @@
+//! CPU reference of Crytek SSAO and its 4 × 4 blur (`shaders/ssao.wgsl`, `shaders/ssao_blur.wgsl`),
+//! in the shaders' f32 operation order.
+
+use super::{Image, NdImage};
+use crate::camera::FrameView;
+
+/// What a screen-space pass needs to go from a pixel and its normalized depth to view space
+/// and back: the linear depth range of the ND map and the projection in pixels.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ViewParams {
+    /// −z_view at normalized depth 0 and 1 (world units).
+    pub near: f32,
+    pub far: f32,
+    /// Focal length in pixels (perspective) or pixels per world unit (orthographic).
+    pub f_px: f32,
+    pub orthographic: bool,
+    /// The optical axis in pixel coordinates of the guard-banded image: (W, H) / 2.
+    pub center: [f32; 2],
+}
+
+impl ViewParams {
+    pub fn of(view: &FrameView) -> ViewParams {
+        let (w, h) = view.banded_size();
+        ViewParams {
+            near: view.near,
+            far: view.far,
+            f_px: view.f_px,
+            orthographic: view.orthographic,
+            center: [w as f32 * 0.5, h as f32 * 0.5],
+        }
+    }
+
+    /// −z_view of a normalized depth.
+    pub fn linear_depth(&self, d: f32) -> f32 {
+        self.near + d * (self.far - self.near)
+    }
+
+    /// The view-space point seen at pixel (x, y) at linear depth `depth`.
+    pub fn view_position(&self, x: u32, y: u32, depth: f32) -> [f32; 3] {
+        let sx = (x as f32 + 0.5 - self.center[0]) / self.f_px;
+        let sy = (self.center[1] - (y as f32 + 0.5)) / self.f_px;
+        if self.orthographic { [sx, sy, -depth] } else { [sx * depth, sy * depth, -depth] }
+    }
+
+    /// The pixel coordinates (not yet floored) a view-space point projects to.
+    pub fn project(&self, q: [f32; 3]) -> [f32; 2] {
+        let depth = -q[2];
+        if self.orthographic {
+            [self.center[0] + self.f_px * q[0], self.center[1] - self.f_px * q[1]]
+        } else {
+            [self.center[0] + self.f_px * q[0] / depth, self.center[1] - self.f_px * q[1] / depth]
+        }
+    }
+}
+
+/// A sample counts as occluded only when the surface is in front of it by more than this
+/// fraction of the depth range (f32 noise on a flat surface stays unoccluded).
+pub const SSAO_EPSILON: f32 = 1e-5;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SsaoParams {
+    pub view: ViewParams,
+    /// Sphere radius and range check, world units.
+    pub radius: f32,
+    pub range: f32,
+    /// Pixel of the visible viewport's top-left corner: the rotation tile starts there.
+    pub noise_origin: [i32; 2],
+}
+
+/// The raw SSAO image: the occluded fraction of the kernel at every pixel (0 on background).
+pub fn ssao(nd: &NdImage, kernel: &[[f32; 3]], noise: &[[f32; 3]], params: &SsaoParams) -> Image<f32> {
+    Image::from_fn(nd.width, nd.height, |x, y| ssao_pixel(nd, kernel, noise, params, x as u32, y as u32))
+}
+
+pub fn ssao_pixel(nd: &NdImage, kernel: &[[f32; 3]], noise: &[[f32; 3]], p: &SsaoParams, x: u32, y: u32) -> f32 {
+    let here = nd.get(x as usize, y as usize);
+    if here[0] == 0.0 && here[1] == 0.0 && here[2] == 0.0 {
+        return 0.0;
+    }
+    let v = &p.view;
+    let depth = v.linear_depth(here[3]);
+    let pos = v.view_position(x, y, depth);
+    let tile = |c: u32, o: i32| (c as i32 - o).rem_euclid(4) as usize;
+    let r = noise[tile(y, p.noise_origin[1]) * 4 + tile(x, p.noise_origin[0])];
+    let epsilon = SSAO_EPSILON * (v.far - v.near);
+    let mut occluded = 0u32;
+    for k in kernel {
+        // reflect(k, r) = k − 2 (r · k) r
+        let dot = r[0] * k[0] + r[1] * k[1] + r[2] * k[2];
+        let k = [k[0] - 2.0 * dot * r[0], k[1] - 2.0 * dot * r[1], k[2] - 2.0 * dot * r[2]];
+        let q = [pos[0] + p.radius * k[0], pos[1] + p.radius * k[1], pos[2] + p.radius * k[2]];
+        let q_depth = -q[2];
+        if q_depth <= 0.0 {
+            continue;
+        }
+        let t = v.project(q);
+        let tx = t[0].floor().clamp(0.0, (nd.width - 1) as f32) as usize;
+        let ty = t[1].floor().clamp(0.0, (nd.height - 1) as f32) as usize;
+        let surface = v.linear_depth(nd.get(tx, ty)[3]);
+        let diff = q_depth - surface;
+        if diff > epsilon && diff < p.range {
+            occluded += 1;
+        }
+    }
+    occluded as f32 / kernel.len() as f32
+}
+
+/// The matching 4 × 4 blur: the mean over the window x−2..=x+1, y−2..=y+1 (every rotation of
+/// the tile exactly once) of the geometry pixels in it; background stays 0.
+pub fn ssao_blur(nd: &NdImage, raw: &Image<f32>) -> Image<f32> {
+    let geometry = |x: usize, y: usize| {
+        let n = nd.get(x, y);
+        !(n[0] == 0.0 && n[1] == 0.0 && n[2] == 0.0)
+    };
+    Image::from_fn(raw.width, raw.height, |x, y| {
+        if !geometry(x, y) {
+            return 0.0;
+        }
+        let (mut sum, mut count) = (0.0f32, 0u32);
+        for dy in -2i64..=1 {
+            for dx in -2i64..=1 {
+                let (sx, sy) = (x as i64 + dx, y as i64 + dy);
+                if sx < 0 || sy < 0 || sx >= raw.width as i64 || sy >= raw.height as i64 {
+                    continue;
+                }
+                if geometry(sx as usize, sy as usize) {
+                    sum += raw.get(sx as usize, sy as usize);
+                    count += 1;
+                }
+            }
+        }
+        sum / count as f32
+    })
+}
