@@ -11,7 +11,9 @@
 //! - `lineao-chain`: pyramid + LineAO in one span (what a frame pays for the occlusion);
 //! - `ssao-12`: Crytek SSAO with 12 point samples (the VO paper's comparison);
 //! - `ssao-16-chain`: SSAO with 16 samples and its 4 × 4 blur in one span (the LineAO paper's
-//!   baseline frame, against `lineao-chain`).
+//!   baseline frame, against `lineao-chain`);
+//! - `vo-line-5`: Volumetric Obscurance with 5 line samples (against `ssao-12`: the VO paper's
+//!   0.56×).
 
 use std::time::Instant;
 
@@ -23,15 +25,16 @@ use lineao::passes::lines::{GeometryOptions, LineGeometry, LineRenderer, LineSty
 use lineao::passes::nd_pyramid::NdPyramid;
 use lineao::passes::ssao::Ssao;
 use lineao::passes::ssao_blur::SsaoBlur;
+use lineao::passes::vo_line::VoLine;
 use lineao::targets::{FrameTargets, Target};
 use lineao::timing::{PassTimer, Span};
-use lineao::{AoChain, ChainSettings, Gpu, LineAoSettings, SsaoSettings};
+use lineao::{AoChain, ChainSettings, Gpu, LineAoSettings, SsaoSettings, VoSettings};
 use serde_json::json;
 
 use crate::cli::BenchArgs;
 
 /// The passes of one run, in CONTRACT.md's order.
-pub const PASSES: [&str; 9] = [
+pub const PASSES: [&str; 10] = [
     "lines",
     "lines-native-1px",
     "nd-pyramid",
@@ -41,6 +44,7 @@ pub const PASSES: [&str; 9] = [
     "lineao-chain",
     "ssao-12",
     "ssao-16-chain",
+    "vo-line-5",
 ];
 
 /// Every pass of the benchmark, prepared for one view over one G-buffer.
@@ -54,6 +58,7 @@ struct Passes {
     ssao_12: Ssao,
     ssao_16: Ssao,
     ssao_blur: SsaoBlur,
+    vo_line_5: VoLine,
     output: Target,
 }
 
@@ -71,6 +76,7 @@ impl Passes {
             ssao_12: Ssao::new(device, &SsaoSettings { samples: 12, ..settings.ssao.clone() }),
             ssao_16: Ssao::new(device, &SsaoSettings { samples: 16, ..settings.ssao.clone() }),
             ssao_blur: SsaoBlur::new(device),
+            vo_line_5: VoLine::new(device, &VoSettings { samples: 5, ..settings.vo.clone() }),
             output: Target::output(device, "lineao::bench::output", (view.width, view.height), format),
         };
         for renderer in [&passes.lines, &passes.lines_native] {
@@ -86,6 +92,8 @@ impl Passes {
             pass.prepare(queue, targets, view, &SsaoSettings { samples, ..settings.ssao.clone() });
         }
         passes.ssao_blur.resize(device, targets);
+        passes.vo_line_5.resize(device, targets);
+        passes.vo_line_5.prepare(queue, targets, view, &VoSettings { samples: 5, ..settings.vo.clone() });
         passes.composite.resize(device, targets);
         passes.composite.prepare(queue, targets, settings.strength, settings.debug_view, view.zoom_max());
         passes
@@ -117,6 +125,7 @@ impl Passes {
                 self.ssao_16.encode(encoder, targets, span.map(Span::begin_only));
                 self.ssao_blur.encode(encoder, targets, span.map(Span::end_only));
             }
+            "vo-line-5" => self.vo_line_5.encode(encoder, targets, span),
             _ => unreachable!("unknown bench pass {name}"),
         }
     }
@@ -238,7 +247,12 @@ fn print_table(report: &serde_json::Value, passes: &[serde_json::Value]) {
             f("ms_max")
         );
     }
-    for (a, b) in [("lineao", "lineao-tap-floor"), ("lines", "lines-native-1px"), ("lineao-chain", "ssao-16-chain")] {
+    for (a, b) in [
+        ("lineao", "lineao-tap-floor"),
+        ("lines", "lines-native-1px"),
+        ("lineao-chain", "ssao-16-chain"),
+        ("vo-line-5", "ssao-12"),
+    ] {
         if let (Some(x), Some(y)) = (median(a), median(b)) {
             println!("{a} / {b}: {:.2}x", x / y);
         }

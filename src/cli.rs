@@ -75,6 +75,8 @@ pub enum Method {
     Lineao,
     /// Crytek SSAO with its 4 × 4 blur (the LineAO paper's baseline).
     Ssao,
+    /// Volumetric Obscurance with line samples (Loos & Sloan 2010).
+    VoLine,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -184,10 +186,17 @@ pub struct RenderArgs {
     /// Variant `reference`: base radius in pixels at the home zoom (the authors' u_lineAORadius).
     #[arg(long, default_value_t = 2.0)]
     pub reference_radius: f32,
-    /// SSAO: point samples in the sphere (8..=32).
-    #[arg(long, default_value_t = 16)]
-    pub samples: u32,
-    /// SSAO: sphere radius in world units (mm for tractograms).
+    /// SSAO: point samples in the sphere (8..=32) [default: 16]; VO: line samples (5, 7, 9,
+    /// 12, 13 or 16) [default: 9].
+    #[arg(long)]
+    pub samples: Option<u32>,
+    /// VO: no normal clamp (the whole sphere, not the half above the surface).
+    #[arg(long)]
+    pub no_normal_clamp: bool,
+    /// VO: thickness model, world units (0 = off).
+    #[arg(long, default_value_t = 0.0)]
+    pub thickness: f32,
+    /// SSAO and VO: sphere radius in world units (mm for tractograms).
     #[arg(long, default_value_t = 2.0)]
     pub radius: f32,
     /// SSAO: range check in world units [default: the radius].

@@ -1,6 +1,7 @@
 //! `--dump DIR` (CONTRACT.md): the method's inputs and raw output at the guard-banded size, so an
 //! outside implementation can recompute the result: `nd_<j>.npy`, `zoom.npy`, `ao.npy`,
-//! `noise.npy`, `samples.npy` (LineAO) or `ssao_kernel.npy`, `ssao_noise.npy` (SSAO), and
+//! `noise.npy`, `samples.npy` (LineAO), `ssao_kernel.npy`, `ssao_noise.npy` (SSAO) or
+//! `vo_samples.npy`, `vo_noise.npy` (VO), and
 //! `params.json`. `ao.npy` is the method's raw occlusion, before SSAO's blur.
 
 use std::fs::File;
@@ -117,6 +118,21 @@ pub fn write(dir: &Path, gpu: &Gpu, chain: &AoChain, camera: &Camera) -> Result<
         let kernel = noise::ssao_kernel(ssao.noise_seed, ssao.samples);
         write_npy(dir, "ssao_kernel.npy", &[ssao.samples as u64, 3], &flat3(&kernel))?;
         write_npy(dir, "ssao_noise.npy", &[4, 4, 3], &flat3(&noise::ssao_noise(ssao.noise_seed)))?;
+    }
+    if s.method == AoMethod::VoLine {
+        let vo = &s.vo;
+        let extra = json!({
+            "samples": vo.samples,
+            "radius_world": vo.radius_world,
+            "normal_clamp": vo.normal_clamp,
+            "thickness": vo.thickness_world,
+            "noise_seed": vo.noise_seed,
+        });
+        params.as_object_mut().expect("object").extend(extra.as_object().expect("object").clone());
+        let samples = lineao::sample_sets::vo_disk_samples(vo.samples).context("no VO sample set of that size")?;
+        write_npy(dir, "vo_samples.npy", &[vo.samples as u64, 3], &flat3(samples))?;
+        let tile: Vec<f32> = noise::vo_noise(vo.noise_seed).into_iter().flatten().collect();
+        write_npy(dir, "vo_noise.npy", &[4, 4, 2], &tile)?;
     }
     let path = dir.join("params.json");
     let text = serde_json::to_string_pretty(&params)?;

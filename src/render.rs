@@ -4,7 +4,9 @@ use anyhow::{Context, Result};
 use glam::Vec3;
 use lineao::camera::{Camera, Projection};
 use lineao::passes::lines::LineGeometry;
-use lineao::{AoChain, AoMethod, ChainSettings, Gpu, LineAoSettings, LineAoVariant, LineColor, SsaoSettings};
+use lineao::{
+    AoChain, AoMethod, ChainSettings, Gpu, LineAoSettings, LineAoVariant, LineColor, SsaoSettings, VoSettings,
+};
 use lineao_tracts::scenes::ViewHint;
 
 use crate::cli::{ColorArg, Method, RenderArgs, Variant};
@@ -16,9 +18,17 @@ pub fn settings(args: &RenderArgs, zoom_unit: f32) -> ChainSettings {
             Method::None => AoMethod::None,
             Method::Lineao => AoMethod::LineAo,
             Method::Ssao => AoMethod::Ssao,
+            Method::VoLine => AoMethod::VoLine,
+        },
+        vo: VoSettings {
+            samples: args.samples.unwrap_or(VoSettings::default().samples),
+            radius_world: args.radius,
+            normal_clamp: !args.no_normal_clamp,
+            thickness_world: args.thickness,
+            noise_seed: args.noise_seed,
         },
         ssao: SsaoSettings {
-            samples: args.samples,
+            samples: args.samples.unwrap_or(SsaoSettings::default().samples),
             radius_world: args.radius,
             range_world: args.ssao_range.unwrap_or(args.radius),
             noise_seed: args.noise_seed,

@@ -228,7 +228,8 @@ fn bench_json_is_the_contract() {
             "composite",
             "lineao-chain",
             "ssao-12",
-            "ssao-16-chain"
+            "ssao-16-chain",
+            "vo-line-5"
         ]
     );
     for p in passes {

@@ -14,12 +14,13 @@
 //! ```
 //!
 //! With [`AoMethod::Ssao`] the pyramid and LineAO give way to Crytek SSAO (`nd[0]` → `ao_raw`)
-//! and its 4 × 4 blur (`ao_raw` → `ao`).
+//! and its 4 × 4 blur (`ao_raw` → `ao`); with [`AoMethod::VoLine`] to Volumetric Obscurance
+//! with line samples (`nd[0]`, `zoom` → `ao`).
 //!
 //! Every pass is labelled and the frame sits in a `lineao` debug group, so GPU debuggers show
 //! the chain by name. With [`AoChain::set_timing`] each pass also records timestamp queries under
 //! the names `lineao bench` uses (CONTRACT.md): `lines`, `nd-pyramid`, `lineao`, `ssao`,
-//! `ssao-blur`, `composite`.
+//! `ssao-blur`, `vo-line`, `composite`.
 
 use crate::Error;
 use crate::camera::{self, Bounds, Camera, FrameView};
@@ -29,12 +30,13 @@ use crate::passes::lines::{LineGeometry, LineRenderer};
 use crate::passes::nd_pyramid::NdPyramid;
 use crate::passes::ssao::Ssao;
 use crate::passes::ssao_blur::SsaoBlur;
+use crate::passes::vo_line::VoLine;
 use crate::settings::{AoMethod, ChainSettings, LineAoVariant};
 use crate::targets::FrameTargets;
 use crate::timing::{PassTime, PassTimer};
 
 /// The spans of a timed frame, in chain order.
-pub const PASS_NAMES: [&str; 6] = ["lines", "nd-pyramid", "lineao", "ssao", "ssao-blur", "composite"];
+pub const PASS_NAMES: [&str; 7] = ["lines", "nd-pyramid", "lineao", "ssao", "ssao-blur", "vo-line", "composite"];
 
 pub struct AoChain {
     settings: ChainSettings,
@@ -43,6 +45,7 @@ pub struct AoChain {
     line_ao: LineAo,
     ssao: Ssao,
     ssao_blur: SsaoBlur,
+    vo_line: VoLine,
     composite: Composite,
     size: (u32, u32),
     max_texture: u32,
@@ -61,6 +64,7 @@ impl AoChain {
             line_ao: LineAo::new(device, &settings.line_ao, &settings.lighting),
             ssao: Ssao::new(device, &settings.ssao),
             ssao_blur: SsaoBlur::new(device),
+            vo_line: VoLine::new(device, &settings.vo),
             composite: Composite::new(device, format),
             settings,
             size: (0, 0),
@@ -91,6 +95,12 @@ impl AoChain {
                 self.ssao.resize(device, targets);
             }
         }
+        if !self.vo_line.matches(&settings.vo) {
+            self.vo_line = VoLine::new(device, &settings.vo);
+            if let Some(targets) = &self.targets {
+                self.vo_line.resize(device, targets);
+            }
+        }
         if settings.levels() != self.settings.levels() {
             self.targets = None;
         }
@@ -113,6 +123,7 @@ impl AoChain {
             (AoMethod::LineAo, 2..) => &["lines", "nd-pyramid", "lineao", "composite"],
             (AoMethod::LineAo, _) => &["lines", "lineao", "composite"],
             (AoMethod::Ssao, _) => &["lines", "ssao", "ssao-blur", "composite"],
+            (AoMethod::VoLine, _) => &["lines", "vo-line", "composite"],
             (AoMethod::None, _) => &["lines", "composite"],
         };
         timer.read(device, used).map(Some)
@@ -142,9 +153,11 @@ impl AoChain {
             (AoMethod::None, _) => 0,
             // The sphere's radius in pixels where it is largest (at the near plane), plus the
             // blur's 2 px.
-            (AoMethod::Ssao, _) => {
+            (AoMethod::Ssao | AoMethod::VoLine, _) => {
                 let unguarded = FrameView::new(camera, bounds, self.size.0, self.size.1, 0, s.zoom_unit);
-                let radius = s.ssao.radius_world * unguarded.zoom_max() / s.zoom_unit + 2.0;
+                let (radius_world, blur) =
+                    if s.method == AoMethod::Ssao { (s.ssao.radius_world, 2.0) } else { (s.vo.radius_world, 0.0) };
+                let radius = radius_world * unguarded.zoom_max() / s.zoom_unit + blur;
                 camera::guard_band(radius, 1, s.line_ao.guard_max_px)
             }
             // Its radius grows as 1/(1 − d), without bound toward the far plane.
@@ -185,6 +198,7 @@ impl AoChain {
             self.line_ao.resize(device, &targets);
             self.ssao.resize(device, &targets);
             self.ssao_blur.resize(device, &targets);
+            self.vo_line.resize(device, &targets);
             self.composite.resize(device, &targets);
             self.targets = Some(targets);
         }
@@ -194,6 +208,7 @@ impl AoChain {
         match s.method {
             AoMethod::LineAo => self.line_ao.prepare(queue, targets, &view, &s.line_ao, s.r0_px(), &s.lighting),
             AoMethod::Ssao => self.ssao.prepare(queue, targets, &view, &s.ssao),
+            AoMethod::VoLine => self.vo_line.prepare(queue, targets, &view, &s.vo),
             AoMethod::None => {}
         }
         let strength = if s.method == AoMethod::None { 0.0 } else { s.strength };
@@ -223,6 +238,7 @@ impl AoChain {
                 self.ssao.encode(encoder, targets, span("ssao"));
                 self.ssao_blur.encode(encoder, targets, span("ssao-blur"));
             }
+            AoMethod::VoLine => self.vo_line.encode(encoder, targets, span("vo-line")),
             AoMethod::None => {}
         }
         self.composite.encode(encoder, target, span("composite"));

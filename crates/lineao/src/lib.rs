@@ -45,6 +45,7 @@ pub mod noise;
 pub mod passes;
 pub mod readback;
 pub mod reference;
+pub mod sample_sets;
 pub mod settings;
 pub mod shader;
 pub mod targets;
@@ -53,7 +54,9 @@ pub mod verify;
 
 pub use chain::AoChain;
 pub use gpu::Gpu;
-pub use settings::{AoMethod, ChainSettings, DebugView, LineAoSettings, LineAoVariant, LineColor, SsaoSettings};
+pub use settings::{
+    AoMethod, ChainSettings, DebugView, LineAoSettings, LineAoVariant, LineColor, SsaoSettings, VoSettings,
+};
 
 /// Pyramid levels (and so LineAO hemispheres) the shaders can bind.
 pub const MAX_LEVELS: u32 = 5;

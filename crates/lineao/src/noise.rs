@@ -77,6 +77,19 @@ pub fn ssao_noise(seed: u32) -> Vec<[f32; 3]> {
     (0..(SSAO_NOISE_SIZE * SSAO_NOISE_SIZE) as u32).map(|i| unit_vector(seed, STREAM_SSAO_NOISE, i)).collect()
 }
 
+const STREAM_VO_NOISE: u32 = 5;
+
+/// VO's 4 × 4 tile of unit 2D directions, `noise[y * 4 + x]`: each pixel reflects its disk
+/// samples about its direction (§4.5: "a reflection about a random direction in 2D").
+pub fn vo_noise(seed: u32) -> Vec<[f32; 2]> {
+    (0..(SSAO_NOISE_SIZE * SSAO_NOISE_SIZE) as u32)
+        .map(|i| {
+            let phi = std::f32::consts::TAU * uniform(seed, STREAM_VO_NOISE, i);
+            [phi.cos(), phi.sin()]
+        })
+        .collect()
+}
+
 /// n_j = ⌈s_h / (j + 1)⌉ (Eq. 7): the harmonic series of samples per hemisphere.
 pub fn samples_on_hemisphere(s_h: u32, j: u32) -> u32 {
     s_h.div_ceil(j + 1)

@@ -12,6 +12,8 @@ pub enum AoMethod {
     LineAo,
     /// Crytek SSAO (Mittring 2007), the LineAO paper's baseline, with its 4 × 4 blur.
     Ssao,
+    /// Volumetric Obscurance with line samples (Loos & Sloan 2010, §4.1).
+    VoLine,
 }
 
 impl AoMethod {
@@ -21,6 +23,7 @@ impl AoMethod {
             AoMethod::None => "none",
             AoMethod::LineAo => "lineao",
             AoMethod::Ssao => "ssao",
+            AoMethod::VoLine => "vo-line",
         }
     }
 }
@@ -111,6 +114,28 @@ impl Default for SsaoSettings {
     }
 }
 
+/// Volumetric Obscurance (`lineao::passes::vo_line`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct VoSettings {
+    /// Line samples: one of `lineao::sample_sets::VO_SAMPLE_COUNTS` (5, 7, 9, 12, 13, 16).
+    pub samples: u32,
+    /// Radius of the sphere in world units.
+    pub radius_world: f32,
+    /// Restrict the sphere to the half above the surface's tangent plane (§4.4).
+    pub normal_clamp: bool,
+    /// Thickness model (§4.3): occupied only this far behind the visible surface, world units;
+    /// 0 = off (occupied all the way back).
+    pub thickness_world: f32,
+    /// Seed of the 4 × 4 tile of 2D reflection directions.
+    pub noise_seed: u32,
+}
+
+impl Default for VoSettings {
+    fn default() -> Self {
+        VoSettings { samples: 9, radius_world: 2.0, normal_clamp: true, thickness_world: 0.0, noise_seed: 1 }
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum DebugView {
     /// color · (1 − strength · ao) + specular.
@@ -157,6 +182,7 @@ pub struct ChainSettings {
     pub method: AoMethod,
     pub line_ao: LineAoSettings,
     pub ssao: SsaoSettings,
+    pub vo: VoSettings,
     pub lighting: Lighting,
     /// Line width in pixels, > 0. Default 2.
     pub line_width_px: f32,
@@ -176,6 +202,7 @@ impl Default for ChainSettings {
             method: AoMethod::LineAo,
             line_ao: LineAoSettings::default(),
             ssao: SsaoSettings::default(),
+            vo: VoSettings::default(),
             lighting: Lighting::default(),
             line_width_px: 2.0,
             line_color: LineColor::Tangent,
@@ -198,7 +225,7 @@ impl ChainSettings {
     pub fn levels(&self) -> u32 {
         match (self.method, self.line_ao.variant) {
             (AoMethod::LineAo, LineAoVariant::Paper) => self.line_ao.s_r,
-            (AoMethod::LineAo, LineAoVariant::Reference) | (AoMethod::None | AoMethod::Ssao, _) => 1,
+            (AoMethod::LineAo, LineAoVariant::Reference) | (AoMethod::None | AoMethod::Ssao | AoMethod::VoLine, _) => 1,
         }
     }
 
@@ -236,6 +263,20 @@ impl ChainSettings {
         }
         if !(ssao.range_world.is_finite() && ssao.range_world > 0.0) {
             return bad(format!("the SSAO range must be > 0 world units, got {}", ssao.range_world));
+        }
+        let vo = &self.vo;
+        if !crate::sample_sets::VO_SAMPLE_COUNTS.contains(&vo.samples) {
+            return bad(format!(
+                "VO samples must be one of {:?}, got {}",
+                crate::sample_sets::VO_SAMPLE_COUNTS,
+                vo.samples
+            ));
+        }
+        if !(vo.radius_world.is_finite() && vo.radius_world > 0.0) {
+            return bad(format!("the VO radius must be > 0 world units, got {}", vo.radius_world));
+        }
+        if !(vo.thickness_world.is_finite() && vo.thickness_world >= 0.0) {
+            return bad(format!("the VO thickness must be >= 0 world units, got {}", vo.thickness_world));
         }
         if !(self.strength.is_finite() && self.strength >= 0.0) {
             return bad(format!("strength must be >= 0, got {}", self.strength));

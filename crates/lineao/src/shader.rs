@@ -18,6 +18,7 @@ pub const FILES: &[(&str, &str)] = &[
     ("nd_pyramid.wgsl", include_str!("../shaders/nd_pyramid.wgsl")),
     ("ssao.wgsl", include_str!("../shaders/ssao.wgsl")),
     ("ssao_blur.wgsl", include_str!("../shaders/ssao_blur.wgsl")),
+    ("vo_line.wgsl", include_str!("../shaders/vo_line.wgsl")),
 ];
 
 /// The embedded source of `path` (relative to `shaders/`), without imports resolved.

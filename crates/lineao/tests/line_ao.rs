@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{flat_view, gpu, is_geometry, line_ao_on, render};
+use common::{cameras_for_polylines, flat_view, gpu, is_geometry, line_ao_on, polylines, render};
 use glam::Vec3;
 use lineao::camera::FrameView;
 use lineao::camera::{Camera, Projection};
@@ -177,32 +177,6 @@ fn light_attenuation_scales_by_the_brdf() {
         occluded += (ao_off.data[i] > 0.0) as usize;
     }
     assert!(occluded > 0);
-}
-
-fn polylines(count: usize, seed: f32) -> (Vec<[f32; 3]>, Vec<u64>) {
-    let mut positions = Vec::new();
-    let mut offsets = vec![0u64];
-    for k in 0..count {
-        let phase = seed + k as f32 * 0.61;
-        positions.extend((0..60).map(|i| {
-            let s = i as f32 / 59.0;
-            let r = 10.0 + 25.0 * (phase * 3.1).sin().abs();
-            [r * (phase + 3.0 * s).cos(), -40.0 + 80.0 * s + 5.0 * (phase * 5.0).sin(), r * (phase + 3.0 * s).sin()]
-        }));
-        offsets.push(positions.len() as u64);
-    }
-    (positions, offsets)
-}
-
-/// A perspective and an orthographic camera framing [`polylines`].
-fn cameras_for_polylines() -> (Camera, Camera) {
-    let perspective = Camera {
-        eye: Vec3::new(20.0, 30.0, 140.0),
-        target: Vec3::ZERO,
-        up: Vec3::Y,
-        projection: Projection::Perspective { fov_y_deg: 40.0 },
-    };
-    (perspective, Camera { projection: Projection::Orthographic { height: 110.0 }, ..perspective })
 }
 
 #[test]

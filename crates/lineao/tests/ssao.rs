@@ -3,9 +3,7 @@
 
 mod common;
 
-use common::{flat_view, gpu, is_geometry, render};
-use glam::Vec3;
-use lineao::camera::{Camera, Projection};
+use common::{cameras_for_polylines, flat_view, gpu, is_geometry, polylines, render};
 use lineao::passes::ssao::Ssao;
 use lineao::passes::ssao_blur::SsaoBlur;
 use lineao::reference::{self, Image, NdImage, SsaoParams, ViewParams};
@@ -115,24 +113,8 @@ fn blur_skips_the_background_and_keeps_a_constant() {
 #[test]
 fn gpu_matches_cpu_reference_on_rendered_lines() {
     let gpu = gpu();
-    let mut positions = Vec::new();
-    let mut offsets = vec![0u64];
-    for k in 0..120 {
-        let phase = 0.3 + k as f32 * 0.61;
-        positions.extend((0..60).map(|i| {
-            let s = i as f32 / 59.0;
-            let r = 10.0 + 25.0 * (phase * 3.1).sin().abs();
-            [r * (phase + 3.0 * s).cos(), -40.0 + 80.0 * s + 5.0 * (phase * 5.0).sin(), r * (phase + 3.0 * s).sin()]
-        }));
-        offsets.push(positions.len() as u64);
-    }
-    let perspective = Camera {
-        eye: Vec3::new(20.0, 30.0, 140.0),
-        target: Vec3::ZERO,
-        up: Vec3::Y,
-        projection: Projection::Perspective { fov_y_deg: 40.0 },
-    };
-    let ortho = Camera { projection: Projection::Orthographic { height: 110.0 }, ..perspective };
+    let (positions, offsets) = polylines(120, 0.3);
+    let (perspective, ortho) = cameras_for_polylines();
     for (name, cam, samples) in
         [("perspective, 16", perspective, 16), ("orthographic, 12", ortho, 12), ("perspective, 32", perspective, 32)]
     {

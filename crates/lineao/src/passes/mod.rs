@@ -8,6 +8,7 @@ pub mod lines;
 pub mod nd_pyramid;
 pub mod ssao;
 pub mod ssao_blur;
+pub mod vo_line;
 
 /// Workgroup size of the compute passes (8 × 8, as in the WGSL files).
 pub(crate) const WORKGROUP: u32 = 8;

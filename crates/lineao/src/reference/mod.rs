@@ -7,9 +7,11 @@
 
 mod line_ao;
 mod ssao;
+mod vo_line;
 
 pub use line_ao::{LineAoParams, delta, depth_weight, hermite, light_weight, line_ao, line_ao_pixel};
 pub use ssao::{SSAO_EPSILON, SsaoParams, ViewParams, ssao, ssao_blur, ssao_pixel};
+pub use vo_line::{VoParams, vo_line, vo_line_pixel, vo_line_sample};
 
 /// A row-major image, `data[y * width + x]`.
 #[derive(Clone, Debug, PartialEq)]

@@ -124,3 +124,31 @@ pub fn line_ao_on(
 pub fn is_geometry(nd: [f32; 4]) -> bool {
     nd[..3] != [0.0; 3]
 }
+
+/// `count` helical polylines of 60 points around the y axis (radius 10–35, height ±40), the
+/// scene of the GPU-vs-CPU tests.
+pub fn polylines(count: usize, seed: f32) -> (Vec<[f32; 3]>, Vec<u64>) {
+    let mut positions = Vec::new();
+    let mut offsets = vec![0u64];
+    for k in 0..count {
+        let phase = seed + k as f32 * 0.61;
+        positions.extend((0..60).map(|i| {
+            let s = i as f32 / 59.0;
+            let r = 10.0 + 25.0 * (phase * 3.1).sin().abs();
+            [r * (phase + 3.0 * s).cos(), -40.0 + 80.0 * s + 5.0 * (phase * 5.0).sin(), r * (phase + 3.0 * s).sin()]
+        }));
+        offsets.push(positions.len() as u64);
+    }
+    (positions, offsets)
+}
+
+/// A perspective and an orthographic camera framing [`polylines`].
+pub fn cameras_for_polylines() -> (Camera, Camera) {
+    let perspective = Camera {
+        eye: glam::Vec3::new(20.0, 30.0, 140.0),
+        target: glam::Vec3::ZERO,
+        up: glam::Vec3::Y,
+        projection: lineao::camera::Projection::Perspective { fov_y_deg: 40.0 },
+    };
+    (perspective, Camera { projection: lineao::camera::Projection::Orthographic { height: 110.0 }, ..perspective })
+}
