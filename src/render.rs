@@ -21,14 +21,15 @@ pub fn settings(args: &RenderArgs, zoom_unit: f32) -> ChainSettings {
             Method::VoLine => AoMethod::VoLine,
         },
         vo: VoSettings {
-            samples: args.samples.unwrap_or(VoSettings::default().samples),
+            // --samples counts the chosen method's samples; the other keeps its default.
+            samples: args.samples.filter(|_| args.method == Method::VoLine).unwrap_or(VoSettings::default().samples),
             radius_world: args.radius,
             normal_clamp: !args.no_normal_clamp,
             thickness_world: args.thickness,
             noise_seed: args.noise_seed,
         },
         ssao: SsaoSettings {
-            samples: args.samples.unwrap_or(SsaoSettings::default().samples),
+            samples: args.samples.filter(|_| args.method == Method::Ssao).unwrap_or(SsaoSettings::default().samples),
             radius_world: args.radius,
             range_world: args.ssao_range.unwrap_or(args.radius),
             noise_seed: args.noise_seed,

@@ -9,7 +9,7 @@ use common::{lineao, scratch};
 
 use lineao::LineAoVariant;
 use lineao::lighting::Light;
-use lineao::reference::{self, Image, LineAoParams, SsaoParams, ViewParams};
+use lineao::reference::{self, Image, LineAoParams, SsaoParams, ViewParams, VoParams};
 use lineao::verify::{check_policy, line_ao_flip_bound, line_ao_reference_flip_bound};
 use serde_json::Value;
 
@@ -307,4 +307,50 @@ fn render_and_dump_let_an_outside_tool_recompute_ssao() {
     let stats = check_policy(&ao, &cpu, &nd0, 2.0 / 12.0).unwrap_or_else(|e| panic!("{e}"));
     println!("ssao from --dump: {stats}");
     assert!(ao.data.iter().filter(|&&a| a > 0.05).count() > 200, "SSAO occludes something");
+}
+
+/// `--method vo-line --dump`: VO recomputed from the dumped files and `params.json` alone.
+#[test]
+fn render_and_dump_let_an_outside_tool_recompute_vo() {
+    let extra = ["--scene", "spiral", "--method", "vo-line", "--samples", "7", "--radius", "3", "--thickness", "1"];
+    let (_, dump) = render_with_dump("dump-vo", &extra);
+    let params: Value = serde_json::from_str(&std::fs::read_to_string(dump.join("params.json")).unwrap()).unwrap();
+    assert_eq!(params["method"], "vo-line");
+    assert_eq!((params["samples"].as_u64(), params["normal_clamp"].as_bool()), (Some(7), Some(true)));
+    let f = |k: &str| params[k].as_f64().unwrap() as f32;
+    let guard = params["guard_px"].as_u64().unwrap() as usize;
+    let (w, h) = (
+        params["width"].as_u64().unwrap() as usize + 2 * guard,
+        params["height"].as_u64().unwrap() as usize + 2 * guard,
+    );
+    let fov = params["camera"]["fov_y_deg"].as_f64().unwrap() as f32;
+    let view = ViewParams {
+        near: f("depth_near"),
+        far: f("depth_far"),
+        f_px: f("height") / (2.0 * (fov.to_radians() * 0.5).tan()),
+        orthographic: false,
+        center: [w as f32 * 0.5, h as f32 * 0.5],
+    };
+    let (_, nd) = read_npy(&dump.join("nd_0.npy"));
+    let nd0 = Image { width: w, height: h, data: nd.chunks_exact(4).map(|t| [t[0], t[1], t[2], t[3]]).collect() };
+    let zoom = Image { width: w, height: h, data: read_npy(&dump.join("zoom.npy")).1 };
+    let ao = Image { width: w, height: h, data: read_npy(&dump.join("ao.npy")).1 };
+    let (sshape, samples) = read_npy(&dump.join("vo_samples.npy"));
+    assert_eq!(sshape, [7, 3]);
+    let (nshape, tile) = read_npy(&dump.join("vo_noise.npy"));
+    assert_eq!(nshape, [4, 4, 2]);
+    let samples: Vec<[f32; 3]> = samples.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+    let tile: Vec<[f32; 2]> = tile.chunks_exact(2).map(|c| [c[0], c[1]]).collect();
+    let p = VoParams {
+        view,
+        radius: f("radius_world"),
+        zoom_unit: f("zoom_unit"),
+        normal_clamp: true,
+        thickness: f("thickness"),
+        noise_origin: [guard as i32; 2],
+    };
+    let cpu = reference::vo_line(&nd0, &zoom, &samples, &tile, &p);
+    let stats = check_policy(&ao, &cpu, &nd0, 2.0 / 7.0).unwrap_or_else(|e| panic!("{e}"));
+    println!("vo-line from --dump: {stats}");
+    assert!(ao.data.iter().filter(|&&a| a > 0.05).count() > 200, "VO obscures something");
 }
