@@ -107,3 +107,36 @@ pub fn pipeline_layout(device: &wgpu::Device, label: &str, group: &wgpu::BindGro
         immediate_size: 0,
     })
 }
+
+/// `vectors` as vec4s (w = 0), zero-padded to `len` entries: the sample and noise tables of the
+/// passes.
+pub fn vec4_buffer(
+    device: &wgpu::Device,
+    label: &str,
+    vectors: &[[f32; 3]],
+    len: usize,
+    usage: wgpu::BufferUsages,
+) -> wgpu::Buffer {
+    use wgpu::util::DeviceExt;
+    let mut padded: Vec<[f32; 4]> = vectors.iter().map(|v| [v[0], v[1], v[2], 0.0]).collect();
+    padded.resize(padded.len().max(len), [0.0; 4]);
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: bytemuck::cast_slice(&padded),
+        usage,
+    })
+}
+
+/// Two tables in one uniform buffer of vec4s: `first` from entry 0, `second` from entry `at`.
+pub fn two_tables(
+    device: &wgpu::Device,
+    label: &str,
+    first: &[[f32; 3]],
+    at: usize,
+    second: &[[f32; 3]],
+) -> wgpu::Buffer {
+    let mut rows = first.to_vec();
+    rows.resize(at, [0.0; 3]);
+    rows.extend_from_slice(second);
+    vec4_buffer(device, label, &rows, rows.len(), wgpu::BufferUsages::UNIFORM)
+}

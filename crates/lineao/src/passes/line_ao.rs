@@ -41,8 +41,6 @@
 //! scene's. 1 − d is kept above 1e−6. The radius grows without bound as d → 1, so the guard
 //! band of this variant is the cap.
 
-use wgpu::util::DeviceExt;
-
 use crate::binding::{self, Slot};
 use crate::camera::FrameView;
 use crate::lighting::{Lighting, LightingUniform};
@@ -133,23 +131,6 @@ pub struct LineAo {
 /// Entries of the uniform sample table (`samples` in `shaders/line_ao.wgsl`): s_r ≤ 5, s_h ≤ 256.
 const SAMPLE_TABLE_LEN: usize = crate::MAX_LEVELS as usize * 256;
 
-/// `vectors` as vec4s, zero-padded to `len` entries.
-fn vec4_buffer(
-    device: &wgpu::Device,
-    label: &str,
-    vectors: &[[f32; 3]],
-    len: usize,
-    usage: wgpu::BufferUsages,
-) -> wgpu::Buffer {
-    let mut padded: Vec<[f32; 4]> = vectors.iter().map(|v| [v[0], v[1], v[2], 0.0]).collect();
-    padded.resize(padded.len().max(len), [0.0; 4]);
-    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some(label),
-        contents: bytemuck::cast_slice(&padded),
-        usage,
-    })
-}
-
 impl LineAo {
     /// The pass for `settings` lit by `lighting` (the number of lights is compiled in).
     pub fn new(device: &wgpu::Device, settings: &LineAoSettings, lighting: &Lighting) -> LineAo {
@@ -196,14 +177,14 @@ impl LineAo {
             pipeline,
             uniform: binding::uniform_buffer::<LineAoUniform>(device, "lineao::LineAo::uniform"),
             lighting: binding::uniform_buffer::<LightingUniform>(device, "lineao::LineAo::lighting"),
-            noise: vec4_buffer(
+            noise: binding::vec4_buffer(
                 device,
                 "lineao::LineAo::noise",
                 &noise::noise_tile(shape.noise_seed),
                 0,
                 wgpu::BufferUsages::STORAGE,
             ),
-            samples: vec4_buffer(
+            samples: binding::vec4_buffer(
                 device,
                 "lineao::LineAo::samples",
                 &sample_table(settings),

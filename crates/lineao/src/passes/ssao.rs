@@ -18,8 +18,6 @@
 //! lines far away get a sphere of a pixel or two — the paper's point about screen-space AO on
 //! lines. The CPU reference is [`crate::reference::ssao`].
 
-use wgpu::util::DeviceExt;
-
 use crate::binding::{self, Slot};
 use crate::camera::FrameView;
 use crate::noise;
@@ -64,9 +62,6 @@ pub struct SsaoUniform {
     pub range: f32,
 }
 
-/// The kernel and the tile as the shader reads them: kernel in 0..32, tile in 32..48.
-const TABLES: usize = 48;
-
 pub struct Ssao {
     samples: u32,
     noise_seed: u32,
@@ -93,24 +88,20 @@ impl Ssao {
             "ssao",
             &[("SAMPLES", settings.samples as f64)],
         );
-        let mut tables = [[0.0f32; 4]; TABLES];
-        for (slot, k) in tables.iter_mut().zip(noise::ssao_kernel(settings.noise_seed, settings.samples)) {
-            *slot = [k[0], k[1], k[2], 0.0];
-        }
-        for (slot, r) in tables[32..].iter_mut().zip(noise::ssao_noise(settings.noise_seed)) {
-            *slot = [r[0], r[1], r[2], 0.0];
-        }
         Ssao {
             samples: settings.samples,
             noise_seed: settings.noise_seed,
             pipeline,
             layout,
             uniform: binding::uniform_buffer::<SsaoUniform>(device, "lineao::Ssao::uniform"),
-            tables: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("lineao::Ssao::tables"),
-                contents: bytemuck::cast_slice(&tables),
-                usage: wgpu::BufferUsages::UNIFORM,
-            }),
+            // The kernel in entries 0..32, the 4 × 4 tile in 32..48 (`tables` in ssao.wgsl).
+            tables: binding::two_tables(
+                device,
+                "lineao::Ssao::tables",
+                &noise::ssao_kernel(settings.noise_seed, settings.samples),
+                32,
+                &noise::ssao_noise(settings.noise_seed),
+            ),
             group: None,
         }
     }

@@ -25,8 +25,6 @@
 //! The sphere's radius is in world units, mapped to pixels by the zoom map. The CPU reference
 //! is [`crate::reference::vo_line`].
 
-use wgpu::util::DeviceExt;
-
 use crate::binding::{self, Slot};
 use crate::camera::FrameView;
 use crate::noise;
@@ -78,25 +76,16 @@ impl VoLine {
             "vo_line",
             &[("SAMPLES", settings.samples as f64)],
         );
-        let mut tables = [[0.0f32; 4]; 32];
         let samples = sample_sets::vo_disk_samples(settings.samples).unwrap_or_default();
-        for (slot, s) in tables.iter_mut().zip(samples) {
-            *slot = [s[0], s[1], s[2], 0.0];
-        }
-        for (slot, u) in tables[16..].iter_mut().zip(noise::vo_noise(settings.noise_seed)) {
-            *slot = [u[0], u[1], 0.0, 0.0];
-        }
+        let tile: Vec<[f32; 3]> = noise::vo_noise(settings.noise_seed).iter().map(|u| [u[0], u[1], 0.0]).collect();
         VoLine {
             samples: settings.samples,
             noise_seed: settings.noise_seed,
             pipeline,
             layout,
             uniform: binding::uniform_buffer::<VoUniform>(device, "lineao::VoLine::uniform"),
-            tables: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("lineao::VoLine::tables"),
-                contents: bytemuck::cast_slice(&tables),
-                usage: wgpu::BufferUsages::UNIFORM,
-            }),
+            // (x, y, A_i) in entries 0..16, the 4 × 4 tile of directions in 16..32.
+            tables: binding::two_tables(device, "lineao::VoLine::tables", samples, 16, &tile),
             group: None,
         }
     }
