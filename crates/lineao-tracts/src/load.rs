@@ -258,7 +258,13 @@ fn checked(t: Tractogram) -> Parse<Tractogram> {
 /// removes the partial file.
 pub fn save(t: &Tractogram, path: impl AsRef<Path>) -> Result<Vec<String>, Error> {
     let path = path.as_ref();
-    let format = Format::from_path(path);
+    let format = match Format::from_path(path) {
+        Some(f @ (Format::Tck | Format::Trk | Format::Trx)) => f,
+        _ => {
+            let ext = path.extension().map(|e| e.to_string_lossy().to_string()).unwrap_or_default();
+            return Err(ErrorKind::Unsupported(format!("writing '{ext}': we write .tck, .trk and .trx")).at(path));
+        }
+    };
     if !t.has_points() {
         return Err(
             ErrorKind::Unsupported("values without points (a .tsf) cannot be written as streamlines".into()).at(path)
@@ -266,29 +272,19 @@ pub fn save(t: &Tractogram, path: impl AsRef<Path>) -> Result<Vec<String>, Error
     }
     let write = || -> std::io::Result<Vec<String>> {
         let file = File::create(path)?;
-        match format {
-            Some(Format::Trx) => trx::write(t, BufWriter::new(file)).map(|_| Vec::new()),
-            Some(f @ (Format::Tck | Format::Trk)) => {
-                let mut out = BufWriter::with_capacity(1 << 20, file);
-                let dropped = if f == Format::Tck {
-                    mrtrix::write_tck(t, &mut out)?;
-                    t.vertex_fields.iter().chain(&t.streamline_fields).map(|f| f.name.clone()).collect()
-                } else {
-                    trk::write(t, &mut out)?
-                };
-                out.flush()?;
-                Ok(dropped)
-            }
-            _ => unreachable!(),
+        if format == Format::Trx {
+            return trx::write(t, BufWriter::new(file)).map(|_| Vec::new());
         }
+        let mut out = BufWriter::with_capacity(1 << 20, file);
+        let dropped = if format == Format::Tck {
+            mrtrix::write_tck(t, &mut out)?;
+            t.vertex_fields.iter().chain(&t.streamline_fields).map(|f| f.name.clone()).collect()
+        } else {
+            trk::write(t, &mut out)?
+        };
+        out.flush()?;
+        Ok(dropped)
     };
-    if !matches!(format, Some(Format::Tck | Format::Trk | Format::Trx)) {
-        return Err(ErrorKind::Unsupported(format!(
-            "writing '{}': we write .tck, .trk and .trx",
-            path.extension().map(|e| e.to_string_lossy().to_string()).unwrap_or_default()
-        ))
-        .at(path));
-    }
     write().map_err(|e| {
         let _ = std::fs::remove_file(path);
         ErrorKind::Io(e).at(path)
