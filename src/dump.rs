@@ -29,6 +29,13 @@ fn write_npy(dir: &Path, name: &str, shape: &[u64], data: &[f32]) -> Result<()> 
     Ok(())
 }
 
+/// Adds the keys of the JSON object `extra` to the object `params`.
+fn merge(params: &mut serde_json::Value, extra: serde_json::Value) {
+    if let (Some(params), serde_json::Value::Object(extra)) = (params.as_object_mut(), extra) {
+        params.extend(extra);
+    }
+}
+
 fn flat3(vectors: &[[f32; 3]]) -> Vec<f32> {
     vectors.iter().flatten().copied().collect()
 }
@@ -100,8 +107,8 @@ pub fn write(dir: &Path, gpu: &Gpu, chain: &AoChain, camera: &Camera) -> Result<
                 "zoom_fit": view.zoom_fit(),
             }),
         };
-        extra.as_object_mut().expect("object").extend(variant_keys.as_object().expect("object").clone());
-        params.as_object_mut().expect("object").extend(extra.as_object().expect("object").clone());
+        merge(&mut extra, variant_keys);
+        merge(&mut params, extra);
         write_npy(dir, "noise.npy", &[64, 64, 3], &flat3(&noise::noise_tile(ao.noise_seed)))?;
         let samples = lineao::passes::line_ao::sample_table(ao);
         write_npy(dir, "samples.npy", &[ao.s_r as u64, ao.s_h as u64, 3], &flat3(&samples))?;
@@ -114,7 +121,7 @@ pub fn write(dir: &Path, gpu: &Gpu, chain: &AoChain, camera: &Camera) -> Result<
             "ssao_range": ssao.range_world,
             "noise_seed": ssao.noise_seed,
         });
-        params.as_object_mut().expect("object").extend(extra.as_object().expect("object").clone());
+        merge(&mut params, extra);
         let kernel = noise::ssao_kernel(ssao.noise_seed, ssao.samples);
         write_npy(dir, "ssao_kernel.npy", &[ssao.samples as u64, 3], &flat3(&kernel))?;
         write_npy(dir, "ssao_noise.npy", &[4, 4, 3], &flat3(&noise::ssao_noise(ssao.noise_seed)))?;
@@ -128,7 +135,7 @@ pub fn write(dir: &Path, gpu: &Gpu, chain: &AoChain, camera: &Camera) -> Result<
             "thickness": vo.thickness_world,
             "noise_seed": vo.noise_seed,
         });
-        params.as_object_mut().expect("object").extend(extra.as_object().expect("object").clone());
+        merge(&mut params, extra);
         let samples = lineao::sample_sets::vo_disk_samples(vo.samples).context("no VO sample set of that size")?;
         write_npy(dir, "vo_samples.npy", &[vo.samples as u64, 3], &flat3(samples))?;
         let tile: Vec<f32> = noise::vo_noise(vo.noise_seed).into_iter().flatten().collect();
