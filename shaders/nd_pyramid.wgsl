@@ -7,25 +7,12 @@
 @group(0) @binding(0) var src: texture_2d<f32>;
 @group(0) @binding(1) var dst: texture_storage_2d<rgba32float, write>;
 
-const BINOMIAL: array<f32, 5> = array<f32, 5>(0.0625, 0.25, 0.375, 0.25, 0.0625);
-
 @compute @workgroup_size(8, 8, 1)
 fn downsample(@builtin(global_invocation_id) id: vec3<u32>) {
-    let dst_size = textureDimensions(dst);
-    if (any(id.xy >= dst_size)) {
+    if (any(id.xy >= textureDimensions(dst))) {
         return;
     }
-    let src_max = vec2<i32>(textureDimensions(src)) - 1;
-    let centre = vec2<i32>(id.xy) * 2;
-    var sum = vec4<f32>(0.0);
-    for (var dy = 0; dy < 5; dy++) {
-        var row = vec4<f32>(0.0);
-        for (var dx = 0; dx < 5; dx++) {
-            let texel = clamp(centre + vec2<i32>(dx - 2, dy - 2), vec2<i32>(0), src_max);
-            row += BINOMIAL[dx] * textureLoad(src, texel, 0);
-        }
-        sum += BINOMIAL[dy] * row;
-    }
+    let sum = binomial_5x5(src, vec2<i32>(id.xy) * 2);
     let len = length(sum.xyz);
     let n = select(vec3<f32>(0.0), sum.xyz / len, len > 1e-6);
     textureStore(dst, vec2<i32>(id.xy), vec4<f32>(n, sum.w));

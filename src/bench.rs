@@ -13,28 +13,32 @@
 //! - `ssao-16-chain`: SSAO with 16 samples and its 4 × 4 blur in one span (the LineAO paper's
 //!   baseline frame, against `lineao-chain`);
 //! - `vo-line-5`: Volumetric Obscurance with 5 line samples (against `ssao-12`: the VO paper's
-//!   0.56×).
+//!   0.56×);
+//! - `vo-area-1`: VO with one area sample, moments pyramid included (what the method costs);
+//! - `bilateral`: the separable bilateral blur (radius 4), which can follow any method.
 
 use std::time::Instant;
 
 use anyhow::{Context, Result};
 use lineao::camera::FrameView;
+use lineao::passes::bilateral::Bilateral;
 use lineao::passes::composite::Composite;
 use lineao::passes::line_ao::{Evaluation, LineAo};
 use lineao::passes::lines::{GeometryOptions, LineGeometry, LineRenderer, LineStyle};
 use lineao::passes::nd_pyramid::NdPyramid;
 use lineao::passes::ssao::Ssao;
 use lineao::passes::ssao_blur::SsaoBlur;
+use lineao::passes::vo_area::VoArea;
 use lineao::passes::vo_line::VoLine;
 use lineao::targets::{FrameTargets, Target};
 use lineao::timing::{PassTimer, Span};
-use lineao::{AoChain, ChainSettings, Gpu, LineAoSettings, SsaoSettings, VoSettings};
+use lineao::{AoChain, BilateralSettings, ChainSettings, Gpu, LineAoSettings, SsaoSettings, VoSettings};
 use serde_json::json;
 
 use crate::cli::BenchArgs;
 
 /// The passes of one run, in CONTRACT.md's order.
-pub const PASSES: [&str; 10] = [
+pub const PASSES: [&str; 12] = [
     "lines",
     "lines-native-1px",
     "nd-pyramid",
@@ -45,6 +49,8 @@ pub const PASSES: [&str; 10] = [
     "ssao-12",
     "ssao-16-chain",
     "vo-line-5",
+    "vo-area-1",
+    "bilateral",
 ];
 
 /// Every pass of the benchmark, prepared for one view over one G-buffer.
@@ -59,6 +65,10 @@ struct Passes {
     ssao_16: Ssao,
     ssao_blur: SsaoBlur,
     vo_line_5: VoLine,
+    vo_area_1: VoArea,
+    /// The chain's G-buffer copied into targets with a moments pyramid, for `vo_area_1`.
+    area_targets: FrameTargets,
+    bilateral: Bilateral,
     output: Target,
 }
 
@@ -77,6 +87,9 @@ impl Passes {
             ssao_16: Ssao::new(device, &SsaoSettings { samples: 16, ..settings.ssao.clone() }),
             ssao_blur: SsaoBlur::new(device),
             vo_line_5: VoLine::new(device, &VoSettings { samples: 5, ..settings.vo.clone() }),
+            vo_area_1: VoArea::new(device, &VoSettings { area_samples: 1, ..settings.vo.clone() }),
+            area_targets: FrameTargets::new(device, view.width, view.height, targets.guard, 1).with_moments(device),
+            bilateral: Bilateral::new(device),
             output: Target::output(device, "lineao::bench::output", (view.width, view.height), format),
         };
         for renderer in [&passes.lines, &passes.lines_native] {
@@ -94,7 +107,16 @@ impl Passes {
         passes.ssao_blur.resize(device, targets);
         passes.vo_line_5.resize(device, targets);
         passes.vo_line_5.prepare(queue, targets, view, &VoSettings { samples: 5, ..settings.vo.clone() });
-        passes.composite.resize(device, targets);
+        passes.vo_area_1.resize(device, &passes.area_targets);
+        passes.vo_area_1.prepare(
+            queue,
+            &passes.area_targets,
+            view,
+            &VoSettings { area_samples: 1, ..settings.vo.clone() },
+        );
+        passes.bilateral.resize(device, targets);
+        passes.bilateral.prepare(queue, view, &BilateralSettings::default());
+        passes.composite.resize(device, targets, &targets.ao);
         passes.composite.prepare(queue, targets, settings.strength, settings.debug_view, view.zoom_max());
         passes
     }
@@ -126,6 +148,11 @@ impl Passes {
                 self.ssao_blur.encode(encoder, targets, span.map(Span::end_only));
             }
             "vo-line-5" => self.vo_line_5.encode(encoder, targets, span),
+            "vo-area-1" => {
+                let area = &self.area_targets;
+                self.vo_area_1.encode(encoder, area, span.map(Span::begin_only), span.map(Span::end_only))
+            }
+            "bilateral" => self.bilateral.encode(encoder, targets, span),
             _ => unreachable!("unknown bench pass {name}"),
         }
     }
@@ -167,6 +194,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::bench") });
     passes.encode("lines", &mut encoder, targets, &geometry, settings.background, None);
     passes.encode("nd-pyramid", &mut encoder, targets, &geometry, settings.background, None);
+    for (from, to) in [(&targets.nd[0], &passes.area_targets.nd[0]), (&targets.zoom, &passes.area_targets.zoom)] {
+        encoder.copy_texture_to_texture(from.texture.as_image_copy(), to.texture.as_image_copy(), from.texture.size());
+    }
     queue.submit([encoder.finish()]);
     let selected = |name: &str| args.passes.is_empty() || args.passes.iter().any(|p| p == name);
     for frame in 0..args.warmup + args.frames {
@@ -252,6 +282,7 @@ fn print_table(report: &serde_json::Value, passes: &[serde_json::Value]) {
         ("lines", "lines-native-1px"),
         ("lineao-chain", "ssao-16-chain"),
         ("vo-line-5", "ssao-12"),
+        ("vo-area-1", "ssao-12"),
     ] {
         if let (Some(x), Some(y)) = (median(a), median(b)) {
             println!("{a} / {b}: {:.2}x", x / y);

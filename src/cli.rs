@@ -69,14 +69,27 @@ fn parse_bench_pass(s: &str) -> Result<String, String> {
     }
 }
 
+/// An AO method by its CONTRACT.md name: none, lineao, ssao, vo-line, vo-area.
+pub fn parse_method(s: &str) -> Result<lineao::AoMethod, String> {
+    lineao::AoMethod::from_name(s).ok_or_else(|| {
+        let names: Vec<_> = lineao::AoMethod::ALL.iter().map(|m| m.name()).collect();
+        format!("unknown method '{s}' (one of {})", names.join(", "))
+    })
+}
+
+fn parse_pair(s: &str) -> Result<[lineao::AoMethod; 2], String> {
+    match s.split(',').collect::<Vec<_>>()[..] {
+        [a, b] => Ok([parse_method(a.trim())?, parse_method(b.trim())?]),
+        _ => Err(format!("expected two methods A,B, got '{s}'")),
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum Method {
-    None,
-    Lineao,
-    /// Crytek SSAO with its 4 × 4 blur (the LineAO paper's baseline).
-    Ssao,
-    /// Volumetric Obscurance with line samples (Loos & Sloan 2010).
-    VoLine,
+pub enum Combine {
+    /// Brightness multiplies: 1 − (1 − ao_small)(1 − ao_large).
+    Product,
+    /// The darker of the two.
+    Min,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -140,9 +153,18 @@ pub struct RenderArgs {
     /// Seed of the built-in scene.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Ambient occlusion method.
-    #[arg(long, value_enum, default_value_t = Method::Lineao)]
-    pub method: Method,
+    /// Ambient occlusion method: none, lineao, ssao (Crytek, with its 4 × 4 blur), vo-line or
+    /// vo-area (Volumetric Obscurance with line or area samples).
+    #[arg(long, default_value = "lineao", value_parser = parse_method)]
+    pub method: lineao::AoMethod,
+    /// Split screen: method A on the left, B on the right, a labelled divider (e.g.
+    /// `lineao,ssao`).
+    #[arg(long, value_name = "A,B", value_parser = parse_pair, conflicts_with = "grid")]
+    pub compare: Option<[lineao::AoMethod; 2]>,
+    /// Every method in one labelled image (a 3 × 2 grid of --width × --height tiles, LineAO's
+    /// `reference` variant in the sixth).
+    #[arg(long)]
+    pub grid: bool,
     /// LineAO variant.
     #[arg(long, value_enum, default_value_t = Variant::Paper)]
     pub variant: Variant,
@@ -186,10 +208,25 @@ pub struct RenderArgs {
     /// Variant `reference`: base radius in pixels at the home zoom (the authors' u_lineAORadius).
     #[arg(long, default_value_t = 2.0)]
     pub reference_radius: f32,
-    /// SSAO: point samples in the sphere (8..=32) [default: 16]; VO: line samples (5, 7, 9,
-    /// 12, 13 or 16) [default: 9].
+    /// SSAO: point samples in the sphere (8..=32) [default: 16]; vo-line: line samples (5, 7,
+    /// 9, 12, 13 or 16) [default: 9]; vo-area: area samples (1 or a line count) [default: 1].
     #[arg(long)]
     pub samples: Option<u32>,
+    /// VO: a second sphere radius in world units, combined with --radius (VO paper, Fig. 8).
+    #[arg(long)]
+    pub radius2: Option<f32>,
+    /// VO with two radii: how they combine.
+    #[arg(long, value_enum, default_value_t = Combine::Product, requires = "radius2")]
+    pub combine: Combine,
+    /// Bilateral (depth-aware, separable) blur after the method.
+    #[arg(long)]
+    pub bilateral: bool,
+    /// Bilateral blur: taps on each side (1..=16).
+    #[arg(long, default_value_t = 4, requires = "bilateral")]
+    pub bilateral_radius: u32,
+    /// Bilateral blur: σ of the depth weight, world units.
+    #[arg(long, default_value_t = 1.0, requires = "bilateral")]
+    pub bilateral_sigma: f32,
     /// VO: no normal clamp (the whole sphere, not the half above the surface).
     #[arg(long)]
     pub no_normal_clamp: bool,

@@ -1,8 +1,9 @@
 //! `--dump DIR` (CONTRACT.md): the method's inputs and raw output at the guard-banded size, so an
 //! outside implementation can recompute the result: `nd_<j>.npy`, `zoom.npy`, `ao.npy`,
 //! `noise.npy`, `samples.npy` (LineAO), `ssao_kernel.npy`, `ssao_noise.npy` (SSAO) or
-//! `vo_samples.npy`, `vo_noise.npy` (VO), and
-//! `params.json`. `ao.npy` is the method's raw occlusion, before SSAO's blur.
+//! `vo_samples.npy`, `vo_noise.npy` (VO; area sampling adds `moments_<l>.npy`, H_l × W_l × 2),
+//! and `params.json`. `ao.npy` is the method's raw occlusion, before SSAO's blur and before the
+//! bilateral blur.
 
 use std::fs::File;
 use std::io::BufWriter;
@@ -126,20 +127,41 @@ pub fn write(dir: &Path, gpu: &Gpu, chain: &AoChain, camera: &Camera) -> Result<
         write_npy(dir, "ssao_kernel.npy", &[ssao.samples as u64, 3], &flat3(&kernel))?;
         write_npy(dir, "ssao_noise.npy", &[4, 4, 3], &flat3(&noise::ssao_noise(ssao.noise_seed)))?;
     }
-    if s.method == AoMethod::VoLine {
+    if matches!(s.method, AoMethod::VoLine | AoMethod::VoArea) {
         let vo = &s.vo;
-        let extra = json!({
-            "samples": vo.samples,
+        let (count, samples) = if s.method == AoMethod::VoLine {
+            (vo.samples, lineao::sample_sets::vo_disk_samples(vo.samples).map(<[_]>::to_vec))
+        } else {
+            (vo.area_samples, lineao::sample_sets::vo_area_samples(vo.area_samples))
+        };
+        let mut extra = json!({
+            "samples": count,
             "radius_world": vo.radius_world,
             "normal_clamp": vo.normal_clamp,
             "thickness": vo.thickness_world,
             "noise_seed": vo.noise_seed,
         });
+        if let Some(r2) = vo.radius2_world {
+            merge(&mut extra, json!({"radius2_world": r2, "combine": vo.combine.name()}));
+        }
         merge(&mut params, extra);
-        let samples = lineao::sample_sets::vo_disk_samples(vo.samples).context("no VO sample set of that size")?;
-        write_npy(dir, "vo_samples.npy", &[vo.samples as u64, 3], &flat3(samples))?;
+        let samples = samples.context("no VO sample set of that size")?;
+        write_npy(dir, "vo_samples.npy", &[count as u64, 3], &flat3(&samples))?;
         let tile: Vec<f32> = noise::vo_noise(vo.noise_seed).into_iter().flatten().collect();
         write_npy(dir, "vo_noise.npy", &[4, 4, 2], &tile)?;
+        if let Some(moments) = &targets.moments {
+            for (l, level) in lineao::verify::read_moments(&gpu.device, &gpu.queue, moments)?.iter().enumerate() {
+                let shape = [level.height as u64, level.width as u64, 2];
+                write_npy(dir, &format!("moments_{l}.npy"), &shape, &level.data.concat())?;
+            }
+        }
+    }
+    if let (Some(blur), true) = (&s.blur, s.method != AoMethod::None) {
+        // Our extension of CONTRACT.md: the blur after `ao.npy` (what the image shows).
+        merge(
+            &mut params,
+            json!({"bilateral": {"radius_px": blur.radius_px, "depth_sigma_world": blur.depth_sigma_world}}),
+        );
     }
     let path = dir.join("params.json");
     let text = serde_json::to_string_pretty(&params)?;

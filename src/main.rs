@@ -8,6 +8,7 @@ mod bench_load;
 mod cli;
 mod dump;
 mod info;
+mod label;
 mod output;
 mod render;
 

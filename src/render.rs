@@ -1,39 +1,51 @@
-//! `lineao render`: a tractography file or a built-in scene through the pass chain into a PNG (and `--dump`).
+//! `lineao render`: a tractography file or a built-in scene through the pass chain into a PNG
+//! (and `--dump`); with `--compare A,B` a split screen of two methods, with `--grid` all of
+//! them side by side, labelled.
+
+use std::path::Path;
 
 use anyhow::{Context, Result};
 use glam::Vec3;
-use lineao::camera::{Camera, Projection};
+use lineao::camera::{Bounds, Camera, Projection};
 use lineao::passes::lines::LineGeometry;
 use lineao::{
-    AoChain, AoMethod, ChainSettings, Gpu, LineAoSettings, LineAoVariant, LineColor, SsaoSettings, VoSettings,
+    AoChain, AoMethod, BilateralSettings, ChainSettings, Gpu, LineAoSettings, LineAoVariant, LineColor, SsaoSettings,
+    VoCombine, VoSettings,
 };
 use lineao_tracts::scenes::ViewHint;
 
-use crate::cli::{ColorArg, Method, RenderArgs, Variant};
+use crate::cli::{ColorArg, Combine, RenderArgs, Variant};
+use crate::label::Rgba8;
 
-/// The chain's settings from the command line.
-pub fn settings(args: &RenderArgs, zoom_unit: f32) -> ChainSettings {
+/// The chain's settings from the command line, for `method`.
+pub fn settings(args: &RenderArgs, method: AoMethod, zoom_unit: f32) -> ChainSettings {
+    // --samples counts the chosen method's samples; the others keep their defaults.
+    let samples = |m: AoMethod, default: u32| args.samples.filter(|_| method == m).unwrap_or(default);
+    let vo_default = VoSettings::default();
     ChainSettings {
-        method: match args.method {
-            Method::None => AoMethod::None,
-            Method::Lineao => AoMethod::LineAo,
-            Method::Ssao => AoMethod::Ssao,
-            Method::VoLine => AoMethod::VoLine,
-        },
+        method,
         vo: VoSettings {
-            // --samples counts the chosen method's samples; the other keeps its default.
-            samples: args.samples.filter(|_| args.method == Method::VoLine).unwrap_or(VoSettings::default().samples),
+            samples: samples(AoMethod::VoLine, vo_default.samples),
+            area_samples: samples(AoMethod::VoArea, vo_default.area_samples),
             radius_world: args.radius,
+            radius2_world: args.radius2,
+            combine: match args.combine {
+                Combine::Product => VoCombine::Product,
+                Combine::Min => VoCombine::Min,
+            },
             normal_clamp: !args.no_normal_clamp,
             thickness_world: args.thickness,
             noise_seed: args.noise_seed,
         },
         ssao: SsaoSettings {
-            samples: args.samples.filter(|_| args.method == Method::Ssao).unwrap_or(SsaoSettings::default().samples),
+            samples: samples(AoMethod::Ssao, SsaoSettings::default().samples),
             radius_world: args.radius,
             range_world: args.ssao_range.unwrap_or(args.radius),
             noise_seed: args.noise_seed,
         },
+        blur: args
+            .bilateral
+            .then_some(BilateralSettings { radius_px: args.bilateral_radius, depth_sigma_world: args.bilateral_sigma }),
         line_ao: LineAoSettings {
             s_r: args.s_r,
             s_h: args.s_h,
@@ -62,6 +74,40 @@ pub fn settings(args: &RenderArgs, zoom_unit: f32) -> ChainSettings {
     }
 }
 
+/// What one image of the output shows: a label and the chain's settings.
+struct Panel {
+    label: String,
+    settings: ChainSettings,
+}
+
+impl Panel {
+    fn new(settings: ChainSettings) -> Panel {
+        let mut label = settings.method.name().to_string();
+        if settings.method == AoMethod::LineAo && settings.line_ao.variant == LineAoVariant::Reference {
+            label += " (reference)";
+        }
+        Panel { label, settings }
+    }
+}
+
+/// The panels the command line asks for: one method, two (--compare) or all (--grid).
+fn panels(args: &RenderArgs, zoom_unit: f32) -> Vec<Panel> {
+    let panel = |method| Panel::new(settings(args, method, zoom_unit));
+    if let Some(pair) = args.compare {
+        return pair.into_iter().map(panel).collect();
+    }
+    if !args.grid {
+        return vec![panel(args.method)];
+    }
+    let mut all: Vec<Panel> = AoMethod::ALL.into_iter().map(panel).collect();
+    // The sixth tile: LineAO as the authors' code computes it, next to the paper's.
+    let mut reference = settings(args, AoMethod::LineAo, zoom_unit);
+    reference.line_ao.variant =
+        if args.variant == Variant::Reference { LineAoVariant::Paper } else { LineAoVariant::Reference };
+    all.insert(2, Panel::new(reference));
+    all
+}
+
 pub fn run(args: &RenderArgs) -> Result<()> {
     let (name, tracts, hint) = match &args.file {
         Some(path) => {
@@ -82,8 +128,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             (scene.kind.name().to_string(), scene.tractogram, scene.view)
         }
     };
-    let settings = settings(args, hint.zoom_unit);
-    settings.validate()?;
+    let panels = panels(args, hint.zoom_unit);
+    for panel in &panels {
+        panel.settings.validate().with_context(|| panel.label.clone())?;
+    }
     let camera = Camera {
         eye: Vec3::from_array(args.eye.unwrap_or(hint.eye)),
         target: Vec3::from_array(args.target.unwrap_or(hint.target)),
@@ -98,48 +146,90 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let gpu = Gpu::headless()?;
     let geometry = LineGeometry::new(&gpu.device, &gpu.queue, &tracts.positions, &tracts.offsets)?;
     let bounds = geometry.bounds.with_context(|| format!("{name} has no finite points"))?;
-    let format = wgpu::TextureFormat::Rgba8UnormSrgb;
-    let mut chain = AoChain::new(&gpu.device, format, settings)?;
-    if args.timings {
-        chain.set_timing(&gpu.device, &gpu.queue, true);
+    let frame = Frame { gpu: &gpu, geometry: &geometry, bounds, camera, args };
+    let mut images = Vec::new();
+    for panel in &panels {
+        // One method dumps into DIR itself, several into DIR/<label>/.
+        let dump = args.dump.as_ref().map(|dir| match panels.len() {
+            1 => dir.clone(),
+            _ => dir.join(panel.label.replace(" (reference)", "-reference")),
+        });
+        images.push(frame.render(panel, dump.as_deref())?);
     }
-    chain.resize(args.width, args.height)?;
-    chain.prepare(&gpu.device, &gpu.queue, &camera, &bounds);
-    let target =
-        lineao::targets::Target::output(&gpu.device, "lineao::render::output", (args.width, args.height), format);
-    let mut encoder =
-        gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::render") });
-    chain.encode(&mut encoder, &geometry, &target.view);
-    let start = std::time::Instant::now();
-    gpu.queue.submit([encoder.finish()]);
-    if args.timings {
-        gpu.wait()?;
-        let wall_ms = start.elapsed().as_secs_f64() * 1e3;
-        match chain.pass_times(&gpu.device)? {
-            Some(times) => {
-                for t in &times {
-                    eprintln!("lineao: {:<12} {:9.2} ms (GPU)", t.name, t.ms);
-                }
-                eprintln!("lineao: {:<12} {:9.2} ms (GPU, sum)", "frame", times.iter().map(|t| t.ms).sum::<f64>());
-            }
-            None => eprintln!("lineao: frame {wall_ms:.2} ms (CPU wall time: the adapter has no timestamp queries)"),
+    let (width, height) = (args.width, args.height);
+    let image = match &images[..] {
+        [single] => single.clone(),
+        [a, b] if args.compare.is_some() => {
+            crate::label::split(a, b, [&panels[0].label, &panels[1].label]).context("composing --compare")?
         }
-    }
-    let image = lineao::readback::read_texture(&gpu.device, &gpu.queue, &target.texture)?;
-    crate::output::write_png(&args.output, args.width, args.height, &image.bytes)?;
-    if let Some(dir) = &args.dump {
-        crate::dump::write(dir, &gpu, &chain, &camera)?;
-    }
+        tiles => {
+            let labelled: Vec<(&str, &Rgba8)> = panels.iter().map(|p| p.label.as_str()).zip(tiles).collect();
+            crate::label::grid(&labelled, 3)
+        }
+    };
+    crate::output::write_png(&args.output, image.width, image.height, &image.data)?;
+    let methods: Vec<&str> = panels.iter().map(|p| p.label.as_str()).collect();
     eprintln!(
-        "lineao: {} ({} streamlines, {} vertices) with {} on {} -> {}",
+        "lineao: {} ({} streamlines, {} vertices) with {} at {width} x {height} on {} -> {}",
         name,
         geometry.streamlines,
         geometry.vertices,
-        chain.settings().method.name(),
+        methods.join(", "),
         gpu.describe(),
         args.output.display()
     );
     Ok(())
+}
+
+/// What every panel of one `render` shares.
+struct Frame<'a> {
+    gpu: &'a Gpu,
+    geometry: &'a LineGeometry,
+    bounds: Bounds,
+    camera: Camera,
+    args: &'a RenderArgs,
+}
+
+impl Frame<'_> {
+    /// Renders `panel` to sRGB bytes (with `--timings`, prints its passes; with `dump`, writes
+    /// its inputs and output there).
+    fn render(&self, panel: &Panel, dump: Option<&Path>) -> Result<Rgba8> {
+        let (gpu, args) = (self.gpu, self.args);
+        let format = wgpu::TextureFormat::Rgba8UnormSrgb;
+        let mut chain = AoChain::new(&gpu.device, format, panel.settings.clone())?;
+        if args.timings {
+            chain.set_timing(&gpu.device, &gpu.queue, true);
+        }
+        chain.resize(args.width, args.height)?;
+        chain.prepare(&gpu.device, &gpu.queue, &self.camera, &self.bounds);
+        let size = (args.width, args.height);
+        let target = lineao::targets::Target::output(&gpu.device, "lineao::render::output", size, format);
+        let mut encoder =
+            gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::render") });
+        chain.encode(&mut encoder, self.geometry, &target.view);
+        let start = std::time::Instant::now();
+        gpu.queue.submit([encoder.finish()]);
+        if args.timings {
+            gpu.wait()?;
+            let wall_ms = start.elapsed().as_secs_f64() * 1e3;
+            let label = &panel.label;
+            match chain.pass_times(&gpu.device)? {
+                Some(times) => {
+                    for t in &times {
+                        eprintln!("lineao: {label}: {:<12} {:9.2} ms (GPU)", t.name, t.ms);
+                    }
+                    let sum: f64 = times.iter().map(|t| t.ms).sum();
+                    eprintln!("lineao: {label}: {:<12} {sum:9.2} ms (GPU, sum)", "frame");
+                }
+                None => eprintln!("lineao: {label}: frame {wall_ms:.2} ms (CPU wall time: no timestamp queries)"),
+            }
+        }
+        let image = lineao::readback::read_texture(&gpu.device, &gpu.queue, &target.texture)?;
+        if let Some(dir) = dump {
+            crate::dump::write(dir, gpu, &chain, &self.camera)?;
+        }
+        Ok(Rgba8 { width: args.width, height: args.height, data: image.bytes })
+    }
 }
 
 /// The camera a built-in scene suggests.

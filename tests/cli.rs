@@ -229,7 +229,9 @@ fn bench_json_is_the_contract() {
             "lineao-chain",
             "ssao-12",
             "ssao-16-chain",
-            "vo-line-5"
+            "vo-line-5",
+            "vo-area-1",
+            "bilateral"
         ]
     );
     for p in passes {
@@ -309,48 +311,115 @@ fn render_and_dump_let_an_outside_tool_recompute_ssao() {
     assert!(ao.data.iter().filter(|&&a| a > 0.05).count() > 200, "SSAO occludes something");
 }
 
-/// `--method vo-line --dump`: VO recomputed from the dumped files and `params.json` alone.
+/// `--method vo-line|vo-area --dump`: VO recomputed from the dumped files and `params.json`
+/// alone (area sampling from the dumped moments pyramid, which is checked against `nd_0.npy`).
 #[test]
 fn render_and_dump_let_an_outside_tool_recompute_vo() {
-    let extra = ["--scene", "spiral", "--method", "vo-line", "--samples", "7", "--radius", "3", "--thickness", "1"];
-    let (_, dump) = render_with_dump("dump-vo", &extra);
-    let params: Value = serde_json::from_str(&std::fs::read_to_string(dump.join("params.json")).unwrap()).unwrap();
-    assert_eq!(params["method"], "vo-line");
-    assert_eq!((params["samples"].as_u64(), params["normal_clamp"].as_bool()), (Some(7), Some(true)));
-    let f = |k: &str| params[k].as_f64().unwrap() as f32;
-    let guard = params["guard_px"].as_u64().unwrap() as usize;
-    let (w, h) = (
-        params["width"].as_u64().unwrap() as usize + 2 * guard,
-        params["height"].as_u64().unwrap() as usize + 2 * guard,
-    );
-    let fov = params["camera"]["fov_y_deg"].as_f64().unwrap() as f32;
-    let view = ViewParams {
-        near: f("depth_near"),
-        far: f("depth_far"),
-        f_px: f("height") / (2.0 * (fov.to_radians() * 0.5).tan()),
-        orthographic: false,
-        center: [w as f32 * 0.5, h as f32 * 0.5],
-    };
-    let (_, nd) = read_npy(&dump.join("nd_0.npy"));
-    let nd0 = Image { width: w, height: h, data: nd.chunks_exact(4).map(|t| [t[0], t[1], t[2], t[3]]).collect() };
-    let zoom = Image { width: w, height: h, data: read_npy(&dump.join("zoom.npy")).1 };
-    let ao = Image { width: w, height: h, data: read_npy(&dump.join("ao.npy")).1 };
-    let (sshape, samples) = read_npy(&dump.join("vo_samples.npy"));
-    assert_eq!(sshape, [7, 3]);
-    let (nshape, tile) = read_npy(&dump.join("vo_noise.npy"));
-    assert_eq!(nshape, [4, 4, 2]);
-    let samples: Vec<[f32; 3]> = samples.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
-    let tile: Vec<[f32; 2]> = tile.chunks_exact(2).map(|c| [c[0], c[1]]).collect();
-    let p = VoParams {
-        view,
-        radius: f("radius_world"),
-        zoom_unit: f("zoom_unit"),
-        normal_clamp: true,
-        thickness: f("thickness"),
-        noise_origin: [guard as i32; 2],
-    };
-    let cpu = reference::vo_line(&nd0, &zoom, &samples, &tile, &p);
-    let stats = check_policy(&ao, &cpu, &nd0, 2.0 / 7.0).unwrap_or_else(|e| panic!("{e}"));
-    println!("vo-line from --dump: {stats}");
-    assert!(ao.data.iter().filter(|&&a| a > 0.05).count() > 200, "VO obscures something");
+    let runs: [(&str, &[&str]); 2] = [
+        ("vo-line", &["--samples", "7", "--thickness", "1", "--radius2", "6", "--combine", "min"]),
+        ("vo-area", &["--samples", "5", "--no-normal-clamp"]),
+    ];
+    for (method, options) in runs {
+        let mut extra = vec!["--scene", "spiral", "--method", method, "--radius", "3"];
+        extra.extend(options);
+        let (_, dump) = render_with_dump(&format!("dump-{method}"), &extra);
+        let params: Value = serde_json::from_str(&std::fs::read_to_string(dump.join("params.json")).unwrap()).unwrap();
+        assert_eq!(params["method"], method);
+        let n = params["samples"].as_u64().unwrap() as usize;
+        let f = |k: &str| params[k].as_f64().unwrap() as f32;
+        let guard = params["guard_px"].as_u64().unwrap() as usize;
+        let (w, h) = (
+            params["width"].as_u64().unwrap() as usize + 2 * guard,
+            params["height"].as_u64().unwrap() as usize + 2 * guard,
+        );
+        let fov = params["camera"]["fov_y_deg"].as_f64().unwrap() as f32;
+        let view = ViewParams {
+            near: f("depth_near"),
+            far: f("depth_far"),
+            f_px: f("height") / (2.0 * (fov.to_radians() * 0.5).tan()),
+            orthographic: false,
+            center: [w as f32 * 0.5, h as f32 * 0.5],
+        };
+        let (_, nd) = read_npy(&dump.join("nd_0.npy"));
+        let nd0 = Image { width: w, height: h, data: nd.chunks_exact(4).map(|t| [t[0], t[1], t[2], t[3]]).collect() };
+        let zoom = Image { width: w, height: h, data: read_npy(&dump.join("zoom.npy")).1 };
+        let ao = Image { width: w, height: h, data: read_npy(&dump.join("ao.npy")).1 };
+        let (sshape, samples) = read_npy(&dump.join("vo_samples.npy"));
+        assert_eq!(sshape, [n as u64, 3]);
+        let (nshape, tile) = read_npy(&dump.join("vo_noise.npy"));
+        assert_eq!(nshape, [4, 4, 2]);
+        let samples: Vec<[f32; 3]> = samples.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
+        let tile: Vec<[f32; 2]> = tile.chunks_exact(2).map(|c| [c[0], c[1]]).collect();
+        let p = VoParams {
+            view,
+            radius: f("radius_world"),
+            radius2: params["radius2_world"].as_f64().map(|r| r as f32),
+            combine: match params["combine"].as_str() {
+                Some("min") => lineao::VoCombine::Min,
+                None | Some("product") => lineao::VoCombine::Product,
+                Some(other) => panic!("combine {other}"),
+            },
+            zoom_unit: f("zoom_unit"),
+            normal_clamp: params["normal_clamp"].as_bool().unwrap(),
+            thickness: f("thickness"),
+            noise_origin: [guard as i32; 2],
+        };
+        let (cpu, bound) = if method == "vo-line" {
+            assert_eq!((p.radius2, p.combine), (Some(6.0), lineao::VoCombine::Min));
+            (reference::vo_line(&nd0, &zoom, &samples, &tile, &p), 2.0 / n as f32)
+        } else {
+            let moments: Vec<_> = (0..)
+                .map(|l| dump.join(format!("moments_{l}.npy")))
+                .take_while(|path| path.exists())
+                .map(|path| {
+                    let (shape, data) = read_npy(&path);
+                    let (height, width) = (shape[0] as usize, shape[1] as usize);
+                    Image { width, height, data: data.chunks_exact(2).map(|c| [c[0], c[1]]).collect() }
+                })
+                .collect();
+            assert_eq!(moments.last().map(|m| (m.width, m.height)), Some((1, 1)));
+            let z = view.linear_depth(nd0.get(40, 30)[3]);
+            let m = moments[0].get(40, 30);
+            assert!((m[0] - z).abs() <= 1e-5 * z && (m[1] - z * z).abs() <= 1e-5 * z * z, "{m:?} vs {z}");
+            let lod = lineao::sample_sets::vo_area_lod_offsets(&samples);
+            (reference::vo_area(&nd0, &zoom, &moments, &samples, &lod, &tile, &p), 1e-2)
+        };
+        let stats = check_policy(&ao, &cpu, &nd0, bound).unwrap_or_else(|e| panic!("{method}: {e}"));
+        println!("{method} from --dump: {stats}");
+        assert!(ao.data.iter().filter(|&&a| a > 0.05).count() > 200, "{method} obscures something");
+    }
+}
+
+/// `--compare` and `--grid` write one labelled image of the right size; `--dump` with several
+/// methods writes one folder per method; a wrong pair is a command-line error.
+#[test]
+fn compare_and_grid_write_one_image() {
+    let dir = scratch("compare-grid");
+    for (name, extra, size) in
+        [("compare", &["--compare", "vo-area,lineao"][..], (90, 60)), ("grid", &["--grid"][..], (270, 120))]
+    {
+        let png = dir.join(format!("{name}.png"));
+        let dump = dir.join(format!("{name}-dump"));
+        let mut args = vec!["render", "--vertices", "5000", "--width", "90", "--height", "60", "-o"];
+        args.extend([png.to_str().unwrap(), "--dump", dump.to_str().unwrap()]);
+        args.extend(extra);
+        let output = lineao(&args);
+        assert!(output.status.success(), "{name}: {}", stderr(&output));
+        let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&png).unwrap()));
+        let info = decoder.read_info().unwrap();
+        assert_eq!((info.info().width, info.info().height), size, "{name}");
+        let folders = if name == "compare" {
+            vec!["vo-area", "lineao"]
+        } else {
+            vec!["none", "lineao", "lineao-reference", "vo-line", "vo-area", "ssao"]
+        };
+        for folder in folders {
+            let params = std::fs::read_to_string(dump.join(folder).join("params.json")).unwrap();
+            assert!(params.contains("\"method\""), "{name}: {folder}");
+        }
+    }
+    for bad in ["lineao", "lineao,ssao,vo-line", "lineao,magic"] {
+        let output = lineao(&["render", "--compare", bad, "-o", dir.join("x.png").to_str().unwrap()]);
+        assert_eq!(output.status.code(), Some(2), "--compare {bad}: {}", stderr(&output));
+    }
 }

@@ -1,15 +1,18 @@
-//! Snapshot images of every pass on the built-in scenes, to catch regressions (correctness comes
-//! from the CPU reference and the closed-form tests). `UPDATE_SNAPSHOTS=1 cargo test` rewrites
-//! them; a failure leaves `*.actual.png` and `*.diff.png` beside the snapshot (ignored by git).
+//! Snapshot images of every pass on the built-in scenes, and of `lineao render --grid` and
+//! `--compare`, to catch regressions (correctness comes from the CPU reference and the
+//! closed-form tests). `UPDATE_SNAPSHOTS=1 cargo test` rewrites them; a failure leaves
+//! `*.actual.png` and `*.diff.png` beside the snapshot (ignored by git).
 
 use std::path::{Path, PathBuf};
+
+mod common;
 
 use glam::Vec3;
 use lineao::camera::{Camera, Projection};
 use lineao::passes::lines::LineGeometry;
 use lineao::readback::read_texture;
 use lineao::targets::Target;
-use lineao::{AoChain, AoMethod, ChainSettings, DebugView, Gpu, LineAoSettings, LineAoVariant};
+use lineao::{AoChain, AoMethod, BilateralSettings, ChainSettings, DebugView, Gpu, LineAoSettings, LineAoVariant};
 use lineao_tracts::SceneKind;
 
 const SIZE: (u32, u32) = (160, 128);
@@ -22,35 +25,37 @@ fn snapshot_path(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/snapshots").join(format!("{name}.png"))
 }
 
-fn write_png(path: &Path, rgba: &[u8]) {
+fn write_png(path: &Path, (width, height): (u32, u32), rgba: &[u8]) {
     let file = std::fs::File::create(path).unwrap();
-    let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), SIZE.0, SIZE.1);
+    let mut encoder = png::Encoder::new(std::io::BufWriter::new(file), width, height);
     encoder.set_color(png::ColorType::Rgba);
     encoder.set_depth(png::BitDepth::Eight);
     encoder.write_header().unwrap().write_image_data(rgba).unwrap();
 }
 
-fn read_png(path: &Path) -> Vec<u8> {
+fn read_png(path: &Path) -> ((u32, u32), Vec<u8>) {
     let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
     let mut reader = decoder.read_info().unwrap();
     let mut buffer = vec![0; reader.output_buffer_size().unwrap()];
     let info = reader.next_frame(&mut buffer).unwrap();
-    assert_eq!((info.width, info.height), SIZE, "{}", path.display());
     buffer.truncate(info.buffer_size());
-    buffer
+    ((info.width, info.height), buffer)
 }
 
-/// Compares against the stored snapshot; returns a description of the failure.
-fn check(name: &str, rgba: &[u8]) -> Option<String> {
+/// Compares a `size` image against the stored snapshot; returns a description of the failure.
+fn check(name: &str, size: (u32, u32), rgba: &[u8]) -> Option<String> {
     let path = snapshot_path(name);
     if std::env::var_os("UPDATE_SNAPSHOTS").is_some() {
-        write_png(&path, rgba);
+        write_png(&path, size, rgba);
         return None;
     }
     if !path.exists() {
         return Some(format!("{name}: no snapshot at {} (run with UPDATE_SNAPSHOTS=1)", path.display()));
     }
-    let expected = read_png(&path);
+    let (stored, expected) = read_png(&path);
+    if stored != size {
+        return Some(format!("{name}: the snapshot is {stored:?}, the image {size:?}"));
+    }
     let mut diff = vec![0u8; rgba.len()];
     let mut changed = 0usize;
     for (i, (a, b)) in rgba.chunks(4).zip(expected.chunks(4)).enumerate() {
@@ -60,10 +65,10 @@ fn check(name: &str, rgba: &[u8]) -> Option<String> {
         }
         diff[4 * i..4 * i + 4].copy_from_slice(&[worst.saturating_mul(8), 0, 0, 255]);
     }
-    let share = changed as f64 / (SIZE.0 * SIZE.1) as f64;
+    let share = changed as f64 / (size.0 * size.1) as f64;
     if share > MAX_CHANGED {
-        write_png(&path.with_extension("actual.png"), rgba);
-        write_png(&path.with_extension("diff.png"), &diff);
+        write_png(&path.with_extension("actual.png"), size, rgba);
+        write_png(&path.with_extension("diff.png"), size, &diff);
         return Some(format!(
             "{name}: {:.2} % of pixels changed (allowed {:.2} %)",
             100.0 * share,
@@ -99,6 +104,22 @@ fn every_pass_on_every_scene() {
         ("reference_ao", reference),
         ("ssao_ao", ChainSettings { method: AoMethod::Ssao, debug_view: DebugView::Ao, ..ChainSettings::default() }),
         ("ssao_final", ChainSettings { method: AoMethod::Ssao, ..ChainSettings::default() }),
+        (
+            "vo_line_ao",
+            ChainSettings { method: AoMethod::VoLine, debug_view: DebugView::Ao, ..ChainSettings::default() },
+        ),
+        (
+            "vo_area_ao",
+            ChainSettings { method: AoMethod::VoArea, debug_view: DebugView::Ao, ..ChainSettings::default() },
+        ),
+        (
+            "bilateral_ao",
+            ChainSettings {
+                blur: Some(BilateralSettings::default()),
+                debug_view: DebugView::Ao,
+                ..ChainSettings::default()
+            },
+        ),
     ];
     let mut failures = Vec::new();
     for kind in SceneKind::ALL {
@@ -118,8 +139,29 @@ fn every_pass_on_every_scene() {
             chain.encode(&mut encoder, &geometry, &target.view);
             gpu.queue.submit([encoder.finish()]);
             let image = read_texture(&gpu.device, &gpu.queue, &target.texture).unwrap();
-            failures.extend(check(&format!("{}_{view_name}", kind.name()), &image.bytes));
+            failures.extend(check(&format!("{}_{view_name}", kind.name()), SIZE, &image.bytes));
         }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// `lineao render --grid` (every method, labelled) on every scene, and `--compare` on one.
+#[test]
+fn the_comparison_images() {
+    let dir = common::scratch("snapshots-compare");
+    let mut runs: Vec<(String, Vec<&str>)> =
+        SceneKind::ALL.iter().map(|k| (format!("{}_grid", k.name()), vec!["--scene", k.name(), "--grid"])).collect();
+    runs.push(("bundles_compare_lineao_ssao".into(), vec!["--scene", "bundles", "--compare", "lineao,ssao"]));
+    let mut failures = Vec::new();
+    for (name, extra) in &runs {
+        let png = dir.join(format!("{name}.png"));
+        let mut args = vec!["render", "--vertices", "40000", "--width", "160", "--height", "128", "-o"];
+        args.push(png.to_str().unwrap());
+        args.extend(extra);
+        let output = common::lineao(&args);
+        assert!(output.status.success(), "{name}: {}", String::from_utf8_lossy(&output.stderr));
+        let (size, rgba) = read_png(&png);
+        failures.extend(check(name, size, &rgba));
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }

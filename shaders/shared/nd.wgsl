@@ -25,3 +25,21 @@ fn level_texel(pixel: vec2<u32>, offset: vec2<f32>, scale: vec2<f32>, size: vec2
     let texel = vec2<i32>(floor(uv));
     return clamp(texel, vec2<i32>(0), vec2<i32>(size) - 1);
 }
+
+const BINOMIAL: array<f32, 5> = array<f32, 5>(0.0625, 0.25, 0.375, 0.25, 0.0625);
+
+// The separable binomial [1 4 6 4 1]/16 of `src` around `centre`, clamp-to-edge: one step of a
+// Gaussian pyramid when `centre` is twice the destination texel.
+fn binomial_5x5(src: texture_2d<f32>, centre: vec2<i32>) -> vec4<f32> {
+    let src_max = vec2<i32>(textureDimensions(src)) - 1;
+    var sum = vec4<f32>(0.0);
+    for (var dy = 0; dy < 5; dy++) {
+        var row = vec4<f32>(0.0);
+        for (var dx = 0; dx < 5; dx++) {
+            let texel = clamp(centre + vec2<i32>(dx - 2, dy - 2), vec2<i32>(0), src_max);
+            row += BINOMIAL[dx] * textureLoad(src, texel, 0);
+        }
+        sum += BINOMIAL[dy] * row;
+    }
+    return sum;
+}

@@ -7,6 +7,8 @@ pub enum Slot {
     Uniform,
     /// Read-only storage buffer.
     Storage,
+    /// Read-write storage buffer.
+    StorageReadWrite,
     /// `texture_2d<f32>` read with `textureLoad` (unfilterable, so f32 formats work everywhere).
     Texture,
     /// `texture_storage_2d<format, write>`.
@@ -32,8 +34,8 @@ pub fn layout(
                     has_dynamic_offset: false,
                     min_binding_size: None,
                 },
-                Slot::Storage => wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Storage { read_only: true },
+                Slot::Storage | Slot::StorageReadWrite => wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Storage { read_only: matches!(slot, Slot::Storage) },
                     has_dynamic_offset: false,
                     min_binding_size: None,
                 },
@@ -108,17 +110,24 @@ pub fn pipeline_layout(device: &wgpu::Device, label: &str, group: &wgpu::BindGro
     })
 }
 
-/// `vectors` as vec4s (w = 0), zero-padded to `len` entries: the sample and noise tables of the
-/// passes.
-pub fn vec4_buffer(
+/// `vectors` (up to 4 components) as vec4s, missing components 0, zero-padded to `len`
+/// entries: the sample and noise tables of the passes.
+pub fn vec4_buffer<const N: usize>(
     device: &wgpu::Device,
     label: &str,
-    vectors: &[[f32; 3]],
+    vectors: &[[f32; N]],
     len: usize,
     usage: wgpu::BufferUsages,
 ) -> wgpu::Buffer {
     use wgpu::util::DeviceExt;
-    let mut padded: Vec<[f32; 4]> = vectors.iter().map(|v| [v[0], v[1], v[2], 0.0]).collect();
+    let mut padded: Vec<[f32; 4]> = vectors
+        .iter()
+        .map(|v| {
+            let mut row = [0.0; 4];
+            row[..N].copy_from_slice(v);
+            row
+        })
+        .collect();
     padded.resize(padded.len().max(len), [0.0; 4]);
     device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
         label: Some(label),
@@ -128,15 +137,15 @@ pub fn vec4_buffer(
 }
 
 /// Two tables in one uniform buffer of vec4s: `first` from entry 0, `second` from entry `at`.
-pub fn two_tables(
+pub fn two_tables<const N: usize>(
     device: &wgpu::Device,
     label: &str,
-    first: &[[f32; 3]],
+    first: &[[f32; N]],
     at: usize,
-    second: &[[f32; 3]],
+    second: &[[f32; N]],
 ) -> wgpu::Buffer {
     let mut rows = first.to_vec();
-    rows.resize(at, [0.0; 3]);
+    rows.resize(at, [0.0; N]);
     rows.extend_from_slice(second);
     vec4_buffer(device, label, &rows, rows.len(), wgpu::BufferUsages::UNIFORM)
 }

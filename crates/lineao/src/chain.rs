@@ -15,28 +15,33 @@
 //!
 //! With [`AoMethod::Ssao`] the pyramid and LineAO give way to Crytek SSAO (`nd[0]` → `ao_raw`)
 //! and its 4 × 4 blur (`ao_raw` → `ao`); with [`AoMethod::VoLine`] to Volumetric Obscurance
-//! with line samples (`nd[0]`, `zoom` → `ao`).
+//! with line samples (`nd[0]`, `zoom` → `ao`); with [`AoMethod::VoArea`] to the moments pyramid
+//! (`nd[0]` → `moments`) and VO with area samples (→ `ao`). With `ChainSettings::blur` the
+//! bilateral blur follows any method (`ao` → `ao_blurred`, which the composite then shows).
 //!
 //! Every pass is labelled and the frame sits in a `lineao` debug group, so GPU debuggers show
 //! the chain by name. With [`AoChain::set_timing`] each pass also records timestamp queries under
 //! the names `lineao bench` uses (CONTRACT.md): `lines`, `nd-pyramid`, `lineao`, `ssao`,
-//! `ssao-blur`, `vo-line`, `composite`.
+//! `ssao-blur`, `vo-line`, `moments`, `vo-area`, `blur`, `composite`.
 
 use crate::Error;
 use crate::camera::{self, Bounds, Camera, FrameView};
+use crate::passes::bilateral::Bilateral;
 use crate::passes::composite::Composite;
 use crate::passes::line_ao::LineAo;
 use crate::passes::lines::{LineGeometry, LineRenderer};
 use crate::passes::nd_pyramid::NdPyramid;
 use crate::passes::ssao::Ssao;
 use crate::passes::ssao_blur::SsaoBlur;
+use crate::passes::vo_area::VoArea;
 use crate::passes::vo_line::VoLine;
 use crate::settings::{AoMethod, ChainSettings, LineAoVariant};
 use crate::targets::FrameTargets;
 use crate::timing::{PassTime, PassTimer};
 
 /// The spans of a timed frame, in chain order.
-pub const PASS_NAMES: [&str; 7] = ["lines", "nd-pyramid", "lineao", "ssao", "ssao-blur", "vo-line", "composite"];
+pub const PASS_NAMES: [&str; 10] =
+    ["lines", "nd-pyramid", "lineao", "ssao", "ssao-blur", "vo-line", "moments", "vo-area", "blur", "composite"];
 
 pub struct AoChain {
     settings: ChainSettings,
@@ -46,6 +51,8 @@ pub struct AoChain {
     ssao: Ssao,
     ssao_blur: SsaoBlur,
     vo_line: VoLine,
+    vo_area: VoArea,
+    bilateral: Bilateral,
     composite: Composite,
     size: (u32, u32),
     max_texture: u32,
@@ -65,6 +72,8 @@ impl AoChain {
             ssao: Ssao::new(device, &settings.ssao),
             ssao_blur: SsaoBlur::new(device),
             vo_line: VoLine::new(device, &settings.vo),
+            vo_area: VoArea::new(device, &settings.vo),
+            bilateral: Bilateral::new(device),
             composite: Composite::new(device, format),
             settings,
             size: (0, 0),
@@ -101,7 +110,16 @@ impl AoChain {
                 self.vo_line.resize(device, targets);
             }
         }
-        if settings.levels() != self.settings.levels() {
+        if !self.vo_area.matches(&settings.vo) {
+            self.vo_area = VoArea::new(device, &settings.vo);
+            if let Some(targets) = &self.targets {
+                self.vo_area.resize(device, targets);
+            }
+        }
+        // The pyramid's depth, whether moments exist and what the composite shows are bound at
+        // allocation.
+        let layout = |s: &ChainSettings| (s.levels(), s.method == AoMethod::VoArea, s.blur.is_some());
+        if layout(&settings) != layout(&self.settings) {
             self.targets = None;
         }
         self.settings = settings;
@@ -119,14 +137,18 @@ impl AoChain {
     /// is off. Passes the method skips are left out.
     pub fn pass_times(&self, device: &wgpu::Device) -> Result<Option<Vec<PassTime>>, Error> {
         let Some(timer) = &self.timer else { return Ok(None) };
-        let used: &[&str] = match (self.settings.method, self.settings.levels()) {
-            (AoMethod::LineAo, 2..) => &["lines", "nd-pyramid", "lineao", "composite"],
-            (AoMethod::LineAo, _) => &["lines", "lineao", "composite"],
-            (AoMethod::Ssao, _) => &["lines", "ssao", "ssao-blur", "composite"],
-            (AoMethod::VoLine, _) => &["lines", "vo-line", "composite"],
-            (AoMethod::None, _) => &["lines", "composite"],
+        let method: &[&str] = match (self.settings.method, self.settings.levels()) {
+            (AoMethod::LineAo, 2..) => &["nd-pyramid", "lineao"],
+            (AoMethod::LineAo, _) => &["lineao"],
+            (AoMethod::Ssao, _) => &["ssao", "ssao-blur"],
+            (AoMethod::VoLine, _) => &["vo-line"],
+            (AoMethod::VoArea, _) => &["moments", "vo-area"],
+            (AoMethod::None, _) => &[],
         };
-        timer.read(device, used).map(Some)
+        let blur: &[&str] =
+            if self.settings.blur.is_some() && self.settings.method != AoMethod::None { &["blur"] } else { &[] };
+        let used = [&["lines"], method, blur, &["composite"]].concat();
+        timer.read(device, &used).map(Some)
     }
 
     /// Sets the visible size. 0 × 0 (a minimized window) is allowed: nothing is rendered until a
@@ -153,10 +175,15 @@ impl AoChain {
             (AoMethod::None, _) => 0,
             // The sphere's radius in pixels where it is largest (at the near plane), plus the
             // blur's 2 px.
-            (AoMethod::Ssao | AoMethod::VoLine, _) => {
+            // The bilateral blur reaches its radius further.
+            (AoMethod::Ssao | AoMethod::VoLine | AoMethod::VoArea, _) => {
                 let unguarded = FrameView::new(camera, bounds, self.size.0, self.size.1, 0, s.zoom_unit);
-                let (radius_world, blur) =
-                    if s.method == AoMethod::Ssao { (s.ssao.radius_world, 2.0) } else { (s.vo.radius_world, 0.0) };
+                let (radius_world, blur) = if s.method == AoMethod::Ssao {
+                    (s.ssao.radius_world, 2.0)
+                } else {
+                    (s.vo.max_radius_world(), 0.0)
+                };
+                let blur = blur + s.blur.as_ref().map_or(0.0, |b| b.radius_px as f32);
                 let radius = radius_world * unguarded.zoom_max() / s.zoom_unit + blur;
                 camera::guard_band(radius, 1, s.line_ao.guard_max_px)
             }
@@ -167,7 +194,10 @@ impl AoChain {
                 // The widest hemisphere reads the deepest level, whose texels near the band's
                 // edge are filtered with clamp-to-edge: the band covers that reach too.
                 let deepest = s.line_ao.s_r - 1;
-                let radius = s.r0_px() + deepest as f32 * unguarded.zoom_max() + camera::pyramid_reach(deepest);
+                let radius = s.r0_px()
+                    + deepest as f32 * unguarded.zoom_max()
+                    + camera::pyramid_reach(deepest)
+                    + s.blur.as_ref().map_or(0.0, |b| b.radius_px as f32);
                 camera::guard_band(radius, s.line_ao.s_r, s.line_ao.guard_max_px)
             }
         }
@@ -193,13 +223,19 @@ impl AoChain {
         let levels = s.levels();
         let stale = self.targets.as_ref().is_none_or(|t| t.guard != guard || t.nd.len() != levels as usize);
         if stale {
-            let targets = FrameTargets::new(device, width, height, guard, levels);
+            let mut targets = FrameTargets::new(device, width, height, guard, levels);
+            if s.method == AoMethod::VoArea {
+                targets = targets.with_moments(device);
+            }
             self.pyramid.resize(device, &targets);
             self.line_ao.resize(device, &targets);
             self.ssao.resize(device, &targets);
             self.ssao_blur.resize(device, &targets);
             self.vo_line.resize(device, &targets);
-            self.composite.resize(device, &targets);
+            self.vo_area.resize(device, &targets);
+            self.bilateral.resize(device, &targets);
+            let shown = if s.blur.is_some() { &targets.ao_blurred } else { &targets.ao };
+            self.composite.resize(device, &targets, shown);
             self.targets = Some(targets);
         }
         let targets = self.targets.as_ref()?;
@@ -209,7 +245,11 @@ impl AoChain {
             AoMethod::LineAo => self.line_ao.prepare(queue, targets, &view, &s.line_ao, s.r0_px(), &s.lighting),
             AoMethod::Ssao => self.ssao.prepare(queue, targets, &view, &s.ssao),
             AoMethod::VoLine => self.vo_line.prepare(queue, targets, &view, &s.vo),
+            AoMethod::VoArea => self.vo_area.prepare(queue, targets, &view, &s.vo),
             AoMethod::None => {}
+        }
+        if let Some(blur) = &s.blur {
+            self.bilateral.prepare(queue, &view, blur);
         }
         let strength = if s.method == AoMethod::None { 0.0 } else { s.strength };
         self.composite.prepare(queue, targets, strength, s.debug_view, view.zoom_max());
@@ -239,7 +279,11 @@ impl AoChain {
                 self.ssao_blur.encode(encoder, targets, span("ssao-blur"));
             }
             AoMethod::VoLine => self.vo_line.encode(encoder, targets, span("vo-line")),
+            AoMethod::VoArea => self.vo_area.encode(encoder, targets, span("moments"), span("vo-area")),
             AoMethod::None => {}
+        }
+        if self.settings.blur.is_some() && self.settings.method != AoMethod::None {
+            self.bilateral.encode(encoder, targets, span("blur"));
         }
         self.composite.encode(encoder, target, span("composite"));
         if let Some(timer) = &self.timer {

@@ -55,7 +55,8 @@ pub mod verify;
 pub use chain::AoChain;
 pub use gpu::Gpu;
 pub use settings::{
-    AoMethod, ChainSettings, DebugView, LineAoSettings, LineAoVariant, LineColor, SsaoSettings, VoSettings,
+    AoMethod, BilateralSettings, ChainSettings, DebugView, LineAoSettings, LineAoVariant, LineColor, SsaoSettings,
+    VoCombine, VoSettings,
 };
 
 /// Pyramid levels (and so LineAO hemispheres) the shaders can bind.

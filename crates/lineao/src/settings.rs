@@ -14,6 +14,8 @@ pub enum AoMethod {
     Ssao,
     /// Volumetric Obscurance with line samples (Loos & Sloan 2010, §4.1).
     VoLine,
+    /// Volumetric Obscurance with area samples over a pyramid of depth moments (§4.2).
+    VoArea,
 }
 
 impl AoMethod {
@@ -24,7 +26,17 @@ impl AoMethod {
             AoMethod::LineAo => "lineao",
             AoMethod::Ssao => "ssao",
             AoMethod::VoLine => "vo-line",
+            AoMethod::VoArea => "vo-area",
         }
+    }
+
+    /// Every method, in the order `--grid` shows them.
+    pub const ALL: [AoMethod; 5] =
+        [AoMethod::None, AoMethod::LineAo, AoMethod::VoLine, AoMethod::VoArea, AoMethod::Ssao];
+
+    /// The method called `name` (`none`, `lineao`, `ssao`, `vo-line`, `vo-area`).
+    pub fn from_name(name: &str) -> Option<AoMethod> {
+        AoMethod::ALL.into_iter().find(|m| m.name() == name)
     }
 }
 
@@ -93,7 +105,6 @@ impl Default for LineAoSettings {
     }
 }
 
-/// What the composite shows.
 /// Crytek SSAO (`lineao::passes::ssao`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct SsaoSettings {
@@ -114,13 +125,40 @@ impl Default for SsaoSettings {
     }
 }
 
-/// Volumetric Obscurance (`lineao::passes::vo_line`).
+/// How two VO radii combine (VO paper, Fig. 8).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum VoCombine {
+    /// Brightness multiplies: ao = 1 − (1 − ao_small)(1 − ao_large).
+    #[default]
+    Product,
+    /// The darker one: ao = max(ao_small, ao_large).
+    Min,
+}
+
+impl VoCombine {
+    /// The name used on the command line and in `params.json`.
+    pub fn name(self) -> &'static str {
+        match self {
+            VoCombine::Product => "product",
+            VoCombine::Min => "min",
+        }
+    }
+}
+
+/// Volumetric Obscurance (`lineao::passes::vo_line`, `lineao::passes::vo_area`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct VoSettings {
     /// Line samples: one of `lineao::sample_sets::VO_SAMPLE_COUNTS` (5, 7, 9, 12, 13, 16).
     pub samples: u32,
+    /// Area samples: one of `lineao::sample_sets::VO_AREA_SAMPLE_COUNTS` (1 or a line count).
+    /// Default 1.
+    pub area_samples: u32,
     /// Radius of the sphere in world units.
     pub radius_world: f32,
+    /// A second radius: VO is evaluated at both and combined by `combine`, so fine features
+    /// (the small one) and wide contact shadows (the large one) both show.
+    pub radius2_world: Option<f32>,
+    pub combine: VoCombine,
     /// Restrict the sphere to the half above the surface's tangent plane (§4.4).
     pub normal_clamp: bool,
     /// Thickness model (§4.3): occupied only this far behind the visible surface, world units;
@@ -130,9 +168,43 @@ pub struct VoSettings {
     pub noise_seed: u32,
 }
 
+impl VoSettings {
+    /// The larger of the radii: what the guard band must cover.
+    pub fn max_radius_world(&self) -> f32 {
+        self.radius2_world.map_or(self.radius_world, |r| r.max(self.radius_world))
+    }
+}
+
 impl Default for VoSettings {
     fn default() -> Self {
-        VoSettings { samples: 9, radius_world: 2.0, normal_clamp: true, thickness_world: 0.0, noise_seed: 1 }
+        VoSettings {
+            samples: 9,
+            area_samples: 1,
+            radius_world: 2.0,
+            radius2_world: None,
+            combine: VoCombine::Product,
+            normal_clamp: true,
+            thickness_world: 0.0,
+            noise_seed: 1,
+        }
+    }
+}
+
+/// The separable depth-aware (bilateral) blur that can follow any method
+/// (`lineao::passes::bilateral`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct BilateralSettings {
+    /// Taps on each side of the centre, 1..=16; the spatial Gaussian's σ is half of it.
+    /// Default 4.
+    pub radius_px: u32,
+    /// σ of the depth Gaussian in world units: neighbours this much nearer or farther count
+    /// e^(−1/2) as much, so occlusion does not bleed across depth edges. Default 1.
+    pub depth_sigma_world: f32,
+}
+
+impl Default for BilateralSettings {
+    fn default() -> Self {
+        BilateralSettings { radius_px: 4, depth_sigma_world: 1.0 }
     }
 }
 
@@ -183,6 +255,8 @@ pub struct ChainSettings {
     pub line_ao: LineAoSettings,
     pub ssao: SsaoSettings,
     pub vo: VoSettings,
+    /// The bilateral blur after the method, or none. Default none.
+    pub blur: Option<BilateralSettings>,
     pub lighting: Lighting,
     /// Line width in pixels, > 0. Default 2.
     pub line_width_px: f32,
@@ -203,6 +277,7 @@ impl Default for ChainSettings {
             line_ao: LineAoSettings::default(),
             ssao: SsaoSettings::default(),
             vo: VoSettings::default(),
+            blur: None,
             lighting: Lighting::default(),
             line_width_px: 2.0,
             line_color: LineColor::Tangent,
@@ -225,7 +300,7 @@ impl ChainSettings {
     pub fn levels(&self) -> u32 {
         match (self.method, self.line_ao.variant) {
             (AoMethod::LineAo, LineAoVariant::Paper) => self.line_ao.s_r,
-            (AoMethod::LineAo, LineAoVariant::Reference) | (AoMethod::None | AoMethod::Ssao | AoMethod::VoLine, _) => 1,
+            _ => 1,
         }
     }
 
@@ -272,11 +347,28 @@ impl ChainSettings {
                 vo.samples
             ));
         }
-        if !(vo.radius_world.is_finite() && vo.radius_world > 0.0) {
-            return bad(format!("the VO radius must be > 0 world units, got {}", vo.radius_world));
+        if !crate::sample_sets::VO_AREA_SAMPLE_COUNTS.contains(&vo.area_samples) {
+            return bad(format!(
+                "VO area samples must be one of {:?}, got {}",
+                crate::sample_sets::VO_AREA_SAMPLE_COUNTS,
+                vo.area_samples
+            ));
+        }
+        for radius in std::iter::once(vo.radius_world).chain(vo.radius2_world) {
+            if !(radius.is_finite() && radius > 0.0) {
+                return bad(format!("a VO radius must be > 0 world units, got {radius}"));
+            }
         }
         if !(vo.thickness_world.is_finite() && vo.thickness_world >= 0.0) {
             return bad(format!("the VO thickness must be >= 0 world units, got {}", vo.thickness_world));
+        }
+        if let Some(blur) = &self.blur {
+            if !(1..=16).contains(&blur.radius_px) {
+                return bad(format!("the blur radius must be in 1..=16 px, got {}", blur.radius_px));
+            }
+            if !(blur.depth_sigma_world.is_finite() && blur.depth_sigma_world > 0.0) {
+                return bad(format!("the blur's depth sigma must be > 0, got {}", blur.depth_sigma_world));
+            }
         }
         if !(self.strength.is_finite() && self.strength >= 0.0) {
             return bad(format!("strength must be >= 0, got {}", self.strength));

@@ -10,14 +10,19 @@ use std::borrow::Cow;
 pub const FILES: &[(&str, &str)] = &[
     ("shared/fullscreen.wgsl", include_str!("../shaders/shared/fullscreen.wgsl")),
     ("shared/lighting.wgsl", include_str!("../shaders/shared/lighting.wgsl")),
+    ("shared/moments.wgsl", include_str!("../shaders/shared/moments.wgsl")),
     ("shared/nd.wgsl", include_str!("../shaders/shared/nd.wgsl")),
     ("shared/view.wgsl", include_str!("../shaders/shared/view.wgsl")),
+    ("shared/vo.wgsl", include_str!("../shaders/shared/vo.wgsl")),
+    ("bilateral.wgsl", include_str!("../shaders/bilateral.wgsl")),
     ("composite.wgsl", include_str!("../shaders/composite.wgsl")),
     ("line_ao.wgsl", include_str!("../shaders/line_ao.wgsl")),
     ("lines.wgsl", include_str!("../shaders/lines.wgsl")),
+    ("moments.wgsl", include_str!("../shaders/moments.wgsl")),
     ("nd_pyramid.wgsl", include_str!("../shaders/nd_pyramid.wgsl")),
     ("ssao.wgsl", include_str!("../shaders/ssao.wgsl")),
     ("ssao_blur.wgsl", include_str!("../shaders/ssao_blur.wgsl")),
+    ("vo_area.wgsl", include_str!("../shaders/vo_area.wgsl")),
     ("vo_line.wgsl", include_str!("../shaders/vo_line.wgsl")),
 ];
 

@@ -9,9 +9,13 @@
 //! | zoom      | R32Float      | z(P): pixels per `zoom_unit` at P; 0 on background          |
 //! | specular  | R32Float      | illuminated-lines specular, added in the composite         |
 //! | depth     | Depth32Float  | hardware depth                                             |
-//! | ao        | R32Float      | raw occlusion of the chosen method, 0 = none               |
+//! | ao        | R32Float      | occlusion of the chosen method, 0 = none                   |
+//! | ao_raw    | R32Float      | SSAO's occlusion before its 4 × 4 blur                     |
+//! | ao_blurred| R32Float      | `ao` after the bilateral blur (via `ao_blur_tmp`)          |
 //!
-//! All at the guard-banded size; level j is ⌈W_{j−1}/2⌉ × ⌈H_{j−1}/2⌉ (CONTRACT.md).
+//! All at the guard-banded size; level j is ⌈W_{j−1}/2⌉ × ⌈H_{j−1}/2⌉ (CONTRACT.md). VO area
+//! sampling adds [`Moments`], a buffer of (E[z], E[z²]) pyramids, only when a chain needs it
+//! ([`FrameTargets::with_moments`]).
 
 pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub const ND_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
@@ -19,6 +23,9 @@ pub const ZOOM_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 pub const SPECULAR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 pub const AO_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+
+/// Levels the moments pyramid can have (`shared/moments.wgsl`): enough for 32768² pixels.
+pub const MAX_MOMENT_LEVELS: usize = 16;
 
 /// A texture with its default view.
 pub struct Target {
@@ -89,6 +96,72 @@ pub struct FrameTargets {
     pub ao: Target,
     /// A method's occlusion before its blur (SSAO); the blur writes `ao`.
     pub ao_raw: Target,
+    /// The bilateral blur's horizontal half, and its result.
+    pub ao_blur_tmp: Target,
+    pub ao_blurred: Target,
+    /// VO area's pyramid of depth moments.
+    pub moments: Option<Moments>,
+}
+
+/// One level of [`Moments`]: `width` × `height` texels from element `offset`, row-major.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MomentsLevel {
+    pub offset: u32,
+    pub width: u32,
+    pub height: u32,
+}
+
+/// VO area sampling's pyramid of depth moments (`lineao::passes::moments`): every level in one
+/// storage buffer of vec2<f32> (E[z], E[z²]), and the layout as a uniform
+/// (array<vec4<u32>, 16> of (offset, width, height, 0)).
+pub struct Moments {
+    pub buffer: wgpu::Buffer,
+    pub levels: Vec<MomentsLevel>,
+    pub layout: wgpu::Buffer,
+}
+
+impl Moments {
+    /// Level l is ⌊W_{l−1}/2⌋ × ⌊H_{l−1}/2⌋ (at least 1) down to 1 × 1, as a mip chain.
+    pub fn levels((width, height): (u32, u32)) -> Vec<MomentsLevel> {
+        let mut levels = vec![MomentsLevel { offset: 0, width, height }];
+        while let Some(&last) = levels.last().filter(|l| l.width > 1 || l.height > 1) {
+            levels.push(MomentsLevel {
+                offset: last.offset + last.width * last.height,
+                width: (last.width / 2).max(1),
+                height: (last.height / 2).max(1),
+            });
+        }
+        levels
+    }
+
+    /// Bytes of the buffer for a `size` pyramid.
+    pub fn bytes(size: (u32, u32)) -> u64 {
+        let last = *Moments::levels(size).last().expect("level 0 exists");
+        (last.offset as u64 + (last.width * last.height) as u64) * 8
+    }
+
+    fn new(device: &wgpu::Device, size: (u32, u32)) -> Moments {
+        use wgpu::util::DeviceExt;
+        let levels = Moments::levels(size);
+        let mut rects = [[0u32; 4]; MAX_MOMENT_LEVELS];
+        for (rect, l) in rects.iter_mut().zip(&levels) {
+            *rect = [l.offset, l.width, l.height, 0];
+        }
+        Moments {
+            buffer: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("lineao::Moments"),
+                size: Moments::bytes(size),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            }),
+            layout: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("lineao::Moments::layout"),
+                contents: bytemuck::cast_slice(&rects),
+                usage: wgpu::BufferUsages::UNIFORM,
+            }),
+            levels,
+        }
+    }
 }
 
 impl FrameTargets {
@@ -118,7 +191,17 @@ impl FrameTargets {
             depth: Target::new(device, "lineao::FrameTargets::depth", size, DEPTH_FORMAT, attachment),
             ao: Target::new(device, "lineao::FrameTargets::ao", size, AO_FORMAT, ao_usage),
             ao_raw: Target::new(device, "lineao::FrameTargets::ao_raw", size, AO_FORMAT, ao_usage),
+            ao_blur_tmp: Target::new(device, "lineao::FrameTargets::ao_blur_tmp", size, AO_FORMAT, ao_usage),
+            ao_blurred: Target::new(device, "lineao::FrameTargets::ao_blurred", size, AO_FORMAT, ao_usage),
+            moments: None,
         }
+    }
+
+    /// These targets with the moments pyramid of VO area sampling. The caller checks the
+    /// size against the device's storage-buffer limits ([`Moments::bytes`]).
+    pub fn with_moments(mut self, device: &wgpu::Device) -> FrameTargets {
+        self.moments = Some(Moments::new(device, self.size));
+        self
     }
 
     /// Visible size (without the guard band).

@@ -19,6 +19,26 @@ pub fn read_rgba(device: &wgpu::Device, queue: &wgpu::Queue, target: &Target) ->
     Ok(Image { width: data.width as usize, height: data.height as usize, data: data.to_vec4() })
 }
 
+/// The moments pyramid (`targets.moments`) as the CPU reference takes it: (E[z], E[z²]) per
+/// level.
+pub fn read_moments(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    moments: &crate::targets::Moments,
+) -> Result<Vec<crate::reference::MomentsImage>, Error> {
+    let all: Vec<[f32; 2]> =
+        bytemuck::pod_collect_to_vec(&crate::readback::read_buffer(device, queue, &moments.buffer)?);
+    Ok(moments
+        .levels
+        .iter()
+        .map(|l| {
+            let start = l.offset as usize;
+            let (width, height) = (l.width as usize, l.height as usize);
+            Image { width, height, data: all[start..start + width * height].to_vec() }
+        })
+        .collect())
+}
+
 /// Writes `image` into an Rgba32Float or R32Float target (a host's own G-buffer, or a test's).
 pub fn write_target<T: bytemuck::Pod>(queue: &wgpu::Queue, target: &Target, image: &Image<T>) {
     let texel = std::mem::size_of::<T>() as u32;

@@ -12,7 +12,7 @@
 
 use crate::binding::{self, Slot};
 use crate::settings::DebugView;
-use crate::targets::{FrameTargets, LevelsUniform};
+use crate::targets::{FrameTargets, LevelsUniform, Target};
 use crate::timing::{self, Span};
 
 /// Keep in sync with `CompositeUniform` in `shaders/composite.wgsl`.
@@ -71,12 +71,13 @@ impl Composite {
         }
     }
 
-    pub fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets) {
+    /// Shows `ao` (`targets.ao`, or `targets.ao_blurred` after the bilateral blur).
+    pub fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets, ao: &Target) {
         let mut resources = vec![
             self.uniform.as_entire_binding(),
             wgpu::BindingResource::TextureView(&targets.color.view),
             wgpu::BindingResource::TextureView(&targets.specular.view),
-            wgpu::BindingResource::TextureView(&targets.ao.view),
+            wgpu::BindingResource::TextureView(&ao.view),
             wgpu::BindingResource::TextureView(&targets.zoom.view),
         ];
         resources.extend(targets.level_views().into_iter().map(wgpu::BindingResource::TextureView));

@@ -2,12 +2,15 @@
 //! layouts, rebuilds its bind groups on `resize`, writes its uniforms in `prepare` and records
 //! itself in `encode`, so a host with its own render graph can use any of them alone.
 
+pub mod bilateral;
 pub mod composite;
 pub mod line_ao;
 pub mod lines;
+pub mod moments;
 pub mod nd_pyramid;
 pub mod ssao;
 pub mod ssao_blur;
+pub mod vo_area;
 pub mod vo_line;
 
 /// Workgroup size of the compute passes (8 × 8, as in the WGSL files).

@@ -21,9 +21,12 @@
 //!   stop casting obscurance on what lies far behind them.
 //! - **Randomization** (§4.5): each pixel reflects its samples about a 2D direction from a 4 × 4
 //!   tile (a reflection keeps |s|, so chords and weights stay valid).
+//! - **Two radii** (Fig. 8): with `radius2_world` the sphere is evaluated at both radii and
+//!   the results combined — brightness multiplied, or the darker one.
 //!
 //! The sphere's radius is in world units, mapped to pixels by the zoom map. The CPU reference
-//! is [`crate::reference::vo_line`].
+//! is [`crate::reference::vo_line`]. [`VoCore`] is what line and area sampling
+//! ([`crate::passes::vo_area`]) share: the uniform, the tables, the pipeline and its bindings.
 
 use crate::binding::{self, Slot};
 use crate::camera::FrameView;
@@ -32,26 +35,53 @@ use crate::passes::dispatch_full_screen;
 use crate::passes::ssao::ViewUniform;
 use crate::reference::ViewParams;
 use crate::sample_sets;
-use crate::settings::VoSettings;
-use crate::targets::{AO_FORMAT, FrameTargets};
+use crate::settings::{VoCombine, VoSettings};
+use crate::targets::{AO_FORMAT, FrameTargets, Moments};
 use crate::timing::Span;
 
-/// Keep in sync with `VoUniform` in `shaders/vo_line.wgsl`.
+/// Keep in sync with `VoUniform` in `shaders/shared/vo.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct VoUniform {
     pub view: ViewUniform,
     pub noise_origin: [i32; 2],
-    pub radius: f32,
+    pub radius: [f32; 2],
     pub zoom_unit: f32,
     pub thickness: f32,
     pub normal_clamp: u32,
+    pub combine: u32,
+    pub max_level: f32,
+    pub sigma_floor: f32,
     pub _pad: [u32; 2],
 }
 
-pub struct VoLine {
-    samples: u32,
-    noise_seed: u32,
+impl VoUniform {
+    /// The uniform for a frame; `max_level` is the moments pyramid's deepest level (area
+    /// sampling; 0 for lines).
+    pub fn new(targets: &FrameTargets, view: &FrameView, settings: &VoSettings, max_level: u32) -> VoUniform {
+        let guard = targets.guard as i32;
+        VoUniform {
+            view: ViewParams::of(view).into(),
+            noise_origin: [guard, guard],
+            radius: [settings.radius_world, settings.radius2_world.unwrap_or(settings.radius_world)],
+            zoom_unit: view.zoom_unit,
+            thickness: settings.thickness_world,
+            normal_clamp: settings.normal_clamp as u32,
+            combine: (settings.combine == VoCombine::Min) as u32,
+            max_level: max_level as f32,
+            sigma_floor: crate::reference::vo_sigma_floor(view.near, view.far),
+            _pad: [0; 2],
+        }
+    }
+}
+
+/// What both VO passes hold: a pipeline over (uniform, tables, `nd[0]`, `zoom`, [moments
+/// layout, moments], `ao`), its uniform and its table of (x, y, A_i, w) samples and 2D
+/// reflection directions.
+pub(crate) struct VoCore {
+    label: &'static str,
+    /// (samples, noise seed, radii): what the pipeline and the tables were built for.
+    key: (u32, u32, u32),
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
     uniform: wgpu::Buffer,
@@ -59,75 +89,99 @@ pub struct VoLine {
     group: Option<wgpu::BindGroup>,
 }
 
-impl VoLine {
-    /// `settings` must be valid (`ChainSettings::validate`): its sample count has a table.
-    pub fn new(device: &wgpu::Device, settings: &VoSettings) -> VoLine {
-        let layout = binding::layout(
-            device,
-            "lineao::VoLine::layout",
-            wgpu::ShaderStages::COMPUTE,
-            &[Slot::Uniform, Slot::Uniform, Slot::Texture, Slot::Texture, Slot::StorageTexture(AO_FORMAT)],
-        );
-        let pipeline = binding::compute_pipeline(
-            device,
-            "lineao::VoLine::pipeline",
-            &layout,
-            "vo_line.wgsl",
-            "vo_line",
-            &[("SAMPLES", settings.samples as f64)],
-        );
-        let samples = sample_sets::vo_disk_samples(settings.samples).unwrap_or_default();
-        let tile: Vec<[f32; 3]> = noise::vo_noise(settings.noise_seed).iter().map(|u| [u[0], u[1], 0.0]).collect();
-        VoLine {
-            samples: settings.samples,
-            noise_seed: settings.noise_seed,
+impl VoCore {
+    /// `samples`: (x, y, A_i, w) per sample, w for the shader's own use.
+    pub(crate) fn new(
+        device: &wgpu::Device,
+        label: &'static str,
+        shader: &str,
+        samples: &[[f32; 4]],
+        settings: &VoSettings,
+        reads_moments: bool,
+    ) -> VoCore {
+        let mut slots = vec![Slot::Uniform, Slot::Uniform, Slot::Texture, Slot::Texture];
+        if reads_moments {
+            slots.extend([Slot::Uniform, Slot::Storage]);
+        }
+        slots.push(Slot::StorageTexture(AO_FORMAT));
+        let layout = binding::layout(device, label, wgpu::ShaderStages::COMPUTE, &slots);
+        let radii = 1 + settings.radius2_world.is_some() as u32;
+        let entry = shader.trim_end_matches(".wgsl");
+        let constants = [("SAMPLES", samples.len() as f64), ("RADII", radii as f64)];
+        let pipeline = binding::compute_pipeline(device, label, &layout, shader, entry, &constants);
+        let tile: Vec<[f32; 4]> = noise::vo_noise(settings.noise_seed).iter().map(|u| [u[0], u[1], 0.0, 0.0]).collect();
+        VoCore {
+            label,
+            key: (samples.len() as u32, settings.noise_seed, radii),
             pipeline,
             layout,
-            uniform: binding::uniform_buffer::<VoUniform>(device, "lineao::VoLine::uniform"),
-            // (x, y, A_i) in entries 0..16, the 4 × 4 tile of directions in 16..32.
-            tables: binding::two_tables(device, "lineao::VoLine::tables", samples, 16, &tile),
+            uniform: binding::uniform_buffer::<VoUniform>(device, label),
+            // The samples in entries 0..16, the 4 × 4 tile of directions in 16..32.
+            tables: binding::two_tables(device, label, samples, 16, &tile),
             group: None,
         }
     }
 
+    pub(crate) fn matches(&self, samples: u32, settings: &VoSettings) -> bool {
+        self.key == (samples, settings.noise_seed, 1 + settings.radius2_world.is_some() as u32)
+    }
+
+    /// Binds `nd[0]`, `zoom`, the moments when given, and `ao`.
+    pub(crate) fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets, moments: Option<&Moments>) {
+        let mut resources = vec![
+            self.uniform.as_entire_binding(),
+            self.tables.as_entire_binding(),
+            wgpu::BindingResource::TextureView(&targets.nd[0].view),
+            wgpu::BindingResource::TextureView(&targets.zoom.view),
+        ];
+        if let Some(m) = moments {
+            resources.extend([m.layout.as_entire_binding(), m.buffer.as_entire_binding()]);
+        }
+        resources.push(wgpu::BindingResource::TextureView(&targets.ao.view));
+        self.group = Some(binding::group(device, self.label, &self.layout, &resources));
+    }
+
+    pub(crate) fn prepare(&self, queue: &wgpu::Queue, uniform: &VoUniform) {
+        queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(uniform));
+    }
+
+    pub(crate) fn encode(&self, encoder: &mut wgpu::CommandEncoder, targets: &FrameTargets, span: Option<Span>) {
+        let Some(group) = &self.group else { return };
+        dispatch_full_screen(encoder, self.label, &self.pipeline, group, targets.size, span);
+    }
+}
+
+pub struct VoLine {
+    core: VoCore,
+}
+
+impl VoLine {
+    /// `settings` must be valid (`ChainSettings::validate`): its sample count has a table.
+    pub fn new(device: &wgpu::Device, settings: &VoSettings) -> VoLine {
+        let samples: Vec<[f32; 4]> = sample_sets::vo_disk_samples(settings.samples)
+            .unwrap_or_default()
+            .iter()
+            .map(|s| [s[0], s[1], s[2], 0.0])
+            .collect();
+        VoLine { core: VoCore::new(device, "lineao::VoLine", "vo_line.wgsl", &samples, settings, false) }
+    }
+
     /// Whether `settings` can reuse this pipeline and its tables.
     pub fn matches(&self, settings: &VoSettings) -> bool {
-        (self.samples, self.noise_seed) == (settings.samples, settings.noise_seed)
+        self.core.matches(settings.samples, settings)
     }
 
     /// Reads `nd[0]` and `zoom`, writes `ao`.
     pub fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets) {
-        self.group = Some(binding::group(
-            device,
-            "lineao::VoLine::group",
-            &self.layout,
-            &[
-                self.uniform.as_entire_binding(),
-                self.tables.as_entire_binding(),
-                wgpu::BindingResource::TextureView(&targets.nd[0].view),
-                wgpu::BindingResource::TextureView(&targets.zoom.view),
-                wgpu::BindingResource::TextureView(&targets.ao.view),
-            ],
-        ));
+        self.core.resize(device, targets, None);
     }
 
     pub fn prepare(&self, queue: &wgpu::Queue, targets: &FrameTargets, view: &FrameView, settings: &VoSettings) {
-        let guard = targets.guard as i32;
-        let uniform = VoUniform {
-            view: ViewParams::of(view).into(),
-            noise_origin: [guard, guard],
-            radius: settings.radius_world,
-            zoom_unit: view.zoom_unit,
-            thickness: settings.thickness_world / settings.radius_world,
-            normal_clamp: settings.normal_clamp as u32,
-            _pad: [0; 2],
-        };
-        queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
+        self.core.prepare(queue, &VoUniform::new(targets, view, settings, 0));
     }
 
     /// Records the pass, timed into `span` when given.
     pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, targets: &FrameTargets, span: Option<Span>) {
-        let Some(group) = &self.group else { return };
-        dispatch_full_screen(encoder, "lineao::VoLine", &self.pipeline, group, targets.size, span);
+        self.core.encode(encoder, targets, span);
     }
 }

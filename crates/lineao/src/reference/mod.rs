@@ -5,13 +5,19 @@
 //! agreement"). The arithmetic follows the WGSL line by line, in f32 and in the same order, so
 //! the two differ only by rounding inside the GPU (fused multiply-adds, `pow`, `sqrt`).
 
+mod bilateral;
 mod line_ao;
 mod ssao;
+mod vo_area;
 mod vo_line;
 
+pub use bilateral::bilateral;
 pub use line_ao::{LineAoParams, delta, depth_weight, hermite, light_weight, line_ao, line_ao_pixel};
 pub use ssao::{SSAO_EPSILON, SsaoParams, ViewParams, ssao, ssao_blur, ssao_pixel};
-pub use vo_line::{VoParams, vo_line, vo_line_pixel, vo_line_sample};
+pub use vo_area::{MomentsImage, moments_pyramid, moments_trilinear, vo_area, vo_area_pixel, vo_sigma_floor};
+pub use vo_line::{
+    VoParams, vo_chord, vo_combine, vo_line, vo_line_pixel, vo_line_sample, vo_reflect, vo_sample, vo_visible,
+};
 
 /// A row-major image, `data[y * width + x]`.
 #[derive(Clone, Debug, PartialEq)]
@@ -53,23 +59,29 @@ impl<T: Copy> Image<T> {
 
 const BINOMIAL: [f32; 5] = [0.0625, 0.25, 0.375, 0.25, 0.0625];
 
+/// The separable binomial [1 4 6 4 1]/16 of `src` around `centre`, clamp-to-edge
+/// (`shared/nd.wgsl::binomial_5x5`), on every channel.
+pub fn binomial_5x5<const N: usize>(src: &Image<[f32; N]>, centre: [i64; 2]) -> [f32; N] {
+    let mut sum = [0.0f32; N];
+    for (dy, wy) in BINOMIAL.iter().enumerate() {
+        let mut row = [0.0f32; N];
+        for (dx, wx) in BINOMIAL.iter().enumerate() {
+            let t = src.clamped(centre[0] + dx as i64 - 2, centre[1] + dy as i64 - 2);
+            for c in 0..N {
+                row[c] += wx * t[c];
+            }
+        }
+        for c in 0..N {
+            sum[c] += wy * row[c];
+        }
+    }
+    sum
+}
+
 /// One pyramid step (`shaders/nd_pyramid.wgsl`): ⌈W/2⌉ × ⌈H/2⌉, binomial 5 × 5 around (2x, 2y).
 pub fn nd_downsample(src: &NdImage) -> NdImage {
     Image::from_fn(src.width.div_ceil(2), src.height.div_ceil(2), |x, y| {
-        let (cx, cy) = (2 * x as i64, 2 * y as i64);
-        let mut sum = [0.0f32; 4];
-        for (dy, wy) in BINOMIAL.iter().enumerate() {
-            let mut row = [0.0f32; 4];
-            for (dx, wx) in BINOMIAL.iter().enumerate() {
-                let t = src.clamped(cx + dx as i64 - 2, cy + dy as i64 - 2);
-                for c in 0..4 {
-                    row[c] += wx * t[c];
-                }
-            }
-            for c in 0..4 {
-                sum[c] += wy * row[c];
-            }
-        }
+        let sum = binomial_5x5(src, [2 * x as i64, 2 * y as i64]);
         let len = (sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]).sqrt();
         if len > 1e-6 { [sum[0] / len, sum[1] / len, sum[2] / len, sum[3]] } else { [0.0, 0.0, 0.0, sum[3]] }
     })

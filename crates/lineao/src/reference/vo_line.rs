@@ -1,14 +1,20 @@
-//! CPU reference of Volumetric Obscurance with line samples (`shaders/vo_line.wgsl`), in the
-//! shader's f32 operation order.
+//! CPU reference of Volumetric Obscurance with line samples (`shaders/vo_line.wgsl`) and of
+//! what VO's line and area sampling share (`shaders/shared/vo.wgsl`), in the shaders' f32
+//! operation order.
 
 use super::ssao::ViewParams;
 use super::{Image, NdImage};
+use crate::camera::FrameView;
+use crate::settings::{VoCombine, VoSettings};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct VoParams {
     pub view: ViewParams,
     /// Sphere radius, world units; world units per zoom unit.
     pub radius: f32,
+    /// A second radius, combined with the first by `combine`.
+    pub radius2: Option<f32>,
+    pub combine: VoCombine,
     pub zoom_unit: f32,
     pub normal_clamp: bool,
     /// Thickness in world units, 0 = off.
@@ -17,14 +23,27 @@ pub struct VoParams {
     pub noise_origin: [i32; 2],
 }
 
-/// The free and allowed lengths of one line sample through the unit sphere at disk point
-/// (x, y): the chord is [−z_s, z_s] (z_d away from the camera), occupied behind the surface
-/// at d_r (and free again past d_r + thickness with the thickness model); the normal clamp keeps
-/// the part above the tangent plane n_x x + n_y y − n_z z_d ≥ 0.
-pub fn vo_line_sample(s: [f32; 2], d_r: f32, n: [f32; 3], clamp: bool, thickness: f32) -> (f32, f32) {
+impl VoParams {
+    /// The parameters the VO passes use for `view` (guard band `guard`) and `settings`.
+    pub fn of(view: &FrameView, settings: &VoSettings, guard: u32) -> VoParams {
+        VoParams {
+            view: ViewParams::of(view),
+            radius: settings.radius_world,
+            radius2: settings.radius2_world,
+            combine: settings.combine,
+            zoom_unit: view.zoom_unit,
+            normal_clamp: settings.normal_clamp,
+            thickness: settings.thickness_world,
+            noise_origin: [guard as i32; 2],
+        }
+    }
+}
+
+/// The allowed part (lo, hi) of the chord at disk point s: [−z_s, z_s], or with the normal
+/// clamp the part above the tangent plane n_x x + n_y y − n_z z_d ≥ 0. Empty when hi ≤ lo.
+pub fn vo_chord(s: [f32; 2], n: [f32; 3], clamp: bool) -> (f32, f32) {
     let z_s = (1.0 - (s[0] * s[0] + s[1] * s[1])).max(0.0).sqrt();
-    let mut lo = -z_s;
-    let mut hi = z_s;
+    let (mut lo, mut hi) = (-z_s, z_s);
     if clamp {
         let c = n[0] * s[0] + n[1] * s[1];
         if n[2].abs() < 1e-6 {
@@ -37,16 +56,87 @@ pub fn vo_line_sample(s: [f32; 2], d_r: f32, n: [f32; 3], clamp: bool, thickness
             lo = lo.max(c / n[2]);
         }
     }
-    let allowed = (hi - lo).max(0.0);
-    let mut free = (hi.min(d_r) - lo).max(0.0);
+    (lo, hi)
+}
+
+/// ∫ from lo to hi of the chance that z_d lies in front of a surface whose depth is a box
+/// over μ ± σ (§4.2): the constant part up to μ − σ and the linear part (z1 − z0)(μ + σ −
+/// (z0 + z1)/2)/(2σ) over [z0, z1] = [μ − σ, μ + σ] ∩ [lo, hi]. σ = 0: a step at μ.
+pub fn vo_visible(lo: f32, hi: f32, mu: f32, sigma: f32) -> f32 {
+    let mut free = (hi.min(mu - sigma) - lo).max(0.0);
+    if sigma > 0.0 {
+        let z0 = (mu - sigma).max(lo).min(hi);
+        let z1 = (mu + sigma).max(lo).min(hi);
+        free += (z1 - z0) * (mu + sigma - 0.5 * (z0 + z1)) / (2.0 * sigma);
+    }
+    free
+}
+
+/// The free and allowed lengths of the chord at s for a surface at μ ± σ, with the thickness
+/// model (in units of the radius, 0 = off) adding the part behind the surface's back face.
+pub fn vo_sample(s: [f32; 2], mu: f32, sigma: f32, thickness: f32, n: [f32; 3], clamp: bool) -> (f32, f32) {
+    let (lo, hi) = vo_chord(s, n, clamp);
+    if hi <= lo {
+        return (0.0, 0.0);
+    }
+    let allowed = hi - lo;
+    let mut free = vo_visible(lo, hi, mu, sigma);
     if thickness > 0.0 {
-        free += (hi - lo.max(d_r + thickness)).max(0.0);
+        free += allowed - vo_visible(lo - thickness, hi - thickness, mu, sigma);
     }
     (free.min(allowed), allowed)
 }
 
-/// VO at every pixel: ao = 1 − Σ A_i free_i / Σ A_i allowed_i (0 on background and where no
-/// sample has an allowed part).
+/// A line sample: the chord at s against the visible surface at d_r (§4.1, σ = 0).
+pub fn vo_line_sample(s: [f32; 2], d_r: f32, n: [f32; 3], clamp: bool, thickness: f32) -> (f32, f32) {
+    vo_sample(s, d_r, 0.0, thickness, n, clamp)
+}
+
+/// Two radii (Fig. 8): brightness multiplies, or the darker one.
+pub fn vo_combine(small: f32, large: f32, combine: VoCombine) -> f32 {
+    match combine {
+        VoCombine::Product => 1.0 - (1.0 - small) * (1.0 - large),
+        VoCombine::Min => small.max(large),
+    }
+}
+
+/// A disk sample reflected about the line through the unit 2D direction u: s' = 2 (s · u) u − s.
+pub fn vo_reflect(sample: [f32; 2], u: [f32; 2]) -> [f32; 2] {
+    let d = sample[0] * u[0] + sample[1] * u[1];
+    [2.0 * d * u[0] - sample[0], 2.0 * d * u[1] - sample[1]]
+}
+
+/// What a VO pixel shares between line and area sampling: 0 on background; otherwise
+/// `obscurance(depth, zoom, u, radius)` at the first radius, combined with the second.
+pub(super) fn vo_pixel(
+    nd: &NdImage,
+    zoom: &Image<f32>,
+    noise: &[[f32; 2]],
+    p: &VoParams,
+    (x, y): (u32, u32),
+    obscurance: impl Fn(f32, f32, [f32; 2], f32) -> f32,
+) -> f32 {
+    let here = nd.get(x as usize, y as usize);
+    if here[0] == 0.0 && here[1] == 0.0 && here[2] == 0.0 {
+        return 0.0;
+    }
+    let depth = p.view.linear_depth(here[3]);
+    let z = zoom.get(x as usize, y as usize);
+    let tile = |c: u32, o: i32| (c as i32 - o).rem_euclid(4) as usize;
+    let u = noise[tile(y, p.noise_origin[1]) * 4 + tile(x, p.noise_origin[0])];
+    let ao = obscurance(depth, z, u, p.radius);
+    match p.radius2 {
+        Some(r2) => vo_combine(ao, obscurance(depth, z, u, r2), p.combine),
+        None => ao,
+    }
+}
+
+/// ao = 1 − Σ A_i free_i / Σ A_i allowed_i; 0 when nothing is allowed.
+pub(super) fn vo_ao(free: f32, allowed: f32) -> f32 {
+    if allowed > 0.0 { 1.0 - free / allowed } else { 0.0 }
+}
+
+/// VO with line samples at every pixel.
 pub fn vo_line(nd: &NdImage, zoom: &Image<f32>, samples: &[[f32; 3]], noise: &[[f32; 2]], p: &VoParams) -> Image<f32> {
     Image::from_fn(nd.width, nd.height, |x, y| vo_line_pixel(nd, zoom, samples, noise, p, x as u32, y as u32))
 }
@@ -61,26 +151,20 @@ pub fn vo_line_pixel(
     y: u32,
 ) -> f32 {
     let here = nd.get(x as usize, y as usize);
-    if here[0] == 0.0 && here[1] == 0.0 && here[2] == 0.0 {
-        return 0.0;
-    }
-    let v = &p.view;
-    let depth = v.linear_depth(here[3]);
-    let scale = p.radius * zoom.get(x as usize, y as usize) / p.zoom_unit;
-    let tile = |c: u32, o: i32| (c as i32 - o).rem_euclid(4) as usize;
-    let u = noise[tile(y, p.noise_origin[1]) * 4 + tile(x, p.noise_origin[0])];
-    let thickness = p.thickness / p.radius;
-    let (mut free, mut allowed) = (0.0f32, 0.0f32);
-    for sample in samples {
-        // Reflection about the line through u: s' = 2 (s · u) u − s.
-        let dot = sample[0] * u[0] + sample[1] * u[1];
-        let s = [2.0 * dot * u[0] - sample[0], 2.0 * dot * u[1] - sample[1]];
-        let tx = (x as f32 + 0.5 + s[0] * scale).floor().clamp(0.0, (nd.width - 1) as f32) as usize;
-        let ty = (y as f32 + 0.5 - s[1] * scale).floor().clamp(0.0, (nd.height - 1) as f32) as usize;
-        let d_r = (v.linear_depth(nd.get(tx, ty)[3]) - depth) / p.radius;
-        let (f, a) = vo_line_sample(s, d_r, [here[0], here[1], here[2]], p.normal_clamp, thickness);
-        free += sample[2] * f;
-        allowed += sample[2] * a;
-    }
-    if allowed > 0.0 { 1.0 - free / allowed } else { 0.0 }
+    let n = [here[0], here[1], here[2]];
+    vo_pixel(nd, zoom, noise, p, (x, y), |depth, z, u, radius| {
+        let scale = radius * z / p.zoom_unit;
+        let thickness = p.thickness / radius;
+        let (mut free, mut allowed) = (0.0f32, 0.0f32);
+        for sample in samples {
+            let s = vo_reflect([sample[0], sample[1]], u);
+            let tx = (x as f32 + 0.5 + s[0] * scale).floor().clamp(0.0, (nd.width - 1) as f32) as usize;
+            let ty = (y as f32 + 0.5 - s[1] * scale).floor().clamp(0.0, (nd.height - 1) as f32) as usize;
+            let d_r = (p.view.linear_depth(nd.get(tx, ty)[3]) - depth) / radius;
+            let (f, a) = vo_sample(s, d_r, 0.0, thickness, n, p.normal_clamp);
+            free += sample[2] * f;
+            allowed += sample[2] * a;
+        }
+        vo_ao(free, allowed)
+    })
 }

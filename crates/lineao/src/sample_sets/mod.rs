@@ -32,6 +32,26 @@ pub fn vo_disk_samples(n: u32) -> Option<&'static [[f32; 3]]> {
     VO_DISK_SAMPLES.iter().find(|(count, _)| *count == n).map(|(_, table)| *table)
 }
 
+/// The sample counts of area sampling (§4.2): one sample (the whole disk) or a line set.
+pub const VO_AREA_SAMPLE_COUNTS: [u32; 7] = [1, 5, 7, 9, 12, 13, 16];
+
+/// (x, y, A_i) of area sampling with `n` samples: the line table, or for n = 1 the disk's
+/// centre weighted as the whole sphere (A · 2 z_s = 4π/3).
+pub fn vo_area_samples(n: u32) -> Option<Vec<[f32; 3]>> {
+    match n {
+        1 => Some(vec![[0.0, 0.0, 2.0 * std::f32::consts::PI / 3.0]]),
+        _ => vo_disk_samples(n).map(<[_]>::to_vec),
+    }
+}
+
+/// Level-of-detail offset of each area sample, ½ log2(π A_i / Σ A): the footprint of sample i
+/// covers the fraction A_i / Σ A of the disk, π r² A_i / Σ A pixels for a sphere of r pixels,
+/// so its side is 2^(log2 r + offset_i) pixels (the paper's precomputed logs, §4.2).
+pub fn vo_area_lod_offsets(samples: &[[f32; 3]]) -> Vec<f32> {
+    let total: f32 = samples.iter().map(|s| s[2]).sum();
+    samples.iter().map(|s| 0.5 * (std::f32::consts::PI * s[2] / total).log2()).collect()
+}
+
 const STREAM: u32 = 7;
 
 /// Centres of the cells of a `res`² grid over [−1, 1]² that fall inside the unit disk, with

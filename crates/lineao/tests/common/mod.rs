@@ -31,6 +31,10 @@ pub struct Frame {
     pub ao: Image<f32>,
     /// A method's occlusion before its blur (SSAO).
     pub ao_raw: Image<f32>,
+    /// `ao` after the bilateral blur (when on).
+    pub ao_blurred: Image<f32>,
+    /// VO area's moments pyramid (empty for other methods).
+    pub moments: Vec<lineao::reference::MomentsImage>,
     /// The composite's output (Rgba32Float, linear), visible size.
     pub output: NdImage,
 }
@@ -78,6 +82,8 @@ pub fn render_geometry(
         depth: read_f32(d, q, &t.depth).unwrap(),
         ao: read_f32(d, q, &t.ao).unwrap(),
         ao_raw: read_f32(d, q, &t.ao_raw).unwrap(),
+        ao_blurred: read_f32(d, q, &t.ao_blurred).unwrap(),
+        moments: t.moments.as_ref().map(|m| lineao::verify::read_moments(d, q, m).unwrap()).unwrap_or_default(),
         output: read_rgba(d, q, &output).unwrap(),
     }
 }

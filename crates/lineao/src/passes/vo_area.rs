@@ -1,0 +1,85 @@
+//! Volumetric Obscurance with area samples (Loos & Sloan, I3D 2010, §4.2).
+//!
+//! Line sampling reads one depth per disk sample; area sampling reads the *distribution* of
+//! depth over the part of the disk the sample stands for. The [`MomentsPyramid`] gives the mean
+//! μ and standard deviation σ of depth over any footprint; the paper models the distribution as
+//! a box over μ ± σ (a Gaussian's convolution with the step has no closed form), so the chance
+//! that a point at depth z_d of the chord lies in front of the surface is 1 before μ − σ, falls
+//! linearly to 0 at μ + σ, and the chord's free length is the two-part integral
+//!
+//! ```text
+//!   V = (min(z_max, μ − σ) − z_min)⁺  +  a (z1² − z0²)/2 + b (z1 − z0),
+//!   a = −1/(2σ), b = −a (μ + σ), [z0, z1] = [μ − σ, μ + σ] ∩ [z_min, z_max]
+//! ```
+//!
+//! with everything in the unit sphere's coordinates, as for lines (σ = 0 *is* a line sample).
+//! The normal clamp, the thickness model, the per-pixel reflection and two radii work as in
+//! [`crate::passes::vo_line`]. The footprint of sample i covers π r² A_i/ΣA pixels for a sphere
+//! of r pixels: one log2 per pixel plus a precomputed per-sample offset gives its level of
+//! detail ([`crate::sample_sets::vo_area_lod_offsets`]); reads are trilinear. One sample — the
+//! whole sphere — already darkens creases and contacts without any noise; more samples keep
+//! finer structure. σ below 1e-3 · (far − near) is f32 cancellation and counts as 0
+//! (CONTRACT.md). The CPU reference is [`crate::reference::vo_area`].
+
+use crate::camera::FrameView;
+use crate::passes::moments::MomentsPyramid;
+use crate::passes::vo_line::{VoCore, VoUniform};
+use crate::sample_sets;
+use crate::settings::VoSettings;
+use crate::targets::FrameTargets;
+use crate::timing::Span;
+
+pub struct VoArea {
+    moments: MomentsPyramid,
+    core: VoCore,
+    max_level: u32,
+}
+
+impl VoArea {
+    /// `settings` must be valid (`ChainSettings::validate`): its area sample count has a set.
+    pub fn new(device: &wgpu::Device, settings: &VoSettings) -> VoArea {
+        let samples = sample_sets::vo_area_samples(settings.area_samples).unwrap_or_default();
+        let lod = sample_sets::vo_area_lod_offsets(&samples);
+        let table: Vec<[f32; 4]> = samples.iter().zip(lod).map(|(s, w)| [s[0], s[1], s[2], w]).collect();
+        VoArea {
+            moments: MomentsPyramid::new(device),
+            core: VoCore::new(device, "lineao::VoArea", "vo_area.wgsl", &table, settings, true),
+            max_level: 0,
+        }
+    }
+
+    /// Whether `settings` can reuse this pipeline and its tables.
+    pub fn matches(&self, settings: &VoSettings) -> bool {
+        self.core.matches(settings.area_samples, settings)
+    }
+
+    /// Reads `nd[0]`, `zoom` and `moments` (which it writes first), writes `ao`. Does nothing
+    /// without `targets.moments` ([`FrameTargets::with_moments`]).
+    pub fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets) {
+        self.moments.resize(device, targets);
+        if let Some(moments) = &targets.moments {
+            self.core.resize(device, targets, Some(moments));
+            self.max_level = moments.levels.len() as u32 - 1;
+        }
+    }
+
+    pub fn prepare(&self, queue: &wgpu::Queue, targets: &FrameTargets, view: &FrameView, settings: &VoSettings) {
+        self.moments.prepare(queue, view);
+        self.core.prepare(queue, &VoUniform::new(targets, view, settings, self.max_level));
+    }
+
+    /// Records the moments pyramid and the pass, timed into `moments` and `span` when given.
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &FrameTargets,
+        moments: Option<Span>,
+        span: Option<Span>,
+    ) {
+        if targets.moments.is_none() {
+            return;
+        }
+        self.moments.encode(encoder, moments);
+        self.core.encode(encoder, targets, span);
+    }
+}
