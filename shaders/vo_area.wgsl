@@ -58,6 +58,7 @@ fn obscurance(pixel: vec2<u32>, here: vec4<f32>, depth: f32, zoom: f32, u: vec2<
     let scale = radius * zoom / params.zoom_unit;
     let thickness = params.thickness / radius;
     let lod_sphere = log2(scale);
+    let g = vo_plane(here.xyz);
     var sums = vec2<f32>(0.0);
     for (var i = 0u; i < SAMPLES; i++) {
         let sample = tables[i];
@@ -69,7 +70,9 @@ fn obscurance(pixel: vec2<u32>, here: vec4<f32>, depth: f32, zoom: f32, u: vec2<
             sigma = 0.0;
         }
         let mu = (m.x - depth) / radius;
-        sums += sample.z * vo_sample(s, mu, sigma / radius, thickness, here.xyz, params.normal_clamp != 0u);
+        let z_s = sqrt(max(1.0 - (s.x * s.x + s.y * s.y), 0.0));
+        let chord = vo_chord(s, z_s, here.xyz, g, params.normal_clamp != 0u);
+        sums += sample.z * vo_sample(chord, mu, sigma / radius, thickness);
     }
     return vo_ao(sums);
 }

@@ -15,7 +15,7 @@ override SAMPLES: u32 = 9u;
 override RADII: u32 = 1u;
 
 @group(0) @binding(0) var<uniform> params: VoUniform;
-// samples[0..16]: (x, y, A_i, unused); tile[16..32]: (u.x, u.y) unit 2D directions.
+// samples[0..16]: (x, y, A_i, z_s = √(1 − x² − y²)); tile[16..32]: (u.x, u.y) unit 2D directions.
 @group(0) @binding(1) var<uniform> tables: array<vec4<f32>, 32>;
 @group(0) @binding(2) var nd0: texture_2d<f32>;
 @group(0) @binding(3) var zoom_map: texture_2d<f32>;
@@ -25,6 +25,11 @@ fn obscurance(pixel: vec2<u32>, here: vec4<f32>, depth: f32, zoom: f32, u: vec2<
     let v = params.view;
     let scale = radius * zoom / params.zoom_unit;
     let thickness = params.thickness / radius;
+    // d_r = (linear depth at the sample − depth(P)) / R as one multiply-add of the stored depth.
+    let d_scale = (v.far - v.near) / radius;
+    let d_offset = (v.near - depth) / radius;
+    let g = vo_plane(here.xyz);
+    let clamp_on = params.normal_clamp != 0u;
     let last = vec2<f32>(textureDimensions(nd0)) - 1.0;
     var sums = vec2<f32>(0.0);
     for (var i = 0u; i < SAMPLES; i++) {
@@ -32,8 +37,9 @@ fn obscurance(pixel: vec2<u32>, here: vec4<f32>, depth: f32, zoom: f32, u: vec2<
         let s = vo_reflect(sample.xy, u);
         let at = vec2<f32>(f32(pixel.x) + 0.5 + s.x * scale, f32(pixel.y) + 0.5 - s.y * scale);
         let t = vec2<i32>(clamp(floor(at), vec2<f32>(0.0), last));
-        let d_r = (linear_depth(v, textureLoad(nd0, t, 0).w) - depth) / radius;
-        sums += sample.z * vo_sample(s, d_r, 0.0, thickness, here.xyz, params.normal_clamp != 0u);
+        let d_r = textureLoad(nd0, t, 0).w * d_scale + d_offset;
+        let chord = vo_chord(s, sample.w, here.xyz, g, clamp_on);
+        sums += sample.z * vo_sample(chord, d_r, 0.0, thickness);
     }
     return vo_ao(sums);
 }

@@ -22,25 +22,30 @@ struct VoUniform {
     _pad: vec2<u32>,
 }
 
-// The allowed part [lo, hi] of the chord at s: all of it, or with the normal clamp (§4.4) the
-// part above the tangent plane n_x x + n_y y − n_z z_d ≥ 0. Empty when hi ≤ lo.
-fn vo_chord(s: vec2<f32>, n: vec3<f32>, normal_clamp: bool) -> vec2<f32> {
-    let z_s = sqrt(max(1.0 - (s.x * s.x + s.y * s.y), 0.0));
+// The allowed part [lo, hi] of the chord at s (z_s = √(1 − |s|²), which the caller has): all
+// of it, or with the normal clamp (§4.4) the part above the tangent plane
+// n_x x + n_y y − n_z z_d ≥ 0, whose depth at s is s · g with g = n.xy / n_z. Empty when
+// hi ≤ lo.
+fn vo_chord(s: vec2<f32>, z_s: f32, n: vec3<f32>, g: vec2<f32>, normal_clamp: bool) -> vec2<f32> {
     var lo = -z_s;
     var hi = z_s;
     if normal_clamp {
-        let c = n.x * s.x + n.y * s.y;
         if abs(n.z) < 1e-6 {
-            if c < 0.0 {
+            if n.x * s.x + n.y * s.y < 0.0 {
                 hi = lo;
             }
         } else if n.z > 0.0 {
-            hi = min(hi, c / n.z);
+            hi = min(hi, s.x * g.x + s.y * g.y);
         } else {
-            lo = max(lo, c / n.z);
+            lo = max(lo, s.x * g.x + s.y * g.y);
         }
     }
     return vec2<f32>(lo, hi);
+}
+
+// g = n.xy / n_z of the tangent plane (`vo_chord`), once per pixel; 0 when n_z is 0.
+fn vo_plane(n: vec3<f32>) -> vec2<f32> {
+    return select(vec2<f32>(0.0), n.xy / n.z, abs(n.z) >= 1e-6);
 }
 
 // ∫ from lo to hi (lo < hi) of the chance that z_d lies in front of the visible surface, whose
@@ -61,8 +66,7 @@ fn vo_visible(lo: f32, hi: f32, mu: f32, sigma: f32) -> f32 {
 // (free, allowed) lengths of the chord at s for a surface at μ ± σ; with the thickness model
 // (§4.3, `thickness` > 0, in units of R) the chord is free again behind the surface's back face:
 // the integral once more, of 1 − visibility shifted back by the thickness, summed.
-fn vo_sample(s: vec2<f32>, mu: f32, sigma: f32, thickness: f32, n: vec3<f32>, normal_clamp: bool) -> vec2<f32> {
-    let chord = vo_chord(s, n, normal_clamp);
+fn vo_sample(chord: vec2<f32>, mu: f32, sigma: f32, thickness: f32) -> vec2<f32> {
     let lo = chord.x;
     let hi = chord.y;
     if hi <= lo {

@@ -149,7 +149,8 @@ fn the_box_model_integral_is_the_numeric_one_and_a_step_at_sigma_zero() {
             let line = vo_line_sample(s, d_r, [0.0, 0.0, 1.0], false, 0.0);
             let paper = ((z_s.min(d_r) + z_s).max(0.0), 2.0 * z_s);
             assert!((line.0 - paper.0).abs() < 1e-6 && (line.1 - paper.1).abs() < 1e-6, "{line:?} vs {paper:?}");
-            let area = vo_sample(s, d_r, 1e-4, 0.0, [0.0, 0.0, 1.0], false);
+            let chord = (-z_s, z_s);
+            let area = vo_sample(chord, d_r, 1e-4, 0.0);
             assert!((area.0 - line.0).abs() < 1e-4, "{s:?} {d_r}: {area:?} vs {line:?}");
         }
     }

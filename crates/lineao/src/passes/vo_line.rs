@@ -161,7 +161,7 @@ impl VoLine {
         let samples: Vec<[f32; 4]> = sample_sets::vo_disk_samples(settings.samples)
             .unwrap_or_default()
             .iter()
-            .map(|s| [s[0], s[1], s[2], 0.0])
+            .map(|s| [s[0], s[1], s[2], crate::reference::vo_chord_half(s[0], s[1])])
             .collect();
         VoLine { core: VoCore::new(device, "lineao::VoLine", "vo_line.wgsl", &samples, settings, false) }
     }

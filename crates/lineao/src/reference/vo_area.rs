@@ -2,7 +2,7 @@
 //! pass (`shaders/vo_area.wgsl`), in the shaders' f32 operation order.
 
 use super::ssao::ViewParams;
-use super::vo_line::{VoParams, vo_ao, vo_pixel, vo_reflect, vo_sample};
+use super::vo_line::{VoParams, vo_ao, vo_chord, vo_chord_half, vo_pixel, vo_plane, vo_reflect, vo_sample};
 use super::{Image, NdImage, binomial_5x5};
 
 /// A level of the moments pyramid: (E[z], E[z²]) of linear depth, world units.
@@ -103,6 +103,7 @@ pub fn vo_area_pixel(
     let here = nd.get(x as usize, y as usize);
     let n = [here[0], here[1], here[2]];
     let floor = vo_sigma_floor(p.view.near, p.view.far);
+    let g = vo_plane(n);
     vo_pixel(nd, zoom, noise, p, (x, y), |depth, z, u, radius| {
         let scale = radius * z / p.zoom_unit;
         let thickness = p.thickness / radius;
@@ -117,7 +118,8 @@ pub fn vo_area_pixel(
                 sigma = 0.0;
             }
             let mu = (m[0] - depth) / radius;
-            let (f, a) = vo_sample(s, mu, sigma / radius, thickness, n, p.normal_clamp);
+            let chord = vo_chord(s, vo_chord_half(s[0], s[1]), n, g, p.normal_clamp);
+            let (f, a) = vo_sample(chord, mu, sigma / radius, thickness);
             free += sample[2] * f;
             allowed += sample[2] * a;
         }

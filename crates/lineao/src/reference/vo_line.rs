@@ -39,21 +39,30 @@ impl VoParams {
     }
 }
 
-/// The allowed part (lo, hi) of the chord at disk point s: [−z_s, z_s], or with the normal
-/// clamp the part above the tangent plane n_x x + n_y y − n_z z_d ≥ 0. Empty when hi ≤ lo.
-pub fn vo_chord(s: [f32; 2], n: [f32; 3], clamp: bool) -> (f32, f32) {
-    let z_s = (1.0 - (s[0] * s[0] + s[1] * s[1])).max(0.0).sqrt();
+/// z_s = √(1 − x² − y²): half the chord at disk point (x, y) (the line pass keeps it in its table).
+pub fn vo_chord_half(x: f32, y: f32) -> f32 {
+    (1.0 - (x * x + y * y)).max(0.0).sqrt()
+}
+
+/// g = n.xy / n_z of the tangent plane, whose depth at s is s · g; 0 when n_z is 0.
+pub fn vo_plane(n: [f32; 3]) -> [f32; 2] {
+    if n[2].abs() >= 1e-6 { [n[0] / n[2], n[1] / n[2]] } else { [0.0, 0.0] }
+}
+
+/// The allowed part (lo, hi) of the chord at disk point s (half length z_s): [−z_s, z_s], or
+/// with the normal clamp the part above the tangent plane n_x x + n_y y − n_z z_d ≥ 0, at depth
+/// s · g (`g` from [`vo_plane`]). Empty when hi ≤ lo.
+pub fn vo_chord(s: [f32; 2], z_s: f32, n: [f32; 3], g: [f32; 2], clamp: bool) -> (f32, f32) {
     let (mut lo, mut hi) = (-z_s, z_s);
     if clamp {
-        let c = n[0] * s[0] + n[1] * s[1];
         if n[2].abs() < 1e-6 {
-            if c < 0.0 {
+            if n[0] * s[0] + n[1] * s[1] < 0.0 {
                 hi = lo;
             }
         } else if n[2] > 0.0 {
-            hi = hi.min(c / n[2]);
+            hi = hi.min(s[0] * g[0] + s[1] * g[1]);
         } else {
-            lo = lo.max(c / n[2]);
+            lo = lo.max(s[0] * g[0] + s[1] * g[1]);
         }
     }
     (lo, hi)
@@ -72,10 +81,10 @@ pub fn vo_visible(lo: f32, hi: f32, mu: f32, sigma: f32) -> f32 {
     free
 }
 
-/// The free and allowed lengths of the chord at s for a surface at μ ± σ, with the thickness
-/// model (in units of the radius, 0 = off) adding the part behind the surface's back face.
-pub fn vo_sample(s: [f32; 2], mu: f32, sigma: f32, thickness: f32, n: [f32; 3], clamp: bool) -> (f32, f32) {
-    let (lo, hi) = vo_chord(s, n, clamp);
+/// The free and allowed lengths of the chord (lo, hi) for a surface at μ ± σ, with the
+/// thickness model (in units of the radius, 0 = off) adding the part behind the surface's back
+/// face.
+pub fn vo_sample((lo, hi): (f32, f32), mu: f32, sigma: f32, thickness: f32) -> (f32, f32) {
     if hi <= lo {
         return (0.0, 0.0);
     }
@@ -89,7 +98,8 @@ pub fn vo_sample(s: [f32; 2], mu: f32, sigma: f32, thickness: f32, n: [f32; 3], 
 
 /// A line sample: the chord at s against the visible surface at d_r (§4.1, σ = 0).
 pub fn vo_line_sample(s: [f32; 2], d_r: f32, n: [f32; 3], clamp: bool, thickness: f32) -> (f32, f32) {
-    vo_sample(s, d_r, 0.0, thickness, n, clamp)
+    let chord = vo_chord(s, vo_chord_half(s[0], s[1]), n, vo_plane(n), clamp);
+    vo_sample(chord, d_r, 0.0, thickness)
 }
 
 /// Two radii (Fig. 8): brightness multiplies, or the darker one.
@@ -152,16 +162,20 @@ pub fn vo_line_pixel(
 ) -> f32 {
     let here = nd.get(x as usize, y as usize);
     let n = [here[0], here[1], here[2]];
+    let g = vo_plane(n);
     vo_pixel(nd, zoom, noise, p, (x, y), |depth, z, u, radius| {
         let scale = radius * z / p.zoom_unit;
         let thickness = p.thickness / radius;
+        let d_scale = (p.view.far - p.view.near) / radius;
+        let d_offset = (p.view.near - depth) / radius;
         let (mut free, mut allowed) = (0.0f32, 0.0f32);
         for sample in samples {
             let s = vo_reflect([sample[0], sample[1]], u);
             let tx = (x as f32 + 0.5 + s[0] * scale).floor().clamp(0.0, (nd.width - 1) as f32) as usize;
             let ty = (y as f32 + 0.5 - s[1] * scale).floor().clamp(0.0, (nd.height - 1) as f32) as usize;
-            let d_r = (p.view.linear_depth(nd.get(tx, ty)[3]) - depth) / radius;
-            let (f, a) = vo_sample(s, d_r, 0.0, thickness, n, p.normal_clamp);
+            let d_r = nd.get(tx, ty)[3] * d_scale + d_offset;
+            let chord = vo_chord(s, vo_chord_half(sample[0], sample[1]), n, g, p.normal_clamp);
+            let (f, a) = vo_sample(chord, d_r, 0.0, thickness);
             free += sample[2] * f;
             allowed += sample[2] * a;
         }
