@@ -36,7 +36,7 @@ use crate::passes::ssao_blur::SsaoBlur;
 use crate::passes::vo_area::VoArea;
 use crate::passes::vo_line::VoLine;
 use crate::settings::{AoMethod, ChainSettings, LineAoVariant};
-use crate::targets::FrameTargets;
+use crate::targets::{FrameTargets, Moments};
 use crate::timing::{PassTime, PassTimer};
 
 /// The spans of a timed frame, in chain order.
@@ -56,6 +56,8 @@ pub struct AoChain {
     composite: Composite,
     size: (u32, u32),
     max_texture: u32,
+    /// Bytes a storage buffer binding may hold (VO area's moments pyramid).
+    max_storage: u64,
     targets: Option<FrameTargets>,
     view: Option<FrameView>,
     timer: Option<PassTimer>,
@@ -78,6 +80,7 @@ impl AoChain {
             settings,
             size: (0, 0),
             max_texture: device.limits().max_texture_dimension_2d,
+            max_storage: device.limits().max_storage_buffer_binding_size.min(device.limits().max_buffer_size),
             targets: None,
             view: None,
             timer: None,
@@ -91,6 +94,7 @@ impl AoChain {
     /// Changes settings; pipelines and targets are rebuilt only where needed.
     pub fn set_settings(&mut self, device: &wgpu::Device, settings: ChainSettings) -> Result<(), Error> {
         settings.validate()?;
+        self.check_size(&settings, self.size.0, self.size.1)?;
         if !self.line_ao.matches(&settings.line_ao, &settings.lighting) {
             // A new pipeline (sample counts, variant, lights): the targets stay.
             self.line_ao = LineAo::new(device, &settings.line_ao, &settings.lighting);
@@ -154,16 +158,32 @@ impl AoChain {
     /// Sets the visible size. 0 × 0 (a minimized window) is allowed: nothing is rendered until a
     /// real size comes back.
     pub fn resize(&mut self, width: u32, height: u32) -> Result<(), Error> {
-        let limit = self.max_texture.saturating_sub(2 * self.settings.line_ao.guard_max_px);
+        self.check_size(&self.settings, width, height)?;
+        if (width, height) != self.size {
+            self.size = (width, height);
+            self.targets = None;
+        }
+        Ok(())
+    }
+
+    /// Whether `settings` fit the adapter at `width` × `height` with the largest guard band.
+    fn check_size(&self, settings: &ChainSettings, width: u32, height: u32) -> Result<(), Error> {
+        let guard = settings.line_ao.guard_max_px;
+        let limit = self.max_texture.saturating_sub(2 * guard);
         if width > limit || height > limit {
             return Err(Error::TooLarge(format!(
                 "{width} x {height} px exceeds the adapter's {} px textures less the guard band",
                 self.max_texture
             )));
         }
-        if (width, height) != self.size {
-            self.size = (width, height);
-            self.targets = None;
+        let banded = (width + 2 * guard, height + 2 * guard);
+        if settings.method == AoMethod::VoArea && Moments::bytes(banded) > self.max_storage {
+            return Err(Error::TooLarge(format!(
+                "VO area's moments pyramid for {width} x {height} px needs {} bytes, more than the adapter's {} \
+                 byte storage buffers",
+                Moments::bytes(banded),
+                self.max_storage
+            )));
         }
         Ok(())
     }

@@ -83,3 +83,23 @@ fn sizes_beyond_the_adapter_are_errors_and_zero_draws_nothing() {
     assert!(frame.nd[0].data.iter().all(|t| *t == [0.0, 0.0, 0.0, 1.0]));
     assert!(frame.ao.data.iter().all(|&a| a == 0.0));
 }
+
+#[test]
+fn a_moments_pyramid_beyond_the_storage_limit_is_an_error() {
+    let gpu = gpu();
+    let limits = wgpu::Limits { max_storage_buffer_binding_size: 1 << 20, ..gpu.adapter.limits() };
+    let descriptor = wgpu::DeviceDescriptor { required_limits: limits, ..Gpu::device_descriptor(&gpu.adapter) };
+    let (device, _queue) = pollster::block_on(gpu.adapter.request_device(&descriptor)).unwrap();
+    let area = ChainSettings { method: lineao::AoMethod::VoArea, ..ChainSettings::default() };
+    // 640 × 480 with the guard band needs about 4 MiB of moments.
+    let mut chain = AoChain::new(&device, common::OUTPUT_FORMAT, area.clone()).unwrap();
+    match chain.resize(640, 480) {
+        Err(Error::TooLarge(message)) => assert!(message.contains("moments"), "{message}"),
+        other => panic!("expected TooLarge, got {other:?}"),
+    }
+    chain.resize(64, 48).unwrap();
+    // Switching to VO area at a size it cannot hold is refused the same way; LineAO is fine.
+    let mut chain = AoChain::new(&device, common::OUTPUT_FORMAT, ChainSettings::default()).unwrap();
+    chain.resize(640, 480).unwrap();
+    assert!(matches!(chain.set_settings(&device, area), Err(Error::TooLarge(_))));
+}

@@ -113,6 +113,8 @@ pub fn vo_area_pixel(
             let s = vo_reflect([sample[0], sample[1]], u);
             let at = [x as f32 + s[0] * scale, y as f32 - s[1] * scale];
             let m = moments_trilinear(moments, at, lod_sphere + offset);
+            // E[z²] − E[z]² cancels: fused like the multiply-add the GPU compiles it to, so that
+            // both round the product once.
             let mut sigma = (-m[0]).mul_add(m[0], m[1]).max(0.0).sqrt();
             if sigma < floor {
                 sigma = 0.0;
