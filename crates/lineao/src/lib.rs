@@ -11,7 +11,10 @@
 //!   `resize`, `prepare`, `encode` into your `CommandEncoder` and target view.
 //! - [`passes`]: [`LineRenderer`](passes::lines::LineRenderer) (fixed-width lines writing the
 //!   G-buffer), [`NdPyramid`](passes::nd_pyramid::NdPyramid), [`LineAo`](passes::line_ao::LineAo),
-//!   [`Composite`](passes::composite::Composite) — each usable alone.
+//!   the alternatives LineAO is measured against — [`Ssao`](passes::ssao::Ssao) (Crytek),
+//!   [`VoLine`](passes::vo_line::VoLine) and [`VoArea`](passes::vo_area::VoArea) (Volumetric
+//!   Obscurance) — the [`Bilateral`](passes::bilateral::Bilateral) blur and the
+//!   [`Composite`](passes::composite::Composite), each usable alone.
 //! - [`mod@reference`]: the CPU reference of each pass.
 //!
 //! The G-buffer contract (the ND map, the zoom map, normalized depth) is in [`targets`] and

@@ -14,7 +14,7 @@
 //! | ao_blurred| R32Float      | `ao` after the bilateral blur (via `ao_blur_tmp`)          |
 //!
 //! All at the guard-banded size; level j is ⌈W_{j−1}/2⌉ × ⌈H_{j−1}/2⌉ (CONTRACT.md). VO area
-//! sampling adds [`Moments`], a buffer of (E[z], E[z²]) pyramids, only when a chain needs it
+//! sampling adds [`Moments`], a buffer of (E\[z\], E\[z²\]) pyramids, only when a chain needs it
 //! ([`FrameTargets::with_moments`]).
 
 pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
@@ -112,8 +112,8 @@ pub struct MomentsLevel {
 }
 
 /// VO area sampling's pyramid of depth moments (`lineao::passes::moments`): every level in one
-/// storage buffer of vec2<f32> (E[z], E[z²]), and the layout as a uniform
-/// (array<vec4<u32>, 16> of (offset, width, height, 0)).
+/// storage buffer of `vec2<f32>` (E\[z\], E\[z²\]), and the layout as a uniform
+/// (`array<vec4<u32>, 16>` of (offset, width, height, 0)).
 pub struct Moments {
     pub buffer: wgpu::Buffer,
     pub levels: Vec<MomentsLevel>,

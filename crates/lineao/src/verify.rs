@@ -19,7 +19,7 @@ pub fn read_rgba(device: &wgpu::Device, queue: &wgpu::Queue, target: &Target) ->
     Ok(Image { width: data.width as usize, height: data.height as usize, data: data.to_vec4() })
 }
 
-/// The moments pyramid (`targets.moments`) as the CPU reference takes it: (E[z], E[z²]) per
+/// The moments pyramid (`targets.moments`) as the CPU reference takes it: (E\[z\], E\[z²\]) per
 /// level.
 pub fn read_moments(
     device: &wgpu::Device,

@@ -1,7 +1,7 @@
 //! The moments pyramid of VO area sampling (Loos & Sloan §4.2; CONTRACT.md "VO area").
 //!
 //! Area sampling needs the distribution of depth over a sample's footprint, at any footprint
-//! size. As in variance shadow maps, the first two moments M₁ = E[z] and M₂ = E[z²] of depth
+//! size. As in variance shadow maps, the first two moments M₁ = E\[z\] and M₂ = E\[z²\] of depth
 //! filter linearly: level l holds them over a footprint of about 2^l pixels, and a trilinear
 //! read gives the mean μ = M₁ and the variance σ² = M₂ − M₁² of any footprint. Level 0 is the
 //! linear depth z = −z_view (world units) of each pixel and its square, the background at the

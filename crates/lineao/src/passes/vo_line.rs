@@ -25,7 +25,7 @@
 //!   the results combined — brightness multiplied, or the darker one.
 //!
 //! The sphere's radius is in world units, mapped to pixels by the zoom map. The CPU reference
-//! is [`crate::reference::vo_line`]. [`VoCore`] is what line and area sampling
+//! is [`crate::reference::vo_line`]. `VoCore` is what line and area sampling
 //! ([`crate::passes::vo_area`]) share: the uniform, the tables, the pipeline and its bindings.
 
 use crate::binding::{self, Slot};

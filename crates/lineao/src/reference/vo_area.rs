@@ -5,7 +5,7 @@ use super::ssao::ViewParams;
 use super::vo_line::{VoParams, vo_ao, vo_chord, vo_chord_half, vo_pixel, vo_plane, vo_reflect, vo_sample};
 use super::{Image, NdImage, binomial_5x5};
 
-/// A level of the moments pyramid: (E[z], E[z²]) of linear depth, world units.
+/// A level of the moments pyramid: (E\[z\], E\[z²\]) of linear depth, world units.
 pub type MomentsImage = Image<[f32; 2]>;
 
 /// σ below which VO area sampling treats depth as a step (CONTRACT.md): 1e-3 (far − near).
