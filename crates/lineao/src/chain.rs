@@ -198,10 +198,13 @@ impl AoChain {
             // The bilateral blur reaches its radius further.
             (AoMethod::Ssao | AoMethod::VoLine | AoMethod::VoArea, _) => {
                 let unguarded = FrameView::new(camera, bounds, self.size.0, self.size.1, 0, s.zoom_unit);
-                let (radius_world, blur) = if s.method == AoMethod::Ssao {
-                    (s.ssao.radius_world, 2.0)
-                } else {
-                    (s.vo.max_radius_world(), 0.0)
+                // Area samples read moments over a footprint around each sample point: half its
+                // side is at most ½ √π r < r, and the Gaussian levels' tails reach about as far
+                // again, so 2 r covers what they read.
+                let (radius_world, blur) = match s.method {
+                    AoMethod::Ssao => (s.ssao.radius_world, 2.0),
+                    AoMethod::VoArea => (2.0 * s.vo.max_radius_world(), 0.0),
+                    _ => (s.vo.max_radius_world(), 0.0),
                 };
                 let blur = blur + s.blur.as_ref().map_or(0.0, |b| b.radius_px as f32);
                 let radius = radius_world * unguarded.zoom_max() / s.zoom_unit + blur;

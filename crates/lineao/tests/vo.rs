@@ -362,3 +362,25 @@ fn the_checked_in_sample_sets_are_what_the_generator_writes() {
         assert!(table.iter().all(|s| s[0].hypot(s[1]) < 1.0 && s[2] > 0.0));
     }
 }
+
+#[test]
+fn area_sampling_guards_twice_the_sphere_for_its_footprints() {
+    // Area samples read moments around points up to r away, over footprints up to ½ √π r wide
+    // plus the Gaussian tails: the guard band is 2 r, where line samples need r.
+    let gpu = gpu();
+    let (perspective, _) = cameras_for_polylines();
+    let bounds = Bounds { center: glam::Vec3::ZERO, radius: 45.0 };
+    let guard = |method| {
+        let vo = VoSettings { radius_world: 3.0, ..VoSettings::default() };
+        let mut chain = lineao::AoChain::new(
+            &gpu.device,
+            common::OUTPUT_FORMAT,
+            ChainSettings { method, vo, ..Default::default() },
+        )
+        .unwrap();
+        chain.resize(240, 180).unwrap();
+        chain.guard_for(&perspective, &bounds)
+    };
+    let (line, area) = (guard(AoMethod::VoLine), guard(AoMethod::VoArea));
+    assert!(line > 2 && area + 1 >= 2 * line && area <= 2 * line + 1, "line {line}, area {area}");
+}
