@@ -93,6 +93,14 @@ pub enum Combine {
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum SsaoKernelArg {
+    /// Mittring's random kernel, denser near the centre.
+    Crytek,
+    /// The VO paper's generated point set (8, 12, 16, 24 or 32 samples).
+    Sphere,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Variant {
     /// The paper's equations with CONTRACT.md's conventions.
     Paper,
@@ -239,6 +247,9 @@ pub struct RenderArgs {
     /// SSAO: range check in world units [default: the radius].
     #[arg(long)]
     pub ssao_range: Option<f32>,
+    /// SSAO: the kernel's points.
+    #[arg(long, value_enum, default_value_t = SsaoKernelArg::Crytek)]
+    pub ssao_kernel: SsaoKernelArg,
     /// LineAO δ0.
     #[arg(long, default_value_t = 1e-4)]
     pub delta0: f32,

@@ -121,9 +121,10 @@ pub fn write(dir: &Path, gpu: &Gpu, chain: &AoChain, camera: &Camera) -> Result<
             "radius_world": ssao.radius_world,
             "ssao_range": ssao.range_world,
             "noise_seed": ssao.noise_seed,
+            "ssao_kernel": ssao.kernel.name(),
         });
         merge(&mut params, extra);
-        let kernel = noise::ssao_kernel(ssao.noise_seed, ssao.samples);
+        let kernel = ssao.kernel_points();
         write_npy(dir, "ssao_kernel.npy", &[ssao.samples as u64, 3], &flat3(&kernel))?;
         write_npy(dir, "ssao_noise.npy", &[4, 4, 3], &flat3(&noise::ssao_noise(ssao.noise_seed)))?;
     }

@@ -9,12 +9,12 @@ use glam::Vec3;
 use lineao::camera::{Bounds, Camera, Projection};
 use lineao::passes::lines::LineGeometry;
 use lineao::{
-    AoChain, AoMethod, BilateralSettings, ChainSettings, Gpu, LineAoSettings, LineAoVariant, LineColor, SsaoSettings,
-    VoCombine, VoSettings,
+    AoChain, AoMethod, BilateralSettings, ChainSettings, Gpu, LineAoSettings, LineAoVariant, LineColor, SsaoKernel,
+    SsaoSettings, VoCombine, VoSettings,
 };
 use lineao_tracts::scenes::ViewHint;
 
-use crate::cli::{ColorArg, Combine, RenderArgs, Variant};
+use crate::cli::{ColorArg, Combine, RenderArgs, SsaoKernelArg, Variant};
 use crate::label::Rgba8;
 
 /// The chain's settings from the command line, for `method`.
@@ -42,6 +42,10 @@ pub fn settings(args: &RenderArgs, method: AoMethod, zoom_unit: f32) -> ChainSet
             radius_world: args.radius,
             range_world: args.ssao_range.unwrap_or(args.radius),
             noise_seed: args.noise_seed,
+            kernel: match args.ssao_kernel {
+                SsaoKernelArg::Crytek => SsaoKernel::Crytek,
+                SsaoKernelArg::Sphere => SsaoKernel::Sphere,
+            },
         },
         blur: args
             .bilateral

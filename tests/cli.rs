@@ -41,6 +41,7 @@ fn exit_codes() {
         (&["render", "--line-width", "0", "-o", png], "line width"),
         (&["render", "--debug-view", "level:3", "-o", png], "debug level 3"),
         (&["render", "--eye", "0,0,0", "--target", "0,0,0", "-o", png], "coincide"),
+        (&["render", "--method", "ssao", "--ssao-kernel", "sphere", "--samples", "10", "-o", png], "sphere kernel"),
         (
             &["render", "--vertices", "2000", "--width", "64", "--height", "64", "-o", "/nonexistent/dir/x.png"],
             "/nonexistent/dir/x.png",
@@ -276,6 +277,7 @@ fn render_and_dump_let_an_outside_tool_recompute_ssao() {
         (params["samples"].as_u64(), params["radius_world"].as_f64(), params["ssao_range"].as_f64()),
         (Some(12), Some(3.0), Some(3.0))
     );
+    assert_eq!(params["ssao_kernel"], "crytek");
     assert!(params.get("s_r").is_none(), "LineAO keys are omitted for SSAO");
     let f = |k: &str| params[k].as_f64().unwrap() as f32;
     let guard = params["guard_px"].as_u64().unwrap() as usize;

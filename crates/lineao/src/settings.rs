@@ -117,11 +117,44 @@ pub struct SsaoSettings {
     pub range_world: f32,
     /// Seed of the kernel and the 4 × 4 rotation tile.
     pub noise_seed: u32,
+    /// Where the kernel's points come from.
+    pub kernel: SsaoKernel,
 }
 
 impl Default for SsaoSettings {
     fn default() -> Self {
-        SsaoSettings { samples: 16, radius_world: 2.0, range_world: 2.0, noise_seed: 1 }
+        SsaoSettings { samples: 16, radius_world: 2.0, range_world: 2.0, noise_seed: 1, kernel: SsaoKernel::Crytek }
+    }
+}
+
+impl SsaoSettings {
+    /// The kernel's points in the unit ball (scaled by the radius in the pass).
+    pub fn kernel_points(&self) -> Vec<[f32; 3]> {
+        match self.kernel {
+            SsaoKernel::Crytek => crate::noise::ssao_kernel(self.noise_seed, self.samples),
+            SsaoKernel::Sphere => crate::sample_sets::vo_sphere_samples(self.samples).unwrap_or_default().to_vec(),
+        }
+    }
+}
+
+/// The SSAO kernel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum SsaoKernel {
+    /// Mittring's: random directions, lengths growing quadratically (denser near the centre).
+    #[default]
+    Crytek,
+    /// The VO paper's point-sample set (§4.5): every point an equal share of the ball
+    /// (`lineao::sample_sets::VO_SPHERE_SAMPLE_COUNTS` sizes only).
+    Sphere,
+}
+
+impl SsaoKernel {
+    /// The CLI and `params.json` name: `crytek` or `sphere`.
+    pub fn name(self) -> &'static str {
+        match self {
+            SsaoKernel::Crytek => "crytek",
+            SsaoKernel::Sphere => "sphere",
+        }
     }
 }
 
@@ -332,6 +365,13 @@ impl ChainSettings {
         let ssao = &self.ssao;
         if !(8..=32).contains(&ssao.samples) {
             return bad(format!("SSAO samples must be in 8..=32, got {}", ssao.samples));
+        }
+        if ssao.kernel == SsaoKernel::Sphere && !crate::sample_sets::VO_SPHERE_SAMPLE_COUNTS.contains(&ssao.samples) {
+            return bad(format!(
+                "the sphere kernel has {:?} samples, got {}",
+                crate::sample_sets::VO_SPHERE_SAMPLE_COUNTS,
+                ssao.samples
+            ));
         }
         if !(ssao.radius_world.is_finite() && ssao.radius_world > 0.0) {
             return bad(format!("the SSAO radius must be > 0 world units, got {}", ssao.radius_world));

@@ -9,7 +9,7 @@ use lineao::passes::ssao_blur::SsaoBlur;
 use lineao::reference::{self, Image, NdImage, SsaoParams, ViewParams};
 use lineao::targets::FrameTargets;
 use lineao::verify::{check_policy, compare, read_f32, write_target};
-use lineao::{AoMethod, ChainSettings, Gpu, SsaoSettings, noise};
+use lineao::{AoMethod, ChainSettings, Gpu, SsaoKernel, SsaoSettings, noise};
 
 /// Runs SSAO and its blur alone on a G-buffer written from the CPU; returns (raw, blurred).
 fn ssao_on(gpu: &Gpu, nd0: &NdImage, settings: &SsaoSettings, guard: u32) -> (Image<f32>, Image<f32>, SsaoParams) {
@@ -44,12 +44,20 @@ fn reflect(k: [f32; 3], r: [f32; 3]) -> [f32; 3] {
 #[test]
 fn a_plane_facing_the_camera_is_occluded_by_exactly_the_samples_behind_it() {
     let gpu = gpu();
+    for (kernel, points) in [
+        (SsaoKernel::Crytek, noise::ssao_kernel(3, 16)),
+        (SsaoKernel::Sphere, lineao::sample_sets::vo_sphere_samples(16).unwrap().to_vec()),
+    ] {
+        let settings = SsaoSettings { samples: 16, radius_world: 0.05, range_world: 1.0, noise_seed: 3, kernel };
+        a_plane_facing_the_camera(&gpu, &settings, &points);
+    }
+}
+
+fn a_plane_facing_the_camera(gpu: &Gpu, settings: &SsaoSettings, kernel: &[[f32; 3]]) {
     let (w, h, guard) = (40usize, 32usize, 4u32);
     let nd0 = Image::filled(w, h, [0.0, 0.0, 1.0, 0.5]);
-    let settings = SsaoSettings { samples: 16, radius_world: 0.05, range_world: 1.0, noise_seed: 3 };
-    let (raw, blurred, params) = ssao_on(&gpu, &nd0, &settings, guard);
-    let cpu = reference::ssao(&nd0, &noise::ssao_kernel(3, 16), &noise::ssao_noise(3), &params);
-    let kernel = noise::ssao_kernel(3, 16);
+    let (raw, blurred, params) = ssao_on(gpu, &nd0, settings, guard);
+    let cpu = reference::ssao(&nd0, kernel, &noise::ssao_noise(3), &params);
     let tile = noise::ssao_noise(3);
     let mut checked = 0;
     for y in 0..h {
@@ -62,8 +70,8 @@ fn a_plane_facing_the_camera_is_occluded_by_exactly_the_samples_behind_it() {
                 continue; // on the plane up to rounding: not a closed-form case
             }
             let expected = rotated.iter().filter(|k| k[2] < 0.0).count() as f32 / 16.0;
-            assert_eq!(raw.get(x, y), expected, "GPU at ({x}, {y})");
-            assert_eq!(cpu.get(x, y), expected, "CPU at ({x}, {y})");
+            assert_eq!(raw.get(x, y), expected, "{:?}: GPU at ({x}, {y})", settings.kernel);
+            assert_eq!(cpu.get(x, y), expected, "{:?}: CPU at ({x}, {y})", settings.kernel);
             checked += 1;
         }
     }
@@ -115,10 +123,13 @@ fn gpu_matches_cpu_reference_on_rendered_lines() {
     let gpu = gpu();
     let (positions, offsets) = polylines(120, 0.3);
     let (perspective, ortho) = cameras_for_polylines();
-    for (name, cam, samples) in
-        [("perspective, 16", perspective, 16), ("orthographic, 12", ortho, 12), ("perspective, 32", perspective, 32)]
-    {
-        let ssao = SsaoSettings { samples, radius_world: 4.0, range_world: 6.0, noise_seed: 1 };
+    for (name, cam, samples, kernel) in [
+        ("perspective, 16", perspective, 16, SsaoKernel::Crytek),
+        ("orthographic, 12", ortho, 12, SsaoKernel::Crytek),
+        ("perspective, 32", perspective, 32, SsaoKernel::Crytek),
+        ("perspective, sphere set 12", perspective, 12, SsaoKernel::Sphere),
+    ] {
+        let ssao = SsaoSettings { samples, radius_world: 4.0, range_world: 6.0, noise_seed: 1, kernel };
         let s = ChainSettings { method: AoMethod::Ssao, ssao: ssao.clone(), ..Default::default() };
         let frame = render(&gpu, &positions, &offsets, &cam, None, s, (240, 180));
         assert!(frame.guard > 0, "{name}: the sphere reaches past the edge");
@@ -128,7 +139,11 @@ fn gpu_matches_cpu_reference_on_rendered_lines() {
             range: ssao.range_world,
             noise_origin: [frame.guard as i32; 2],
         };
-        let cpu = reference::ssao(&frame.nd[0], &noise::ssao_kernel(1, samples), &noise::ssao_noise(1), &params);
+        let points = match kernel {
+            SsaoKernel::Crytek => noise::ssao_kernel(1, samples),
+            SsaoKernel::Sphere => lineao::sample_sets::vo_sphere_samples(samples).unwrap().to_vec(),
+        };
+        let cpu = reference::ssao(&frame.nd[0], &points, &noise::ssao_noise(1), &params);
         let stats = check_policy(&frame.ao_raw, &cpu, &frame.nd[0], 2.0 / samples as f32)
             .unwrap_or_else(|e| panic!("{name}: {e}"));
         println!("{name}: {stats}");

@@ -364,6 +364,28 @@ fn the_checked_in_sample_sets_are_what_the_generator_writes() {
 }
 
 #[test]
+fn the_checked_in_sphere_sets_are_what_the_generator_writes_and_share_the_ball_evenly() {
+    use lineao::sample_sets::{
+        VO_SPHERE_SAMPLE_COUNTS, generate_vo_sphere_samples, sphere_volume_spread, vo_sphere_samples,
+    };
+    for n in VO_SPHERE_SAMPLE_COUNTS {
+        let generated = generate_vo_sphere_samples(n);
+        let table = vo_sphere_samples(n).unwrap();
+        assert_eq!(generated.len(), n as usize);
+        for (g, t) in generated.iter().zip(table) {
+            assert!((0..3).all(|k| (g[k] - t[k]).abs() <= 1e-6), "N = {n}: {g:?} vs {t:?}");
+        }
+        assert!(table.iter().all(|p| p.iter().map(|c| c * c).sum::<f32>() < 1.0));
+        // The goal of §4.5: every point's Voronoi region an equal share of the ball, here on the
+        // paper's 128³ diagram; Crytek's random kernel of the same size for comparison.
+        let spread = sphere_volume_spread(table, 128);
+        let random = sphere_volume_spread(&lineao::noise::ssao_kernel(1, n), 128);
+        println!("N = {n}: Voronoi volume spread {spread:.3} (random kernel {random:.3})");
+        assert!(spread < 0.5 * random && spread < 0.1, "N = {n}: {spread} vs {random}");
+    }
+}
+
+#[test]
 fn area_sampling_guards_twice_the_sphere_for_its_footprints() {
     // Area samples read moments around points up to r away, over footprints up to ½ √π r wide
     // plus the Gaussian tails: the guard band is 2 r, where line samples need r.

@@ -23,7 +23,7 @@ use crate::camera::FrameView;
 use crate::noise;
 use crate::passes::dispatch_full_screen;
 use crate::reference::ViewParams;
-use crate::settings::SsaoSettings;
+use crate::settings::{SsaoKernel, SsaoSettings};
 use crate::targets::{AO_FORMAT, FrameTargets};
 use crate::timing::Span;
 
@@ -65,6 +65,7 @@ pub struct SsaoUniform {
 pub struct Ssao {
     samples: u32,
     noise_seed: u32,
+    kernel: SsaoKernel,
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
     uniform: wgpu::Buffer,
@@ -91,6 +92,7 @@ impl Ssao {
         Ssao {
             samples: settings.samples,
             noise_seed: settings.noise_seed,
+            kernel: settings.kernel,
             pipeline,
             layout,
             uniform: binding::uniform_buffer::<SsaoUniform>(device, "lineao::Ssao::uniform"),
@@ -98,7 +100,7 @@ impl Ssao {
             tables: binding::two_tables(
                 device,
                 "lineao::Ssao::tables",
-                &noise::ssao_kernel(settings.noise_seed, settings.samples),
+                &settings.kernel_points(),
                 32,
                 &noise::ssao_noise(settings.noise_seed),
             ),
@@ -108,7 +110,7 @@ impl Ssao {
 
     /// Whether `settings` can reuse this pipeline and its tables.
     pub fn matches(&self, settings: &SsaoSettings) -> bool {
-        (self.samples, self.noise_seed) == (settings.samples, settings.noise_seed)
+        (self.samples, self.noise_seed, self.kernel) == (settings.samples, settings.noise_seed, settings.kernel)
     }
 
     /// Reads `nd[0]`, writes `ao_raw`.

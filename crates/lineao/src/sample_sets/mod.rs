@@ -1,12 +1,15 @@
 //! Sample sets of Volumetric Obscurance (Loos & Sloan 2010, §4.5): N points in the unit disk,
-//! each with the weight its line integral is scaled by.
+//! each with the weight its line integral is scaled by, and N points in the unit ball for point
+//! sampling (the kernel of [`crate::SsaoKernel::Sphere`]).
 //!
 //! The generator follows the paper: several Poisson-disk starting sets; a 1/d⁴ repulsion
 //! between the points whose step grows while the error falls and shrinks (without applying it)
 //! otherwise; periodically each point is pushed to the weighted centroid of its Voronoi region;
 //! the regions come from a discrete Voronoi diagram of the disk (512² cells for the final
 //! weights, 128² while optimising), weighted by the sphere's z extent 2√(1 − r²) over each cell,
-//! because the disk is the orthographic projection of the sphere being integrated. The error is
+//! because the disk is the orthographic projection of the sphere being integrated. The sphere
+//! sets run the same optimisation in 3D on a 32³ diagram (the paper's 128³ costs 64× more per
+//! step; a test measures the result on 128³ instead). The error is
 //! the spread of the regions' volumes (the goal: every sample integrates an equal share) plus
 //! each point's distance from its region's centroid. The best set of all starts wins.
 //!
@@ -15,12 +18,13 @@
 //! Σ A_i · 2 z_s,i = 4π/3 exactly (the weights are normalized to it). For evenly sized regions
 //! A_i is about the region's area, CONTRACT.md's "Voronoi area".
 //!
-//! [`VO_DISK_SAMPLES`] holds the tables for N ∈ {5, 7, 9, 12, 13, 16}, written by
+//! [`VO_DISK_SAMPLES`] holds the disk tables for N ∈ {5, 7, 9, 12, 13, 16},
+//! [`VO_SPHERE_SAMPLES`] the sphere tables for N ∈ {8, 12, 16, 24, 32}, written by
 //! `cargo run --release --example gen_vo_samples`; a test regenerates them and compares.
 
 mod tables;
 
-pub use tables::VO_DISK_SAMPLES;
+pub use tables::{VO_DISK_SAMPLES, VO_SPHERE_SAMPLES};
 
 use crate::noise;
 
@@ -54,74 +58,103 @@ pub fn vo_area_lod_offsets(samples: &[[f32; 3]]) -> Vec<f32> {
 
 const STREAM: u32 = 7;
 
-/// Centres of the cells of a `res`² grid over [−1, 1]² that fall inside the unit disk, with
-/// the z extent 2√(1 − r²) of each as its weight.
-fn disk_cells(res: usize) -> Vec<([f64; 2], f64)> {
+type Point<const D: usize> = [f64; D];
+
+fn distance_sq<const D: usize>(a: &Point<D>, b: &Point<D>) -> f64 {
+    (0..D).map(|k| (a[k] - b[k]).powi(2)).sum()
+}
+
+fn length<const D: usize>(a: &Point<D>) -> f64 {
+    a.iter().map(|c| c * c).sum::<f64>().sqrt()
+}
+
+/// Centres of the cells of a `res`^D grid over [−1, 1]^D that fall inside the unit ball, each
+/// with the volume it stands for: the sphere's z extent 2√(1 − r²) over a disk cell (the disk
+/// is the sphere seen along z), 1 for a cell of the ball itself.
+fn ball_cells<const D: usize>(res: usize) -> Vec<(Point<D>, f64)> {
     let mut cells = Vec::new();
-    for j in 0..res {
-        for i in 0..res {
-            let x = -1.0 + (i as f64 + 0.5) * 2.0 / res as f64;
-            let y = -1.0 + (j as f64 + 0.5) * 2.0 / res as f64;
-            let r2 = x * x + y * y;
-            if r2 < 1.0 {
-                cells.push(([x, y], 2.0 * (1.0 - r2).sqrt()));
-            }
+    for index in 0..res.pow(D as u32) {
+        let mut rest = index;
+        let p: Point<D> = std::array::from_fn(|_| {
+            let i = rest % res;
+            rest /= res;
+            -1.0 + (i as f64 + 0.5) * 2.0 / res as f64
+        });
+        let r2: f64 = p.iter().map(|c| c * c).sum();
+        if r2 < 1.0 {
+            cells.push((p, if D == 2 { 2.0 * (1.0 - r2).sqrt() } else { 1.0 }));
         }
     }
     cells
 }
 
-/// Each sample's Voronoi column volume and weighted centroid, from a discrete diagram.
-fn voronoi(points: &[[f64; 2]], cells: &[([f64; 2], f64)]) -> (Vec<f64>, Vec<[f64; 2]>) {
+/// Each sample's Voronoi volume and weighted centroid, from a discrete diagram.
+fn voronoi<const D: usize>(points: &[Point<D>], cells: &[(Point<D>, f64)]) -> (Vec<f64>, Vec<Point<D>>) {
     let mut volume = vec![0.0; points.len()];
-    let mut centroid = vec![[0.0; 2]; points.len()];
+    let mut centroid = vec![[0.0; D]; points.len()];
     for (c, w) in cells {
         let nearest = (0..points.len())
-            .min_by(|&a, &b| {
-                let d = |p: [f64; 2]| (p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2);
-                d(points[a]).total_cmp(&d(points[b]))
-            })
+            .min_by(|&a, &b| distance_sq(&points[a], c).total_cmp(&distance_sq(&points[b], c)))
             .expect("at least one point");
         volume[nearest] += w;
-        centroid[nearest][0] += w * c[0];
-        centroid[nearest][1] += w * c[1];
+        for k in 0..D {
+            centroid[nearest][k] += w * c[k];
+        }
     }
     for (c, v) in centroid.iter_mut().zip(&volume) {
         if *v > 0.0 {
-            *c = [c[0] / v, c[1] / v];
+            *c = c.map(|ck| ck / v);
         }
     }
     (volume, centroid)
 }
 
-/// How far a set is from the goal: the relative spread of the column volumes, plus the mean
+/// How far a set is from the goal: the relative spread of the Voronoi volumes, plus the mean
 /// distance of each point from its region's weighted centroid in units of the point spacing
 /// (equal volumes alone are met by pie slices with every point on the rim, where a line sample
 /// has no chord; the centroid term is what the paper's boundary charge and centroid pushes
 /// enforce).
-fn error(points: &[[f64; 2]], cells: &[([f64; 2], f64)]) -> f64 {
+fn error<const D: usize>(points: &[Point<D>], cells: &[(Point<D>, f64)]) -> f64 {
     let (volume, centroid) = voronoi(points, cells);
     let n = volume.len() as f64;
-    let mean = volume.iter().sum::<f64>() / n;
-    let spread = (volume.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n).sqrt() / mean;
-    let spacing = 1.0 / n.sqrt();
-    let off_centre = points.iter().zip(&centroid).map(|(p, c)| (p[0] - c[0]).hypot(p[1] - c[1])).sum::<f64>() / n;
-    spread + off_centre / spacing
+    let spacing = n.powf(-1.0 / D as f64);
+    let off_centre = points.iter().zip(&centroid).map(|(p, c)| distance_sq(p, c).sqrt()).sum::<f64>() / n;
+    volume_spread(&volume) + off_centre / spacing
 }
 
-/// Poisson-disk dart throwing in the unit disk (minimum distance relaxed until n fit).
-fn poisson(n: u32, start: u32) -> Vec<[f64; 2]> {
-    let mut radius = 1.6 / (n as f64).sqrt();
+/// Standard deviation of the volumes over their mean.
+fn volume_spread(volume: &[f64]) -> f64 {
+    let n = volume.len() as f64;
+    let mean = volume.iter().sum::<f64>() / n;
+    (volume.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / n).sqrt() / mean
+}
+
+/// A uniformly distributed point of the unit ball from the hash stream at `index`.
+fn ball_point<const D: usize>(start: u32, index: u32) -> Point<D> {
+    let u = |k: u32| noise::uniform(start, STREAM, index + k) as f64;
+    let phi = std::f64::consts::TAU * u(1);
+    let mut p = [0.0; D];
+    if D == 2 {
+        let r = u(0).sqrt();
+        (p[0], p[1]) = (r * phi.cos(), r * phi.sin());
+    } else {
+        let (r, z) = (u(0).cbrt(), 1.0 - 2.0 * u(2));
+        let ring = (1.0 - z * z).max(0.0).sqrt();
+        (p[0], p[1], p[2]) = (r * ring * phi.cos(), r * ring * phi.sin(), r * z);
+    }
+    p
+}
+
+/// Poisson-disk dart throwing in the unit ball (minimum distance relaxed until n fit).
+fn poisson<const D: usize>(n: u32, start: u32) -> Vec<Point<D>> {
+    let mut radius = 1.6 / (n as f64).powf(1.0 / D as f64);
     let mut index = 0u32;
     loop {
-        let mut points: Vec<[f64; 2]> = Vec::new();
+        let mut points: Vec<Point<D>> = Vec::new();
         for _ in 0..2000 {
-            let u = noise::uniform(start, STREAM, index) as f64;
-            let v = noise::uniform(start, STREAM, index + 1) as f64;
-            index += 2;
-            let (r, phi) = (u.sqrt(), std::f64::consts::TAU * v);
-            let p = [r * phi.cos(), r * phi.sin()];
-            if points.iter().all(|q| (q[0] - p[0]).hypot(q[1] - p[1]) >= radius) {
+            let p = ball_point::<D>(start, index);
+            index += D as u32;
+            if points.iter().all(|q| distance_sq(q, &p).sqrt() >= radius) {
                 points.push(p);
                 if points.len() == n as usize {
                     return points;
@@ -132,44 +165,45 @@ fn poisson(n: u32, start: u32) -> Vec<[f64; 2]> {
     }
 }
 
-/// One repulsion step of size `step`: 1/d⁴ forces, points kept inside the disk.
-fn repel(points: &[[f64; 2]], step: f64) -> Vec<[f64; 2]> {
+/// One repulsion step of size `step`: 1/d⁴ forces, points kept inside the ball.
+fn repel<const D: usize>(points: &[Point<D>], step: f64) -> Vec<Point<D>> {
     points
         .iter()
         .enumerate()
         .map(|(i, p)| {
-            let mut f = [0.0; 2];
+            let mut f = [0.0; D];
             for (j, q) in points.iter().enumerate() {
                 if i != j {
-                    let d = [p[0] - q[0], p[1] - q[1]];
-                    let len = d[0].hypot(d[1]).max(1e-9);
-                    let scale = 1.0 / len.powi(5); // |F| = 1/d⁴ along d/|d|
-                    f = [f[0] + d[0] * scale, f[1] + d[1] * scale];
+                    let d: Point<D> = std::array::from_fn(|k| p[k] - q[k]);
+                    let scale = 1.0 / length(&d).max(1e-9).powi(5); // |F| = 1/d⁴ along d/|d|
+                    for k in 0..D {
+                        f[k] += d[k] * scale;
+                    }
                 }
             }
-            let norm = f[0].hypot(f[1]).max(1e-12);
-            let moved = [p[0] + step * f[0] / norm, p[1] + step * f[1] / norm];
-            let r = moved[0].hypot(moved[1]);
-            if r > 0.999 { [moved[0] * 0.999 / r, moved[1] * 0.999 / r] } else { moved }
+            let norm = length(&f).max(1e-12);
+            let moved: Point<D> = std::array::from_fn(|k| p[k] + step * f[k] / norm);
+            let r = length(&moved);
+            if r > 0.999 { moved.map(|c| c * 0.999 / r) } else { moved }
         })
         .collect()
 }
 
-/// Generates the N-sample set: (x, y, A_i).
-pub fn generate_vo_disk_samples(n: u32) -> Vec<[f32; 3]> {
-    let coarse = disk_cells(128);
-    let mut best: Option<(f64, Vec<[f64; 2]>)> = None;
+/// The paper's optimisation on a coarse discrete Voronoi diagram: the best of 12 Poisson starts,
+/// each relaxed by 60 steps of repulsion with a centroid push every tenth.
+fn optimise<const D: usize>(n: u32, coarse: &[(Point<D>, f64)]) -> Vec<Point<D>> {
+    let mut best: Option<(f64, Vec<Point<D>>)> = None;
     for start in 0..12 {
-        let mut points = poisson(n, start);
-        let mut err = error(&points, &coarse);
+        let mut points = poisson::<D>(n, start);
+        let mut err = error(&points, coarse);
         let mut step = 0.05;
         for iteration in 0..60 {
             let candidate = if iteration % 10 == 9 {
-                voronoi(&points, &coarse).1 // the periodic push to the weighted centroids
+                voronoi(&points, coarse).1 // the periodic push to the weighted centroids
             } else {
                 repel(&points, step)
             };
-            let candidate_err = error(&candidate, &coarse);
+            let candidate_err = error(&candidate, coarse);
             if candidate_err < err {
                 (points, err) = (candidate, candidate_err);
                 step *= 1.2;
@@ -181,11 +215,37 @@ pub fn generate_vo_disk_samples(n: u32) -> Vec<[f32; 3]> {
             best = Some((err, points));
         }
     }
-    let (_, points) = best.expect("at least one start");
-    let (volume, _) = voronoi(&points, &disk_cells(512));
-    let chord = |p: [f64; 2]| 2.0 * (1.0 - p[0] * p[0] - p[1] * p[1]).max(0.0).sqrt();
+    best.expect("at least one start").1
+}
+
+/// Generates the N-sample disk set: (x, y, A_i).
+pub fn generate_vo_disk_samples(n: u32) -> Vec<[f32; 3]> {
+    let points = optimise::<2>(n, &ball_cells(128));
+    let (volume, _) = voronoi(&points, &ball_cells(512));
+    let chord = |p: Point<2>| 2.0 * (1.0 - p[0] * p[0] - p[1] * p[1]).max(0.0).sqrt();
     let raw: Vec<f64> = points.iter().zip(&volume).map(|(p, v)| v / chord(*p)).collect();
     let total: f64 = points.iter().zip(&raw).map(|(p, a)| a * chord(*p)).sum();
     let normalize = 4.0 / 3.0 * std::f64::consts::PI / total;
     points.iter().zip(raw).map(|(p, a)| [p[0] as f32, p[1] as f32, (a * normalize) as f32]).collect()
+}
+
+/// The sample counts with a checked-in sphere (point-sample) table.
+pub const VO_SPHERE_SAMPLE_COUNTS: [u32; 5] = [8, 12, 16, 24, 32];
+
+/// The checked-in sphere table for `n` points: (x, y, z) in the unit ball.
+pub fn vo_sphere_samples(n: u32) -> Option<&'static [[f32; 3]]> {
+    VO_SPHERE_SAMPLES.iter().find(|(count, _)| *count == n).map(|(_, table)| *table)
+}
+
+/// Generates the N-point sphere set (§4.5's point samples), optimised on a 32³ diagram; every
+/// point stands for an equal share of the ball, so the points carry no weights.
+pub fn generate_vo_sphere_samples(n: u32) -> Vec<[f32; 3]> {
+    optimise::<3>(n, &ball_cells(32)).iter().map(|p| p.map(|c| c as f32)).collect()
+}
+
+/// Relative spread (standard deviation over mean) of the Voronoi volumes of `points` in the
+/// unit ball, on a `res`³ diagram: how evenly a point set shares the sphere.
+pub fn sphere_volume_spread(points: &[[f32; 3]], res: usize) -> f64 {
+    let points: Vec<Point<3>> = points.iter().map(|p| p.map(f64::from)).collect();
+    volume_spread(&voronoi(&points, &ball_cells(res)).0)
 }
