@@ -11,6 +11,9 @@
 //
 // With REFERENCE the pass computes variant `reference` instead, the authors' own shader
 // (`lineao::passes::line_ao` documents it): `reference_ao` below.
+//
+// With OUTER_LEVEL (`outer = level`) hemispheres j >= 1 come from `line_ao_outer`, run before
+// at level j's resolution, and are upsampled depth-aware here (`upsample_outer`).
 #import shared/nd.wgsl
 #import shared/lighting.wgsl
 
@@ -26,6 +29,13 @@ override REFERENCE: bool = false;
 // Number of lights (<= MAX_LIGHTS): a constant, so the per-sample light loop unrolls (3x faster
 // LineAO than looping to lighting.count on lavapipe, measured with `lineao bench`).
 override LIGHTS: u32 = 1u;
+// `outer = level`: `line_ao` reads hemispheres j >= 1 from outer1..outer4, which
+// `line_ao_outer` wrote for hemisphere LEVEL.
+override OUTER_LEVEL: bool = false;
+override LEVEL: u32 = 1u;
+
+// Keep in sync with `lineao::reference::line_ao::OUTER_DEPTH_TOLERANCE`.
+const OUTER_DEPTH_TOLERANCE: f32 = 0.005;
 
 // The authors' falloff: occluded iff Δd >= 1e-5, also the lower edge of their smoothstep.
 const REFERENCE_FALLOFF: f32 = 1e-5;
@@ -58,6 +68,12 @@ struct LineAoUniform {
 @group(0) @binding(8) var nd2: texture_2d<f32>;
 @group(0) @binding(9) var nd3: texture_2d<f32>;
 @group(0) @binding(10) var nd4: texture_2d<f32>;
+// `outer = level`: (AO_j, d_j) at level j's resolution for j = 1..4, and line_ao_outer's output.
+@group(0) @binding(11) var outer1: texture_2d<f32>;
+@group(0) @binding(12) var outer2: texture_2d<f32>;
+@group(0) @binding(13) var outer3: texture_2d<f32>;
+@group(0) @binding(14) var outer4: texture_2d<f32>;
+@group(0) @binding(15) var outer_out: texture_storage_2d<rgba32float, write>;
 
 // Illumination-based attenuation (Eq. 14-15): 1 - min(sum over lights of the Blinn-Phong BRDF
 // lit from L_s and seen from ω, 1). `n_omega` = n · ω. For unit L and ω, |L + ω|² = 2 + 2 L·ω,
@@ -108,6 +124,31 @@ fn hemisphere(nd: texture_2d<f32>, j: u32, pixel: vec2<u32>, r1: vec3<f32>, zoom
         occlusion += select(0.0, weight, dd > params.epsilon);
     }
     return occlusion / f32(count);
+}
+
+// AO_j at `pixel` from level j's (AO_j, d_j): bilinear over the four nearest texels, each
+// weight scaled by max(0, 1 - |d_j(t) - d_j(t_P)| / τ), t_P the texel `outer = full` would
+// read the centre from (so it always contributes).
+fn upsample_outer(outer: texture_2d<f32>, j: u32, pixel: vec2<u32>) -> f32 {
+    let scale = params.levels.scale[j].xy;
+    let size = vec2<i32>(params.levels.size[j].xy);
+    let reference = textureLoad(outer, level_texel(pixel, vec2<f32>(0.0), scale, params.levels.size[j].xy), 0);
+    let u = (vec2<f32>(pixel) + 0.5) * scale - 0.5;
+    let base = floor(u);
+    let f = u - base;
+    var sum = 0.0;
+    var total = 0.0;
+    for (var dy = 0; dy < 2; dy++) {
+        for (var dx = 0; dx < 2; dx++) {
+            let at = clamp(vec2<i32>(base) + vec2<i32>(dx, dy), vec2<i32>(0), size - 1);
+            let texel = textureLoad(outer, at, 0);
+            let bilinear = select(1.0 - f.x, f.x, dx == 1) * select(1.0 - f.y, f.y, dy == 1);
+            let weight = bilinear * max(1.0 - abs(texel.y - reference.y) / OUTER_DEPTH_TOLERANCE, 0.0);
+            sum += weight * texel.x;
+            total += weight;
+        }
+    }
+    return select(reference.x, sum / total, total > 0.0);
 }
 
 // Σ over lights of the light an occluder with normal `n_o` reflects toward ω: the authors'
@@ -167,6 +208,12 @@ fn reference_ao(pixel: vec2<u32>, r1: vec3<f32>, zoom: f32) -> f32 {
     return max(total / f32(S_R), 0.0);
 }
 
+// R1 at `pixel`: the tile indexed relative to the visible viewport's corner.
+fn r1_at(pixel: vec2<u32>) -> vec3<f32> {
+    let tile = ((vec2<i32>(pixel) - params.noise_origin) % 64 + 64) % 64;
+    return noise[tile.y * 64 + tile.x].xyz;
+}
+
 @compute @workgroup_size(8, 8, 1)
 fn line_ao(@builtin(global_invocation_id) id: vec3<u32>) {
     let pixel = id.xy;
@@ -178,14 +225,29 @@ fn line_ao(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let zoom = textureLoad(zoom_map, pixel, 0).r;
-    let tile = ((vec2<i32>(pixel) - params.noise_origin) % 64 + 64) % 64;
-    let r1 = noise[tile.y * 64 + tile.x].xyz;
+    let r1 = r1_at(pixel);
     if (REFERENCE) {
         textureStore(ao_out, pixel, vec4<f32>(reference_ao(pixel, r1, zoom)));
         return;
     }
 
     var ao = hemisphere(nd0, 0u, pixel, r1, zoom);
+    if (OUTER_LEVEL) {
+        if (S_R > 1u) {
+            ao += upsample_outer(outer1, 1u, pixel);
+        }
+        if (S_R > 2u) {
+            ao += upsample_outer(outer2, 2u, pixel);
+        }
+        if (S_R > 3u) {
+            ao += upsample_outer(outer3, 3u, pixel);
+        }
+        if (S_R > 4u) {
+            ao += upsample_outer(outer4, 4u, pixel);
+        }
+        textureStore(ao_out, pixel, vec4<f32>(clamp(ao, 0.0, 1.0)));
+        return;
+    }
     if (S_R > 1u) {
         ao += hemisphere(nd1, 1u, pixel, r1, zoom);
     }
@@ -199,4 +261,42 @@ fn line_ao(@builtin(global_invocation_id) id: vec3<u32>) {
         ao += hemisphere(nd4, 4u, pixel, r1, zoom);
     }
     textureStore(ao_out, pixel, vec4<f32>(clamp(ao, 0.0, 1.0)));
+}
+
+// ⌊(t + ½) · size_0 / size_j⌋ in integers: the full-resolution pixel that stands for texel t.
+fn representative_pixel(t: vec2<u32>, size_j: vec2<u32>, size_0: vec2<u32>) -> vec2<u32> {
+    return min((2u * t + 1u) * size_0 / (2u * size_j), size_0 - 1u);
+}
+
+// `outer = level`: hemisphere LEVEL at every texel of its level, evaluated as `line_ao` would
+// at the texel's representative pixel; writes (AO_j, d_j).
+@compute @workgroup_size(8, 8, 1)
+fn line_ao_outer(@builtin(global_invocation_id) id: vec3<u32>) {
+    let texel = id.xy;
+    let size = params.levels.size[LEVEL].xy;
+    if (any(texel >= size)) {
+        return;
+    }
+    var centre: vec4<f32>;
+    switch LEVEL {
+        case 1u: { centre = textureLoad(nd1, texel, 0); }
+        case 2u: { centre = textureLoad(nd2, texel, 0); }
+        case 3u: { centre = textureLoad(nd3, texel, 0); }
+        default: { centre = textureLoad(nd4, texel, 0); }
+    }
+    if (nd_is_background(centre)) {
+        textureStore(outer_out, texel, vec4<f32>(0.0, centre.w, 0.0, 0.0));
+        return;
+    }
+    let pixel = representative_pixel(texel, size, params.levels.size[0].xy);
+    let zoom = textureLoad(zoom_map, pixel, 0).r;
+    let r1 = r1_at(pixel);
+    var ao: f32;
+    switch LEVEL {
+        case 1u: { ao = hemisphere(nd1, 1u, pixel, r1, zoom); }
+        case 2u: { ao = hemisphere(nd2, 2u, pixel, r1, zoom); }
+        case 3u: { ao = hemisphere(nd3, 3u, pixel, r1, zoom); }
+        default: { ao = hemisphere(nd4, 4u, pixel, r1, zoom); }
+    }
+    textureStore(outer_out, texel, vec4<f32>(ao, centre.w, 0.0, 0.0));
 }

@@ -9,6 +9,7 @@
 //! - `lineao-tap-floor`: the LineAO shader with the same sample addresses that only sums the
 //!   fetched depths ([`Evaluation::TapFloor`]);
 //! - `lineao-chain`: pyramid + LineAO in one span (what a frame pays for the occlusion);
+//! - `lineao-level`, `lineao-chain-level`: the same with `outer = level` (CONTRACT.md);
 //! - `ssao-12`: Crytek SSAO with 12 point samples (the VO paper's comparison);
 //! - `ssao-16-chain`: SSAO with 16 samples and its 4 × 4 blur in one span (the LineAO paper's
 //!   baseline frame, against `lineao-chain`);
@@ -32,13 +33,13 @@ use lineao::passes::vo_area::VoArea;
 use lineao::passes::vo_line::VoLine;
 use lineao::targets::{FrameTargets, Target};
 use lineao::timing::{PassTimer, Span};
-use lineao::{AoChain, BilateralSettings, ChainSettings, Gpu, LineAoSettings, SsaoSettings, VoSettings};
+use lineao::{AoChain, BilateralSettings, ChainSettings, Gpu, LineAoOuter, LineAoSettings, SsaoSettings, VoSettings};
 use serde_json::json;
 
 use crate::cli::BenchArgs;
 
 /// The passes of one run, in CONTRACT.md's order.
-pub const PASSES: [&str; 12] = [
+pub const PASSES: [&str; 14] = [
     "lines",
     "lines-native-1px",
     "nd-pyramid",
@@ -46,6 +47,8 @@ pub const PASSES: [&str; 12] = [
     "lineao-tap-floor",
     "composite",
     "lineao-chain",
+    "lineao-level",
+    "lineao-chain-level",
     "ssao-12",
     "ssao-16-chain",
     "vo-line-5",
@@ -60,6 +63,7 @@ struct Passes {
     pyramid: NdPyramid,
     line_ao: LineAo,
     tap_floor: LineAo,
+    line_ao_level: LineAo,
     composite: Composite,
     ssao_12: Ssao,
     ssao_16: Ssao,
@@ -76,12 +80,14 @@ impl Passes {
     fn new(gpu: &Gpu, settings: &ChainSettings, targets: &FrameTargets, view: &FrameView) -> Passes {
         let (device, queue) = (&gpu.device, &gpu.queue);
         let format = wgpu::TextureFormat::Rgba8UnormSrgb;
+        let level = LineAoSettings { outer: LineAoOuter::Level, ..settings.line_ao.clone() };
         let mut passes = Passes {
             lines: LineRenderer::new(device),
             lines_native: LineRenderer::with_style(device, LineStyle::Native1px),
             pyramid: NdPyramid::new(device),
             line_ao: LineAo::new(device, &settings.line_ao, &settings.lighting),
             tap_floor: LineAo::with_evaluation(device, &settings.line_ao, &settings.lighting, Evaluation::TapFloor),
+            line_ao_level: LineAo::new(device, &level, &settings.lighting),
             composite: Composite::new(device, format),
             ssao_12: Ssao::new(device, &SsaoSettings { samples: 12, ..settings.ssao.clone() }),
             ssao_16: Ssao::new(device, &SsaoSettings { samples: 16, ..settings.ssao.clone() }),
@@ -96,9 +102,13 @@ impl Passes {
             renderer.prepare(queue, view, settings.line_width_px, settings.line_color, &settings.lighting);
         }
         passes.pyramid.resize(device, targets);
-        for pass in [&mut passes.line_ao, &mut passes.tap_floor] {
+        for (pass, line_ao) in [
+            (&mut passes.line_ao, &settings.line_ao),
+            (&mut passes.tap_floor, &settings.line_ao),
+            (&mut passes.line_ao_level, &level),
+        ] {
             pass.resize(device, targets);
-            pass.prepare(queue, targets, view, &settings.line_ao, settings.r0_px(), &settings.lighting);
+            pass.prepare(queue, targets, view, line_ao, settings.r0_px(), &settings.lighting);
         }
         for (pass, samples) in [(&mut passes.ssao_12, 12), (&mut passes.ssao_16, 16)] {
             pass.resize(device, targets);
@@ -141,6 +151,11 @@ impl Passes {
             "lineao-chain" => {
                 self.pyramid.encode(encoder, targets, span.map(Span::begin_only));
                 self.line_ao.encode(encoder, targets, span.map(Span::end_only));
+            }
+            "lineao-level" => self.line_ao_level.encode(encoder, targets, span),
+            "lineao-chain-level" => {
+                self.pyramid.encode(encoder, targets, span.map(Span::begin_only));
+                self.line_ao_level.encode(encoder, targets, span.map(Span::end_only));
             }
             "ssao-12" => self.ssao_12.encode(encoder, targets, span),
             "ssao-16-chain" => {
@@ -281,6 +296,8 @@ fn print_table(report: &serde_json::Value, passes: &[serde_json::Value]) {
         ("lineao", "lineao-tap-floor"),
         ("lines", "lines-native-1px"),
         ("lineao-chain", "ssao-16-chain"),
+        ("lineao-level", "lineao"),
+        ("lineao-chain-level", "ssao-16-chain"),
         ("vo-line-5", "ssao-12"),
         ("vo-area-1", "ssao-12"),
     ] {

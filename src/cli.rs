@@ -101,6 +101,14 @@ pub enum SsaoKernelArg {
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Outer {
+    /// At every pixel, as the paper does.
+    Full,
+    /// At level j's resolution, upsampled depth-aware.
+    Level,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum Variant {
     /// The paper's equations with CONTRACT.md's conventions.
     Paper,
@@ -176,6 +184,10 @@ pub struct RenderArgs {
     /// LineAO variant.
     #[arg(long, value_enum, default_value_t = Variant::Paper)]
     pub variant: Variant,
+    /// LineAO (variant paper): hemispheres j ≥ 1 at every pixel (`full`) or at their pyramid
+    /// level's resolution, upsampled depth-aware (`level`: faster).
+    #[arg(long, value_enum, default_value_t = Outer::Full)]
+    pub outer: Outer,
     /// Output PNG.
     #[arg(short, long, default_value = "lineao.png")]
     pub output: PathBuf,

@@ -91,8 +91,11 @@ pub fn write(dir: &Path, gpu: &Gpu, chain: &AoChain, camera: &Camera) -> Result<
             "light_attenuation": ao.light_attenuation,
             "lights": lights,
             "noise_seed": ao.noise_seed,
-            "outer": "full",
+            "outer": ao.outer.name(),
         });
+        if ao.outer == lineao::LineAoOuter::Level {
+            merge(&mut extra, json!({"outer_depth_tolerance": lineao::reference::OUTER_DEPTH_TOLERANCE}));
+        }
         let variant_keys = match ao.variant {
             LineAoVariant::Paper => json!({
                 "r0_px": s.r0_px(),

@@ -9,12 +9,12 @@ use glam::Vec3;
 use lineao::camera::{Bounds, Camera, Projection};
 use lineao::passes::lines::LineGeometry;
 use lineao::{
-    AoChain, AoMethod, BilateralSettings, ChainSettings, Gpu, LineAoSettings, LineAoVariant, LineColor, SsaoKernel,
-    SsaoSettings, VoCombine, VoSettings,
+    AoChain, AoMethod, BilateralSettings, ChainSettings, Gpu, LineAoOuter, LineAoSettings, LineAoVariant, LineColor,
+    SsaoKernel, SsaoSettings, VoCombine, VoSettings,
 };
 use lineao_tracts::scenes::ViewHint;
 
-use crate::cli::{ColorArg, Combine, RenderArgs, SsaoKernelArg, Variant};
+use crate::cli::{ColorArg, Combine, Outer, RenderArgs, SsaoKernelArg, Variant};
 use crate::label::Rgba8;
 
 /// The chain's settings from the command line, for `method`.
@@ -64,6 +64,10 @@ pub fn settings(args: &RenderArgs, method: AoMethod, zoom_unit: f32) -> ChainSet
                 Variant::Reference => LineAoVariant::Reference,
             },
             reference_radius_px: args.reference_radius,
+            outer: match args.outer {
+                Outer::Full => LineAoOuter::Full,
+                Outer::Level => LineAoOuter::Level,
+            },
         },
         line_width_px: args.line_width,
         line_color: match args.color {

@@ -7,10 +7,10 @@ use std::process::Output;
 mod common;
 use common::{lineao, scratch};
 
-use lineao::LineAoVariant;
 use lineao::lighting::Light;
 use lineao::reference::{self, Image, LineAoParams, SsaoParams, ViewParams, VoParams};
 use lineao::verify::{check_policy, line_ao_flip_bound, line_ao_reference_flip_bound};
+use lineao::{LineAoOuter, LineAoVariant};
 use serde_json::Value;
 
 fn stderr(output: &Output) -> String {
@@ -42,6 +42,7 @@ fn exit_codes() {
         (&["render", "--debug-view", "level:3", "-o", png], "debug level 3"),
         (&["render", "--eye", "0,0,0", "--target", "0,0,0", "-o", png], "coincide"),
         (&["render", "--method", "ssao", "--ssao-kernel", "sphere", "--samples", "10", "-o", png], "sphere kernel"),
+        (&["render", "--variant", "reference", "--outer", "level", "-o", png], "outer = level"),
         (
             &["render", "--vertices", "2000", "--width", "64", "--height", "64", "-o", "/nonexistent/dir/x.png"],
             "/nonexistent/dir/x.png",
@@ -67,12 +68,17 @@ fn vec3(v: &Value) -> [f32; 3] {
 
 #[test]
 fn render_and_dump_let_an_outside_tool_recompute_lineao() {
-    recompute_from_dump("paper");
+    recompute_from_dump("paper", "full");
 }
 
 #[test]
 fn render_and_dump_let_an_outside_tool_recompute_the_reference_variant() {
-    recompute_from_dump("reference");
+    recompute_from_dump("reference", "full");
+}
+
+#[test]
+fn render_and_dump_let_an_outside_tool_recompute_lineao_with_outer_level() {
+    recompute_from_dump("paper", "level");
 }
 
 /// `lineao render` at 200 × 150 on 60 000 vertices with `extra` options and `--dump`; returns
@@ -90,9 +96,11 @@ fn render_with_dump(name: &str, extra: &[&str]) -> (PathBuf, PathBuf) {
 
 /// Renders with `--variant variant --dump`, then recomputes LineAO from the dumped files and
 /// `params.json` alone, as an outside implementation would.
-fn recompute_from_dump(variant: &str) {
-    let (png, dump) =
-        render_with_dump(&format!("dump-{variant}"), &["--scene", "spiral", "--variant", variant, "--guard-max", "48"]);
+fn recompute_from_dump(variant: &str, outer: &str) {
+    let (png, dump) = render_with_dump(
+        &format!("dump-{variant}-{outer}"),
+        &["--scene", "spiral", "--variant", variant, "--outer", outer, "--guard-max", "48"],
+    );
 
     let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&png).unwrap()));
     let reader = decoder.read_info().unwrap();
@@ -127,6 +135,14 @@ fn recompute_from_dump(variant: &str) {
         assert!(params.get(key).is_some(), "params.json lacks {key}");
     }
     assert_eq!(params["variant"], variant);
+    assert_eq!(params["outer"], outer);
+    assert_eq!(
+        params.get("outer_depth_tolerance").and_then(Value::as_f64).map(|t| t as f32),
+        match outer {
+            "level" => Some(lineao::reference::OUTER_DEPTH_TOLERANCE),
+            _ => None,
+        }
+    );
     assert_eq!(params["method"], "lineao");
     assert_eq!((params["width"].as_u64(), params["height"].as_u64()), (Some(200), Some(150)));
     assert!(params["camera"]["fov_y_deg"].is_number());
@@ -174,6 +190,7 @@ fn recompute_from_dump(variant: &str) {
     };
     let p = LineAoParams {
         variant: if variant == "paper" { LineAoVariant::Paper } else { LineAoVariant::Reference },
+        outer: if outer == "level" { LineAoOuter::Level } else { LineAoOuter::Full },
         reference_scale,
         s_r,
         s_h,
@@ -193,7 +210,7 @@ fn recompute_from_dump(variant: &str) {
     let cpu_ao = reference::line_ao(&levels, &zoom, &triples(&noise), &triples(&samples), &p);
     let bound = if variant == "paper" { line_ao_flip_bound(s_r, s_h) } else { line_ao_reference_flip_bound(s_h) };
     let stats = check_policy(&gpu_ao, &cpu_ao, &levels[0], bound).unwrap();
-    println!("{variant} recomputed from the dump: {stats}");
+    println!("{variant}, outer = {outer}, recomputed from the dump: {stats}");
     assert!(gpu_ao.data.iter().filter(|&&a| a > 0.1).count() > 1000);
 }
 
@@ -228,6 +245,8 @@ fn bench_json_is_the_contract() {
             "lineao-tap-floor",
             "composite",
             "lineao-chain",
+            "lineao-level",
+            "lineao-chain-level",
             "ssao-12",
             "ssao-16-chain",
             "vo-line-5",

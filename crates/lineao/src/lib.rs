@@ -58,8 +58,8 @@ pub mod verify;
 pub use chain::AoChain;
 pub use gpu::Gpu;
 pub use settings::{
-    AoMethod, BilateralSettings, ChainSettings, DebugView, LineAoSettings, LineAoVariant, LineColor, SsaoKernel,
-    SsaoSettings, VoCombine, VoSettings,
+    AoMethod, BilateralSettings, ChainSettings, DebugView, LineAoOuter, LineAoSettings, LineAoVariant, LineColor,
+    SsaoKernel, SsaoSettings, VoCombine, VoSettings,
 };
 
 /// Pyramid levels (and so LineAO hemispheres) the shaders can bind.

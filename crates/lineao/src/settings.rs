@@ -86,6 +86,30 @@ pub struct LineAoSettings {
     /// Variant `reference`: the base radius in pixels at the home zoom (the authors'
     /// `u_lineAORadius`). Default 2.
     pub reference_radius_px: f32,
+    /// Variant `paper`: hemispheres j ≥ 1 at full resolution or at their level's (CONTRACT.md).
+    pub outer: LineAoOuter,
+}
+
+/// Where LineAO evaluates its outer hemispheres (j ≥ 1; CONTRACT.md `outer`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum LineAoOuter {
+    /// At every pixel, as the paper does.
+    #[default]
+    Full,
+    /// At every texel of pyramid level j (a quarter of the pixels for j = 1, a sixteenth for
+    /// j = 2), then upsampled depth-aware: the wide hemispheres read blurred levels anyway, so
+    /// their AO varies slowly and costs far less this way.
+    Level,
+}
+
+impl LineAoOuter {
+    /// The `params.json` and CLI name: `full` or `level`.
+    pub fn name(self) -> &'static str {
+        match self {
+            LineAoOuter::Full => "full",
+            LineAoOuter::Level => "level",
+        }
+    }
 }
 
 impl Default for LineAoSettings {
@@ -101,6 +125,7 @@ impl Default for LineAoSettings {
             guard_max_px: 128,
             variant: LineAoVariant::Paper,
             reference_radius_px: 2.0,
+            outer: LineAoOuter::Full,
         }
     }
 }
@@ -355,6 +380,9 @@ impl ChainSettings {
         }
         if !(ao.delta0.is_finite() && ao.delta0 >= 0.0 && ao.delta0 < (1.0 / ao.s_r as f32).powi(2)) {
             return bad(format!("delta0 must be in [0, (1/s_r)^2), got {}", ao.delta0));
+        }
+        if ao.variant == LineAoVariant::Reference && ao.outer == LineAoOuter::Level {
+            return bad("outer = level applies to variant paper (reference reads level 0 only)".into());
         }
         if !(ao.reference_radius_px.is_finite() && ao.reference_radius_px >= 0.0) {
             return bad(format!("the reference radius must be >= 0 px, got {}", ao.reference_radius_px));

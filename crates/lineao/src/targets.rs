@@ -23,6 +23,8 @@ pub const ZOOM_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 pub const SPECULAR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 pub const AO_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+/// LineAO `outer = level`: (AO_j, d_j) per texel of level j.
+pub const OUTER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
 /// Levels the moments pyramid can have (`shared/moments.wgsl`): enough for 32768² pixels.
 pub const MAX_MOMENT_LEVELS: usize = 16;
@@ -99,6 +101,9 @@ pub struct FrameTargets {
     /// The bilateral blur's horizontal half, and its result.
     pub ao_blur_tmp: Target,
     pub ao_blurred: Target,
+    /// LineAO `outer = level`: hemisphere j's (AO_j, d_j) at level j's size, for j = 1..levels
+    /// (`outer[j − 1]`).
+    pub outer: Vec<Target>,
     /// VO area's pyramid of depth moments.
     pub moments: Option<Moments>,
 }
@@ -173,12 +178,19 @@ impl FrameTargets {
         // COPY_DST lets a host (or a test) write a G-buffer of its own into the targets.
         let attachment = U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC | U::COPY_DST;
         let ao_usage = U::STORAGE_BINDING | U::TEXTURE_BINDING | U::COPY_SRC | U::COPY_DST;
-        let nd = level_sizes(size, levels.max(1))
-            .into_iter()
+        let level_usage = U::STORAGE_BINDING | U::TEXTURE_BINDING | U::COPY_SRC;
+        let sizes = level_sizes(size, levels.max(1));
+        let nd = sizes
+            .iter()
             .enumerate()
-            .map(|(j, level)| {
-                let usage = if j == 0 { attachment } else { U::STORAGE_BINDING | U::TEXTURE_BINDING | U::COPY_SRC };
+            .map(|(j, &level)| {
+                let usage = if j == 0 { attachment } else { level_usage };
                 Target::new(device, &format!("lineao::FrameTargets::nd[{j}]"), level, ND_FORMAT, usage)
+            })
+            .collect();
+        let outer = (sizes.iter().enumerate().skip(1))
+            .map(|(j, &level)| {
+                Target::new(device, &format!("lineao::FrameTargets::outer[{j}]"), level, OUTER_FORMAT, level_usage)
             })
             .collect();
         FrameTargets {
@@ -193,6 +205,7 @@ impl FrameTargets {
             ao_raw: Target::new(device, "lineao::FrameTargets::ao_raw", size, AO_FORMAT, ao_usage),
             ao_blur_tmp: Target::new(device, "lineao::FrameTargets::ao_blur_tmp", size, AO_FORMAT, ao_usage),
             ao_blurred: Target::new(device, "lineao::FrameTargets::ao_blurred", size, AO_FORMAT, ao_usage),
+            outer,
             moments: None,
         }
     }
@@ -227,5 +240,11 @@ impl FrameTargets {
     /// shaders' fixed bindings.
     pub fn level_views(&self) -> Vec<&wgpu::TextureView> {
         (0..crate::MAX_LEVELS as usize).map(|k| &self.nd[k.min(self.nd.len() - 1)].view).collect()
+    }
+
+    /// Views of `outer` for j = 1..MAX_LEVELS, padded with the last pyramid level (never read).
+    pub fn outer_views(&self) -> Vec<&wgpu::TextureView> {
+        let pad = &self.nd[self.nd.len() - 1].view;
+        (1..crate::MAX_LEVELS as usize).map(|j| self.outer.get(j - 1).map_or(pad, |t| &t.view)).collect()
     }
 }

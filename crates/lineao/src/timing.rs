@@ -31,6 +31,14 @@ impl<'a> Span<'a> {
         Span { begin: None, ..self }
     }
 
+    /// `span` over several passes: what the first records (its start, if it has one) and what
+    /// the last records (its end, if it has one).
+    pub fn split(span: Option<Span<'a>>) -> (Option<Span<'a>>, Option<Span<'a>>) {
+        let first = span.map(Span::begin_only).filter(|s| s.begin.is_some());
+        let last = span.map(Span::end_only).filter(|s| s.end.is_some());
+        (first, last)
+    }
+
     pub fn compute(&self) -> wgpu::ComputePassTimestampWrites<'a> {
         wgpu::ComputePassTimestampWrites {
             query_set: self.query_set,

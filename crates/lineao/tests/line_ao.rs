@@ -12,7 +12,7 @@ use lineao::noise::noise_tile;
 use lineao::passes::line_ao::sample_table;
 use lineao::reference::{self, Image, LineAoParams, NdImage};
 use lineao::verify::{check_policy, compare, line_ao_flip_bound, line_ao_reference_flip_bound};
-use lineao::{ChainSettings, LineAoSettings, LineAoVariant};
+use lineao::{ChainSettings, LineAoOuter, LineAoSettings, LineAoVariant};
 
 fn settings(s_r: u32, r0_px: f32, light_attenuation: bool) -> ChainSettings {
     ChainSettings {
@@ -43,6 +43,7 @@ fn delta_curve_and_depth_weight() {
 fn light_weight_closed_form() {
     let params = |dir: Vec3| LineAoParams {
         variant: LineAoVariant::Paper,
+        outer: LineAoOuter::Full,
         reference_scale: [0.0; 2],
         s_r: 3,
         s_h: 32,
@@ -278,6 +279,70 @@ fn gpu_matches_cpu_reference_on_rendered_lines() {
             }
         }
         assert!(frame.nd[0].data.iter().filter(|t| is_geometry(**t)).count() > 2000);
+    }
+}
+
+/// The depth-aware upsampling of `outer = level`: a constant stays constant, a smooth ramp is
+/// interpolated bilinearly, and nothing crosses a depth step of more than τ.
+#[test]
+fn outer_upsampling_is_bilinear_within_a_surface_and_stops_at_depth_steps() {
+    let constant = Image::filled(5, 4, [0.25f32, 0.5]);
+    let ramp = Image::from_fn(5, 4, |x, _| [x as f32 * 0.1, 0.5]);
+    let step = Image::from_fn(5, 4, |x, _| if x < 2 { [1.0f32, 0.3] } else { [0.0, 0.6] });
+    for y in 0..8 {
+        for x in 0..10 {
+            assert_eq!(reference::upsample_outer(&constant, [10, 8], x, y), 0.25);
+            // Texel centres sit at full-resolution x = 2t + 0.5: between them the ramp is linear.
+            let expected = ((x as f32 - 0.5) / 2.0).clamp(0.0, 4.0) * 0.1;
+            assert!((reference::upsample_outer(&ramp, [10, 8], x, y) - expected).abs() < 1e-6, "({x}, {y})");
+            let side = if x < 4 { 1.0 } else { 0.0 };
+            assert_eq!(reference::upsample_outer(&step, [10, 8], x, y), side, "({x}, {y})");
+        }
+    }
+    const { assert!(reference::OUTER_DEPTH_TOLERANCE < 0.3) };
+}
+
+/// `outer = level` on rendered lines: the GPU's level passes and depth-aware upsampling against
+/// the CPU reference, under the same policy as `outer = full`; and what it changes: the level
+/// image is the full one subsampled, so the result differs from `full` by noise, less than
+/// `full` differs from itself under another noise seed, and not on average.
+#[test]
+fn outer_level_matches_the_cpu_reference_and_stays_near_full() {
+    let gpu = gpu();
+    let (positions, offsets) = polylines(120, 0.3);
+    let (perspective, ortho) = cameras_for_polylines();
+    let with = |outer, noise_seed| ChainSettings {
+        line_ao: LineAoSettings { outer, noise_seed, ..Default::default() },
+        ..Default::default()
+    };
+    for (name, cam) in [("perspective", perspective), ("orthographic", ortho)] {
+        let s = with(LineAoOuter::Level, 1);
+        let frame = render(&gpu, &positions, &offsets, &cam, None, s.clone(), (240, 180));
+        let cpu = cpu_line_ao(&frame.nd, &frame.zoom, &s, &frame.view);
+        let stats = check_policy(&frame.ao, &cpu, &frame.nd[0], line_ao_flip_bound(3, 32))
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        println!("{name}, outer = level: {stats}");
+
+        let full = render(&gpu, &positions, &offsets, &cam, None, with(LineAoOuter::Full, 1), (240, 180));
+        let reseeded = render(&gpu, &positions, &offsets, &cam, None, with(LineAoOuter::Full, 2), (240, 180));
+        let geometry = |x: usize, y: usize| is_geometry(frame.nd[0].get(x, y));
+        let level_vs_full = compare(&frame.ao, &full.ao, 0.0, geometry);
+        let seed_vs_seed = compare(&reseeded.ao, &full.ao, 0.0, geometry);
+        let mean = |ao: &Image<f32>| {
+            let values: Vec<f32> = (0..ao.height)
+                .flat_map(|y| (0..ao.width).map(move |x| (x, y)))
+                .filter(|&(x, y)| geometry(x, y))
+                .map(|(x, y)| ao.get(x, y))
+                .collect();
+            values.iter().sum::<f32>() / values.len() as f32
+        };
+        let bias = mean(&frame.ao) - mean(&full.ao);
+        println!(
+            "{name}: mean |level − full| {:.4}, mean |full(seed 2) − full| {:.4}, mean(level) − mean(full) {bias:+.4}",
+            level_vs_full.mean_abs, seed_vs_seed.mean_abs
+        );
+        assert!(level_vs_full.mean_abs < seed_vs_seed.mean_abs, "{name}");
+        assert!(bias.abs() <= 0.02, "{name}: {bias}");
     }
 }
 

@@ -41,13 +41,27 @@
 //! scene's. 1 − d is kept above 1e−6. The radius grows without bound as d → 1, so the guard
 //! band of this variant is the cap.
 
+//! # `outer = level` (CONTRACT.md's optional speed-up)
+//!
+//! Hemispheres j ≥ 1 read level j of the pyramid, which is blurred and 2^j times smaller, so
+//! their AO varies slowly. With [`LineAoOuter::Level`] a pass per j evaluates AO_j once per
+//! texel of level j — exactly as `outer = full` would at the texel's representative pixel
+//! ⌊(t + ½) · size_0/size_j⌋ (same centre texel, noise, zoom and radius), so the level image is
+//! the full image subsampled — and stores (AO_j, d_j). The full-resolution pass then computes
+//! hemisphere 0 and adds each AO_j upsampled depth-aware: bilinear over the four nearest texels,
+//! each weight times max(0, 1 − |d_j(t) − d_j(t_P)|/τ), τ = [`crate::reference::OUTER_DEPTH_TOLERANCE`],
+//! t_P the texel `full` reads its centre from. At the defaults this replaces 27 of 59 taps per
+//! pixel by 8 (plus 16/4 + 11/16 per pixel in the level passes). It is not the default: its
+//! per-pixel difference from `full` is below the noise (`full` against itself with another
+//! seed differs more) but above CONTRACT.md's 0.02 (README, "Measured").
+
 use crate::binding::{self, Slot};
 use crate::camera::FrameView;
 use crate::lighting::{Lighting, LightingUniform};
 use crate::noise;
 use crate::passes::dispatch_full_screen;
-use crate::settings::{LineAoSettings, LineAoVariant};
-use crate::targets::{AO_FORMAT, FrameTargets, LevelsUniform};
+use crate::settings::{LineAoOuter, LineAoSettings, LineAoVariant};
+use crate::targets::{AO_FORMAT, FrameTargets, LevelsUniform, OUTER_FORMAT};
 use crate::timing::Span;
 
 /// Keep in sync with `LineAoUniform` in `shaders/line_ao.wgsl`.
@@ -87,6 +101,7 @@ pub enum Evaluation {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 struct Shape {
     variant: LineAoVariant,
+    outer: LineAoOuter,
     s_r: u32,
     s_h: u32,
     noise_seed: u32,
@@ -98,6 +113,7 @@ impl Shape {
     fn of(settings: &LineAoSettings, lighting: &Lighting) -> Shape {
         Shape {
             variant: settings.variant,
+            outer: if settings.variant == LineAoVariant::Paper { settings.outer } else { LineAoOuter::Full },
             s_r: settings.s_r,
             s_h: settings.s_h,
             noise_seed: settings.noise_seed,
@@ -121,6 +137,11 @@ pub struct LineAo {
     shape: Shape,
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
+    /// `outer = level`: one pipeline per hemisphere j ≥ 1 (`line_ao_outer`), their layout (the
+    /// main one plus the output) and groups.
+    outer_pipelines: Vec<wgpu::ComputePipeline>,
+    outer_layout: wgpu::BindGroupLayout,
+    outer_groups: Vec<wgpu::BindGroup>,
     uniform: wgpu::Buffer,
     lighting: wgpu::Buffer,
     noise: wgpu::Buffer,
@@ -143,19 +164,21 @@ impl LineAo {
         lighting: &Lighting,
         evaluation: Evaluation,
     ) -> LineAo {
-        let layout = binding::layout(device, "lineao::LineAo::layout", wgpu::ShaderStages::COMPUTE, &{
-            let mut slots = vec![
-                Slot::Uniform,
-                Slot::Uniform,
-                Slot::Storage,
-                Slot::Uniform,
-                Slot::Texture,
-                Slot::StorageTexture(AO_FORMAT),
-            ];
-            slots.extend([Slot::Texture; crate::MAX_LEVELS as usize]);
-            slots
-        });
+        // line_ao.wgsl's bindings: 0..=5, the pyramid, then outer1..outer4 and outer_out.
+        let mut slots = vec![
+            Slot::Uniform,
+            Slot::Uniform,
+            Slot::Storage,
+            Slot::Uniform,
+            Slot::Texture,
+            Slot::StorageTexture(AO_FORMAT),
+        ];
+        slots.extend([Slot::Texture; 2 * crate::MAX_LEVELS as usize - 1]);
+        let layout = binding::layout(device, "lineao::LineAo::layout", wgpu::ShaderStages::COMPUTE, &slots);
+        slots.push(Slot::StorageTexture(OUTER_FORMAT));
+        let outer_layout = binding::layout(device, "lineao::LineAo::outer_layout", wgpu::ShaderStages::COMPUTE, &slots);
         let shape = Shape::of(settings, lighting);
+        let outer_level = shape.outer == LineAoOuter::Level;
         let constants = [
             ("S_R", shape.s_r as f64),
             ("S_H", shape.s_h as f64),
@@ -163,6 +186,7 @@ impl LineAo {
             ("LIGHT_ATTENUATION", shape.light_attenuation as u32 as f64),
             ("REFERENCE", (shape.variant == LineAoVariant::Reference) as u32 as f64),
             ("LIGHTS", shape.lights as f64),
+            ("OUTER_LEVEL", outer_level as u32 as f64),
         ];
         let pipeline = binding::compute_pipeline(
             device,
@@ -172,6 +196,14 @@ impl LineAo {
             "line_ao",
             &constants,
         );
+        let outer_pipelines = (1..if outer_level { shape.s_r } else { 1 })
+            .map(|j| {
+                let mut constants = constants.to_vec();
+                constants.push(("LEVEL", j as f64));
+                let label = format!("lineao::LineAo::outer[{j}]");
+                binding::compute_pipeline(device, &label, &outer_layout, "line_ao.wgsl", "line_ao_outer", &constants)
+            })
+            .collect();
         LineAo {
             shape,
             pipeline,
@@ -193,6 +225,9 @@ impl LineAo {
             ),
             layout,
             group: None,
+            outer_pipelines,
+            outer_layout,
+            outer_groups: Vec::new(),
         }
     }
 
@@ -211,8 +246,22 @@ impl LineAo {
             wgpu::BindingResource::TextureView(&targets.zoom.view),
             wgpu::BindingResource::TextureView(&targets.ao.view),
         ];
-        resources.extend(targets.level_views().into_iter().map(wgpu::BindingResource::TextureView));
+        let levels = targets.level_views();
+        resources.extend(levels.iter().map(|v| wgpu::BindingResource::TextureView(v)));
+        let common = resources.len();
+        resources.extend(targets.outer_views().into_iter().map(wgpu::BindingResource::TextureView));
         self.group = Some(binding::group(device, "lineao::LineAo::group", &self.layout, &resources));
+        // Each outer pass writes its level, so it must not also bind it for reading: the
+        // pyramid's levels stand in for outer1..outer4 there (line_ao_outer reads none of them).
+        resources.truncate(common);
+        resources.extend(levels[1..].iter().map(|v| wgpu::BindingResource::TextureView(v)));
+        self.outer_groups = (targets.outer.iter().take(self.outer_pipelines.len()))
+            .map(|target| {
+                let mut resources = resources.clone();
+                resources.push(wgpu::BindingResource::TextureView(&target.view));
+                binding::group(device, "lineao::LineAo::outer_group", &self.outer_layout, &resources)
+            })
+            .collect();
     }
 
     pub fn prepare(
@@ -238,9 +287,16 @@ impl LineAo {
         queue.write_buffer(&self.lighting, 0, bytemuck::bytes_of(&lighting.uniform()));
     }
 
-    /// Records the pass, timed into `span` when given.
+    /// Records the pass (with `outer = level` first one pass per outer hemisphere at its level's
+    /// size), timed into `span` when given.
     pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, targets: &FrameTargets, span: Option<Span>) {
         let Some(group) = &self.group else { return };
-        dispatch_full_screen(encoder, "lineao::LineAo", &self.pipeline, group, targets.size, span);
+        let (first, last) = if self.outer_pipelines.is_empty() { (None, span) } else { Span::split(span) };
+        let outer = self.outer_pipelines.iter().zip(&self.outer_groups).zip(&targets.outer);
+        for (k, ((pipeline, group), target)) in outer.enumerate() {
+            let span = first.filter(|_| k == 0);
+            dispatch_full_screen(encoder, "lineao::LineAo::outer", pipeline, group, target.size(), span);
+        }
+        dispatch_full_screen(encoder, "lineao::LineAo", &self.pipeline, group, targets.size, last);
     }
 }

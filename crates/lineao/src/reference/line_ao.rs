@@ -7,12 +7,14 @@ use glam::Vec3;
 use super::{Image, NdImage, level_texel};
 use crate::camera::FrameView;
 use crate::lighting::Light;
-use crate::settings::{ChainSettings, LineAoVariant};
+use crate::settings::{ChainSettings, LineAoOuter, LineAoVariant};
 
 /// Every number LineAO reads besides the images and the noise.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LineAoParams {
     pub variant: LineAoVariant,
+    /// Hemispheres j ≥ 1 at full resolution or at their level's (CONTRACT.md `outer`).
+    pub outer: LineAoOuter,
     pub s_r: u32,
     pub s_h: u32,
     pub r0_px: f32,
@@ -37,6 +39,7 @@ impl LineAoParams {
         let ao = &settings.line_ao;
         LineAoParams {
             variant: ao.variant,
+            outer: ao.outer,
             reference_scale: crate::passes::line_ao::reference_scale(view, ao.reference_radius_px),
             s_r: ao.s_r,
             s_h: ao.s_h,
@@ -103,8 +106,8 @@ fn vec3(v: [f32; 3]) -> Vec3 {
     Vec3::from_array(v)
 }
 
-/// LineAO at full-resolution pixel (x, y) in the variant `p.variant`. `levels` is the ND pyramid
-/// (only level 0 is read by `reference`), `zoom` the zoom map (level-0 size), `noise` R1
+/// LineAO at full-resolution pixel (x, y) in the variant `p.variant`, `outer = full`. `levels`
+/// is the ND pyramid (only level 0 is read by `reference`), `zoom` the zoom map (level-0 size), `noise` R1
 /// (64 × 64) and `samples` R2 (`s_r × s_h`, zero-padded).
 pub fn line_ao_pixel(
     levels: &[NdImage],
@@ -137,42 +140,98 @@ fn r1_at(noise: &[[f32; 3]], p: &LineAoParams, x: usize, y: usize) -> Vec3 {
     vec3(noise[tile_y * 64 + tile_x])
 }
 
-/// Variant `paper`: the sum over hemispheres, clamped to [0, 1].
-fn paper_pixel(&Inputs { levels, zoom, noise, samples }: &Inputs, p: &LineAoParams, x: usize, y: usize) -> f32 {
-    let centre0 = levels[0].get(x, y);
-    if centre0[0] == 0.0 && centre0[1] == 0.0 && centre0[2] == 0.0 {
+fn is_background(nd: [f32; 4]) -> bool {
+    nd[0] == 0.0 && nd[1] == 0.0 && nd[2] == 0.0
+}
+
+/// Variant `paper`, `outer = full`: the sum over hemispheres, clamped to [0, 1].
+fn paper_pixel(inputs: &Inputs, p: &LineAoParams, x: usize, y: usize) -> f32 {
+    if is_background(inputs.levels[0].get(x, y)) {
         return 0.0;
     }
-    let (w0, h0) = (levels[0].width, levels[0].height);
-    let r1 = r1_at(noise, p, x, y);
-    let z = zoom.get(x, y);
-    let pixel = [x as u32, y as u32];
-    let mut ao = 0.0f32;
-    for j in 0..p.s_r {
-        let level = &levels[j as usize];
-        let scale = [level.width as f32 / w0 as f32, level.height as f32 / h0 as f32];
-        let size = [level.width, level.height];
-        let [cx, cy] = level_texel(pixel, [0.0, 0.0], scale, size);
-        let centre = level.clamped(cx, cy);
-        let n = Vec3::new(centre[0], centre[1], centre[2]);
-        let radius = p.r0_px + j as f32 * z;
-        let delta_j = delta(j, p.s_r);
-        let count = crate::noise::samples_on_hemisphere(p.s_h, j);
-        let mut occlusion = 0.0f32;
-        for i in 0..count {
-            let mut omega = reflect(r1, vec3(samples[(j * p.s_h + i) as usize]));
-            if omega.dot(n) < 0.0 {
-                omega = -omega;
-            }
-            let [sx, sy] = level_texel(pixel, [omega.x * radius, -omega.y * radius], scale, size);
-            let dd = centre[3] - level.clamped(sx, sy)[3];
-            if dd > p.epsilon {
-                occlusion += depth_weight(dd, delta_j, p.delta0) * light_weight(p, n, omega);
-            }
-        }
-        ao += occlusion / count as f32;
-    }
+    let ao: f32 = (0..p.s_r).map(|j| hemisphere(inputs, p, j, [x as u32, y as u32])).sum();
     ao.clamp(0.0, 1.0)
+}
+
+/// AO_j(P) of Eq. 6 at full-resolution pixel P on pyramid level j.
+fn hemisphere(&Inputs { levels, zoom, noise, samples }: &Inputs, p: &LineAoParams, j: u32, pixel: [u32; 2]) -> f32 {
+    let (w0, h0) = (levels[0].width, levels[0].height);
+    let (x, y) = (pixel[0] as usize, pixel[1] as usize);
+    let r1 = r1_at(noise, p, x, y);
+    let level = &levels[j as usize];
+    let scale = [level.width as f32 / w0 as f32, level.height as f32 / h0 as f32];
+    let size = [level.width, level.height];
+    let [cx, cy] = level_texel(pixel, [0.0, 0.0], scale, size);
+    let centre = level.clamped(cx, cy);
+    let n = Vec3::new(centre[0], centre[1], centre[2]);
+    let radius = p.r0_px + j as f32 * zoom.get(x, y);
+    let delta_j = delta(j, p.s_r);
+    let count = crate::noise::samples_on_hemisphere(p.s_h, j);
+    let mut occlusion = 0.0f32;
+    for i in 0..count {
+        let mut omega = reflect(r1, vec3(samples[(j * p.s_h + i) as usize]));
+        if omega.dot(n) < 0.0 {
+            omega = -omega;
+        }
+        let [sx, sy] = level_texel(pixel, [omega.x * radius, -omega.y * radius], scale, size);
+        let dd = centre[3] - level.clamped(sx, sy)[3];
+        if dd > p.epsilon {
+            occlusion += depth_weight(dd, delta_j, p.delta0) * light_weight(p, n, omega);
+        }
+    }
+    occlusion / count as f32
+}
+
+/// The full-resolution pixel that stands for texel `t` of a level `size_j` of `size_0`:
+/// ⌊(t + ½) · size_0 / size_j⌋ in integers, whose nearest texel on the level is `t` again.
+pub fn representative_pixel(t: usize, size_j: usize, size_0: usize) -> usize {
+    ((2 * t + 1) * size_0 / (2 * size_j)).min(size_0 - 1)
+}
+
+/// `outer = level`: hemisphere j ≥ 1 at every texel of level j, evaluated exactly as `outer =
+/// full` evaluates it at the texel's representative pixel (same centre texel, noise, zoom and
+/// radius), so the level image is the full image subsampled; texels with a background centre
+/// get 0. Each texel holds (AO_j, d_j) for the depth-aware upsampling ([`upsample_outer`]).
+fn outer_level(inputs: &Inputs, p: &LineAoParams, j: u32) -> Image<[f32; 2]> {
+    let (level, base) = (&inputs.levels[j as usize], &inputs.levels[0]);
+    Image::from_fn(level.width, level.height, |tx, ty| {
+        let centre = level.get(tx, ty);
+        if is_background(centre) {
+            return [0.0, centre[3]];
+        }
+        let pixel = [
+            representative_pixel(tx, level.width, base.width) as u32,
+            representative_pixel(ty, level.height, base.height) as u32,
+        ];
+        [hemisphere(inputs, p, j, pixel), centre[3]]
+    })
+}
+
+/// Depth tolerance of the upsampling, in normalized depth: a level texel whose d_j differs from
+/// the pixel's own level texel by τ or more does not contribute.
+pub const OUTER_DEPTH_TOLERANCE: f32 = 0.005;
+
+/// AO_j at full-resolution pixel (x, y) from the level image: bilinear over the four nearest
+/// texels, each weight scaled by max(0, 1 − |d_j(t) − d_j(t_P)| / τ), where t_P is the texel
+/// `outer = full` reads the centre from (so it always contributes).
+pub fn upsample_outer(outer: &Image<[f32; 2]>, size_0: [usize; 2], x: usize, y: usize) -> f32 {
+    let scale = [outer.width as f32 / size_0[0] as f32, outer.height as f32 / size_0[1] as f32];
+    let [rx, ry] = level_texel([x as u32, y as u32], [0.0, 0.0], scale, [outer.width, outer.height]);
+    let reference = outer.clamped(rx, ry)[1];
+    let u = [(x as f32 + 0.5) * scale[0] - 0.5, (y as f32 + 0.5) * scale[1] - 0.5];
+    let base = [u[0].floor(), u[1].floor()];
+    let f = [u[0] - base[0], u[1] - base[1]];
+    let (mut sum, mut total) = (0.0f32, 0.0f32);
+    for dy in 0..2 {
+        for dx in 0..2 {
+            let texel = outer.clamped(base[0] as i64 + dx, base[1] as i64 + dy);
+            let bilinear = (if dx == 1 { f[0] } else { 1.0 - f[0] }) * (if dy == 1 { f[1] } else { 1.0 - f[1] });
+            let weight = bilinear * (1.0 - (texel[1] - reference).abs() / OUTER_DEPTH_TOLERANCE).max(0.0);
+            sum += weight * texel[0];
+            total += weight;
+        }
+    }
+    if total > 0.0 { sum / total } else { outer.clamped(rx, ry)[0] }
 }
 
 /// The authors' falloff: occluded iff Δd ≥ 1e−5, also the lower edge of their smoothstep.
@@ -246,7 +305,8 @@ fn reference_pixel(&Inputs { levels, zoom, noise, samples }: &Inputs, p: &LineAo
     (total / p.s_r as f32).max(0.0)
 }
 
-/// LineAO over the whole (guard-banded) image.
+/// LineAO over the whole (guard-banded) image; with `outer = level` (variant `paper`) from
+/// hemisphere 0 at full resolution plus the upsampled level images.
 pub fn line_ao(
     levels: &[NdImage],
     zoom: &Image<f32>,
@@ -254,5 +314,18 @@ pub fn line_ao(
     samples: &[[f32; 3]],
     p: &LineAoParams,
 ) -> Image<f32> {
-    Image::from_fn(levels[0].width, levels[0].height, |x, y| line_ao_pixel(levels, zoom, noise, samples, p, x, y))
+    let (w, h) = (levels[0].width, levels[0].height);
+    if p.outer == LineAoOuter::Full || p.variant == LineAoVariant::Reference {
+        return Image::from_fn(w, h, |x, y| line_ao_pixel(levels, zoom, noise, samples, p, x, y));
+    }
+    let inputs = Inputs { levels, zoom, noise, samples };
+    let outer: Vec<_> = (1..p.s_r).map(|j| outer_level(&inputs, p, j)).collect();
+    Image::from_fn(w, h, |x, y| {
+        if is_background(levels[0].get(x, y)) {
+            return 0.0;
+        }
+        let near = hemisphere(&inputs, p, 0, [x as u32, y as u32]);
+        let far: f32 = outer.iter().map(|o| upsample_outer(o, [w, h], x, y)).sum();
+        (near + far).clamp(0.0, 1.0)
+    })
 }

@@ -12,7 +12,10 @@ mod vo_area;
 mod vo_line;
 
 pub use bilateral::bilateral;
-pub use line_ao::{LineAoParams, delta, depth_weight, hermite, light_weight, line_ao, line_ao_pixel};
+pub use line_ao::{
+    LineAoParams, OUTER_DEPTH_TOLERANCE, delta, depth_weight, hermite, light_weight, line_ao, line_ao_pixel,
+    representative_pixel, upsample_outer,
+};
 pub use ssao::{SSAO_EPSILON, SsaoParams, ViewParams, ssao, ssao_blur, ssao_pixel};
 pub use vo_area::{MomentsImage, moments_pyramid, moments_trilinear, vo_area, vo_area_pixel, vo_sigma_floor};
 pub use vo_line::{
