@@ -79,7 +79,10 @@ pub fn parse_method(s: &str) -> Result<lineao::AoMethod, String> {
 
 fn parse_pair(s: &str) -> Result<[lineao::AoMethod; 2], String> {
     match s.split(',').collect::<Vec<_>>()[..] {
-        [a, b] => Ok([parse_method(a.trim())?, parse_method(b.trim())?]),
+        [a, b] => match [parse_method(a.trim())?, parse_method(b.trim())?] {
+            [a, b] if a == b => Err(format!("compare two different methods, got '{s}'")),
+            pair => Ok(pair),
+        },
         _ => Err(format!("expected two methods A,B, got '{s}'")),
     }
 }

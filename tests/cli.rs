@@ -439,7 +439,7 @@ fn compare_and_grid_write_one_image() {
             assert!(params.contains("\"method\""), "{name}: {folder}");
         }
     }
-    for bad in ["lineao", "lineao,ssao,vo-line", "lineao,magic"] {
+    for bad in ["lineao", "lineao,ssao,vo-line", "lineao,magic", "ssao, ssao"] {
         let output = lineao(&["render", "--compare", bad, "-o", dir.join("x.png").to_str().unwrap()]);
         assert_eq!(output.status.code(), Some(2), "--compare {bad}: {}", stderr(&output));
     }
