@@ -91,7 +91,8 @@ pub fn voxelize(positions: &[[f32; 3]], offsets: &[u64], options: &DensityOption
     let extent = (hi - lo + 2.0 * r).max_element();
     let voxel = extent / (options.resolution - 2) as f32;
     let origin = lo - r - voxel;
-    let dims = ((hi - lo + 2.0 * r) / voxel).ceil().as_uvec3().max(glam::UVec3::ONE) + 2;
+    // The longest axis is resolution − 2 voxels up to rounding, which must not add a voxel.
+    let dims = ((hi - lo + 2.0 * r) / voxel - 1e-3).ceil().as_uvec3().max(glam::UVec3::ONE) + 2;
     let dims = [dims.x as usize, dims.y as usize, dims.z as usize];
     let grid = Grid { dims, origin, voxel, r };
 
