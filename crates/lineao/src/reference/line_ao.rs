@@ -106,9 +106,9 @@ fn vec3(v: [f32; 3]) -> Vec3 {
     Vec3::from_array(v)
 }
 
-/// LineAO at full-resolution pixel (x, y) in the variant `p.variant`, `outer = full`. `levels`
-/// is the ND pyramid (only level 0 is read by `reference`), `zoom` the zoom map (level-0 size), `noise` R1
-/// (64 × 64) and `samples` R2 (`s_r × s_h`, zero-padded).
+/// LineAO at full-resolution pixel (x, y) in the variant `p.variant`, `outer = full`.
+/// `levels` is the ND pyramid (only level 0 is read by `reference`), `zoom` the zoom map
+/// (level-0 size), `noise` R1 (64 × 64) and `samples` R2 (`s_r × s_h`, zero-padded).
 pub fn line_ao_pixel(
     levels: &[NdImage],
     zoom: &Image<f32>,
