@@ -17,7 +17,7 @@ pub use line_ao::{
     representative_pixel, upsample_outer,
 };
 pub use ssao::{SSAO_EPSILON, SsaoParams, ViewParams, ssao, ssao_blur, ssao_pixel};
-pub use vo_area::{MomentsImage, moments_pyramid, moments_trilinear, vo_area, vo_area_pixel, vo_sigma_floor};
+pub use vo_area::{MomentsImage, moments_pyramid, moments_trilinear, vo_area, vo_sigma_floor};
 pub use vo_line::{
     VoParams, vo_chord, vo_chord_half, vo_combine, vo_line, vo_line_pixel, vo_line_sample, vo_plane, vo_reflect,
     vo_sample, vo_visible,

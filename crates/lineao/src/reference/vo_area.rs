@@ -83,48 +83,34 @@ pub fn vo_area(
     noise: &[[f32; 2]],
     p: &VoParams,
 ) -> Image<f32> {
-    Image::from_fn(nd.width, nd.height, |x, y| {
-        vo_area_pixel(nd, zoom, moments, samples, lod_offsets, noise, p, x as u32, y as u32)
-    })
-}
-
-#[allow(clippy::too_many_arguments)]
-pub fn vo_area_pixel(
-    nd: &NdImage,
-    zoom: &Image<f32>,
-    moments: &[MomentsImage],
-    samples: &[[f32; 3]],
-    lod_offsets: &[f32],
-    noise: &[[f32; 2]],
-    p: &VoParams,
-    x: u32,
-    y: u32,
-) -> f32 {
-    let here = nd.get(x as usize, y as usize);
-    let n = [here[0], here[1], here[2]];
     let floor = vo_sigma_floor(p.view.near, p.view.far);
-    let g = vo_plane(n);
-    vo_pixel(nd, zoom, noise, p, (x, y), |depth, z, u, radius| {
-        let scale = radius * z / p.zoom_unit;
-        let thickness = p.thickness / radius;
-        let lod_sphere = scale.log2();
-        let (mut free, mut allowed) = (0.0f32, 0.0f32);
-        for (sample, offset) in samples.iter().zip(lod_offsets) {
-            let s = vo_reflect([sample[0], sample[1]], u);
-            let at = [x as f32 + s[0] * scale, y as f32 - s[1] * scale];
-            let m = moments_trilinear(moments, at, lod_sphere + offset);
-            // E[z²] − E[z]² cancels: fused like the multiply-add the GPU compiles it to, so that
-            // both round the product once.
-            let mut sigma = (-m[0]).mul_add(m[0], m[1]).max(0.0).sqrt();
-            if sigma < floor {
-                sigma = 0.0;
+    Image::from_fn(nd.width, nd.height, |x, y| {
+        let (x, y) = (x as u32, y as u32);
+        let here = nd.get(x as usize, y as usize);
+        let n = [here[0], here[1], here[2]];
+        let g = vo_plane(n);
+        vo_pixel(nd, zoom, noise, p, (x, y), |depth, z, u, radius| {
+            let scale = radius * z / p.zoom_unit;
+            let thickness = p.thickness / radius;
+            let lod_sphere = scale.log2();
+            let (mut free, mut allowed) = (0.0f32, 0.0f32);
+            for (sample, offset) in samples.iter().zip(lod_offsets) {
+                let s = vo_reflect([sample[0], sample[1]], u);
+                let at = [x as f32 + s[0] * scale, y as f32 - s[1] * scale];
+                let m = moments_trilinear(moments, at, lod_sphere + offset);
+                // E[z²] − E[z]² cancels: fused like the multiply-add the GPU compiles it to, so that
+                // both round the product once.
+                let mut sigma = (-m[0]).mul_add(m[0], m[1]).max(0.0).sqrt();
+                if sigma < floor {
+                    sigma = 0.0;
+                }
+                let mu = (m[0] - depth) / radius;
+                let chord = vo_chord(s, vo_chord_half(s[0], s[1]), n, g, p.normal_clamp);
+                let (f, a) = vo_sample(chord, mu, sigma / radius, thickness);
+                free += sample[2] * f;
+                allowed += sample[2] * a;
             }
-            let mu = (m[0] - depth) / radius;
-            let chord = vo_chord(s, vo_chord_half(s[0], s[1]), n, g, p.normal_clamp);
-            let (f, a) = vo_sample(chord, mu, sigma / radius, thickness);
-            free += sample[2] * f;
-            allowed += sample[2] * a;
-        }
-        vo_ao(free, allowed)
+            vo_ao(free, allowed)
+        })
     })
 }
