@@ -17,6 +17,14 @@
 //!   0.56×);
 //! - `vo-area-1`: VO with one area sample, moments pyramid included (what the method costs);
 //! - `bilateral`: the separable bilateral blur (radius 4), which can follow any method.
+//!
+//! The object-space passes run on the CPU (`"on": "cpu"`), `--frames` times up to 3 (each takes
+//! seconds) without warm-up, on the scene's streamlines:
+//! - `density-256`: voxelizing them at 256³ (occupancy radius 0.5);
+//! - `sweep-256`: voxelizing, the eight occlusion sweeps and every vertex's octant visibilities
+//!   (what `--method sweep` costs once per dataset);
+//! - `variance-volume-256`: the moments pyramid and every vertex's octant visibilities, on the
+//!   density volume of the run (what `--method variance-volume` adds to voxelizing).
 
 use std::time::Instant;
 
@@ -33,13 +41,17 @@ use lineao::passes::vo_area::VoArea;
 use lineao::passes::vo_line::VoLine;
 use lineao::targets::{FrameTargets, Target};
 use lineao::timing::{PassTimer, Span};
+use lineao::volume::density::{DensityOptions, voxelize};
+use lineao::volume::sweep::{self, SweepSettings};
+use lineao::volume::variance::{VarianceMaps, VarianceSettings};
+use lineao::volume::vertex_tangents;
 use lineao::{AoChain, BilateralSettings, ChainSettings, Gpu, LineAoOuter, LineAoSettings, SsaoSettings, VoSettings};
 use serde_json::json;
 
 use crate::cli::BenchArgs;
 
-/// The passes of one run, in CONTRACT.md's order.
-pub const PASSES: [&str; 14] = [
+/// The GPU passes of one run, in CONTRACT.md's order.
+pub const GPU_PASSES: [&str; 14] = [
     "lines",
     "lines-native-1px",
     "nd-pyramid",
@@ -55,6 +67,14 @@ pub const PASSES: [&str; 14] = [
     "vo-area-1",
     "bilateral",
 ];
+
+/// The CPU passes, after the GPU's.
+pub const CPU_PASSES: [&str; 3] = ["density-256", "sweep-256", "variance-volume-256"];
+
+/// Whether `name` is a pass of the benchmark.
+pub fn is_pass(name: &str) -> bool {
+    GPU_PASSES.contains(&name) || CPU_PASSES.contains(&name)
+}
 
 /// Every pass of the benchmark, prepared for one view over one G-buffer.
 struct Passes {
@@ -200,11 +220,11 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let view = chain.prepare(device, queue, &camera, &bounds).context("nothing to render at this size")?;
     let targets = chain.targets().context("the chain allocated no targets")?;
     let passes = Passes::new(&gpu, &settings, targets, &view);
-    let timer = if args.no_timestamps { None } else { PassTimer::new(device, queue, &PASSES) };
+    let timer = if args.no_timestamps { None } else { PassTimer::new(device, queue, &GPU_PASSES) };
 
-    let mut times: Vec<Vec<f64>> = vec![Vec::new(); PASSES.len()];
+    let mut times: Vec<Vec<f64>> = vec![Vec::new(); GPU_PASSES.len()];
     // Quads last among the line passes, so the G-buffer the later passes read is the chain's.
-    let order = std::iter::once("lines-native-1px").chain(PASSES.into_iter().filter(|p| *p != "lines-native-1px"));
+    let order = std::iter::once("lines-native-1px").chain(GPU_PASSES.into_iter().filter(|p| *p != "lines-native-1px"));
     // The G-buffer and pyramid every later pass reads, also when `--passes` leaves them out.
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::bench") });
     passes.encode("lines", &mut encoder, targets, &geometry, settings.background, None);
@@ -240,14 +260,23 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 None => wall_ms,
             };
             if frame >= args.warmup {
-                times[PASSES.iter().position(|p| *p == name).expect("every pass is listed")].push(ms);
+                times[GPU_PASSES.iter().position(|p| *p == name).expect("every pass is listed")].push(ms);
             }
         }
     }
 
     let on = if timer.is_some() { "gpu" } else { "cpu" };
-    let passes: Vec<_> =
-        PASSES.iter().zip(times).filter(|(name, _)| selected(name)).map(|(name, ms)| summary(name, on, ms)).collect();
+    let mut passes: Vec<_> = GPU_PASSES
+        .iter()
+        .zip(times)
+        .filter(|(name, _)| selected(name))
+        .map(|(name, ms)| summary(name, on, ms))
+        .collect();
+    let runs = args.frames.min(3);
+    let tractogram = &scene.tractogram;
+    for (name, ms) in object_space_times(&tractogram.positions, &tractogram.offsets, runs, &selected)? {
+        passes.push(summary(name, "cpu", ms));
+    }
     let info = gpu.adapter.get_info();
     let report = json!({
         "adapter": info.name,
@@ -266,6 +295,48 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         print_table(&report, &passes);
     }
     Ok(())
+}
+
+/// Times of the selected CPU passes over `runs` runs each.
+fn object_space_times(
+    positions: &[[f32; 3]],
+    offsets: &[u64],
+    runs: u32,
+    selected: &dyn Fn(&str) -> bool,
+) -> Result<Vec<(&'static str, Vec<f64>)>> {
+    let density = DensityOptions { resolution: 256, occupancy_radius: 0.5, threads: 0 };
+    let timed = |f: &mut dyn FnMut() -> Result<()>| -> Result<Vec<f64>> {
+        (0..runs)
+            .map(|_| {
+                let start = Instant::now();
+                f()?;
+                Ok(start.elapsed().as_secs_f64() * 1e3)
+            })
+            .collect()
+    };
+    let mut out = Vec::new();
+    if selected("density-256") {
+        out.push(("density-256", timed(&mut || voxelize(positions, offsets, &density).map(drop).map_err(Into::into))?));
+    }
+    let tangents = vertex_tangents(positions, offsets);
+    if selected("sweep-256") {
+        let ms = timed(&mut || {
+            let volume = voxelize(positions, offsets, &density)?;
+            sweep::octant_visibility(&volume, positions, &tangents, &SweepSettings::default())?;
+            Ok(())
+        })?;
+        out.push(("sweep-256", ms));
+    }
+    if selected("variance-volume-256") {
+        let volume = voxelize(positions, offsets, &density)?;
+        let ms = timed(&mut || {
+            let maps = VarianceMaps::new(&volume, &VarianceSettings::default())?;
+            maps.octant_visibility(&volume, positions, &tangents, 0)?;
+            Ok(())
+        })?;
+        out.push(("variance-volume-256", ms));
+    }
+    Ok(out)
 }
 
 fn print_table(report: &serde_json::Value, passes: &[serde_json::Value]) {

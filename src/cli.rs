@@ -62,10 +62,11 @@ pub struct BenchArgs {
 }
 
 fn parse_bench_pass(s: &str) -> Result<String, String> {
-    if crate::bench::PASSES.contains(&s) {
+    if crate::bench::is_pass(s) {
         Ok(s.to_string())
     } else {
-        Err(format!("unknown pass '{s}' (one of {})", crate::bench::PASSES.join(", ")))
+        let all = [&crate::bench::GPU_PASSES[..], &crate::bench::CPU_PASSES[..]].concat();
+        Err(format!("unknown pass '{s}' (one of {})", all.join(", ")))
     }
 }
 

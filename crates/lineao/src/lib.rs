@@ -42,7 +42,6 @@
 pub mod binding;
 pub mod camera;
 pub mod chain;
-pub mod density;
 pub mod gpu;
 pub mod lighting;
 pub mod noise;
@@ -55,6 +54,7 @@ pub mod shader;
 pub mod targets;
 pub mod timing;
 pub mod verify;
+pub mod volume;
 
 pub use chain::AoChain;
 pub use gpu::Gpu;
