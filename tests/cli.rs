@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use std::process::Output;
 
 mod common;
-use common::{lineao, scratch};
+use common::{lineao, lineao_command, scratch};
 
 use lineao::lighting::Light;
 use lineao::reference::{self, Image, LineAoParams, SsaoParams, ViewParams, VoParams};
@@ -447,4 +447,20 @@ fn compare_and_grid_write_one_image() {
         let output = lineao(&["render", "--compare", bad, "-o", dir.join("x.png").to_str().unwrap()]);
         assert_eq!(output.status.code(), Some(2), "--compare {bad}: {}", stderr(&output));
     }
+}
+
+#[test]
+fn an_adapter_that_cannot_run_the_passes_is_a_clear_error() {
+    // wgpu's GL backend (llvmpipe through EGL) renders no Rgba32Float: exit 1 with what it lacks
+    // (or, where no GL driver is installed, that there is no adapter), never a panic.
+    let out = lineao_command()
+        .env("WGPU_BACKEND", "gl")
+        .args(["render", "--scene", "spiral", "--vertices", "2000", "--width", "64", "--height", "48", "-o"])
+        .arg(scratch("gl").join("x.png"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("lineao: error:") && !stderr.contains("internal error"), "{stderr}");
+    assert!(stderr.contains("cannot run lineao") || stderr.contains("no GPU adapter"), "{stderr}");
 }

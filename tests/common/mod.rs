@@ -5,7 +5,15 @@ use std::process::{Command, Output};
 
 /// Runs the `lineao` binary under test.
 pub fn lineao(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_lineao")).args(args).env("XDG_RUNTIME_DIR", std::env::temp_dir()).output().unwrap()
+    lineao_command().args(args).output().unwrap()
+}
+
+/// The `lineao` binary under test, for callers that set more than arguments.
+#[allow(dead_code)]
+pub fn lineao_command() -> Command {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_lineao"));
+    command.env("XDG_RUNTIME_DIR", std::env::temp_dir());
+    command
 }
 
 /// An empty folder under cargo's test scratch space.

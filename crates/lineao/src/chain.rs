@@ -64,10 +64,12 @@ pub struct AoChain {
 }
 
 impl AoChain {
-    /// A chain that composites into targets of `format`.
+    /// A chain that composites into targets of `format`. A device that cannot run the passes
+    /// (see [`crate::gpu::check_adapter`]) or a `format` that cannot be rendered to is an
+    /// [`Error::Unsupported`], not wgpu's panic.
     pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat, settings: ChainSettings) -> Result<AoChain, Error> {
         settings.validate()?;
-        Ok(AoChain {
+        crate::gpu::validated(device, "creating the pass chain's pipelines", || AoChain {
             lines: LineRenderer::new(device),
             pyramid: NdPyramid::new(device),
             line_ao: LineAo::new(device, &settings.line_ao, &settings.lighting),

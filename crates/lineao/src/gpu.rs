@@ -1,9 +1,58 @@
 //! A headless wgpu device for the CLI, the tests and the examples.
 //!
 //! Requests the adapter's own limits (wgpu's defaults cap buffers at 256 MiB, far below what an
-//! 11 M-vertex tractogram needs) and timestamp queries where the adapter has them.
+//! 11 M-vertex tractogram needs) and timestamp queries where the adapter has them. Adapters that
+//! cannot run the passes (wgpu's GL backend renders no `Rgba32Float`) are skipped for one that
+//! can, or refused with what they lack ([`check_adapter`]).
 
 use crate::Error;
+use crate::targets;
+
+/// The texture capabilities the passes rely on: the G-buffer is rendered into (`Rgba32Float`
+/// color and ND map, `R32Float` zoom and specular), the compute passes write storage textures
+/// (`R32Float` AO, `Rgba32Float` levels), every pass reads textures.
+const FORMAT_NEEDS: [(wgpu::TextureFormat, wgpu::TextureUsages); 3] = {
+    use wgpu::TextureUsages as U;
+    let all = U::RENDER_ATTACHMENT.union(U::STORAGE_BINDING).union(U::TEXTURE_BINDING);
+    [
+        (targets::ND_FORMAT, all),
+        (targets::AO_FORMAT, all),
+        (targets::DEPTH_FORMAT, U::RENDER_ATTACHMENT.union(U::TEXTURE_BINDING)),
+    ]
+};
+
+/// Whether `adapter` can run lineao's passes; the error lists everything it lacks.
+pub fn check_adapter(adapter: &wgpu::Adapter) -> Result<(), Error> {
+    let mut missing = Vec::new();
+    if !adapter.get_downlevel_capabilities().flags.contains(wgpu::DownlevelFlags::COMPUTE_SHADERS) {
+        missing.push("compute shaders".to_string());
+    }
+    for (format, usages) in FORMAT_NEEDS {
+        let lacking = usages - adapter.get_texture_format_features(format).allowed_usages;
+        if !lacking.is_empty() {
+            missing.push(format!("{format:?} for {lacking:?}"));
+        }
+    }
+    if adapter.limits().max_color_attachments < 4 {
+        missing.push(format!("4 color attachments (has {})", adapter.limits().max_color_attachments));
+    }
+    if missing.is_empty() {
+        return Ok(());
+    }
+    let info = adapter.get_info();
+    Err(Error::Unsupported(format!("{} ({:?}) lacks {}", info.name, info.backend, missing.join(", "))))
+}
+
+/// Runs `create` inside a validation error scope of `device`: what wgpu would report to its
+/// uncaptured-error handler (a panic by default) comes back as [`Error::Unsupported`].
+pub fn validated<T>(device: &wgpu::Device, what: &str, create: impl FnOnce() -> T) -> Result<T, Error> {
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let value = create();
+    match pollster::block_on(scope.pop()) {
+        None => Ok(value),
+        Some(error) => Err(Error::Unsupported(format!("{what}: {error}"))),
+    }
+}
 
 /// Instance, adapter, device and queue of one headless GPU.
 pub struct Gpu {
@@ -18,13 +67,21 @@ impl Gpu {
     /// with its full limits.
     pub fn headless() -> Result<Gpu, Error> {
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+        let preferred = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
             power_preference: wgpu::PowerPreference::HighPerformance,
             force_fallback_adapter: false,
             compatible_surface: None,
             ..Default::default()
         }))
         .map_err(|e| Error::NoAdapter(e.to_string()))?;
+        let adapter = match check_adapter(&preferred) {
+            Ok(()) => preferred,
+            // Another adapter of the environment may do (e.g. Vulkan beside GL).
+            Err(refusal) => pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()))
+                .into_iter()
+                .find(|a| check_adapter(a).is_ok())
+                .ok_or(refusal)?,
+        };
         let (device, queue) = pollster::block_on(adapter.request_device(&Self::device_descriptor(&adapter)))
             .map_err(|e| Error::RequestDevice(e.to_string()))?;
         Ok(Gpu { instance, adapter, device, queue })

@@ -81,4 +81,6 @@ pub enum Error {
     TooLarge(String),
     #[error("GPU operation failed: {0}")]
     Gpu(String),
+    #[error("the GPU cannot run lineao: {0}")]
+    Unsupported(String),
 }

@@ -103,3 +103,15 @@ fn a_moments_pyramid_beyond_the_storage_limit_is_an_error() {
     chain.resize(640, 480).unwrap();
     assert!(matches!(chain.set_settings(&device, area), Err(Error::TooLarge(_))));
 }
+
+#[test]
+fn what_the_device_cannot_do_is_a_clear_error() {
+    let gpu = gpu();
+    lineao::gpu::check_adapter(&gpu.adapter).expect("the test adapter runs lineao");
+    // A host's surface format that cannot be rendered to: refused by `new`, not wgpu's panic.
+    let error = AoChain::new(&gpu.device, wgpu::TextureFormat::Rgb9e5Ufloat, ChainSettings::default()).err();
+    let message = error.as_ref().map(ToString::to_string).unwrap_or_default();
+    assert!(matches!(error, Some(Error::Unsupported(_))) && message.contains("Rgb9e5Ufloat"), "{message}");
+    // The device stays usable afterwards.
+    assert!(AoChain::new(&gpu.device, wgpu::TextureFormat::Rgba8Unorm, ChainSettings::default()).is_ok());
+}
