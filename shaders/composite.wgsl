@@ -13,8 +13,9 @@ struct CompositeUniform {
     debug_level: u32,
     // The zoom value shown as white in the zoom view.
     zoom_max: f32,
+    // 0: ao_map, 1: volume_map, 2: both, brightness multiplied, 3: both, the darker.
+    combine: u32,
     _pad0: u32,
-    _pad1: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: CompositeUniform;
@@ -22,11 +23,13 @@ struct CompositeUniform {
 @group(0) @binding(2) var specular_map: texture_2d<f32>;
 @group(0) @binding(3) var ao_map: texture_2d<f32>;
 @group(0) @binding(4) var zoom_map: texture_2d<f32>;
-@group(0) @binding(5) var nd0: texture_2d<f32>;
-@group(0) @binding(6) var nd1: texture_2d<f32>;
-@group(0) @binding(7) var nd2: texture_2d<f32>;
-@group(0) @binding(8) var nd3: texture_2d<f32>;
-@group(0) @binding(9) var nd4: texture_2d<f32>;
+// Object-space AO (`volume_ao` pass); bound to ao_map when there is none.
+@group(0) @binding(5) var volume_map: texture_2d<f32>;
+@group(0) @binding(6) var nd0: texture_2d<f32>;
+@group(0) @binding(7) var nd1: texture_2d<f32>;
+@group(0) @binding(8) var nd2: texture_2d<f32>;
+@group(0) @binding(9) var nd3: texture_2d<f32>;
+@group(0) @binding(10) var nd4: texture_2d<f32>;
 
 @vertex
 fn vs_main(@builtin(vertex_index) vertex_index: u32) -> @builtin(position) vec4<f32> {
@@ -51,7 +54,15 @@ fn pyramid_level(k: u32, pixel: vec2<u32>) -> vec4<f32> {
 @fragment
 fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
     let pixel = vec2<u32>(position.xy) + params.guard;
-    let ao = textureLoad(ao_map, pixel, 0).r;
+    let screen = textureLoad(ao_map, pixel, 0).r;
+    let volume = textureLoad(volume_map, pixel, 0).r;
+    var ao = screen;
+    switch params.combine {
+        case 1u: { ao = volume; }
+        case 2u: { ao = 1.0 - (1.0 - screen) * (1.0 - volume); }
+        case 3u: { ao = max(screen, volume); }
+        default: {}
+    }
     var rgb: vec3<f32>;
     switch params.debug_view {
         case 1u: { rgb = vec3<f32>(1.0 - ao); }

@@ -36,11 +36,28 @@ struct StripVertex {
     @location(1) t: vec4<f32>,
 }
 
+// Per-vertex octant visibilities (object-space AO) from the attribute stream. Keep in sync with
+// `lineao::passes::lines::LineAttributes`.
+struct Attributes {
+    @location(2) octants_lo: vec4<f32>,
+    @location(3) octants_hi: vec4<f32>,
+}
+
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) view_pos: vec3<f32>,
     @location(1) view_tangent: vec3<f32>,
     @location(2) color: vec3<f32>,
+}
+
+// The strip's outputs and the octant visibilities, interpolated along and across the line.
+struct VsOutOctants {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) view_pos: vec3<f32>,
+    @location(1) view_tangent: vec3<f32>,
+    @location(2) color: vec3<f32>,
+    @location(3) octants_lo: vec4<f32>,
+    @location(4) octants_hi: vec4<f32>,
 }
 
 // Pixel-space direction of the projected curve at clip position `clip`, given the clip-space
@@ -86,6 +103,22 @@ fn vs_native(v: StripVertex) -> VsOut {
     return line_vertex(v.p, v.t.xyz, 0.0);
 }
 
+// Fixed-width lines with the octant visibilities of the attribute stream.
+@vertex
+fn vs_octants(v: StripVertex, a: Attributes) -> VsOutOctants {
+    return with_octants(line_vertex(v.p, v.t.xyz, sign(v.t.w)), a.octants_lo, a.octants_hi);
+}
+
+// Fixed-width lines of geometry without attributes, into a G-buffer with octants: all visible.
+@vertex
+fn vs_visible(v: StripVertex) -> VsOutOctants {
+    return with_octants(line_vertex(v.p, v.t.xyz, sign(v.t.w)), vec4<f32>(1.0), vec4<f32>(1.0));
+}
+
+fn with_octants(base: VsOut, lo: vec4<f32>, hi: vec4<f32>) -> VsOutOctants {
+    return VsOutOctants(base.clip, base.view_pos, base.view_tangent, base.color, lo, hi);
+}
+
 struct GBuffer {
     @location(0) color: vec4<f32>,
     @location(1) nd: vec4<f32>,
@@ -93,17 +126,38 @@ struct GBuffer {
     @location(3) specular: f32,
 }
 
+struct GBufferOctants {
+    @location(0) color: vec4<f32>,
+    @location(1) nd: vec4<f32>,
+    @location(2) zoom: f32,
+    @location(3) specular: f32,
+    // Octants 0–3 and 4–7 as unorm8 each (`pack4x8unorm`: x in the low byte).
+    @location(4) octants: vec2<u32>,
+}
+
 @fragment
 fn fs_main(in: VsOut) -> GBuffer {
-    let t = normalize(in.view_tangent);
+    return gbuffer(in.view_pos, in.view_tangent, in.color);
+}
+
+@fragment
+fn fs_octants(in: VsOutOctants) -> GBufferOctants {
+    let g = gbuffer(in.view_pos, in.view_tangent, in.color);
+    let octants = vec2<u32>(pack4x8unorm(in.octants_lo), pack4x8unorm(in.octants_hi));
+    return GBufferOctants(g.color, g.nd, g.zoom, g.specular, octants);
+}
+
+// The G-buffer of a point of the line at `view_pos` with tangent `view_tangent`.
+fn gbuffer(view_pos: vec3<f32>, view_tangent: vec3<f32>, color: vec3<f32>) -> GBuffer {
+    let t = normalize(view_tangent);
     // C: from the point toward the eye (orthographic: the eye is at infinity along +z).
-    let c = select(normalize(-in.view_pos), vec3<f32>(0.0, 0.0, 1.0), frame.orthographic != 0u);
+    let c = select(normalize(-view_pos), vec3<f32>(0.0, 0.0, 1.0), frame.orthographic != 0u);
     // n = (T x C) x T (paper §3.2): perpendicular to T, in the plane of T and C, facing the eye.
     var n = cross(cross(t, c), t);
     n = select(c, normalize(n), dot(n, n) > 1e-12);
     n = select(n, -n, dot(n, c) < 0.0);
 
-    let depth = -in.view_pos.z;
+    let depth = -view_pos.z;
     let d = clamp((depth - frame.near) / (frame.far - frame.near), 0.0, 1.0);
     let zoom = select(frame.f_px * frame.zoom_unit / depth, frame.f_px * frame.zoom_unit, frame.orthographic != 0u);
 
@@ -119,7 +173,7 @@ fn fs_main(in: VsOut) -> GBuffer {
     }
 
     var out: GBuffer;
-    out.color = vec4<f32>(in.color, 1.0);
+    out.color = vec4<f32>(color, 1.0);
     out.nd = vec4<f32>(n, d);
     out.zoom = zoom;
     out.specular = specular;

@@ -147,7 +147,14 @@ impl Passes {
         passes.bilateral.resize(device, targets);
         passes.bilateral.prepare(queue, view, &BilateralSettings::default());
         passes.composite.resize(device, targets, &targets.ao);
-        passes.composite.prepare(queue, targets, settings.strength, settings.debug_view, view.zoom_max());
+        passes.composite.prepare(
+            queue,
+            targets,
+            settings.strength,
+            settings.debug_view,
+            view.zoom_max(),
+            lineao::passes::composite::Shown::Screen,
+        );
         passes
     }
 

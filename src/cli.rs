@@ -70,15 +70,51 @@ fn parse_bench_pass(s: &str) -> Result<String, String> {
     }
 }
 
-/// An AO method by its CONTRACT.md name: none, lineao, ssao, vo-line, vo-area.
-pub fn parse_method(s: &str) -> Result<lineao::AoMethod, String> {
-    lineao::AoMethod::from_name(s).ok_or_else(|| {
-        let names: Vec<_> = lineao::AoMethod::ALL.iter().map(|m| m.name()).collect();
-        format!("unknown method '{s}' (one of {})", names.join(", "))
-    })
+/// What `--method` and `--compare` name: a screen-space method (CONTRACT.md: none, lineao,
+/// ssao, vo-line, vo-area), object-space AO (sweep, variance-volume), or both (`lineao+sweep`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Method {
+    pub screen: lineao::AoMethod,
+    pub volume: Option<lineao::volume::VolumeMethod>,
 }
 
-fn parse_pair(s: &str) -> Result<[lineao::AoMethod; 2], String> {
+impl Method {
+    pub fn name(&self) -> String {
+        match (self.screen, self.volume) {
+            (screen, None) => screen.name().to_string(),
+            (lineao::AoMethod::None, Some(volume)) => volume.name().to_string(),
+            (screen, Some(volume)) => format!("{}+{}", screen.name(), volume.name()),
+        }
+    }
+}
+
+pub fn parse_method(s: &str) -> Result<Method, String> {
+    use lineao::volume::VolumeMethod;
+    let screen = |name: &str| lineao::AoMethod::from_name(name);
+    let unknown = || {
+        let screen: Vec<_> = lineao::AoMethod::ALL.iter().map(|m| m.name()).collect();
+        let volume: Vec<_> = VolumeMethod::ALL.iter().map(|m| m.name()).collect();
+        format!(
+            "unknown method '{s}' (one of {}, {}, or SCREEN+VOLUME such as lineao+sweep)",
+            screen.join(", "),
+            volume.join(", ")
+        )
+    };
+    match s.split_once('+') {
+        None => match (screen(s), VolumeMethod::from_name(s)) {
+            (Some(screen), _) => Ok(Method { screen, volume: None }),
+            (None, Some(volume)) => Ok(Method { screen: lineao::AoMethod::None, volume: Some(volume) }),
+            (None, None) => Err(unknown()),
+        },
+        Some((a, b)) => match (screen(a.trim()), VolumeMethod::from_name(b.trim())) {
+            (Some(lineao::AoMethod::None), Some(_)) => Err(format!("'{s}': name the volume method alone")),
+            (Some(screen), Some(volume)) => Ok(Method { screen, volume: Some(volume) }),
+            _ => Err(unknown()),
+        },
+    }
+}
+
+fn parse_pair(s: &str) -> Result<[Method; 2], String> {
     match s.split(',').collect::<Vec<_>>()[..] {
         [a, b] => match [parse_method(a.trim())?, parse_method(b.trim())?] {
             [a, b] if a == b => Err(format!("compare two different methods, got '{s}'")),
@@ -86,6 +122,25 @@ fn parse_pair(s: &str) -> Result<[lineao::AoMethod; 2], String> {
         },
         _ => Err(format!("expected two methods A,B, got '{s}'")),
     }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum SkyArg {
+    /// Light from every direction.
+    Uniform,
+    /// Light only from above (the octants toward the camera's up axis; +z, superior, for
+    /// tractograms): a cloudy day.
+    Cloudy,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum VolumeNormal {
+    /// The geometry term with each pixel's (view-dependent) line normal, as the paper does it.
+    Pixel,
+    /// The geometry term averaged over the normals around the tangent: view-independent.
+    Tangent,
+    /// No geometry term: every octant counts the same (view-independent).
+    None,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -174,15 +229,18 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Ambient occlusion method: none, lineao, ssao (Crytek, with its 4 × 4 blur), vo-line or
-    /// vo-area (Volumetric Obscurance with line or area samples).
+    /// vo-area (Volumetric Obscurance with line or area samples); object-space sweep (occlusion
+    /// sweeping) or variance-volume (variance occlusion maps); or a screen-space method with an
+    /// object-space one, e.g. lineao+sweep (see --volume-combine).
     #[arg(long, default_value = "lineao", value_parser = parse_method)]
-    pub method: lineao::AoMethod,
+    pub method: Method,
     /// Split screen: method A on the left, B on the right, a labelled divider (e.g.
     /// `lineao,ssao`).
     #[arg(long, value_name = "A,B", value_parser = parse_pair, conflicts_with = "grid")]
-    pub compare: Option<[lineao::AoMethod; 2]>,
-    /// Every method in one labelled image (a 3 × 2 grid of --width × --height tiles, LineAO's
-    /// `reference` variant in the sixth).
+    pub compare: Option<[Method; 2]>,
+    /// Every method in one labelled image (a 3 × 3 grid of --width × --height tiles: none,
+    /// lineao, its `reference` variant, vo-line, vo-area, ssao, sweep, variance-volume,
+    /// lineao+sweep).
     #[arg(long)]
     pub grid: bool,
     /// LineAO variant.
@@ -293,6 +351,25 @@ pub struct RenderArgs {
     /// What to show: final, ao, normals, depth, zoom, or level:K (pyramid level K).
     #[arg(long, default_value = "final", value_parser = parse_debug_view)]
     pub debug_view: lineao::DebugView,
+    /// Object-space AO: voxels of the density volume along its longest axis (64–256 typical).
+    #[arg(long, default_value_t = 128, value_parser = clap::value_parser!(u32).range(8..=1024))]
+    pub volume_resolution: u32,
+    /// Object-space AO: occupancy radius of the streamlines in world units [default: 0.5 mm].
+    #[arg(long)]
+    pub occupancy_radius: Option<f32>,
+    /// Object-space AO: where the light comes from.
+    #[arg(long, value_enum, default_value_t = SkyArg::Uniform)]
+    pub sky: SkyArg,
+    /// Object-space AO: how the eight octant visibilities meet the line's normal.
+    #[arg(long, value_enum, default_value_t = VolumeNormal::Pixel)]
+    pub volume_normal: VolumeNormal,
+    /// Occlusion sweeping: opacity α of the translucent transmittance (Eq. 8), in (0, 1].
+    #[arg(long, default_value_t = 1.0)]
+    pub sweep_alpha: f32,
+    /// A screen-space method with object-space AO: brightness multiplied (`product`) or the
+    /// darker of the two (`min`).
+    #[arg(long, value_enum, default_value_t = Combine::Product)]
+    pub volume_combine: Combine,
     /// Write the method's inputs and output as .npy files and params.json into this folder.
     #[arg(long)]
     pub dump: Option<PathBuf>,

@@ -4,6 +4,15 @@
 //! `vo_samples.npy`, `vo_noise.npy` (VO; area sampling adds `moments_<l>.npy`, H_l × W_l × 2),
 //! and `params.json`. `ao.npy` is the method's raw occlusion, before SSAO's blur and before the
 //! bilateral blur.
+//!
+//! Object-space AO (our extension of CONTRACT.md) adds `octants.npy` (H × W × 8: the lines'
+//! octant visibilities per pixel, as the `volume_ao` pass reads them), `geometry_term.npy`
+//! (T × T × 8: G_o over the octahedral map) and `volume_ao.npy` (H × W), and the keys `volume`
+//! (`sweep`, `variance-volume`), `volume_normal` (`pixel`, `tangent`, `none`), `sky` (eight
+//! weights), `view_to_world` (3 × 3, row-major), `volume_resolution`, `occupancy_radius`,
+//! `sweep_alpha` or `variance` ({`levels`, `iso`, `offset`}), and with a screen-space method
+//! `volume_combine`. `method` is then `sweep`, `variance-volume` or e.g. `lineao+sweep`;
+//! `ao.npy` is `volume_ao.npy` alone, the screen-space method's otherwise.
 
 use std::fs::File;
 use std::io::BufWriter;
@@ -12,6 +21,7 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use lineao::camera::{Camera, Projection};
 use lineao::readback::read_texture;
+use lineao::volume::{ScalarForm, VolumeAoOptions, VolumeMethod};
 use lineao::{AoChain, AoMethod, Gpu, LineAoVariant, noise};
 use npyz::WriterBuilder;
 use serde_json::json;
@@ -41,7 +51,16 @@ fn flat3(vectors: &[[f32; 3]]) -> Vec<f32> {
     vectors.iter().flatten().copied().collect()
 }
 
-pub fn write(dir: &Path, gpu: &Gpu, chain: &AoChain, camera: &Camera) -> Result<()> {
+/// Writes the dump of the frame `chain` last prepared, for `method` (its name in `params.json`)
+/// with object-space AO computed by `volume` where the chain shows it.
+pub fn write(
+    dir: &Path,
+    gpu: &Gpu,
+    chain: &AoChain,
+    camera: &Camera,
+    method: &str,
+    volume: Option<&VolumeAoOptions>,
+) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let (targets, view) = chain.targets().zip(chain.frame_view()).context("nothing was rendered")?;
     let s = chain.settings();
@@ -53,11 +72,15 @@ pub fn write(dir: &Path, gpu: &Gpu, chain: &AoChain, camera: &Camera) -> Result<
     }
     let (w, h) = (targets.size.0 as u64, targets.size.1 as u64);
     write_npy(dir, "zoom.npy", &[h, w], &read(&targets.zoom.texture)?.to_f32())?;
-    let raw = if s.method == AoMethod::Ssao { &targets.ao_raw } else { &targets.ao };
+    let raw = match (s.method, &targets.volume_ao) {
+        (AoMethod::None, Some(volume_ao)) => volume_ao,
+        (AoMethod::Ssao, _) => &targets.ao_raw,
+        _ => &targets.ao,
+    };
     write_npy(dir, "ao.npy", &[h, w], &read(&raw.texture)?.to_f32())?;
 
     let mut params = json!({
-        "method": s.method.name(),
+        "method": method,
         "geometry": "lines",
         "line_width_px": s.line_width_px,
         "strength": s.strength,
@@ -159,6 +182,43 @@ pub fn write(dir: &Path, gpu: &Gpu, chain: &AoChain, camera: &Camera) -> Result<
                 write_npy(dir, &format!("moments_{l}.npy"), &shape, &level.data.concat())?;
             }
         }
+    }
+    if let (Some(options), Some(settings), Some(octants), Some(volume_ao)) =
+        (volume, &s.volume, &targets.octants, &targets.volume_ao)
+    {
+        let packed: lineao::reference::Image<[u32; 2]> = lineao::verify::read_image(&gpu.device, &gpu.queue, octants)?;
+        let unpacked: Vec<f32> = packed.data.iter().flat_map(|&p| lineao::reference::unpack_octants(p)).collect();
+        write_npy(dir, "octants.npy", &[h, w, 8], &unpacked)?;
+        write_npy(dir, "volume_ao.npy", &[h, w], &read(&volume_ao.texture)?.to_f32())?;
+        let size = lineao::volume::geometry_term::TABLE_SIZE;
+        let table = lineao::volume::geometry_term::GeometryTable::normals(size);
+        write_npy(dir, "geometry_term.npy", &[size as u64, size as u64, 8], &table.values.concat())?;
+        let rotation = lineao::passes::volume_ao::view_to_world(view).transpose().to_cols_array_2d();
+        let mut extra = json!({
+            "volume": options.method.name(),
+            "volume_normal": match options.form {
+                None => "pixel",
+                Some(ScalarForm::AroundTangent) => "tangent",
+                Some(ScalarForm::NoGeometryTerm) => "none",
+            },
+            "sky": settings.sky,
+            "view_to_world": rotation,
+            "volume_resolution": options.density.resolution,
+            "occupancy_radius": options.density.occupancy_radius,
+        });
+        merge(
+            &mut extra,
+            match options.method {
+                VolumeMethod::Sweep => json!({"sweep_alpha": options.sweep.alpha}),
+                VolumeMethod::VarianceVolume => json!({"variance": {
+                    "levels": options.variance.levels, "iso": options.variance.iso, "offset": options.variance.offset,
+                }}),
+            },
+        );
+        if s.method != AoMethod::None {
+            merge(&mut extra, json!({"volume_combine": settings.combine.name()}));
+        }
+        merge(&mut params, extra);
     }
     if let (Some(blur), true) = (&s.blur, s.method != AoMethod::None) {
         // Our extension of CONTRACT.md: the blur after `ao.npy` (what the image shows).

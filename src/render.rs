@@ -7,32 +7,79 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use glam::Vec3;
 use lineao::camera::{Bounds, Camera, Projection};
-use lineao::passes::lines::LineGeometry;
+use lineao::passes::lines::{LineGeometry, VertexAttributes};
+use lineao::volume::density::DensityOptions;
+use lineao::volume::sweep::SweepSettings;
+use lineao::volume::{ScalarForm, Sky, VertexVisibility, VolumeAoOptions, VolumeMethod};
 use lineao::{
     AoChain, AoMethod, BilateralSettings, ChainSettings, Gpu, LineAoOuter, LineAoSettings, LineAoVariant, LineColor,
-    SsaoKernel, SsaoSettings, VoCombine, VoSettings,
+    SsaoKernel, SsaoSettings, VoCombine, VoSettings, VolumeAoSettings,
 };
 use lineao_tracts::scenes::ViewHint;
 
-use crate::cli::{ColorArg, Combine, Outer, RenderArgs, SsaoKernelArg, Variant};
+use crate::cli::{ColorArg, Combine, Method, Outer, RenderArgs, SkyArg, SsaoKernelArg, Variant, VolumeNormal};
 use crate::label::Rgba8;
 
-/// The chain's settings from the command line, for `method`.
-pub fn settings(args: &RenderArgs, method: AoMethod, zoom_unit: f32) -> ChainSettings {
+fn combine(c: Combine) -> VoCombine {
+    match c {
+        Combine::Product => VoCombine::Product,
+        Combine::Min => VoCombine::Min,
+    }
+}
+
+/// The sky of object-space AO: open, or lit from the world axis nearest to the camera's `up`.
+pub fn sky(args: &RenderArgs, up: Vec3) -> Sky {
+    match args.sky {
+        SkyArg::Uniform => Sky::Uniform,
+        SkyArg::Cloudy => {
+            let axis = up.abs().max_position();
+            let mut direction = [0.0; 3];
+            direction[axis] = up[axis].signum();
+            Sky::Above(direction)
+        }
+    }
+}
+
+/// How object-space AO is computed, from the command line.
+pub fn volume_options(args: &RenderArgs, method: VolumeMethod, sky: Sky, zoom_unit: f32) -> VolumeAoOptions {
+    VolumeAoOptions {
+        method,
+        density: DensityOptions {
+            resolution: args.volume_resolution as usize,
+            occupancy_radius: args.occupancy_radius.unwrap_or(0.5 * zoom_unit),
+            threads: 0,
+        },
+        sweep: SweepSettings { alpha: args.sweep_alpha, threads: 0 },
+        form: match args.volume_normal {
+            VolumeNormal::Pixel => None,
+            VolumeNormal::Tangent => Some(ScalarForm::AroundTangent),
+            VolumeNormal::None => Some(ScalarForm::NoGeometryTerm),
+        },
+        sky,
+        ..VolumeAoOptions::default()
+    }
+}
+
+/// The chain's settings from the command line, for `method` (object-space AO lit by `sky`).
+pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky) -> ChainSettings {
+    let volume = method.volume.map(|_| VolumeAoSettings {
+        // The view-independent forms hold the sky already.
+        sky: if args.volume_normal == VolumeNormal::Pixel { sky.weights() } else { [1.0; 8] },
+        combine: combine(args.volume_combine),
+    });
+    let method = method.screen;
     // --samples counts the chosen method's samples; the others keep their defaults.
     let samples = |m: AoMethod, default: u32| args.samples.filter(|_| method == m).unwrap_or(default);
     let vo_default = VoSettings::default();
     ChainSettings {
         method,
+        volume,
         vo: VoSettings {
             samples: samples(AoMethod::VoLine, vo_default.samples),
             area_samples: samples(AoMethod::VoArea, vo_default.area_samples),
             radius_world: args.radius,
             radius2_world: args.radius2,
-            combine: match args.combine {
-                Combine::Product => VoCombine::Product,
-                Combine::Min => VoCombine::Min,
-            },
+            combine: combine(args.combine),
             normal_clamp: !args.no_normal_clamp,
             thickness_world: args.thickness,
             noise_seed: args.noise_seed,
@@ -82,37 +129,51 @@ pub fn settings(args: &RenderArgs, method: AoMethod, zoom_unit: f32) -> ChainSet
     }
 }
 
-/// What one image of the output shows: a label and the chain's settings.
+/// What one image of the output shows: a label, the chain's settings and the object-space
+/// method whose visibilities the geometry must carry.
 struct Panel {
     label: String,
+    /// The method's name (`params.json` `method`).
+    name: String,
     settings: ChainSettings,
+    volume: Option<VolumeMethod>,
 }
 
 impl Panel {
-    fn new(settings: ChainSettings) -> Panel {
-        let mut label = settings.method.name().to_string();
-        if settings.method == AoMethod::LineAo && settings.line_ao.variant == LineAoVariant::Reference {
+    fn new(method: Method, settings: ChainSettings) -> Panel {
+        let name = method.name();
+        let mut label = name.clone();
+        if method.screen == AoMethod::LineAo && settings.line_ao.variant == LineAoVariant::Reference {
             label += " (reference)";
         }
-        Panel { label, settings }
+        Panel { label, name, settings, volume: method.volume }
     }
 }
 
+/// The methods of `--grid`, in order (LineAO's other variant is inserted third).
+fn grid_methods() -> Vec<Method> {
+    let screen = AoMethod::ALL.map(|screen| Method { screen, volume: None });
+    let volume = VolumeMethod::ALL.map(|volume| Method { screen: AoMethod::None, volume: Some(volume) });
+    let both = Method { screen: AoMethod::LineAo, volume: Some(VolumeMethod::Sweep) };
+    screen.into_iter().chain(volume).chain([both]).collect()
+}
+
 /// The panels the command line asks for: one method, two (--compare) or all (--grid).
-fn panels(args: &RenderArgs, zoom_unit: f32) -> Vec<Panel> {
-    let panel = |method| Panel::new(settings(args, method, zoom_unit));
+fn panels(args: &RenderArgs, zoom_unit: f32, sky: Sky) -> Vec<Panel> {
+    let panel = |method| Panel::new(method, settings(args, method, zoom_unit, sky));
     if let Some(pair) = args.compare {
         return pair.into_iter().map(panel).collect();
     }
     if !args.grid {
         return vec![panel(args.method)];
     }
-    let mut all: Vec<Panel> = AoMethod::ALL.into_iter().map(panel).collect();
-    // The sixth tile: LineAO as the authors' code computes it, next to the paper's.
-    let mut reference = settings(args, AoMethod::LineAo, zoom_unit);
+    let mut all: Vec<Panel> = grid_methods().into_iter().map(panel).collect();
+    // The third tile: LineAO as the authors' code computes it, next to the paper's.
+    let lineao = Method { screen: AoMethod::LineAo, volume: None };
+    let mut reference = settings(args, lineao, zoom_unit, sky);
     reference.line_ao.variant =
         if args.variant == Variant::Reference { LineAoVariant::Paper } else { LineAoVariant::Reference };
-    all.insert(2, Panel::new(reference));
+    all.insert(2, Panel::new(lineao, reference));
     all
 }
 
@@ -136,10 +197,6 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             (scene.kind.name().to_string(), scene.tractogram, scene.view)
         }
     };
-    let panels = panels(args, hint.zoom_unit);
-    for panel in &panels {
-        panel.settings.validate().with_context(|| panel.label.clone())?;
-    }
     let camera = Camera {
         eye: Vec3::from_array(args.eye.unwrap_or(hint.eye)),
         target: Vec3::from_array(args.target.unwrap_or(hint.target)),
@@ -150,19 +207,52 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         },
     };
     validate_camera(&camera)?;
+    let sky = sky(args, camera.up);
+    let panels = panels(args, hint.zoom_unit, sky);
+    for panel in &panels {
+        panel.settings.validate().with_context(|| panel.label.clone())?;
+    }
+    let volume_options = |method| volume_options(args, method, sky, hint.zoom_unit);
+    if panels.iter().any(|p| p.volume.is_some()) {
+        volume_options(VolumeMethod::Sweep).sweep.validate()?;
+    }
 
     let gpu = Gpu::headless()?;
-    let geometry = LineGeometry::new(&gpu.device, &gpu.queue, &tracts.positions, &tracts.offsets)?;
+    let mut geometry = LineGeometry::new(&gpu.device, &gpu.queue, &tracts.positions, &tracts.offsets)?;
     let bounds = geometry.bounds.with_context(|| format!("{name} has no finite points"))?;
-    let frame = Frame { gpu: &gpu, geometry: &geometry, bounds, camera, args };
+    // Object-space AO once per method, uploaded as the geometry's attributes when a panel needs
+    // another method's than the last.
+    let mut volumes: Vec<(VolumeMethod, VertexVisibility)> = Vec::new();
+    let mut attributes: Option<VolumeMethod> = None;
     let mut images = Vec::new();
     for panel in &panels {
+        if let Some(method) = panel.volume.filter(|&m| attributes != Some(m)) {
+            if !volumes.iter().any(|(m, _)| *m == method) {
+                let start = std::time::Instant::now();
+                let computed =
+                    lineao::volume::vertex_visibility(&tracts.positions, &tracts.offsets, &volume_options(method))
+                        .with_context(|| format!("{name}: {}", method.name()))?;
+                eprintln!(
+                    "lineao: {} at {} voxels along the longest axis: {:.2} s on the CPU",
+                    method.name(),
+                    args.volume_resolution,
+                    start.elapsed().as_secs_f64()
+                );
+                volumes.push((method, computed));
+            }
+            let (_, visibility) = volumes.iter().find(|(m, _)| *m == method).expect("computed above");
+            let octants = VertexAttributes { octants: Some(&visibility.octants) };
+            geometry.set_attributes(&gpu.device, &gpu.queue, &tracts.positions, &tracts.offsets, &octants)?;
+            attributes = Some(method);
+        }
         // One method dumps into DIR itself, several into DIR/<label>/.
         let dump = args.dump.as_ref().map(|dir| match panels.len() {
             1 => dir.clone(),
             _ => dir.join(panel.label.replace(" (reference)", "-reference")),
         });
-        images.push(frame.render(panel, dump.as_deref())?);
+        let frame = Frame { gpu: &gpu, geometry: &geometry, bounds, camera, args };
+        let volume = panel.volume.map(&volume_options);
+        images.push(frame.render(panel, dump.as_deref(), volume.as_ref())?);
     }
     let (width, height) = (args.width, args.height);
     let image = match &images[..] {
@@ -200,8 +290,8 @@ struct Frame<'a> {
 
 impl Frame<'_> {
     /// Renders `panel` to sRGB bytes (with `--timings`, prints its passes; with `dump`, writes
-    /// its inputs and output there).
-    fn render(&self, panel: &Panel, dump: Option<&Path>) -> Result<Rgba8> {
+    /// its inputs and output there, with `volume`'s settings when it has object-space AO).
+    fn render(&self, panel: &Panel, dump: Option<&Path>, volume: Option<&VolumeAoOptions>) -> Result<Rgba8> {
         let (gpu, args) = (self.gpu, self.args);
         let format = wgpu::TextureFormat::Rgba8UnormSrgb;
         let mut chain = AoChain::new(&gpu.device, format, panel.settings.clone())?;
@@ -234,7 +324,7 @@ impl Frame<'_> {
         }
         let image = lineao::readback::read_texture(&gpu.device, &gpu.queue, &target.texture)?;
         if let Some(dir) = dump {
-            crate::dump::write(dir, gpu, &chain, &self.camera)?;
+            crate::dump::write(dir, gpu, &chain, &self.camera, &panel.name, volume)?;
         }
         Ok(Rgba8 { width: args.width, height: args.height, data: image.bytes })
     }

@@ -421,7 +421,7 @@ fn render_and_dump_let_an_outside_tool_recompute_vo() {
 fn compare_and_grid_write_one_image() {
     let dir = scratch("compare-grid");
     for (name, extra, size) in
-        [("compare", &["--compare", "vo-area,lineao"][..], (90, 60)), ("grid", &["--grid"][..], (270, 120))]
+        [("compare", &["--compare", "vo-area,lineao"][..], (90, 60)), ("grid", &["--grid"][..], (270, 180))]
     {
         let png = dir.join(format!("{name}.png"));
         let dump = dir.join(format!("{name}-dump"));
@@ -436,14 +436,25 @@ fn compare_and_grid_write_one_image() {
         let folders = if name == "compare" {
             vec!["vo-area", "lineao"]
         } else {
-            vec!["none", "lineao", "lineao-reference", "vo-line", "vo-area", "ssao"]
+            vec![
+                "none",
+                "lineao",
+                "lineao-reference",
+                "vo-line",
+                "vo-area",
+                "ssao",
+                "sweep",
+                "variance-volume",
+                "lineao+sweep",
+            ]
         };
         for folder in folders {
             let params = std::fs::read_to_string(dump.join(folder).join("params.json")).unwrap();
             assert!(params.contains("\"method\""), "{name}: {folder}");
         }
     }
-    for bad in ["lineao", "lineao,ssao,vo-line", "lineao,magic", "ssao, ssao"] {
+    for bad in ["lineao", "lineao,ssao,vo-line", "lineao,magic", "ssao, ssao", "sweep,none+sweep", "sweep+lineao,ssao"]
+    {
         let output = lineao(&["render", "--compare", bad, "-o", dir.join("x.png").to_str().unwrap()]);
         assert_eq!(output.status.code(), Some(2), "--compare {bad}: {}", stderr(&output));
     }
@@ -463,4 +474,72 @@ fn an_adapter_that_cannot_run_the_passes_is_a_clear_error() {
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     assert!(stderr.contains("lineao: error:") && !stderr.contains("internal error"), "{stderr}");
     assert!(stderr.contains("cannot run lineao") || stderr.contains("no GPU adapter"), "{stderr}");
+}
+
+/// Object-space AO from `--dump` alone: `volume_ao.npy` recomputed per pixel from `octants.npy`,
+/// `nd_0.npy`, `geometry_term.npy` and params.json's `sky` and `view_to_world`, as an outside
+/// tool would; `ao.npy` is that occlusion for a volume method alone.
+#[test]
+fn render_and_dump_let_an_outside_tool_recompute_object_space_ao() {
+    use lineao::volume::geometry_term::GeometryTable;
+    for (name, extra) in [
+        ("sweep", &["--method", "sweep", "--sky", "cloudy"][..]),
+        ("variance", &["--method", "lineao+variance-volume", "--volume-combine", "min", "--volume-resolution", "64"]),
+        ("tangent", &["--method", "sweep", "--volume-normal", "tangent", "--scene", "vortex"]),
+    ] {
+        let (_, dump) = render_with_dump(&format!("dump-volume-{name}"), extra);
+        let params: Value = serde_json::from_str(&std::fs::read_to_string(dump.join("params.json")).unwrap()).unwrap();
+        let (shape, octants) = read_npy(&dump.join("octants.npy"));
+        let (h, w) = (shape[0] as usize, shape[1] as usize);
+        assert_eq!(shape[2], 8);
+        let (_, nd0) = read_npy(&dump.join("nd_0.npy"));
+        let (table_shape, table) = read_npy(&dump.join("geometry_term.npy"));
+        let (_, volume_ao) = read_npy(&dump.join("volume_ao.npy"));
+        let size = table_shape[0] as usize;
+        let table = GeometryTable { size, values: table.chunks(8).map(|c| c.try_into().unwrap()).collect() };
+        let rows: Vec<[f32; 3]> = params["view_to_world"].as_array().unwrap().iter().map(vec3).collect();
+        let to_world = glam::Mat3::from_cols_array_2d(&[rows[0], rows[1], rows[2]]).transpose();
+        let sky: Vec<f32> = params["sky"].as_array().unwrap().iter().map(|w| w.as_f64().unwrap() as f32).collect();
+        let sky: [f32; 8] = sky.try_into().unwrap();
+        let (mut worst, mut geometry) = (0.0f32, 0);
+        for i in 0..w * h {
+            let n = glam::Vec3::new(nd0[4 * i], nd0[4 * i + 1], nd0[4 * i + 2]);
+            let expected = if n == glam::Vec3::ZERO {
+                0.0
+            } else {
+                geometry += 1;
+                let v: [f32; 8] = octants[8 * i..8 * i + 8].try_into().unwrap();
+                1.0 - lineao::volume::geometry_term::weighted_visibility(&v, &table.lookup(to_world * n), &sky)
+            };
+            worst = worst.max((expected - volume_ao[i]).abs());
+        }
+        println!("{name}: {geometry} geometry pixels, worst |Δ| {worst:.2e} recomputed from the dump");
+        assert!(geometry > 1000 && worst < 1e-5, "{name}: {worst}");
+        assert!(volume_ao.iter().filter(|&&a| a > 0.2).count() > 100, "{name}: something is occluded");
+        let (_, ao) = read_npy(&dump.join("ao.npy"));
+        match name {
+            "variance" => {
+                assert_eq!(
+                    (params["method"].as_str(), params["volume_combine"].as_str()),
+                    (Some("lineao+variance-volume"), Some("min"))
+                );
+                assert!(params["variance"]["levels"].as_u64().is_some() && ao != volume_ao);
+            }
+            _ => {
+                assert_eq!(params["method"], "sweep");
+                assert_eq!(ao, volume_ao);
+            }
+        }
+        if name == "sweep" {
+            // Cloudy: the lower octants are dark (the built-in scenes' up is +y).
+            assert_eq!(sky.iter().sum::<f32>(), 4.0);
+        }
+        if name == "tangent" {
+            // View-independent: one value in all eight octants, the sky applied already.
+            assert!(octants.chunks(8).all(|v| v.iter().all(|&x| x == v[0])) && sky == [1.0; 8]);
+        }
+    }
+    let out = lineao(&["render", "--method", "sweep", "--sweep-alpha", "0", "-o", "/tmp/lineao-never.png"]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert!(stderr(&out).contains("opacity"), "{}", stderr(&out));
 }

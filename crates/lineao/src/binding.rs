@@ -11,6 +11,8 @@ pub enum Slot {
     StorageReadWrite,
     /// `texture_2d<f32>` read with `textureLoad` (unfilterable, so f32 formats work everywhere).
     Texture,
+    /// `texture_2d<u32>` read with `textureLoad`.
+    UintTexture,
     /// `texture_storage_2d<format, write>`.
     StorageTexture(wgpu::TextureFormat),
 }
@@ -41,6 +43,11 @@ pub fn layout(
                 },
                 Slot::Texture => wgpu::BindingType::Texture {
                     sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+                Slot::UintTexture => wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Uint,
                     view_dimension: wgpu::TextureViewDimension::D2,
                     multisampled: false,
                 },

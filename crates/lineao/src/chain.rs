@@ -18,30 +18,47 @@
 //! with line samples (`nd[0]`, `zoom` → `ao`); with [`AoMethod::VoArea`] to the moments pyramid
 //! (`nd[0]` → `moments`) and VO with area samples (→ `ao`). With `ChainSettings::blur` the
 //! bilateral blur follows any method (`ao` → `ao_blurred`, which the composite then shows).
+//! With `ChainSettings::volume` the line renderer also writes the geometry's octant
+//! visibilities (`octants`), the [`VolumeAo`] pass makes object-space AO of them with each
+//! pixel's normal (`volume_ao`), and the composite shows it alone (method `None`) or combined
+//! with the method's occlusion.
 //!
 //! Every pass is labelled and the frame sits in a `lineao` debug group, so GPU debuggers show
 //! the chain by name. With [`AoChain::set_timing`] each pass also records timestamp queries under
 //! the names `lineao bench` uses (CONTRACT.md): `lines`, `nd-pyramid`, `lineao`, `ssao`,
-//! `ssao-blur`, `vo-line`, `moments`, `vo-area`, `blur`, `composite`.
+//! `ssao-blur`, `vo-line`, `moments`, `vo-area`, `blur`, `volume-ao`, `composite`.
 
 use crate::Error;
 use crate::camera::{self, Bounds, Camera, FrameView};
 use crate::passes::bilateral::Bilateral;
-use crate::passes::composite::Composite;
+use crate::passes::composite::{Composite, Shown};
 use crate::passes::line_ao::LineAo;
+use crate::passes::lines::LineStyle;
 use crate::passes::lines::{LineGeometry, LineRenderer};
 use crate::passes::nd_pyramid::NdPyramid;
 use crate::passes::ssao::Ssao;
 use crate::passes::ssao_blur::SsaoBlur;
 use crate::passes::vo_area::VoArea;
 use crate::passes::vo_line::VoLine;
+use crate::passes::volume_ao::VolumeAo;
 use crate::settings::{AoMethod, ChainSettings, LineAoVariant};
 use crate::targets::{FrameTargets, Moments};
 use crate::timing::{PassTime, PassTimer};
 
 /// The spans of a timed frame, in chain order.
-pub const PASS_NAMES: [&str; 10] =
-    ["lines", "nd-pyramid", "lineao", "ssao", "ssao-blur", "vo-line", "moments", "vo-area", "blur", "composite"];
+pub const PASS_NAMES: [&str; 11] = [
+    "lines",
+    "nd-pyramid",
+    "lineao",
+    "ssao",
+    "ssao-blur",
+    "vo-line",
+    "moments",
+    "vo-area",
+    "blur",
+    "volume-ao",
+    "composite",
+];
 
 pub struct AoChain {
     settings: ChainSettings,
@@ -53,6 +70,8 @@ pub struct AoChain {
     vo_line: VoLine,
     vo_area: VoArea,
     bilateral: Bilateral,
+    /// Made when the settings ask for object-space AO.
+    volume_ao: Option<VolumeAo>,
     composite: Composite,
     size: (u32, u32),
     max_texture: u32,
@@ -70,7 +89,7 @@ impl AoChain {
     pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat, settings: ChainSettings) -> Result<AoChain, Error> {
         settings.validate()?;
         crate::gpu::validated(device, "creating the pass chain's pipelines", || AoChain {
-            lines: LineRenderer::new(device),
+            lines: LineRenderer::with_outputs(device, LineStyle::Quads, settings.volume.is_some()),
             pyramid: NdPyramid::new(device),
             line_ao: LineAo::new(device, &settings.line_ao, &settings.lighting),
             ssao: Ssao::new(device, &settings.ssao),
@@ -78,6 +97,7 @@ impl AoChain {
             vo_line: VoLine::new(device, &settings.vo),
             vo_area: VoArea::new(device, &settings.vo),
             bilateral: Bilateral::new(device),
+            volume_ao: settings.volume.as_ref().map(|_| VolumeAo::new(device)),
             composite: Composite::new(device, format),
             settings,
             size: (0, 0),
@@ -122,9 +142,15 @@ impl AoChain {
                 self.vo_area.resize(device, targets);
             }
         }
-        // The pyramid's depth, whether moments exist and what the composite shows are bound at
-        // allocation.
-        let layout = |s: &ChainSettings| (s.levels(), s.method == AoMethod::VoArea, s.blur.is_some());
+        if settings.volume.is_some() != self.lines.writes_octants() {
+            // Writing octants or not is a matter of the line pipelines.
+            self.lines = LineRenderer::with_outputs(device, LineStyle::Quads, settings.volume.is_some());
+            self.volume_ao = settings.volume.as_ref().map(|_| VolumeAo::new(device));
+        }
+        // The pyramid's depth, whether moments and octants exist and what the composite shows
+        // are bound at allocation.
+        let layout =
+            |s: &ChainSettings| (s.levels(), s.method == AoMethod::VoArea, s.blur.is_some(), s.volume.is_some());
         if layout(&settings) != layout(&self.settings) {
             self.targets = None;
         }
@@ -153,7 +179,8 @@ impl AoChain {
         };
         let blur: &[&str] =
             if self.settings.blur.is_some() && self.settings.method != AoMethod::None { &["blur"] } else { &[] };
-        let used = [&["lines"], method, blur, &["composite"]].concat();
+        let volume: &[&str] = if self.settings.volume.is_some() { &["volume-ao"] } else { &[] };
+        let used = [&["lines"], method, blur, volume, &["composite"]].concat();
         timer.read(device, &used).map(Some)
     }
 
@@ -252,6 +279,9 @@ impl AoChain {
             if s.method == AoMethod::VoArea {
                 targets = targets.with_moments(device);
             }
+            if s.volume.is_some() {
+                targets = targets.with_volume(device);
+            }
             self.pyramid.resize(device, &targets);
             self.line_ao.resize(device, &targets);
             self.ssao.resize(device, &targets);
@@ -259,6 +289,9 @@ impl AoChain {
             self.vo_line.resize(device, &targets);
             self.vo_area.resize(device, &targets);
             self.bilateral.resize(device, &targets);
+            if let Some(pass) = &mut self.volume_ao {
+                pass.resize(device, &targets);
+            }
             let shown = if s.blur.is_some() { &targets.ao_blurred } else { &targets.ao };
             self.composite.resize(device, &targets, shown);
             self.targets = Some(targets);
@@ -276,8 +309,16 @@ impl AoChain {
         if let Some(blur) = &s.blur {
             self.bilateral.prepare(queue, &view, blur);
         }
-        let strength = if s.method == AoMethod::None { 0.0 } else { s.strength };
-        self.composite.prepare(queue, targets, strength, s.debug_view, view.zoom_max());
+        if let (Some(pass), Some(volume)) = (&self.volume_ao, &s.volume) {
+            pass.prepare(queue, &view, volume.sky);
+        }
+        let shown = match (s.method, &s.volume) {
+            (_, None) => Shown::Screen,
+            (AoMethod::None, Some(_)) => Shown::Volume,
+            (_, Some(volume)) => Shown::Both(volume.combine),
+        };
+        let strength = if s.method == AoMethod::None && s.volume.is_none() { 0.0 } else { s.strength };
+        self.composite.prepare(queue, targets, strength, s.debug_view, view.zoom_max(), shown);
         self.view = Some(view);
         Some(view)
     }
@@ -309,6 +350,9 @@ impl AoChain {
         }
         if self.settings.blur.is_some() && self.settings.method != AoMethod::None {
             self.bilateral.encode(encoder, targets, span("blur"));
+        }
+        if let Some(pass) = &self.volume_ao {
+            pass.encode(encoder, targets, span("volume-ao"));
         }
         self.composite.encode(encoder, target, span("composite"));
         if let Some(timer) = &self.timer {

@@ -60,7 +60,7 @@ pub use chain::AoChain;
 pub use gpu::Gpu;
 pub use settings::{
     AoMethod, BilateralSettings, ChainSettings, DebugView, LineAoOuter, LineAoSettings, LineAoVariant, LineColor,
-    SsaoKernel, SsaoSettings, VoCombine, VoSettings,
+    SsaoKernel, SsaoSettings, VoCombine, VoSettings, VolumeAoSettings,
 };
 
 /// Pyramid levels (and so LineAO hemispheres) the shaders can bind.

@@ -183,7 +183,8 @@ impl SsaoKernel {
     }
 }
 
-/// How two VO radii combine (VO paper, Fig. 8).
+/// How two occlusions combine: VO at two radii (VO paper, Fig. 8), or object-space AO with the
+/// screen-space method's ([`VolumeAoSettings`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum VoCombine {
     /// Brightness multiplies: ao = 1 − (1 − ao_small)(1 − ao_large).
@@ -245,6 +246,27 @@ impl Default for VoSettings {
             thickness_world: 0.0,
             noise_seed: 1,
         }
+    }
+}
+
+/// Object-space AO in the chain ([`crate::volume`], [`crate::passes::volume_ao`]): the
+/// geometry's per-vertex octant visibilities ([`crate::passes::lines::VertexAttributes`])
+/// turned into occlusion with each pixel's normal, alone (with [`AoMethod::None`]) or combined
+/// with the screen-space method's.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VolumeAoSettings {
+    /// Light from each octant, in [0, 1], indexed as [`crate::volume::octant_signs`]
+    /// ([`crate::volume::Sky::weights`]). Visibilities that already include a sky (the
+    /// view-independent forms of [`crate::volume::scalar_visibility`]) take all ones. Default:
+    /// all ones (an open sky).
+    pub sky: [f32; 8],
+    /// How it meets the screen-space method's occlusion. Default: brightness multiplies.
+    pub combine: VoCombine,
+}
+
+impl Default for VolumeAoSettings {
+    fn default() -> Self {
+        VolumeAoSettings { sky: [1.0; 8], combine: VoCombine::Product }
     }
 }
 
@@ -315,6 +337,8 @@ pub struct ChainSettings {
     pub vo: VoSettings,
     /// The bilateral blur after the method, or none. Default none.
     pub blur: Option<BilateralSettings>,
+    /// Object-space AO from the geometry's attributes, or none. Default none.
+    pub volume: Option<VolumeAoSettings>,
     pub lighting: Lighting,
     /// Line width in pixels, > 0. Default 2.
     pub line_width_px: f32,
@@ -336,6 +360,7 @@ impl Default for ChainSettings {
             ssao: SsaoSettings::default(),
             vo: VoSettings::default(),
             blur: None,
+            volume: None,
             lighting: Lighting::default(),
             line_width_px: 2.0,
             line_color: LineColor::Tangent,
@@ -437,6 +462,11 @@ impl ChainSettings {
             if !(blur.depth_sigma_world.is_finite() && blur.depth_sigma_world > 0.0) {
                 return bad(format!("the blur's depth sigma must be > 0, got {}", blur.depth_sigma_world));
             }
+        }
+        if let Some(volume) = &self.volume
+            && !volume.sky.iter().all(|w| (0.0..=1.0).contains(w))
+        {
+            return bad(format!("sky intensities must be in [0, 1], got {:?}", volume.sky));
         }
         if !(self.strength.is_finite() && self.strength >= 0.0) {
             return bad(format!("strength must be >= 0, got {}", self.strength));

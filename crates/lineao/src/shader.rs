@@ -24,6 +24,7 @@ pub const FILES: &[(&str, &str)] = &[
     ("ssao_blur.wgsl", include_str!("../shaders/ssao_blur.wgsl")),
     ("vo_area.wgsl", include_str!("../shaders/vo_area.wgsl")),
     ("vo_line.wgsl", include_str!("../shaders/vo_line.wgsl")),
+    ("volume_ao.wgsl", include_str!("../shaders/volume_ao.wgsl")),
 ];
 
 /// The embedded source of `path` (relative to `shaders/`), without imports resolved.

@@ -12,10 +12,13 @@
 //! | ao        | R32Float      | occlusion of the chosen method, 0 = none                   |
 //! | ao_raw    | R32Float      | SSAO's occlusion before its 4 × 4 blur                     |
 //! | ao_blurred| R32Float      | `ao` after the bilateral blur (via `ao_blur_tmp`)          |
+//! | octants   | Rg32Uint      | object-space AO: the lines' octant visibilities, unorm8 × 8 |
+//! | volume_ao | R32Float      | object-space AO with the pixel's normal (`volume_ao` pass) |
 //!
 //! All at the guard-banded size; level j is ⌈W_{j−1}/2⌉ × ⌈H_{j−1}/2⌉ (CONTRACT.md). VO area
 //! sampling adds [`Moments`], a buffer of (E\[z\], E\[z²\]) pyramids, only when a chain needs it
-//! ([`FrameTargets::with_moments`]).
+//! ([`FrameTargets::with_moments`]); object-space AO adds `octants` and `volume_ao`
+//! ([`FrameTargets::with_volume`]).
 
 pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub const ND_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
@@ -23,6 +26,9 @@ pub const ZOOM_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 pub const SPECULAR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 pub const AO_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+/// The eight octant visibilities of object-space AO per pixel, `pack4x8unorm` of octants 0–3
+/// and 4–7.
+pub const OCTANTS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Uint;
 /// LineAO `outer = level`: (AO_j, d_j) per texel of level j.
 pub const OUTER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
@@ -106,6 +112,10 @@ pub struct FrameTargets {
     pub outer: Vec<Target>,
     /// VO area's pyramid of depth moments.
     pub moments: Option<Moments>,
+    /// Object-space AO: the geometry's octant visibilities per pixel, and the occlusion the
+    /// `volume_ao` pass makes of them.
+    pub octants: Option<Target>,
+    pub volume_ao: Option<Target>,
 }
 
 /// One level of [`Moments`]: `width` × `height` texels from element `offset`, row-major.
@@ -207,7 +217,20 @@ impl FrameTargets {
             ao_blurred: Target::new(device, "lineao::FrameTargets::ao_blurred", size, AO_FORMAT, ao_usage),
             outer,
             moments: None,
+            octants: None,
+            volume_ao: None,
         }
+    }
+
+    /// These targets with the two of object-space AO (`octants`, `volume_ao`).
+    pub fn with_volume(mut self, device: &wgpu::Device) -> FrameTargets {
+        use wgpu::TextureUsages as U;
+        let attachment = U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC | U::COPY_DST;
+        let storage = U::STORAGE_BINDING | U::TEXTURE_BINDING | U::COPY_SRC | U::COPY_DST;
+        self.octants =
+            Some(Target::new(device, "lineao::FrameTargets::octants", self.size, OCTANTS_FORMAT, attachment));
+        self.volume_ao = Some(Target::new(device, "lineao::FrameTargets::volume_ao", self.size, AO_FORMAT, storage));
+        self
     }
 
     /// These targets with the moments pyramid of VO area sampling. The caller checks the

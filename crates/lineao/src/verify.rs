@@ -19,6 +19,21 @@ pub fn read_rgba(device: &wgpu::Device, queue: &wgpu::Queue, target: &Target) ->
     Ok(Image { width: data.width as usize, height: data.height as usize, data: data.to_vec4() })
 }
 
+/// A target of any format as an image of `T` (one texel's bytes each), e.g. `[u32; 2]` for the
+/// `octants` target.
+pub fn read_image<T: bytemuck::Pod>(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    target: &Target,
+) -> Result<Image<T>, Error> {
+    let data = read_texture(device, queue, &target.texture)?;
+    Ok(Image {
+        width: data.width as usize,
+        height: data.height as usize,
+        data: bytemuck::pod_collect_to_vec(&data.bytes),
+    })
+}
+
 /// The moments pyramid (`targets.moments`) as the CPU reference takes it: (E\[z\], E\[z²\]) per
 /// level.
 pub fn read_moments(

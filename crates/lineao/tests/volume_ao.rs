@@ -306,3 +306,189 @@ fn chebyshev_is_exact_for_two_values_and_soft_shadows_fall_behind_occluders() {
     let inside = maps.octant_visibility(&solid, &[[24.0, 24.0, 24.0]], &[Vec3::X], 1).unwrap();
     assert!(inside[0].iter().all(|&v| v == 0.0), "{inside:?}");
 }
+
+mod common;
+
+use common::{cameras_for_polylines, gpu, is_geometry, polylines};
+use lineao::camera::Camera;
+use lineao::passes::lines::{GeometryOptions, LineGeometry, VertexAttributes};
+use lineao::passes::volume_ao::view_to_world;
+use lineao::reference::{self, Image};
+use lineao::verify::{compare, read_f32, read_image, read_rgba};
+use lineao::{AoChain, AoMethod, ChainSettings, VoCombine, VolumeAoSettings};
+
+/// A chain frame with object-space AO, read back: ND, octants, volume_ao, ao and the output.
+struct VolumeFrame {
+    view: lineao::camera::FrameView,
+    guard: usize,
+    color: reference::NdImage,
+    specular: Image<f32>,
+    nd: reference::NdImage,
+    octants: Image<[u32; 2]>,
+    volume_ao: Image<f32>,
+    ao: Image<f32>,
+    output: reference::NdImage,
+}
+
+fn render_volume(
+    gpu: &lineao::Gpu,
+    geometry: &LineGeometry,
+    camera: &Camera,
+    settings: ChainSettings,
+    size: (u32, u32),
+) -> VolumeFrame {
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let mut chain = AoChain::new(d, common::OUTPUT_FORMAT, settings).unwrap();
+    chain.resize(size.0, size.1).unwrap();
+    let view = chain.prepare(d, q, camera, &geometry.bounds.unwrap()).unwrap();
+    let output = lineao::targets::Target::output(d, "test::output", size, common::OUTPUT_FORMAT);
+    let mut encoder = d.create_command_encoder(&Default::default());
+    chain.encode(&mut encoder, geometry, &output.view);
+    q.submit([encoder.finish()]);
+    let t = chain.targets().unwrap();
+    VolumeFrame {
+        view,
+        guard: t.guard as usize,
+        color: read_rgba(d, q, &t.color).unwrap(),
+        specular: read_f32(d, q, &t.specular).unwrap(),
+        nd: read_rgba(d, q, &t.nd[0]).unwrap(),
+        octants: read_image(d, q, t.octants.as_ref().unwrap()).unwrap(),
+        volume_ao: read_f32(d, q, t.volume_ao.as_ref().unwrap()).unwrap(),
+        ao: read_f32(d, q, &t.ao).unwrap(),
+        output: read_rgba(d, q, &output).unwrap(),
+    }
+}
+
+/// Polylines with octant visibilities from the sweep over their own density volume.
+fn swept_polylines(gpu: &lineao::Gpu, options: GeometryOptions) -> (LineGeometry, Vec<[f32; 8]>) {
+    let (positions, offsets) = polylines(40, 0.3);
+    let volume =
+        voxelize(&positions, &offsets, &DensityOptions { resolution: 48, occupancy_radius: 1.5, threads: 0 }).unwrap();
+    let tangents = vertex_tangents(&positions, &offsets);
+    let octants = sweep::octant_visibility(&volume, &positions, &tangents, &SweepSettings::default()).unwrap();
+    let mut geometry = LineGeometry::with_options(&gpu.device, &gpu.queue, &positions, &offsets, options).unwrap();
+    let attributes = VertexAttributes { octants: Some(&octants) };
+    geometry.set_attributes(&gpu.device, &gpu.queue, &positions, &offsets, &attributes).unwrap();
+    (geometry, octants)
+}
+
+#[test]
+fn the_gpu_agrees_with_the_cpu_reference_on_rendered_lines() {
+    let gpu = gpu();
+    let (geometry, octants) = swept_polylines(&gpu, GeometryOptions::default());
+    let table = GeometryTable::normals(TABLE_SIZE);
+    let (perspective, orthographic) = cameras_for_polylines();
+    for (name, camera, sky, method, combine) in [
+        ("perspective, open sky, alone", perspective, Sky::Uniform, AoMethod::None, VoCombine::Product),
+        ("orthographic, cloudy, alone", orthographic, Sky::Cloudy, AoMethod::None, VoCombine::Product),
+        ("perspective, with LineAO, product", perspective, Sky::Uniform, AoMethod::LineAo, VoCombine::Product),
+        ("perspective, with SSAO, darker", perspective, Sky::Cloudy, AoMethod::Ssao, VoCombine::Min),
+    ] {
+        let settings = ChainSettings {
+            method,
+            volume: Some(VolumeAoSettings { sky: sky.weights(), combine }),
+            ..ChainSettings::default()
+        };
+        let f = render_volume(&gpu, &geometry, &camera, settings.clone(), (200, 150));
+        let cpu = reference::volume_ao(&f.nd, &f.octants, &table, view_to_world(&f.view), sky.weights());
+        let stats = compare(&f.volume_ao, &cpu, 1e-4, |_, _| true);
+        println!("{name}: {stats}");
+        assert!(stats.worst < 1e-4, "{name}: {stats}");
+        // The octants come from the geometry: some pixels dark, some lit.
+        let geometry_pixels: Vec<f32> =
+            (0..f.nd.data.len()).filter(|&i| is_geometry(f.nd.data[i])).map(|i| f.volume_ao.data[i]).collect();
+        let dark = geometry_pixels.iter().filter(|&&a| a > 0.3).count();
+        assert!(dark > 50 && dark < geometry_pixels.len() - 50, "{name}: {dark} of {}", geometry_pixels.len());
+        // The composite shows it alone or combined with the method's.
+        let volume = |x, y| (method != AoMethod::None).then(|| (f.volume_ao.get(x, y), combine));
+        let shown = Image::from_fn(f.ao.width, f.ao.height, |x, y| match method {
+            AoMethod::None => f.volume_ao.get(x, y),
+            _ => reference::combine_ao(f.ao.get(x, y), volume(x, y)),
+        });
+        let expected = reference::composite(&f.color, &f.specular, &shown, f.guard, settings.strength);
+        let worst = expected
+            .data
+            .iter()
+            .zip(&f.output.data)
+            .map(|(e, o)| (0..3).map(|c| (e[c] - o[c]).abs()).fold(0.0, f32::max))
+            .fold(0.0, f32::max);
+        assert!(worst < 1e-5, "{name}: composite differs by {worst}");
+    }
+    assert_eq!(octants.len(), geometry.vertices);
+}
+
+#[test]
+fn a_constant_visibility_gives_the_hemisphere_sky_in_closed_form() {
+    // Every vertex sees c of each octant: with an open sky ao = 1 − c for every normal; with only
+    // the upper four octants lit (a cloudy day) the cosine lobe's share of the upper hemisphere,
+    // (1 + n_z)/2 in world space, so ao = 1 − c (1 + n_z)/2 — through the view-to-world
+    // rotation, the octahedral table and the sky weights.
+    let gpu = gpu();
+    let (positions, offsets) = polylines(30, 1.1);
+    let c = 153.0 / 255.0;
+    let octants = vec![[c; 8]; positions.len()];
+    let mut geometry = LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap();
+    let attributes = VertexAttributes { octants: Some(&octants) };
+    geometry.set_attributes(&gpu.device, &gpu.queue, &positions, &offsets, &attributes).unwrap();
+    let (camera, _) = cameras_for_polylines();
+    for sky in [Sky::Uniform, Sky::Cloudy] {
+        let settings = ChainSettings {
+            method: AoMethod::None,
+            volume: Some(VolumeAoSettings { sky: sky.weights(), ..Default::default() }),
+            ..ChainSettings::default()
+        };
+        let f = render_volume(&gpu, &geometry, &camera, settings, (160, 120));
+        let to_world = view_to_world(&f.view);
+        let (mut worst, mut pixels) = (0.0f32, 0);
+        for (i, nd) in f.nd.data.iter().enumerate() {
+            if !is_geometry(*nd) {
+                assert_eq!(f.volume_ao.data[i], 0.0);
+                continue;
+            }
+            assert_eq!(reference::unpack_octants(f.octants.data[i]), [c; 8]);
+            let n = (to_world * Vec3::new(nd[0], nd[1], nd[2])).normalize();
+            let expected = match sky {
+                Sky::Cloudy => 1.0 - c * (1.0 + n.z) / 2.0,
+                _ => 1.0 - c,
+            };
+            worst = worst.max((f.volume_ao.data[i] - expected).abs());
+            pixels += 1;
+        }
+        println!("{sky:?}: {pixels} pixels, worst |Δ| {worst:.2e} against the closed form");
+        // The table's bilinear error (below 1 % of π per octant) bounds the cloudy case.
+        assert!(pixels > 500 && worst < if sky == Sky::Uniform { 1e-5 } else { 0.015 }, "{sky:?}: {worst}");
+    }
+}
+
+#[test]
+fn attributes_split_with_the_strip_and_bad_attributes_are_errors() {
+    let gpu = gpu();
+    let (whole, _) = swept_polylines(&gpu, GeometryOptions::default());
+    // 40 polylines of 60 points: ~4 900 strip vertices in chunks of 400.
+    let (chunked, _) = swept_polylines(&gpu, GeometryOptions { chunk_bytes: 400 * 20, ..Default::default() });
+    assert!(chunked.chunk_count() > 10 && whole.chunk_count() == 1);
+    let (camera, _) = cameras_for_polylines();
+    let settings =
+        ChainSettings { method: AoMethod::None, volume: Some(Default::default()), ..ChainSettings::default() };
+    let a = render_volume(&gpu, &whole, &camera, settings.clone(), (120, 90));
+    let b = render_volume(&gpu, &chunked, &camera, settings.clone(), (120, 90));
+    assert_eq!(a.octants, b.octants);
+    assert_eq!(a.volume_ao, b.volume_ao);
+    // Geometry without attributes renders fully visible.
+    let (positions, offsets) = polylines(40, 0.3);
+    let mut plain = LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap();
+    let c = render_volume(&gpu, &plain, &camera, settings, (120, 90));
+    assert!(c.nd.data.iter().zip(&c.volume_ao.data).all(|(nd, &ao)| !is_geometry(*nd) || ao.abs() < 1e-6));
+    // Wrong lengths are errors naming what differs.
+    let short = vec![[1.0; 8]; positions.len() - 1];
+    let error = plain
+        .set_attributes(&gpu.device, &gpu.queue, &positions, &offsets, &VertexAttributes { octants: Some(&short) })
+        .unwrap_err()
+        .to_string();
+    assert!(error.contains("octant visibilities"), "{error}");
+    let error = plain
+        .set_attributes(&gpu.device, &gpu.queue, &positions[..60], &offsets[..2], &VertexAttributes::default())
+        .unwrap_err()
+        .to_string();
+    assert!(error.contains("the geometry has"), "{error}");
+}

@@ -7,6 +7,10 @@
 //!   out = color · (1 − clamp(strength · ao, 0, 1)) + specular
 //! ```
 //!
+//! With object-space AO ([`crate::passes::volume_ao`]) `ao` is that occlusion alone, or the
+//! screen-space method's and it combined: brightness multiplied, 1 − (1 − a)(1 − b), or the
+//! darker of the two, max(a, b) ([`crate::reference::combine_ao`]).
+//!
 //! Debug views show the AO alone, the normals, the depth, the zoom map or one pyramid level.
 //! The CPU reference is [`crate::reference::composite`].
 
@@ -25,7 +29,29 @@ pub struct CompositeUniform {
     pub debug_view: u32,
     pub debug_level: u32,
     pub zoom_max: f32,
-    pub _pad: [u32; 2],
+    /// 0: the screen-space AO, 1: object-space AO alone, 2: both, brightness multiplied,
+    /// 3: both, the darker.
+    pub combine: u32,
+    pub _pad: u32,
+}
+
+/// Which occlusion the composite shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shown {
+    Screen,
+    Volume,
+    Both(crate::VoCombine),
+}
+
+impl Shown {
+    fn code(self) -> u32 {
+        match self {
+            Shown::Screen => 0,
+            Shown::Volume => 1,
+            Shown::Both(crate::VoCombine::Product) => 2,
+            Shown::Both(crate::VoCombine::Min) => 3,
+        }
+    }
 }
 
 pub struct Composite {
@@ -38,7 +64,7 @@ pub struct Composite {
 impl Composite {
     /// A composite writing to targets of `format` (sRGB formats encode on write).
     pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat) -> Composite {
-        let mut slots = vec![Slot::Uniform, Slot::Texture, Slot::Texture, Slot::Texture, Slot::Texture];
+        let mut slots = vec![Slot::Uniform, Slot::Texture, Slot::Texture, Slot::Texture, Slot::Texture, Slot::Texture];
         slots.extend([Slot::Texture; crate::MAX_LEVELS as usize]);
         let layout = binding::layout(device, "lineao::Composite::layout", wgpu::ShaderStages::FRAGMENT, &slots);
         let module = crate::shader::module(device, "composite.wgsl");
@@ -71,14 +97,17 @@ impl Composite {
         }
     }
 
-    /// Shows `ao` (`targets.ao`, or `targets.ao_blurred` after the bilateral blur).
+    /// Shows `ao` (`targets.ao`, or `targets.ao_blurred` after the bilateral blur) and, where
+    /// the targets have it, `targets.volume_ao`.
     pub fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets, ao: &Target) {
+        let volume = targets.volume_ao.as_ref().unwrap_or(ao);
         let mut resources = vec![
             self.uniform.as_entire_binding(),
             wgpu::BindingResource::TextureView(&targets.color.view),
             wgpu::BindingResource::TextureView(&targets.specular.view),
             wgpu::BindingResource::TextureView(&ao.view),
             wgpu::BindingResource::TextureView(&targets.zoom.view),
+            wgpu::BindingResource::TextureView(&volume.view),
         ];
         resources.extend(targets.level_views().into_iter().map(wgpu::BindingResource::TextureView));
         self.group = Some(binding::group(device, "lineao::Composite::group", &self.layout, &resources));
@@ -91,6 +120,7 @@ impl Composite {
         strength: f32,
         debug_view: DebugView,
         zoom_max: f32,
+        shown: Shown,
     ) {
         let (debug_view, debug_level) = debug_view.code();
         let uniform = CompositeUniform {
@@ -100,7 +130,8 @@ impl Composite {
             debug_view,
             debug_level,
             zoom_max: zoom_max.max(1e-12),
-            _pad: [0; 2],
+            combine: shown.code(),
+            _pad: 0,
         };
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
     }

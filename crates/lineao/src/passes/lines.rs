@@ -115,16 +115,20 @@ impl Default for GeometryOptions {
     }
 }
 
-/// One vertex buffer of the strip and, on request, the segments of native lines within it.
+/// One vertex buffer of the strip and, on request, the segments of native lines within it and
+/// the vertices' attributes.
 struct Chunk {
     vertices: wgpu::Buffer,
     count: u32,
     segments: Option<(wgpu::Buffer, u32)>,
+    attributes: Option<wgpu::Buffer>,
 }
 
 /// Polylines uploaded to the GPU.
 pub struct LineGeometry {
     chunks: Vec<Chunk>,
+    /// Strip vertices per chunk at most (even).
+    per_chunk: usize,
     /// Bounding sphere of the finite points; `None` when there are none.
     pub bounds: Option<Bounds>,
     pub vertices: usize,
@@ -132,30 +136,87 @@ pub struct LineGeometry {
 }
 
 /// The strip vertices of polylines `positions[offsets[i]..offsets[i + 1]]` (see the module
-/// documentation), streamed to `emit`; memory beyond the longest polyline is never held.
-fn strip_vertices(positions: &[[f32; 3]], offsets: &[u64], mut emit: impl FnMut(LinePoint)) {
+/// documentation), streamed to `emit` with the index of the point each one comes from; memory
+/// beyond the longest polyline is never held.
+fn strip_vertices(positions: &[[f32; 3]], offsets: &[u64], mut emit: impl FnMut(LinePoint, usize)) {
     let mut points = Vec::new();
-    let mut previous: Option<LinePoint> = None;
+    let mut previous: Option<(LinePoint, usize)> = None;
     for range in offsets.windows(2) {
+        let first = range[0] as usize;
         points.clear();
-        polyline_points(&positions[range[0] as usize..range[1] as usize], &mut points);
+        polyline_points(&positions[first..range[1] as usize], &mut points);
         // Runs of points joined by segments (w = 32767 on all but a run's last point).
-        for run in points.split_inclusive(|p| p.tangent[3] != SEGMENT_STARTS) {
-            if run.len() < 2 {
-                continue;
+        let mut start = 0;
+        while start < points.len() {
+            let end = points[start..]
+                .iter()
+                .position(|p| p.tangent[3] != SEGMENT_STARTS)
+                .map_or(points.len(), |k| start + k + 1);
+            let run = &points[start..end];
+            if run.len() >= 2 {
+                if let Some((last, index)) = previous {
+                    emit(last, index);
+                    emit(run[0].with_side(NO_SEGMENT), first + start);
+                }
+                for (k, p) in run.iter().enumerate() {
+                    emit(p.with_side(if k + 1 < run.len() { SEGMENT_STARTS } else { NO_SEGMENT }), first + start + k);
+                    emit(p.with_side(-NO_SEGMENT), first + start + k);
+                }
+                previous = Some((run[run.len() - 1].with_side(-NO_SEGMENT), first + end - 1));
             }
-            if let Some(last) = previous {
-                emit(last);
-                emit(run[0].with_side(NO_SEGMENT));
-            }
-            for (k, p) in run.iter().enumerate() {
-                emit(p.with_side(if k + 1 < run.len() { SEGMENT_STARTS } else { NO_SEGMENT }));
-                emit(p.with_side(-NO_SEGMENT));
-            }
-            previous = run.last().map(|p| p.with_side(-NO_SEGMENT));
+            start = end;
         }
     }
 }
+
+/// Splits a stream of strip vertices into chunks of at most `per_chunk` (even) that overlap by
+/// two vertices, so every triangle lies in one chunk; the vertex and attribute streams of one
+/// geometry split identically.
+struct Chunker<T> {
+    per_chunk: usize,
+    current: Vec<T>,
+}
+
+impl<T: Copy> Chunker<T> {
+    fn new(per_chunk: usize, expected: usize) -> Chunker<T> {
+        Chunker { per_chunk, current: Vec::with_capacity(per_chunk.min(expected)) }
+    }
+
+    fn push(&mut self, value: T, flush: &mut impl FnMut(&[T])) {
+        if self.current.len() == self.per_chunk {
+            flush(&self.current);
+            self.current.drain(..self.per_chunk - 2);
+        }
+        self.current.push(value);
+    }
+
+    /// The last chunk, if it holds a triangle.
+    fn finish(self, flush: &mut impl FnMut(&[T])) {
+        if self.current.len() >= 3 {
+            flush(&self.current);
+        }
+    }
+}
+
+/// Per-vertex data uploaded beside the positions ([`LineGeometry::set_attributes`]).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct VertexAttributes<'a> {
+    /// Visibility of each octant of directions, in [0, 1], indexed as
+    /// [`crate::volume::octant_signs`]: object-space AO ([`crate::volume`]), which
+    /// [`crate::passes::volume_ao`] turns into occlusion with the pixel's normal. `None`: fully
+    /// visible.
+    pub octants: Option<&'a [[f32; 8]]>,
+}
+
+/// One strip vertex's attributes. Keep in sync with `Attributes` in `shaders/lines.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct LineAttributes {
+    /// The eight octant visibilities as unorm8.
+    pub octants: [u8; 8],
+}
+
+const ATTRIBUTE_SIZE: u64 = std::mem::size_of::<LineAttributes>() as u64;
 
 impl LineGeometry {
     /// Uploads polylines `positions[offsets[i]..offsets[i + 1]]` (world units). Waits for the
@@ -180,12 +241,12 @@ impl LineGeometry {
         validate_offsets(offsets, positions.len())?;
         let limit = options.chunk_bytes.min(device.limits().max_buffer_size);
         // Even, so that every chunk starts at an even strip position: a triangle then keeps the
-        // vertex order (and so the exact interpolation) it has in one long strip.
+        // vertex order (and so the exact interpolation) it has in one long strip. The attribute
+        // stream splits at the same vertices, so its buffers must fit the same count.
         let per_chunk = (limit / POINT_SIZE).max(4) as usize & !1;
         let mut chunks = Vec::new();
-        let mut current: Vec<LinePoint> = Vec::with_capacity(per_chunk.min(2 * positions.len() + 2 * offsets.len()));
         let mut failed = None;
-        let mut upload = |vertices: &[LinePoint], chunks: &mut Vec<Chunk>| {
+        let mut upload = |vertices: &[LinePoint]| {
             let chunk = Chunk {
                 vertices: upload_buffer(
                     device,
@@ -196,31 +257,87 @@ impl LineGeometry {
                 ),
                 count: vertices.len() as u32,
                 segments: options.native_lines.then(|| native_segments(device, queue, vertices)),
+                attributes: None,
             };
             if let Err(e) = device.poll(wgpu::PollType::wait_indefinitely()) {
                 failed.get_or_insert(Error::Gpu(e.to_string()));
             }
             chunks.push(chunk);
         };
-        strip_vertices(positions, offsets, |v| {
-            if current.len() == per_chunk {
-                upload(&current, &mut chunks);
-                current.drain(..per_chunk - 2);
-            }
-            current.push(v);
-        });
-        if current.len() >= 3 {
-            upload(&current, &mut chunks);
-        }
+        let mut chunker = Chunker::new(per_chunk, 2 * positions.len() + 2 * offsets.len());
+        strip_vertices(positions, offsets, |v, _| chunker.push(v, &mut upload));
+        chunker.finish(&mut upload);
         if let Some(error) = failed {
             return Err(error);
         }
         Ok(LineGeometry {
             chunks,
+            per_chunk,
             bounds: Bounds::of_points(positions),
             vertices: positions.len(),
             streamlines: offsets.len() - 1,
         })
+    }
+
+    /// Uploads per-vertex `attributes` for the polylines this geometry was made from (the same
+    /// `positions` and `offsets`), replacing earlier ones: object-space AO computed after the
+    /// upload, or recomputed with other settings, needs no new strip.
+    pub fn set_attributes(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        positions: &[[f32; 3]],
+        offsets: &[u64],
+        attributes: &VertexAttributes,
+    ) -> Result<(), Error> {
+        validate_offsets(offsets, positions.len())?;
+        if positions.len() != self.vertices || offsets.len() != self.streamlines + 1 {
+            return Err(Error::InvalidGeometry(format!(
+                "attributes for {} vertices in {} streamlines, but the geometry has {} in {}",
+                positions.len(),
+                offsets.len() - 1,
+                self.vertices,
+                self.streamlines
+            )));
+        }
+        if let Some(octants) = attributes.octants
+            && octants.len() != positions.len()
+        {
+            return Err(Error::InvalidGeometry(format!(
+                "{} octant visibilities for {} vertices",
+                octants.len(),
+                positions.len()
+            )));
+        }
+        let unorm = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
+        let of = |i: usize| LineAttributes { octants: attributes.octants.map_or([255; 8], |o| o[i].map(unorm)) };
+        let mut buffers = Vec::with_capacity(self.chunks.len());
+        let mut upload = |values: &[LineAttributes]| {
+            buffers.push(upload_buffer(
+                device,
+                queue,
+                "lineao::LineGeometry::attributes",
+                wgpu::BufferUsages::VERTEX,
+                values,
+            ));
+        };
+        // Buffers of the same vertex count as the strip's, at most the strip's bytes.
+        let mut chunker = Chunker::new(self.per_chunk, 2 * positions.len() + 2 * offsets.len());
+        strip_vertices(positions, offsets, |_, i| chunker.push(of(i), &mut upload));
+        chunker.finish(&mut upload);
+        if buffers.len() != self.chunks.len() {
+            return Err(Error::InvalidGeometry("the polylines differ from the geometry's".into()));
+        }
+        for (chunk, buffer) in self.chunks.iter_mut().zip(buffers) {
+            chunk.attributes = Some(buffer);
+        }
+        device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| Error::Gpu(e.to_string()))?;
+        Ok(())
+    }
+
+    /// Whether [`LineGeometry::set_attributes`] gave every chunk attributes.
+    pub fn has_attributes(&self) -> bool {
+        self.chunks.iter().all(|c| c.attributes.is_some())
     }
 
     /// Number of vertex buffers the strip was split into.
@@ -297,10 +414,22 @@ pub enum LineStyle {
 pub struct LineRenderer {
     style: LineStyle,
     pipeline: wgpu::RenderPipeline,
+    /// Writing `octants` too: from the geometry's attributes, and fully visible for geometry
+    /// without them.
+    octants: Option<OctantPipelines>,
     uniform: wgpu::Buffer,
     lighting: wgpu::Buffer,
     group: wgpu::BindGroup,
 }
+
+struct OctantPipelines {
+    attributes: wgpu::RenderPipeline,
+    visible: wgpu::RenderPipeline,
+}
+
+/// The G-buffer attachments the line pipelines write, in `fs_main`'s order.
+const GBUFFER_FORMATS: [wgpu::TextureFormat; 4] =
+    [targets::COLOR_FORMAT, targets::ND_FORMAT, targets::ZOOM_FORMAT, targets::SPECULAR_FORMAT];
 
 impl LineRenderer {
     /// The renderer of fixed-width lines.
@@ -309,6 +438,12 @@ impl LineRenderer {
     }
 
     pub fn with_style(device: &wgpu::Device, style: LineStyle) -> LineRenderer {
+        Self::with_outputs(device, style, false)
+    }
+
+    /// With `octants`, targets that have an `octants` texture also get the geometry's
+    /// per-vertex octant visibilities, interpolated ([`crate::passes::volume_ao`]); quads only.
+    pub fn with_outputs(device: &wgpu::Device, style: LineStyle, octants: bool) -> LineRenderer {
         let layout = binding::layout(
             device,
             "lineao::LineRenderer::layout",
@@ -324,55 +459,74 @@ impl LineRenderer {
             &[uniform.as_entire_binding(), lighting.as_entire_binding()],
         );
         let module = crate::shader::module(device, "lines.wgsl");
-        let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Snorm16x4];
-        let buffers = [Some(wgpu::VertexBufferLayout {
+        let pipeline_layout = binding::pipeline_layout(device, "lineao::LineRenderer::pipeline_layout", &layout);
+        let point_attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Snorm16x4];
+        let octant_attributes = wgpu::vertex_attr_array![2 => Unorm8x4, 3 => Unorm8x4];
+        let points = wgpu::VertexBufferLayout {
             array_stride: POINT_SIZE,
             step_mode: wgpu::VertexStepMode::Vertex,
-            attributes: &attributes,
-        })];
-        let target = |format| Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("lineao::LineRenderer::pipeline"),
-            layout: Some(&binding::pipeline_layout(device, "lineao::LineRenderer::pipeline_layout", &layout)),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some(match style {
-                    LineStyle::Quads => "vs_main",
-                    LineStyle::Native1px => "vs_native",
-                }),
-                compilation_options: Default::default(),
-                buffers: &buffers,
-            },
-            primitive: wgpu::PrimitiveState {
-                topology: match style {
-                    LineStyle::Quads => wgpu::PrimitiveTopology::TriangleStrip,
-                    LineStyle::Native1px => wgpu::PrimitiveTopology::LineList,
+            attributes: &point_attributes,
+        };
+        let with_attributes = [
+            Some(points.clone()),
+            Some(wgpu::VertexBufferLayout {
+                array_stride: ATTRIBUTE_SIZE,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &octant_attributes,
+            }),
+        ];
+        let topology = match style {
+            LineStyle::Quads => wgpu::PrimitiveTopology::TriangleStrip,
+            LineStyle::Native1px => wgpu::PrimitiveTopology::LineList,
+        };
+        let create = |label: &str, vertex: &str, fragment: &str, buffers: &[Option<wgpu::VertexBufferLayout>]| {
+            let mut targets: Vec<_> = GBUFFER_FORMATS.iter().map(|&format| color_target(format)).collect();
+            if fragment == "fs_octants" {
+                targets.push(color_target(targets::OCTANTS_FORMAT));
+            }
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some(label),
+                layout: Some(&pipeline_layout),
+                vertex: wgpu::VertexState {
+                    module: &module,
+                    entry_point: Some(vertex),
+                    compilation_options: Default::default(),
+                    buffers,
                 },
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: targets::DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Less),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[
-                    target(targets::COLOR_FORMAT),
-                    target(targets::ND_FORMAT),
-                    target(targets::ZOOM_FORMAT),
-                    target(targets::SPECULAR_FORMAT),
-                ],
-            }),
-            multiview_mask: None,
-            cache: None,
+                primitive: wgpu::PrimitiveState { topology, ..Default::default() },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: targets::DEPTH_FORMAT,
+                    depth_write_enabled: Some(true),
+                    depth_compare: Some(wgpu::CompareFunction::Less),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &module,
+                    entry_point: Some(fragment),
+                    compilation_options: Default::default(),
+                    targets: &targets,
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let vertex = match style {
+            LineStyle::Quads => "vs_main",
+            LineStyle::Native1px => "vs_native",
+        };
+        let pipeline = create("lineao::LineRenderer::pipeline", vertex, "fs_main", &[Some(points.clone())]);
+        let octants = (octants && style == LineStyle::Quads).then(|| OctantPipelines {
+            attributes: create("lineao::LineRenderer::octants", "vs_octants", "fs_octants", &with_attributes),
+            visible: create("lineao::LineRenderer::visible", "vs_visible", "fs_octants", &[Some(points.clone())]),
         });
-        LineRenderer { style, pipeline, uniform, lighting, group }
+        LineRenderer { style, pipeline, octants, uniform, lighting, group }
+    }
+
+    /// Whether this renderer writes the `octants` target.
+    pub fn writes_octants(&self) -> bool {
+        self.octants.is_some()
     }
 
     pub fn prepare(
@@ -423,14 +577,20 @@ impl LineRenderer {
         let attachment =
             |view, ops| Some(wgpu::RenderPassColorAttachment { view, depth_slice: None, resolve_target: None, ops });
         let [r, g, b] = background.map(f64::from);
+        // The octants too when both the pipelines and the target exist.
+        let octants = self.octants.as_ref().zip(targets.octants.as_ref());
+        let mut color_attachments = vec![
+            attachment(&targets.color.view, clear(r, g, b, 1.0)),
+            attachment(&targets.nd[0].view, clear(0.0, 0.0, 0.0, 1.0)),
+            attachment(&targets.zoom.view, clear(0.0, 0.0, 0.0, 0.0)),
+            attachment(&targets.specular.view, clear(0.0, 0.0, 0.0, 0.0)),
+        ];
+        if let Some((_, target)) = octants {
+            color_attachments.push(attachment(&target.view, clear(0.0, 0.0, 0.0, 0.0)));
+        }
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("lineao::LineRenderer"),
-            color_attachments: &[
-                attachment(&targets.color.view, clear(r, g, b, 1.0)),
-                attachment(&targets.nd[0].view, clear(0.0, 0.0, 0.0, 1.0)),
-                attachment(&targets.zoom.view, clear(0.0, 0.0, 0.0, 0.0)),
-                attachment(&targets.specular.view, clear(0.0, 0.0, 0.0, 0.0)),
-            ],
+            color_attachments: &color_attachments,
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                 view: &targets.depth.view,
                 depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
@@ -440,10 +600,19 @@ impl LineRenderer {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(&self.pipeline);
+        let pipeline = match octants {
+            Some((pipelines, _)) if geometry.has_attributes() => &pipelines.attributes,
+            Some((pipelines, _)) => &pipelines.visible,
+            None => &self.pipeline,
+        };
+        let attributes = octants.is_some() && geometry.has_attributes();
+        pass.set_pipeline(pipeline);
         pass.set_bind_group(0, &self.group, &[]);
         for chunk in &geometry.chunks {
             pass.set_vertex_buffer(0, chunk.vertices.slice(..));
+            if let (true, Some(buffer)) = (attributes, &chunk.attributes) {
+                pass.set_vertex_buffer(1, buffer.slice(..));
+            }
             match (self.style, &chunk.segments) {
                 (LineStyle::Quads, _) => pass.draw(0..chunk.count, 0..1),
                 (LineStyle::Native1px, Some((indices, count))) => {
@@ -454,4 +623,8 @@ impl LineRenderer {
             }
         }
     }
+}
+
+fn color_target(format: wgpu::TextureFormat) -> Option<wgpu::ColorTargetState> {
+    Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })
 }

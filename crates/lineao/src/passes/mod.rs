@@ -12,6 +12,7 @@ pub mod ssao;
 pub mod ssao_blur;
 pub mod vo_area;
 pub mod vo_line;
+pub mod volume_ao;
 
 /// Workgroup size of the compute passes (8 × 8, as in the WGSL files).
 pub(crate) const WORKGROUP: u32 = 8;

@@ -10,6 +10,7 @@ mod line_ao;
 mod ssao;
 mod vo_area;
 mod vo_line;
+mod volume_ao;
 
 pub use bilateral::bilateral;
 pub use line_ao::{
@@ -22,6 +23,7 @@ pub use vo_line::{
     VoParams, vo_chord, vo_chord_half, vo_combine, vo_line, vo_line_pixel, vo_line_sample, vo_plane, vo_reflect,
     vo_sample, vo_visible,
 };
+pub use volume_ao::{unpack_octants, volume_ao};
 
 /// A row-major image, `data[y * width + x]`.
 #[derive(Clone, Debug, PartialEq)]
@@ -109,6 +111,16 @@ pub fn level_texel(pixel: [u32; 2], offset: [f32; 2], scale: [f32; 2], size: [us
         (uv.floor() as i64).clamp(0, size[k] as i64 - 1)
     };
     [t(0), t(1)]
+}
+
+/// How the composite merges the screen-space method's occlusion with object-space AO
+/// (`shaders/composite.wgsl`): `None` shows the screen-space one alone.
+pub fn combine_ao(screen: f32, volume: Option<(f32, crate::VoCombine)>) -> f32 {
+    match volume {
+        None => screen,
+        Some((v, crate::VoCombine::Product)) => 1.0 - (1.0 - screen) * (1.0 - v),
+        Some((v, crate::VoCombine::Min)) => screen.max(v),
+    }
 }
 
 /// The composite (`shaders/composite.wgsl`, final view) over the visible window: linear RGB.

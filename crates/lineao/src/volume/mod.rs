@@ -177,6 +177,9 @@ pub enum Sky {
     /// A cloudy day (seed 000 Fig. 7): only the four octants above, "up" being +z (superior
     /// in RAS+ tractography coordinates).
     Cloudy,
+    /// A cloudy day with another "up": the octants whose diagonal points within 90° of it
+    /// (four for an axis).
+    Above([f32; 3]),
     /// Each octant's intensity in [0, 1], indexed as [`octant_signs`].
     Custom([f32; 8]),
 }
@@ -185,7 +188,10 @@ impl Sky {
     pub fn weights(&self) -> [f32; 8] {
         match self {
             Sky::Uniform => [1.0; 8],
-            Sky::Cloudy => std::array::from_fn(|o| if octant_signs(o).z > 0.0 { 1.0 } else { 0.0 }),
+            Sky::Cloudy => Sky::Above([0.0, 0.0, 1.0]).weights(),
+            Sky::Above(up) => {
+                std::array::from_fn(|o| if octant_signs(o).dot(Vec3::from_array(*up)) > 0.0 { 1.0 } else { 0.0 })
+            }
             Sky::Custom(w) => *w,
         }
     }
@@ -198,6 +204,91 @@ pub fn probe(volume: &density::DensityVolume, p: Vec3, t: Vec3, o: usize) -> Vec
     let across = diagonal - diagonal.dot(t) * t;
     let direction = if across.length_squared() > 1e-6 { across.normalize() } else { t.any_orthonormal_vector() };
     p + direction * (volume.radius + 0.5 * volume.grid.voxel)
+}
+
+/// The object-space method that computes the octant visibilities.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VolumeMethod {
+    /// Fast occlusion sweeping ([`sweep`]).
+    Sweep,
+    /// Variance occlusion maps ([`variance`]).
+    VarianceVolume,
+}
+
+impl VolumeMethod {
+    pub const ALL: [VolumeMethod; 2] = [VolumeMethod::Sweep, VolumeMethod::VarianceVolume];
+
+    /// The CLI and `params.json` name: `sweep` or `variance-volume`.
+    pub fn name(self) -> &'static str {
+        match self {
+            VolumeMethod::Sweep => "sweep",
+            VolumeMethod::VarianceVolume => "variance-volume",
+        }
+    }
+
+    pub fn from_name(name: &str) -> Option<VolumeMethod> {
+        VolumeMethod::ALL.into_iter().find(|m| m.name() == name)
+    }
+}
+
+/// Everything [`vertex_visibility`] needs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct VolumeAoOptions {
+    pub method: VolumeMethod,
+    pub density: density::DensityOptions,
+    pub sweep: sweep::SweepSettings,
+    pub variance: variance::VarianceSettings,
+    /// `None`: the eight octants stay apart, for the geometry term with each pixel's normal
+    /// (the paper's way); `Some`: one view-independent value per vertex.
+    pub form: Option<ScalarForm>,
+    pub sky: Sky,
+}
+
+impl Default for VolumeAoOptions {
+    fn default() -> Self {
+        VolumeAoOptions {
+            method: VolumeMethod::Sweep,
+            density: density::DensityOptions::default(),
+            sweep: sweep::SweepSettings::default(),
+            variance: variance::VarianceSettings::default(),
+            form: None,
+            sky: Sky::Uniform,
+        }
+    }
+}
+
+/// Per-vertex octant visibilities for [`crate::passes::lines::VertexAttributes`], and the sky
+/// the chain then applies per pixel ([`crate::VolumeAoSettings::sky`]).
+#[derive(Clone, Debug, PartialEq)]
+pub struct VertexVisibility {
+    pub octants: Vec<OctantVisibility>,
+    /// The options' sky for the per-pixel form; all ones for a view-independent value, which
+    /// holds the sky already (and is stored in all eight octants).
+    pub sky: [f32; 8],
+}
+
+/// Object-space AO of polylines (`positions` split by `offsets`) in one call: voxelized, swept
+/// or mapped, evaluated per vertex.
+pub fn vertex_visibility(
+    positions: &[[f32; 3]],
+    offsets: &[u64],
+    options: &VolumeAoOptions,
+) -> Result<VertexVisibility, crate::Error> {
+    let volume = density::voxelize(positions, offsets, &options.density)?;
+    let tangents = vertex_tangents(positions, offsets);
+    let octants =
+        match options.method {
+            VolumeMethod::Sweep => sweep::octant_visibility(&volume, positions, &tangents, &options.sweep)?,
+            VolumeMethod::VarianceVolume => variance::VarianceMaps::new(&volume, &options.variance)?
+                .octant_visibility(&volume, positions, &tangents, options.variance.threads)?,
+        };
+    Ok(match options.form {
+        None => VertexVisibility { octants, sky: options.sky.weights() },
+        Some(form) => VertexVisibility {
+            octants: scalar_visibility(&octants, &tangents, form, &options.sky).into_iter().map(|v| [v; 8]).collect(),
+            sky: [1.0; 8],
+        },
+    })
 }
 
 /// One tangent per position, or a clear error.

@@ -25,7 +25,7 @@
 //!
 //! [`octant_visibility`] runs the sweeps on worker threads (one octant per thread at a time, so
 //! each needs one field of f32) and samples every V_o trilinearly at the vertices' probes
-//! ([`probe`](super::probe)).
+//! ([`probe`]).
 
 use glam::Vec3;
 

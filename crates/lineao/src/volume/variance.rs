@@ -2,7 +2,7 @@
 //!
 //! Occlusion of a point is the fraction of a spherical region above it that lies inside the
 //! surface. Instead of testing every voxel of the region, each voxel of a pyramid level carries
-//! the first two moments M₁ = E[x], M₂ = E[x²] of the occupancy x over a Gaussian region around
+//! the first two moments M₁ = E\[x\], M₂ = E\[x²\] of the occupancy x over a Gaussian region around
 //! it: the moments of the density volume, blurred by a separable Gaussian and halved in
 //! resolution, level after level (§4.1: start at half resolution; the region's width doubles
 //! per level). From μ = M₁ and σ² = M₂ − M₁², Chebyshev's one-sided inequality bounds the
