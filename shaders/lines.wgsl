@@ -5,34 +5,11 @@
 // a line width sideways, perpendicular to the screen direction of its *vertex* tangent, so
 // consecutive segments share their join corners exactly: joins without gaps or overlaps.
 // `lineao::passes::lines` builds the strip.
-#import shared/lighting.wgsl
-
-// Keep in sync with `lineao::passes::lines::LineUniform`.
-struct LineUniform {
-    view: mat4x4<f32>,
-    proj: mat4x4<f32>,
-    constant_color: vec4<f32>,
-    // Guard-banded viewport size in pixels.
-    viewport: vec2<f32>,
-    near: f32,
-    far: f32,
-    f_px: f32,
-    zoom_unit: f32,
-    line_width_px: f32,
-    orthographic: u32,
-    // 0: tangent direction |T| (world axes as RGB), 1: constant color.
-    color_mode: u32,
-    _pad0: u32,
-    _pad1: u32,
-    _pad2: u32,
-}
-
-@group(0) @binding(0) var<uniform> frame: LineUniform;
-@group(0) @binding(1) var<uniform> lighting: Lighting;
+#import shared/geometry.wgsl
 
 struct StripVertex {
     @location(0) p: vec3<f32>,
-    // xyz: unit world-space tangent; w: side, > 0 left, < 0 right.
+    // xyz: unit world-space tangent; w: side (> 0 left, < 0 right) and flags in its magnitude.
     @location(1) t: vec4<f32>,
 }
 
@@ -66,27 +43,26 @@ fn screen_direction(clip: vec4<f32>, dclip: vec4<f32>) -> vec2<f32> {
     return (dclip.xy * clip.w - clip.xy * dclip.w) * frame.viewport;
 }
 
+// Clip position `clip` of a point with view-space tangent `view_tangent`, pushed `offset_px`
+// pixels to its left (negative: right), perpendicular to the curve on screen.
+fn push_sideways(clip: vec4<f32>, view_tangent: vec3<f32>, offset_px: f32) -> vec4<f32> {
+    let dir = screen_direction(clip, frame.proj * vec4<f32>(view_tangent, 0.0));
+    // A tangent along the view ray has no screen direction: any sideways offset will do.
+    let sideways = select(vec2<f32>(0.0, 1.0), normalize(vec2<f32>(-dir.y, dir.x)), dot(dir, dir) >= 1e-12);
+    // Pixels are 2/viewport in NDC.
+    let offset_ndc = sideways * 2.0 * offset_px / frame.viewport;
+    return vec4<f32>(clip.xy + offset_ndc * clip.w, clip.zw);
+}
+
 // Point `p` with tangent `t_world`, pushed `side` half line widths to its left (−1 right, 0 on it).
 fn line_vertex(p: vec3<f32>, t_world: vec3<f32>, side: f32) -> VsOut {
     var out: VsOut;
     let view_pos = frame.view * vec4<f32>(p, 1.0);
     let view_tangent = (frame.view * vec4<f32>(t_world, 0.0)).xyz;
-    let clip = frame.proj * view_pos;
-
-    let dir = screen_direction(clip, frame.proj * vec4<f32>(view_tangent, 0.0));
-    // A tangent along the view ray has no screen direction: any sideways offset will do.
-    let sideways = select(vec2<f32>(0.0, 1.0), normalize(vec2<f32>(-dir.y, dir.x)), dot(dir, dir) >= 1e-12);
-    // Half the width in pixels is w/2 * 2/viewport in NDC.
-    let offset_ndc = sideways * side * frame.line_width_px / frame.viewport;
-
-    out.clip = vec4<f32>(clip.xy + offset_ndc * clip.w, clip.zw);
+    out.clip = push_sideways(frame.proj * view_pos, view_tangent, side * 0.5 * frame.line_width_px);
     out.view_pos = view_pos.xyz;
     out.view_tangent = view_tangent;
-    if (frame.color_mode == 0u) {
-        out.color = abs(t_world) / max(length(t_world), 1e-20);
-    } else {
-        out.color = frame.constant_color.rgb;
-    }
+    out.color = base_color(t_world);
     return out;
 }
 
@@ -106,60 +82,32 @@ fn vs_native(v: StripVertex) -> VsOut {
 // Fixed-width lines with the octant visibilities of the attribute stream.
 @vertex
 fn vs_octants(v: StripVertex, a: Attributes) -> VsOutOctants {
-    return with_octants(line_vertex(v.p, v.t.xyz, sign(v.t.w)), a.octants_lo, a.octants_hi);
+    let b = line_vertex(v.p, v.t.xyz, sign(v.t.w));
+    return VsOutOctants(b.clip, b.view_pos, b.view_tangent, b.color, a.octants_lo, a.octants_hi);
 }
 
 // Fixed-width lines of geometry without attributes, into a G-buffer with octants: all visible.
 @vertex
 fn vs_visible(v: StripVertex) -> VsOutOctants {
-    return with_octants(line_vertex(v.p, v.t.xyz, sign(v.t.w)), vec4<f32>(1.0), vec4<f32>(1.0));
-}
-
-fn with_octants(base: VsOut, lo: vec4<f32>, hi: vec4<f32>) -> VsOutOctants {
-    return VsOutOctants(base.clip, base.view_pos, base.view_tangent, base.color, lo, hi);
-}
-
-struct GBuffer {
-    @location(0) color: vec4<f32>,
-    @location(1) nd: vec4<f32>,
-    @location(2) zoom: f32,
-    @location(3) specular: f32,
-}
-
-struct GBufferOctants {
-    @location(0) color: vec4<f32>,
-    @location(1) nd: vec4<f32>,
-    @location(2) zoom: f32,
-    @location(3) specular: f32,
-    // Octants 0–3 and 4–7 as unorm8 each (`pack4x8unorm`: x in the low byte).
-    @location(4) octants: vec2<u32>,
+    let b = line_vertex(v.p, v.t.xyz, sign(v.t.w));
+    return VsOutOctants(b.clip, b.view_pos, b.view_tangent, b.color, vec4<f32>(1.0), vec4<f32>(1.0));
 }
 
 @fragment
 fn fs_main(in: VsOut) -> GBuffer {
-    return gbuffer(in.view_pos, in.view_tangent, in.color);
+    return line_gbuffer(in.view_pos, in.view_tangent, in.color);
 }
 
 @fragment
 fn fs_octants(in: VsOutOctants) -> GBufferOctants {
-    let g = gbuffer(in.view_pos, in.view_tangent, in.color);
-    let octants = vec2<u32>(pack4x8unorm(in.octants_lo), pack4x8unorm(in.octants_hi));
-    return GBufferOctants(g.color, g.nd, g.zoom, g.specular, octants);
+    return with_octants(line_gbuffer(in.view_pos, in.view_tangent, in.color), in.octants_lo, in.octants_hi);
 }
 
 // The G-buffer of a point of the line at `view_pos` with tangent `view_tangent`.
-fn gbuffer(view_pos: vec3<f32>, view_tangent: vec3<f32>, color: vec3<f32>) -> GBuffer {
+fn line_gbuffer(view_pos: vec3<f32>, view_tangent: vec3<f32>, color: vec3<f32>) -> GBuffer {
     let t = normalize(view_tangent);
-    // C: from the point toward the eye (orthographic: the eye is at infinity along +z).
-    let c = select(normalize(-view_pos), vec3<f32>(0.0, 0.0, 1.0), frame.orthographic != 0u);
-    // n = (T x C) x T (paper §3.2): perpendicular to T, in the plane of T and C, facing the eye.
-    var n = cross(cross(t, c), t);
-    n = select(c, normalize(n), dot(n, n) > 1e-12);
-    n = select(n, -n, dot(n, c) < 0.0);
-
-    let depth = -view_pos.z;
-    let d = clamp((depth - frame.near) / (frame.far - frame.near), 0.0, 1.0);
-    let zoom = select(frame.f_px * frame.zoom_unit / depth, frame.f_px * frame.zoom_unit, frame.orthographic != 0u);
+    let c = gbuffer_eye_direction(view_pos, is_orthographic());
+    let n = gbuffer_line_normal(t, c);
 
     // Illuminated lines (Zöckler et al. 1996, Mallo et al. 2005): the specular maximum over the
     // circle of normals of an infinitesimal cylinder, added on top of LineAO (paper §3.3).
@@ -174,8 +122,8 @@ fn gbuffer(view_pos: vec3<f32>, view_tangent: vec3<f32>, color: vec3<f32>) -> GB
 
     var out: GBuffer;
     out.color = vec4<f32>(color, 1.0);
-    out.nd = vec4<f32>(n, d);
-    out.zoom = zoom;
+    out.nd = vec4<f32>(n, gbuffer_depth(view_pos, frame.near, frame.far));
+    out.zoom = gbuffer_zoom(view_pos, frame.f_px, frame.zoom_unit, is_orthographic());
     out.specular = specular;
     return out;
 }

@@ -30,6 +30,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use lineao::camera::FrameView;
+use lineao::gbuffer::Load;
 use lineao::passes::bilateral::Bilateral;
 use lineao::passes::composite::Composite;
 use lineao::passes::line_ao::{Evaluation, LineAo};
@@ -169,8 +170,8 @@ impl Passes {
         span: Option<Span>,
     ) {
         match name {
-            "lines" => self.lines.encode(encoder, targets, geometry, background, span),
-            "lines-native-1px" => self.lines_native.encode(encoder, targets, geometry, background, span),
+            "lines" => self.lines.encode(encoder, targets, geometry, Load::Clear(background), span),
+            "lines-native-1px" => self.lines_native.encode(encoder, targets, geometry, Load::Clear(background), span),
             "nd-pyramid" => self.pyramid.encode(encoder, targets, span),
             "lineao" => self.line_ao.encode(encoder, targets, span),
             "lineao-tap-floor" => self.tap_floor.encode(encoder, targets, span),

@@ -241,7 +241,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 volumes.push((method, computed));
             }
             let (_, visibility) = volumes.iter().find(|(m, _)| *m == method).expect("computed above");
-            let octants = VertexAttributes { octants: Some(&visibility.octants) };
+            let octants = VertexAttributes { octants: Some(&visibility.octants), ..Default::default() };
             geometry.set_attributes(&gpu.device, &gpu.queue, &tracts.positions, &tracts.offsets, &octants)?;
             attributes = Some(method);
         }

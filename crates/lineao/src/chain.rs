@@ -30,6 +30,7 @@
 
 use crate::Error;
 use crate::camera::{self, Bounds, Camera, FrameView};
+use crate::gbuffer::Load;
 use crate::passes::bilateral::Bilateral;
 use crate::passes::composite::{Composite, Shown};
 use crate::passes::line_ao::LineAo;
@@ -332,7 +333,7 @@ impl AoChain {
         }
         let span = |name| self.timer.as_ref().and_then(|t| t.span(name));
         encoder.push_debug_group("lineao");
-        self.lines.encode(encoder, targets, geometry, self.settings.background, span("lines"));
+        self.lines.encode(encoder, targets, geometry, Load::Clear(self.settings.background), span("lines"));
         match self.settings.method {
             AoMethod::LineAo => {
                 if self.settings.levels() > 1 {

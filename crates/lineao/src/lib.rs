@@ -42,6 +42,7 @@
 pub mod binding;
 pub mod camera;
 pub mod chain;
+pub mod gbuffer;
 pub mod gpu;
 pub mod lighting;
 pub mod noise;

@@ -9,6 +9,8 @@ use std::borrow::Cow;
 /// Every WGSL file under `shaders/`, by path relative to that folder.
 pub const FILES: &[(&str, &str)] = &[
     ("shared/fullscreen.wgsl", include_str!("../shaders/shared/fullscreen.wgsl")),
+    ("shared/gbuffer.wgsl", include_str!("../shaders/shared/gbuffer.wgsl")),
+    ("shared/geometry.wgsl", include_str!("../shaders/shared/geometry.wgsl")),
     ("shared/lighting.wgsl", include_str!("../shaders/shared/lighting.wgsl")),
     ("shared/moments.wgsl", include_str!("../shaders/shared/moments.wgsl")),
     ("shared/nd.wgsl", include_str!("../shaders/shared/nd.wgsl")),
@@ -26,6 +28,12 @@ pub const FILES: &[(&str, &str)] = &[
     ("vo_line.wgsl", include_str!("../shaders/vo_line.wgsl")),
     ("volume_ao.wgsl", include_str!("../shaders/volume_ao.wgsl")),
 ];
+
+/// WGSL functions a host renderer can paste into (or concatenate with) its own shaders to write
+/// the ND map and zoom map of CONTRACT.md: `gbuffer_nd`, `gbuffer_zoom`, `gbuffer_depth`,
+/// `gbuffer_line_normal`, `gbuffer_eye_direction` (`shaders/shared/gbuffer.wgsl`; no bindings,
+/// no imports).
+pub const GBUFFER_WGSL: &str = include_str!("../shaders/shared/gbuffer.wgsl");
 
 /// The embedded source of `path` (relative to `shaders/`), without imports resolved.
 pub fn raw(path: &str) -> Option<&'static str> {

@@ -310,7 +310,7 @@ fn native_lines_are_one_pixel_and_need_their_segments() {
         let options = GeometryOptions { native_lines, ..Default::default() };
         let geometry = LineGeometry::with_options(d, q, &positions, &offsets, options).unwrap();
         let mut encoder = d.create_command_encoder(&Default::default());
-        renderer.encode(&mut encoder, &targets, &geometry, s.background, None);
+        renderer.encode(&mut encoder, &targets, &geometry, lineao::gbuffer::Load::Clear(s.background), None);
         q.submit([encoder.finish()]);
         let nd = lineao::verify::read_rgba(d, q, &targets.nd[0]).unwrap();
         (60..140).map(|x| (0..SIZE.1 as usize).filter(|&y| is_geometry(nd.get(x, y))).count()).collect::<Vec<_>>()

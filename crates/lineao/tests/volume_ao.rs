@@ -367,7 +367,7 @@ fn swept_polylines(gpu: &lineao::Gpu, options: GeometryOptions) -> (LineGeometry
     let tangents = vertex_tangents(&positions, &offsets);
     let octants = sweep::octant_visibility(&volume, &positions, &tangents, &SweepSettings::default()).unwrap();
     let mut geometry = LineGeometry::with_options(&gpu.device, &gpu.queue, &positions, &offsets, options).unwrap();
-    let attributes = VertexAttributes { octants: Some(&octants) };
+    let attributes = VertexAttributes { octants: Some(&octants), ..Default::default() };
     geometry.set_attributes(&gpu.device, &gpu.queue, &positions, &offsets, &attributes).unwrap();
     (geometry, octants)
 }
@@ -428,7 +428,7 @@ fn a_constant_visibility_gives_the_hemisphere_sky_in_closed_form() {
     let c = 153.0 / 255.0;
     let octants = vec![[c; 8]; positions.len()];
     let mut geometry = LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap();
-    let attributes = VertexAttributes { octants: Some(&octants) };
+    let attributes = VertexAttributes { octants: Some(&octants), ..Default::default() };
     geometry.set_attributes(&gpu.device, &gpu.queue, &positions, &offsets, &attributes).unwrap();
     let (camera, _) = cameras_for_polylines();
     for sky in [Sky::Uniform, Sky::Cloudy] {
@@ -482,7 +482,13 @@ fn attributes_split_with_the_strip_and_bad_attributes_are_errors() {
     // Wrong lengths are errors naming what differs.
     let short = vec![[1.0; 8]; positions.len() - 1];
     let error = plain
-        .set_attributes(&gpu.device, &gpu.queue, &positions, &offsets, &VertexAttributes { octants: Some(&short) })
+        .set_attributes(
+            &gpu.device,
+            &gpu.queue,
+            &positions,
+            &offsets,
+            &VertexAttributes { octants: Some(&short), ..Default::default() },
+        )
         .unwrap_err()
         .to_string();
     assert!(error.contains("octant visibilities"), "{error}");

@@ -4,12 +4,14 @@
 //! the curve (see `shaders/lines.wgsl`).
 //!
 //! The strip buffer holds every point twice (left, right) with its tangent (central difference,
-//! snorm16); the sign of tangent.w says the side. Consecutive polylines are joined by two
-//! repeated vertices, which make zero-area triangles the rasterizer drops, so a whole tractogram
-//! is one draw per buffer. Offsetting along the *vertex* tangent makes consecutive segments share
-//! their join corners exactly: joins without gaps or overlaps. Polylines are split at
-//! non-finite points. Tractograms larger than one buffer are split into chunks that overlap by
-//! two vertices (every triangle of the strip lies in one chunk).
+//! snorm16); the sign of tangent.w says the side, its magnitude [`flags`](VertexFlags).
+//! Consecutive polylines are joined by two repeated vertices, which make zero-area triangles the
+//! rasterizer drops, so a whole tractogram is one draw per buffer. Offsetting along the *vertex*
+//! tangent makes consecutive segments share their join corners exactly: joins without gaps or
+//! overlaps. Polylines are split at non-finite points. Tractograms larger than one buffer are
+//! split into chunks that overlap by two vertices (every triangle of the strip lies in one
+//! chunk), each padded with two copies of its last vertex, so the tube renderer can bind it a
+//! second time two vertices ahead (the next point of every vertex) and still draw all of it.
 //!
 //! Measured with `lineao bench` (1 M vertices, 1280 × 1024, lavapipe): the strip is 1.6× faster
 //! than one instanced 4-vertex quad per segment, whose per-instance cost dominated.
@@ -21,29 +23,49 @@
 use glam::Vec3;
 
 use crate::Error;
-use crate::binding::{self, Slot};
 use crate::camera::{Bounds, FrameView};
-use crate::lighting::{Lighting, LightingUniform};
+use crate::gbuffer::{self, GeometryBindings, GeometryUniform, Load, PipelineSpec};
+use crate::lighting::Lighting;
 use crate::settings::LineColor;
-use crate::targets::{self, FrameTargets};
-use crate::timing::{self, Span};
+use crate::targets::FrameTargets;
+use crate::timing::Span;
 
-/// One vertex of the strip buffer. Keep in sync with `StripVertex` in `shaders/lines.wgsl`.
+/// One vertex of the strip buffer. Keep in sync with `StripVertex` in `shaders/lines.wgsl` and
+/// `shaders/tubes.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct LinePoint {
     pub position: [f32; 3],
-    /// Unit world-space tangent (xyz) as snorm16. w: the side, +1 left or −1 right as ±32767
-    /// when a segment to the next point starts here (left vertices only), ±16384 otherwise.
+    /// Unit world-space tangent (xyz) as snorm16. w: the side (+ left, − right) times
+    /// [`FLAG_UNIT`] · (1 + [`VertexFlags`]).
     pub tangent: [i16; 4],
 }
 
-const SEGMENT_STARTS: i16 = 32767;
-const NO_SEGMENT: i16 = 16384;
+/// What a strip vertex's point is to its run of segments, as bits.
+pub struct VertexFlags;
+
+impl VertexFlags {
+    /// A segment to the next point starts here.
+    pub const SEGMENT: u16 = 1;
+    /// The first point of a run (tubes extend their cap backward).
+    pub const RUN_START: u16 = 2;
+    /// The last point of a run (tubes extend their cap forward).
+    pub const RUN_END: u16 = 4;
+}
+
+/// The step of tangent.w per flag value (snorm16: flags up to 7 fit below 32767).
+pub const FLAG_UNIT: i16 = 4000;
 
 impl LinePoint {
-    fn with_side(self, w: i16) -> LinePoint {
-        LinePoint { tangent: [self.tangent[0], self.tangent[1], self.tangent[2], w], ..self }
+    fn encoded(self, left: bool, flags: u16) -> LinePoint {
+        let w = FLAG_UNIT * (1 + flags as i16);
+        LinePoint { tangent: [self.tangent[0], self.tangent[1], self.tangent[2], if left { w } else { -w }], ..self }
+    }
+
+    /// The side (+1 left, −1 right) and the flags of an encoded vertex.
+    pub fn side_and_flags(&self) -> (i16, u16) {
+        let w = self.tangent[3];
+        (w.signum(), (w.unsigned_abs() / FLAG_UNIT as u16).saturating_sub(1))
     }
 }
 
@@ -75,8 +97,8 @@ pub fn validate_offsets(offsets: &[u64], vertices: usize) -> Result<(), Error> {
     Ok(())
 }
 
-/// The points of one polyline with their tangents (central differences), w = 32767 where a
-/// segment to the next point starts (both finite), appended to `out`.
+/// The points of one polyline with their tangents (central differences), w = 1 where a segment
+/// to the next point starts (both finite), appended to `out` (not yet encoded).
 fn polyline_points(line: &[[f32; 3]], out: &mut Vec<LinePoint>) {
     let at = |k: usize| Vec3::from_array(line[k]);
     for k in 0..line.len() {
@@ -90,12 +112,7 @@ fn polyline_points(line: &[[f32; 3]], out: &mut Vec<LinePoint>) {
         let starts_segment = k + 1 < line.len() && at(k).is_finite() && at(k + 1).is_finite();
         out.push(LinePoint {
             position: line[k],
-            tangent: [
-                snorm16(tangent.x),
-                snorm16(tangent.y),
-                snorm16(tangent.z),
-                if starts_segment { SEGMENT_STARTS } else { 0 },
-            ],
+            tangent: [snorm16(tangent.x), snorm16(tangent.y), snorm16(tangent.z), starts_segment as i16],
         });
     }
 }
@@ -145,24 +162,35 @@ fn strip_vertices(positions: &[[f32; 3]], offsets: &[u64], mut emit: impl FnMut(
         let first = range[0] as usize;
         points.clear();
         polyline_points(&positions[first..range[1] as usize], &mut points);
-        // Runs of points joined by segments (w = 32767 on all but a run's last point).
+        // Runs of points joined by segments (w = 1 on all but a run's last point).
         let mut start = 0;
         while start < points.len() {
-            let end = points[start..]
-                .iter()
-                .position(|p| p.tangent[3] != SEGMENT_STARTS)
-                .map_or(points.len(), |k| start + k + 1);
+            let end = points[start..].iter().position(|p| p.tangent[3] == 0).map_or(points.len(), |k| start + k + 1);
             let run = &points[start..end];
             if run.len() >= 2 {
+                let encode = |k: usize, left: bool| {
+                    let mut flags = 0;
+                    if k + 1 < run.len() {
+                        flags |= VertexFlags::SEGMENT;
+                    }
+                    if k == 0 {
+                        flags |= VertexFlags::RUN_START;
+                    }
+                    if k + 1 == run.len() {
+                        flags |= VertexFlags::RUN_END;
+                    }
+                    run[k].encoded(left, flags)
+                };
+                // Two repeated vertices join this run to the previous one: zero-area triangles.
                 if let Some((last, index)) = previous {
                     emit(last, index);
-                    emit(run[0].with_side(NO_SEGMENT), first + start);
+                    emit(encode(0, true), first + start);
                 }
-                for (k, p) in run.iter().enumerate() {
-                    emit(p.with_side(if k + 1 < run.len() { SEGMENT_STARTS } else { NO_SEGMENT }), first + start + k);
-                    emit(p.with_side(-NO_SEGMENT), first + start + k);
+                for k in 0..run.len() {
+                    emit(encode(k, true), first + start + k);
+                    emit(encode(k, false), first + start + k);
                 }
-                previous = Some((run[run.len() - 1].with_side(-NO_SEGMENT), first + end - 1));
+                previous = Some((encode(run.len() - 1, false), first + end - 1));
             }
             start = end;
         }
@@ -206,14 +234,20 @@ pub struct VertexAttributes<'a> {
     /// [`crate::passes::volume_ao`] turns into occlusion with the pixel's normal. `None`: fully
     /// visible.
     pub octants: Option<&'a [[f32; 8]]>,
+    /// Tube radius per vertex, world units (> 0; others take the chain's radius): tubes of
+    /// varying thickness ([`crate::passes::tubes`]). Lines ignore it.
+    pub radius: Option<&'a [f32]>,
 }
 
-/// One strip vertex's attributes. Keep in sync with `Attributes` in `shaders/lines.wgsl`.
+/// One strip vertex's attributes. Keep in sync with `Attributes` in `shaders/lines.wgsl` and
+/// `shaders/tubes.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct LineAttributes {
     /// The eight octant visibilities as unorm8.
     pub octants: [u8; 8],
+    /// Tube radius, world units; 0 = the chain's.
+    pub radius: f32,
 }
 
 const ATTRIBUTE_SIZE: u64 = std::mem::size_of::<LineAttributes>() as u64;
@@ -241,20 +275,15 @@ impl LineGeometry {
         validate_offsets(offsets, positions.len())?;
         let limit = options.chunk_bytes.min(device.limits().max_buffer_size);
         // Even, so that every chunk starts at an even strip position: a triangle then keeps the
-        // vertex order (and so the exact interpolation) it has in one long strip. The attribute
-        // stream splits at the same vertices, so its buffers must fit the same count.
-        let per_chunk = (limit / POINT_SIZE).max(4) as usize & !1;
+        // vertex order (and so the exact interpolation) it has in one long strip. Two vertices
+        // of padding follow. The attribute stream splits at the same vertices, so its buffers
+        // must fit the same count.
+        let per_chunk = (limit / POINT_SIZE).saturating_sub(2).max(4) as usize & !1;
         let mut chunks = Vec::new();
         let mut failed = None;
         let mut upload = |vertices: &[LinePoint]| {
             let chunk = Chunk {
-                vertices: upload_buffer(
-                    device,
-                    queue,
-                    "lineao::LineGeometry::strip",
-                    wgpu::BufferUsages::VERTEX,
-                    vertices,
-                ),
+                vertices: upload_padded(device, queue, "lineao::LineGeometry::strip", vertices),
                 count: vertices.len() as u32,
                 segments: options.native_lines.then(|| native_segments(device, queue, vertices)),
                 attributes: None,
@@ -300,26 +329,22 @@ impl LineGeometry {
                 self.streamlines
             )));
         }
-        if let Some(octants) = attributes.octants
-            && octants.len() != positions.len()
-        {
-            return Err(Error::InvalidGeometry(format!(
-                "{} octant visibilities for {} vertices",
-                octants.len(),
-                positions.len()
-            )));
+        let lengths =
+            [("octant visibilities", attributes.octants.map(<[_]>::len)), ("radii", attributes.radius.map(<[_]>::len))];
+        for (what, len) in lengths {
+            if let Some(len) = len.filter(|&len| len != positions.len()) {
+                return Err(Error::InvalidGeometry(format!("{len} {what} for {} vertices", positions.len())));
+            }
         }
         let unorm = |v: f32| (v.clamp(0.0, 1.0) * 255.0).round() as u8;
-        let of = |i: usize| LineAttributes { octants: attributes.octants.map_or([255; 8], |o| o[i].map(unorm)) };
+        let radius = |r: f32| if r.is_finite() && r > 0.0 { r } else { 0.0 };
+        let of = |i: usize| LineAttributes {
+            octants: attributes.octants.map_or([255; 8], |o| o[i].map(unorm)),
+            radius: attributes.radius.map_or(0.0, |r| radius(r[i])),
+        };
         let mut buffers = Vec::with_capacity(self.chunks.len());
         let mut upload = |values: &[LineAttributes]| {
-            buffers.push(upload_buffer(
-                device,
-                queue,
-                "lineao::LineGeometry::attributes",
-                wgpu::BufferUsages::VERTEX,
-                values,
-            ));
+            buffers.push(upload_padded(device, queue, "lineao::LineGeometry::attributes", values))
         };
         // Buffers of the same vertex count as the strip's, at most the strip's bytes.
         let mut chunker = Chunker::new(self.per_chunk, 2 * positions.len() + 2 * offsets.len());
@@ -348,15 +373,30 @@ impl LineGeometry {
 
 /// Index pairs (left vertex of a point, left vertex of the next) of the segments that lie
 /// within `vertices`: a segment across a chunk border is in the next chunk, which repeats the
-/// last two vertices.
+/// last two vertices. (A join's repeated left vertex also says SEGMENT, but two vertices on
+/// lies a right vertex, not its point's next left one.)
 fn native_segments(device: &wgpu::Device, queue: &wgpu::Queue, vertices: &[LinePoint]) -> (wgpu::Buffer, u32) {
-    let indices: Vec<u32> = (0..vertices.len().saturating_sub(2))
-        .filter(|&i| vertices[i].tangent[3] == SEGMENT_STARTS)
-        .flat_map(|i| [i as u32, i as u32 + 2])
-        .collect();
+    let starts = |i: usize| {
+        let ((side, flags), (next_side, _)) = (vertices[i].side_and_flags(), vertices[i + 2].side_and_flags());
+        side > 0 && flags & VertexFlags::SEGMENT != 0 && next_side > 0
+    };
+    let indices: Vec<u32> =
+        (0..vertices.len().saturating_sub(2)).filter(|&i| starts(i)).flat_map(|i| [i as u32, i as u32 + 2]).collect();
     let contents = if indices.is_empty() { &[0u32, 0][..] } else { &indices };
     let buffer = upload_buffer(device, queue, "lineao::LineGeometry::segments", wgpu::BufferUsages::INDEX, contents);
     (buffer, indices.len() as u32)
+}
+
+/// A vertex buffer of `values` and two more copies of the last (see the module documentation).
+fn upload_padded<T: bytemuck::Pod>(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    label: &str,
+    values: &[T],
+) -> wgpu::Buffer {
+    let last = *values.last().expect("a chunk holds a triangle");
+    let padded: Vec<T> = values.iter().copied().chain([last, last]).collect();
+    upload_buffer(device, queue, label, wgpu::BufferUsages::VERTEX, &padded)
 }
 
 /// A buffer of `usage` holding `contents`, written through the queue and submitted.
@@ -379,24 +419,6 @@ fn upload_buffer<T: bytemuck::Pod>(
     buffer
 }
 
-/// Keep in sync with `LineUniform` in `shaders/lines.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct LineUniform {
-    pub view: [[f32; 4]; 4],
-    pub proj: [[f32; 4]; 4],
-    pub constant_color: [f32; 4],
-    pub viewport: [f32; 2],
-    pub near: f32,
-    pub far: f32,
-    pub f_px: f32,
-    pub zoom_unit: f32,
-    pub line_width_px: f32,
-    pub orthographic: u32,
-    pub color_mode: u32,
-    pub _pad: [u32; 3],
-}
-
 /// How segments are rasterized.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum LineStyle {
@@ -417,19 +439,26 @@ pub struct LineRenderer {
     /// Writing `octants` too: from the geometry's attributes, and fully visible for geometry
     /// without them.
     octants: Option<OctantPipelines>,
-    uniform: wgpu::Buffer,
-    lighting: wgpu::Buffer,
-    group: wgpu::BindGroup,
+    bindings: GeometryBindings,
 }
 
-struct OctantPipelines {
-    attributes: wgpu::RenderPipeline,
-    visible: wgpu::RenderPipeline,
+/// The pipelines of a geometry pass that also writes the `octants` target.
+pub(crate) struct OctantPipelines {
+    pub attributes: wgpu::RenderPipeline,
+    pub visible: wgpu::RenderPipeline,
 }
 
-/// The G-buffer attachments the line pipelines write, in `fs_main`'s order.
-const GBUFFER_FORMATS: [wgpu::TextureFormat; 4] =
-    [targets::COLOR_FORMAT, targets::ND_FORMAT, targets::ZOOM_FORMAT, targets::SPECULAR_FORMAT];
+/// The strip's vertex layout (slot 0; `shader_location`s 0, 1).
+pub(crate) const STRIP_ATTRIBUTES: [wgpu::VertexAttribute; 2] =
+    wgpu::vertex_attr_array![0 => Float32x3, 1 => Snorm16x4];
+
+pub(crate) fn strip_layout(attributes: &[wgpu::VertexAttribute]) -> wgpu::VertexBufferLayout<'_> {
+    wgpu::VertexBufferLayout { array_stride: POINT_SIZE, step_mode: wgpu::VertexStepMode::Vertex, attributes }
+}
+
+pub(crate) fn attribute_layout(attributes: &[wgpu::VertexAttribute]) -> wgpu::VertexBufferLayout<'_> {
+    wgpu::VertexBufferLayout { array_stride: ATTRIBUTE_SIZE, step_mode: wgpu::VertexStepMode::Vertex, attributes }
+}
 
 impl LineRenderer {
     /// The renderer of fixed-width lines.
@@ -444,84 +473,33 @@ impl LineRenderer {
     /// With `octants`, targets that have an `octants` texture also get the geometry's
     /// per-vertex octant visibilities, interpolated ([`crate::passes::volume_ao`]); quads only.
     pub fn with_outputs(device: &wgpu::Device, style: LineStyle, octants: bool) -> LineRenderer {
-        let layout = binding::layout(
-            device,
-            "lineao::LineRenderer::layout",
-            wgpu::ShaderStages::VERTEX_FRAGMENT,
-            &[Slot::Uniform, Slot::Uniform],
-        );
-        let uniform = binding::uniform_buffer::<LineUniform>(device, "lineao::LineRenderer::uniform");
-        let lighting = binding::uniform_buffer::<LightingUniform>(device, "lineao::LineRenderer::lighting");
-        let group = binding::group(
-            device,
-            "lineao::LineRenderer::group",
-            &layout,
-            &[uniform.as_entire_binding(), lighting.as_entire_binding()],
-        );
+        let bindings = GeometryBindings::new(device, "lineao::LineRenderer::bindings");
         let module = crate::shader::module(device, "lines.wgsl");
-        let pipeline_layout = binding::pipeline_layout(device, "lineao::LineRenderer::pipeline_layout", &layout);
-        let point_attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Snorm16x4];
         let octant_attributes = wgpu::vertex_attr_array![2 => Unorm8x4, 3 => Unorm8x4];
-        let points = wgpu::VertexBufferLayout {
-            array_stride: POINT_SIZE,
-            step_mode: wgpu::VertexStepMode::Vertex,
-            attributes: &point_attributes,
-        };
-        let with_attributes = [
-            Some(points.clone()),
-            Some(wgpu::VertexBufferLayout {
-                array_stride: ATTRIBUTE_SIZE,
-                step_mode: wgpu::VertexStepMode::Vertex,
-                attributes: &octant_attributes,
-            }),
-        ];
+        let strip = [Some(strip_layout(&STRIP_ATTRIBUTES))];
+        let with_attributes = [Some(strip_layout(&STRIP_ATTRIBUTES)), Some(attribute_layout(&octant_attributes))];
         let topology = match style {
             LineStyle::Quads => wgpu::PrimitiveTopology::TriangleStrip,
             LineStyle::Native1px => wgpu::PrimitiveTopology::LineList,
         };
-        let create = |label: &str, vertex: &str, fragment: &str, buffers: &[Option<wgpu::VertexBufferLayout>]| {
-            let mut targets: Vec<_> = GBUFFER_FORMATS.iter().map(|&format| color_target(format)).collect();
-            if fragment == "fs_octants" {
-                targets.push(color_target(targets::OCTANTS_FORMAT));
-            }
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(label),
-                layout: Some(&pipeline_layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some(vertex),
-                    compilation_options: Default::default(),
-                    buffers,
-                },
-                primitive: wgpu::PrimitiveState { topology, ..Default::default() },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: targets::DEPTH_FORMAT,
-                    depth_write_enabled: Some(true),
-                    depth_compare: Some(wgpu::CompareFunction::Less),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-                multisample: Default::default(),
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some(fragment),
-                    compilation_options: Default::default(),
-                    targets: &targets,
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
+        let create = |label, vertex, fragment, buffers| {
+            let octants = fragment == "fs_octants";
+            gbuffer::pipeline(
+                device,
+                &bindings.layout,
+                PipelineSpec { label, module: &module, vertex, fragment, buffers, topology, octants },
+            )
         };
         let vertex = match style {
             LineStyle::Quads => "vs_main",
             LineStyle::Native1px => "vs_native",
         };
-        let pipeline = create("lineao::LineRenderer::pipeline", vertex, "fs_main", &[Some(points.clone())]);
+        let pipeline = create("lineao::LineRenderer::pipeline", vertex, "fs_main", &strip);
         let octants = (octants && style == LineStyle::Quads).then(|| OctantPipelines {
             attributes: create("lineao::LineRenderer::octants", "vs_octants", "fs_octants", &with_attributes),
-            visible: create("lineao::LineRenderer::visible", "vs_visible", "fs_octants", &[Some(points.clone())]),
+            visible: create("lineao::LineRenderer::visible", "vs_visible", "fs_octants", &strip),
         });
-        LineRenderer { style, pipeline, octants, uniform, lighting, group }
+        LineRenderer { style, pipeline, octants, bindings }
     }
 
     /// Whether this renderer writes the `octants` target.
@@ -537,77 +515,29 @@ impl LineRenderer {
         color: LineColor,
         lighting: &Lighting,
     ) {
-        let (w, h) = view.banded_size();
-        let (color_mode, constant) = match color {
-            LineColor::Tangent => (0, [0.0; 3]),
-            LineColor::Constant(rgb) => (1, rgb),
-        };
-        let uniform = LineUniform {
-            view: view.view.to_cols_array_2d(),
-            proj: view.proj.to_cols_array_2d(),
-            constant_color: [constant[0], constant[1], constant[2], 1.0],
-            viewport: [w as f32, h as f32],
-            near: view.near,
-            far: view.far,
-            f_px: view.f_px,
-            zoom_unit: view.zoom_unit,
-            line_width_px,
-            orthographic: view.orthographic as u32,
-            color_mode,
-            _pad: [0; 3],
-        };
-        queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
-        queue.write_buffer(&self.lighting, 0, bytemuck::bytes_of(&lighting.uniform()));
+        self.bindings.write(queue, &GeometryUniform::new(view, color, line_width_px, 0.0), lighting);
     }
 
-    /// Clears the G-buffer (color to `background`, ND to background, zoom and specular to 0,
-    /// depth to 1) and draws `geometry`, timed into `span` when given.
+    /// Draws `geometry` into the G-buffer, clearing it first or over earlier passes (`load`),
+    /// timed into `span` when given.
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         targets: &FrameTargets,
         geometry: &LineGeometry,
-        background: [f32; 3],
+        load: Load,
         span: Option<Span>,
     ) {
-        let clear = |r: f64, g: f64, b: f64, a: f64| wgpu::Operations {
-            load: wgpu::LoadOp::Clear(wgpu::Color { r, g, b, a }),
-            store: wgpu::StoreOp::Store,
-        };
-        let attachment =
-            |view, ops| Some(wgpu::RenderPassColorAttachment { view, depth_slice: None, resolve_target: None, ops });
-        let [r, g, b] = background.map(f64::from);
         // The octants too when both the pipelines and the target exist.
-        let octants = self.octants.as_ref().zip(targets.octants.as_ref());
-        let mut color_attachments = vec![
-            attachment(&targets.color.view, clear(r, g, b, 1.0)),
-            attachment(&targets.nd[0].view, clear(0.0, 0.0, 0.0, 1.0)),
-            attachment(&targets.zoom.view, clear(0.0, 0.0, 0.0, 0.0)),
-            attachment(&targets.specular.view, clear(0.0, 0.0, 0.0, 0.0)),
-        ];
-        if let Some((_, target)) = octants {
-            color_attachments.push(attachment(&target.view, clear(0.0, 0.0, 0.0, 0.0)));
-        }
-        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("lineao::LineRenderer"),
-            color_attachments: &color_attachments,
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &targets.depth.view,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: timing::render_writes(span),
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
-        let pipeline = match octants {
-            Some((pipelines, _)) if geometry.has_attributes() => &pipelines.attributes,
-            Some((pipelines, _)) => &pipelines.visible,
-            None => &self.pipeline,
-        };
+        let octants = self.octants.as_ref().filter(|_| targets.octants.is_some());
+        let mut pass = gbuffer::begin(encoder, "lineao::LineRenderer", targets, load, octants.is_some(), span);
         let attributes = octants.is_some() && geometry.has_attributes();
-        pass.set_pipeline(pipeline);
-        pass.set_bind_group(0, &self.group, &[]);
+        pass.set_pipeline(match octants {
+            Some(pipelines) if attributes => &pipelines.attributes,
+            Some(pipelines) => &pipelines.visible,
+            None => &self.pipeline,
+        });
+        pass.set_bind_group(0, &self.bindings.group, &[]);
         for chunk in &geometry.chunks {
             pass.set_vertex_buffer(0, chunk.vertices.slice(..));
             if let (true, Some(buffer)) = (attributes, &chunk.attributes) {
@@ -623,8 +553,4 @@ impl LineRenderer {
             }
         }
     }
-}
-
-fn color_target(format: wgpu::TextureFormat) -> Option<wgpu::ColorTargetState> {
-    Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })
 }

@@ -1,0 +1,206 @@
+//! What the geometry passes share — [`LineRenderer`](crate::passes::lines::LineRenderer),
+//! [`TubeRenderer`](crate::passes::tubes::TubeRenderer) and
+//! [`MeshRenderer`](crate::passes::meshes::MeshRenderer) all write the G-buffer of CONTRACT.md:
+//! the per-frame uniform (`shaders/shared/geometry.wgsl`), the attachments in their order, and
+//! a pipeline builder. The first writer of a frame clears the targets, the others draw over it.
+//!
+//! A host renderer that writes the ND and zoom maps from its own shaders includes
+//! [`crate::shader::GBUFFER_WGSL`] (`shaders/shared/gbuffer.wgsl`).
+
+use crate::camera::FrameView;
+use crate::settings::LineColor;
+use crate::targets::{self, FrameTargets};
+use crate::timing::{self, Span};
+
+/// Keep in sync with `GeometryUniform` in `shaders/shared/geometry.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct GeometryUniform {
+    pub view: [[f32; 4]; 4],
+    pub proj: [[f32; 4]; 4],
+    pub inv_proj: [[f32; 4]; 4],
+    pub constant_color: [f32; 4],
+    pub viewport: [f32; 2],
+    pub near: f32,
+    pub far: f32,
+    pub f_px: f32,
+    pub zoom_unit: f32,
+    pub line_width_px: f32,
+    pub orthographic: u32,
+    pub color_mode: u32,
+    pub tube_radius: f32,
+    pub _pad: [u32; 2],
+}
+
+impl GeometryUniform {
+    pub fn new(view: &FrameView, color: LineColor, line_width_px: f32, tube_radius: f32) -> GeometryUniform {
+        let (w, h) = view.banded_size();
+        let (color_mode, constant) = match color {
+            LineColor::Tangent => (0, [0.0; 3]),
+            LineColor::Constant(rgb) => (1, rgb),
+        };
+        GeometryUniform {
+            view: view.view.to_cols_array_2d(),
+            proj: view.proj.to_cols_array_2d(),
+            inv_proj: view.proj.inverse().to_cols_array_2d(),
+            constant_color: [constant[0], constant[1], constant[2], 1.0],
+            viewport: [w as f32, h as f32],
+            near: view.near,
+            far: view.far,
+            f_px: view.f_px,
+            zoom_unit: view.zoom_unit,
+            line_width_px,
+            orthographic: view.orthographic as u32,
+            color_mode,
+            tube_radius,
+            _pad: [0; 2],
+        }
+    }
+}
+
+/// The G-buffer attachments a geometry pass writes, in `GBuffer`'s order (`geometry.wgsl`).
+pub const GBUFFER_FORMATS: [wgpu::TextureFormat; 4] =
+    [targets::COLOR_FORMAT, targets::ND_FORMAT, targets::ZOOM_FORMAT, targets::SPECULAR_FORMAT];
+
+/// The two uniform buffers of a geometry pass (frame, lighting) and their bind group.
+pub(crate) struct GeometryBindings {
+    pub layout: wgpu::BindGroupLayout,
+    pub frame: wgpu::Buffer,
+    pub lighting: wgpu::Buffer,
+    pub group: wgpu::BindGroup,
+}
+
+impl GeometryBindings {
+    pub fn new(device: &wgpu::Device, label: &str) -> GeometryBindings {
+        use crate::binding::{self, Slot};
+        let layout =
+            binding::layout(device, label, wgpu::ShaderStages::VERTEX_FRAGMENT, &[Slot::Uniform, Slot::Uniform]);
+        let frame = binding::uniform_buffer::<GeometryUniform>(device, label);
+        let lighting = binding::uniform_buffer::<crate::lighting::LightingUniform>(device, label);
+        let group = binding::group(device, label, &layout, &[frame.as_entire_binding(), lighting.as_entire_binding()]);
+        GeometryBindings { layout, frame, lighting, group }
+    }
+
+    pub fn write(&self, queue: &wgpu::Queue, frame: &GeometryUniform, lighting: &crate::lighting::Lighting) {
+        queue.write_buffer(&self.frame, 0, bytemuck::bytes_of(frame));
+        queue.write_buffer(&self.lighting, 0, bytemuck::bytes_of(&lighting.uniform()));
+    }
+}
+
+/// What differs between the geometry pipelines.
+pub(crate) struct PipelineSpec<'a> {
+    pub label: &'a str,
+    pub module: &'a wgpu::ShaderModule,
+    pub vertex: &'a str,
+    pub fragment: &'a str,
+    pub buffers: &'a [Option<wgpu::VertexBufferLayout<'a>>],
+    pub topology: wgpu::PrimitiveTopology,
+    /// Also write the `octants` target (the fragment entry returns `GBufferOctants`).
+    pub octants: bool,
+}
+
+/// A render pipeline writing the G-buffer (depth test `Less`, depth written).
+pub(crate) fn pipeline(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    spec: PipelineSpec,
+) -> wgpu::RenderPipeline {
+    let mut color_targets: Vec<_> = GBUFFER_FORMATS.iter().map(|&format| color_target(format)).collect();
+    if spec.octants {
+        color_targets.push(color_target(targets::OCTANTS_FORMAT));
+    }
+    let pipeline_layout = crate::binding::pipeline_layout(device, spec.label, layout);
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(spec.label),
+        layout: Some(&pipeline_layout),
+        vertex: wgpu::VertexState {
+            module: spec.module,
+            entry_point: Some(spec.vertex),
+            compilation_options: Default::default(),
+            buffers: spec.buffers,
+        },
+        primitive: wgpu::PrimitiveState { topology: spec.topology, ..Default::default() },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: targets::DEPTH_FORMAT,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(wgpu::CompareFunction::Less),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module: spec.module,
+            entry_point: Some(spec.fragment),
+            compilation_options: Default::default(),
+            targets: &color_targets,
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}
+
+fn color_target(format: wgpu::TextureFormat) -> Option<wgpu::ColorTargetState> {
+    Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })
+}
+
+/// How a geometry pass starts on the G-buffer.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Load {
+    /// The frame's first writer: color to this background (linear RGB), ND to background, zoom,
+    /// specular and octants to 0, depth to 1.
+    Clear([f32; 3]),
+    /// Draw over what earlier passes wrote.
+    Keep,
+}
+
+/// Begins a render pass over the G-buffer of `targets` (with `octants` when asked and present).
+pub(crate) fn begin<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    label: &str,
+    targets: &FrameTargets,
+    load: Load,
+    octants: bool,
+    span: Option<Span>,
+) -> wgpu::RenderPass<'e> {
+    let ops = |clear: [f64; 4]| wgpu::Operations {
+        load: match load {
+            Load::Clear(_) => wgpu::LoadOp::Clear(wgpu::Color { r: clear[0], g: clear[1], b: clear[2], a: clear[3] }),
+            Load::Keep => wgpu::LoadOp::Load,
+        },
+        store: wgpu::StoreOp::Store,
+    };
+    let attachment = |view, clear| {
+        Some(wgpu::RenderPassColorAttachment { view, depth_slice: None, resolve_target: None, ops: ops(clear) })
+    };
+    let [r, g, b] = match load {
+        Load::Clear(background) => background.map(f64::from),
+        Load::Keep => [0.0; 3],
+    };
+    let mut color_attachments = vec![
+        attachment(&targets.color.view, [r, g, b, 1.0]),
+        attachment(&targets.nd[0].view, [0.0, 0.0, 0.0, 1.0]),
+        attachment(&targets.zoom.view, [0.0; 4]),
+        attachment(&targets.specular.view, [0.0; 4]),
+    ];
+    if let (true, Some(target)) = (octants, &targets.octants) {
+        color_attachments.push(attachment(&target.view, [0.0; 4]));
+    }
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        color_attachments: &color_attachments,
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: &targets.depth.view,
+            depth_ops: Some(wgpu::Operations {
+                load: match load {
+                    Load::Clear(_) => wgpu::LoadOp::Clear(1.0),
+                    Load::Keep => wgpu::LoadOp::Load,
+                },
+                store: wgpu::StoreOp::Store,
+            }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: timing::render_writes(span),
+        occlusion_query_set: None,
+        multiview_mask: None,
+    })
+}

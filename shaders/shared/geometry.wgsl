@@ -1,0 +1,62 @@
+// What lineao's geometry passes (lines, tubes, meshes) read per frame.
+#import shared/gbuffer.wgsl
+#import shared/lighting.wgsl
+
+// Keep in sync with `lineao::gbuffer::GeometryUniform`.
+struct GeometryUniform {
+    view: mat4x4<f32>,
+    proj: mat4x4<f32>,
+    inv_proj: mat4x4<f32>,
+    constant_color: vec4<f32>,
+    // Guard-banded viewport size in pixels.
+    viewport: vec2<f32>,
+    near: f32,
+    far: f32,
+    f_px: f32,
+    zoom_unit: f32,
+    line_width_px: f32,
+    orthographic: u32,
+    // 0: tangent direction |T| (world axes as RGB), 1: constant color.
+    color_mode: u32,
+    // Tubes: the radius in world units where the geometry carries none.
+    tube_radius: f32,
+    _pad0: u32,
+    _pad1: u32,
+}
+
+@group(0) @binding(0) var<uniform> frame: GeometryUniform;
+@group(0) @binding(1) var<uniform> lighting: Lighting;
+
+fn is_orthographic() -> bool {
+    return frame.orthographic != 0u;
+}
+
+// The base color of a point with world-space tangent `t_world` (tangent color mode) or the
+// constant color.
+fn base_color(t_world: vec3<f32>) -> vec3<f32> {
+    if frame.color_mode == 0u {
+        return abs(t_world) / max(length(t_world), 1e-20);
+    }
+    return frame.constant_color.rgb;
+}
+
+// The G-buffer's targets, in attachment order; octants only where object-space AO is on.
+struct GBuffer {
+    @location(0) color: vec4<f32>,
+    @location(1) nd: vec4<f32>,
+    @location(2) zoom: f32,
+    @location(3) specular: f32,
+}
+
+struct GBufferOctants {
+    @location(0) color: vec4<f32>,
+    @location(1) nd: vec4<f32>,
+    @location(2) zoom: f32,
+    @location(3) specular: f32,
+    // Octants 0–3 and 4–7 as unorm8 each (`pack4x8unorm`: x in the low byte).
+    @location(4) octants: vec2<u32>,
+}
+
+fn with_octants(g: GBuffer, lo: vec4<f32>, hi: vec4<f32>) -> GBufferOctants {
+    return GBufferOctants(g.color, g.nd, g.zoom, g.specular, vec2<u32>(pack4x8unorm(lo), pack4x8unorm(hi)));
+}
