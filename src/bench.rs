@@ -16,7 +16,8 @@
 //! - `vo-line-5`: Volumetric Obscurance with 5 line samples (against `ssao-12`: the VO paper's
 //!   0.56×);
 //! - `vo-area-1`: VO with one area sample, moments pyramid included (what the method costs);
-//! - `bilateral`: the separable bilateral blur (radius 4), which can follow any method.
+//! - `bilateral`: the separable bilateral blur (radius 4), which can follow any method;
+//! - `tubes`: the same streamlines as ray-cast tubes of radius 0.5 mm (against `lines`).
 //!
 //! The object-space passes run on the CPU (`"on": "cpu"`), `--frames` times up to 3 (each takes
 //! seconds) without warm-up, on the scene's streamlines:
@@ -38,6 +39,7 @@ use lineao::passes::lines::{GeometryOptions, LineGeometry, LineRenderer, LineSty
 use lineao::passes::nd_pyramid::NdPyramid;
 use lineao::passes::ssao::Ssao;
 use lineao::passes::ssao_blur::SsaoBlur;
+use lineao::passes::tubes::TubeRenderer;
 use lineao::passes::vo_area::VoArea;
 use lineao::passes::vo_line::VoLine;
 use lineao::targets::{FrameTargets, Target};
@@ -52,7 +54,7 @@ use serde_json::json;
 use crate::cli::BenchArgs;
 
 /// The GPU passes of one run, in CONTRACT.md's order.
-pub const GPU_PASSES: [&str; 14] = [
+pub const GPU_PASSES: [&str; 15] = [
     "lines",
     "lines-native-1px",
     "nd-pyramid",
@@ -67,7 +69,11 @@ pub const GPU_PASSES: [&str; 14] = [
     "vo-line-5",
     "vo-area-1",
     "bilateral",
+    "tubes",
 ];
+
+/// The radius of pass `tubes` in zoom units (0.5 mm for tractograms).
+const TUBE_RADIUS: f32 = 0.5;
 
 /// The CPU passes, after the GPU's.
 pub const CPU_PASSES: [&str; 3] = ["density-256", "sweep-256", "variance-volume-256"];
@@ -94,6 +100,7 @@ struct Passes {
     /// The chain's G-buffer copied into targets with a moments pyramid, for `vo_area_1`.
     area_targets: FrameTargets,
     bilateral: Bilateral,
+    tubes: TubeRenderer,
     output: Target,
 }
 
@@ -117,11 +124,13 @@ impl Passes {
             vo_area_1: VoArea::new(device, &VoSettings { area_samples: 1, ..settings.vo.clone() }),
             area_targets: FrameTargets::new(device, view.width, view.height, targets.guard, 1).with_moments(device),
             bilateral: Bilateral::new(device),
+            tubes: TubeRenderer::new(device, false),
             output: Target::output(device, "lineao::bench::output", (view.width, view.height), format),
         };
         for renderer in [&passes.lines, &passes.lines_native] {
             renderer.prepare(queue, view, settings.line_width_px, settings.line_color, &settings.lighting);
         }
+        passes.tubes.prepare(queue, view, TUBE_RADIUS * view.zoom_unit, settings.line_color, &settings.lighting);
         passes.pyramid.resize(device, targets);
         for (pass, line_ao) in [
             (&mut passes.line_ao, &settings.line_ao),
@@ -129,7 +138,7 @@ impl Passes {
             (&mut passes.line_ao_level, &level),
         ] {
             pass.resize(device, targets);
-            pass.prepare(queue, targets, view, line_ao, settings.r0_px(), &settings.lighting);
+            pass.prepare(queue, targets, view, line_ao, settings.r0(), &settings.lighting);
         }
         for (pass, samples) in [(&mut passes.ssao_12, 12), (&mut passes.ssao_16, 16)] {
             pass.resize(device, targets);
@@ -196,6 +205,7 @@ impl Passes {
                 self.vo_area_1.encode(encoder, area, span.map(Span::begin_only), span.map(Span::end_only))
             }
             "bilateral" => self.bilateral.encode(encoder, targets, span),
+            "tubes" => self.tubes.encode(encoder, targets, geometry, Load::Clear(background), span),
             _ => unreachable!("unknown bench pass {name}"),
         }
     }

@@ -125,6 +125,14 @@ fn parse_pair(s: &str) -> Result<[Method; 2], String> {
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum GeometryArg {
+    /// Lines of a fixed width in pixels (--line-width).
+    Lines,
+    /// Tubes of a radius in world units (--tube-radius), ray-cast with true depth and normals.
+    Tubes,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum SkyArg {
     /// Light from every direction.
     Uniform,
@@ -260,6 +268,16 @@ pub struct RenderArgs {
     /// Line width in pixels.
     #[arg(long, default_value_t = 2.0)]
     pub line_width: f32,
+    /// Streamlines as lines or tubes.
+    #[arg(long, value_enum, default_value_t = GeometryArg::Lines)]
+    pub geometry: GeometryArg,
+    /// Tubes: radius in world units [default: 0.5 mm].
+    #[arg(long)]
+    pub tube_radius: Option<f32>,
+    /// Tubes: the file's per-vertex field holding each vertex's radius in world units (e.g. a
+    /// TRX dpv or a .trk scalar); vertices without a positive value take --tube-radius.
+    #[arg(long, requires = "file")]
+    pub tube_radius_field: Option<String>,
     /// Camera position, world units: X,Y,Z [default: the scene's].
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     pub eye: Option<[f32; 3]>,
@@ -354,7 +372,8 @@ pub struct RenderArgs {
     /// Object-space AO: voxels of the density volume along its longest axis (64–256 typical).
     #[arg(long, default_value_t = 128, value_parser = clap::value_parser!(u32).range(8..=1024))]
     pub volume_resolution: u32,
-    /// Object-space AO: occupancy radius of the streamlines in world units [default: 0.5 mm].
+    /// Object-space AO: occupancy radius of the streamlines in world units [default: the tube
+    /// radius with --geometry tubes, else 0.5 mm].
     #[arg(long)]
     pub occupancy_radius: Option<f32>,
     /// Object-space AO: where the light comes from.

@@ -81,8 +81,7 @@ pub fn write(
 
     let mut params = json!({
         "method": method,
-        "geometry": "lines",
-        "line_width_px": s.line_width_px,
+        "geometry": if s.tubes.is_some() { "tubes" } else { "lines" },
         "strength": s.strength,
         "zoom_unit": s.zoom_unit,
         "guard_px": targets.guard,
@@ -99,6 +98,13 @@ pub fn write(
             }),
         },
     });
+    merge(
+        &mut params,
+        match &s.tubes {
+            Some(tubes) => json!({"tube_radius_world": tubes.radius_world}),
+            None => json!({"line_width_px": s.line_width_px}),
+        },
+    );
     if s.method == AoMethod::LineAo {
         let ao = &s.line_ao;
         let lights: Vec<_> = s
@@ -121,7 +127,7 @@ pub fn write(
         }
         let variant_keys = match ao.variant {
             LineAoVariant::Paper => json!({
-                "r0_px": s.r0_px(),
+                "r0_px": s.r0().px,
                 "delta0": ao.delta0,
                 "epsilon": ao.epsilon,
                 "kd": s.lighting.kd,

@@ -13,11 +13,13 @@ use lineao::volume::sweep::SweepSettings;
 use lineao::volume::{ScalarForm, Sky, VertexVisibility, VolumeAoOptions, VolumeMethod};
 use lineao::{
     AoChain, AoMethod, BilateralSettings, ChainSettings, Gpu, LineAoOuter, LineAoSettings, LineAoVariant, LineColor,
-    SsaoKernel, SsaoSettings, VoCombine, VoSettings, VolumeAoSettings,
+    SsaoKernel, SsaoSettings, TubeSettings, VoCombine, VoSettings, VolumeAoSettings,
 };
 use lineao_tracts::scenes::ViewHint;
 
-use crate::cli::{ColorArg, Combine, Method, Outer, RenderArgs, SkyArg, SsaoKernelArg, Variant, VolumeNormal};
+use crate::cli::{
+    ColorArg, Combine, GeometryArg, Method, Outer, RenderArgs, SkyArg, SsaoKernelArg, Variant, VolumeNormal,
+};
 use crate::label::Rgba8;
 
 fn combine(c: Combine) -> VoCombine {
@@ -46,7 +48,10 @@ pub fn volume_options(args: &RenderArgs, method: VolumeMethod, sky: Sky, zoom_un
         method,
         density: DensityOptions {
             resolution: args.volume_resolution as usize,
-            occupancy_radius: args.occupancy_radius.unwrap_or(0.5 * zoom_unit),
+            occupancy_radius: args.occupancy_radius.unwrap_or(match args.geometry {
+                GeometryArg::Tubes => tube_radius(args, zoom_unit),
+                GeometryArg::Lines => 0.5 * zoom_unit,
+            }),
             threads: 0,
         },
         sweep: SweepSettings { alpha: args.sweep_alpha, threads: 0 },
@@ -58,6 +63,11 @@ pub fn volume_options(args: &RenderArgs, method: VolumeMethod, sky: Sky, zoom_un
         sky,
         ..VolumeAoOptions::default()
     }
+}
+
+/// The tubes' radius in world units: --tube-radius or 0.5 mm.
+fn tube_radius(args: &RenderArgs, zoom_unit: f32) -> f32 {
+    args.tube_radius.unwrap_or(0.5 * zoom_unit)
 }
 
 /// The chain's settings from the command line, for `method` (object-space AO lit by `sky`).
@@ -117,6 +127,8 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky) -> 
             },
         },
         line_width_px: args.line_width,
+        tubes: (args.geometry == GeometryArg::Tubes)
+            .then(|| TubeSettings { radius_world: tube_radius(args, zoom_unit) }),
         line_color: match args.color {
             ColorArg::Tangent => LineColor::Tangent,
             ColorArg::Constant(rgb) => LineColor::Constant(rgb),
@@ -217,9 +229,18 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         volume_options(VolumeMethod::Sweep).sweep.validate()?;
     }
 
+    let radii = match &args.tube_radius_field {
+        Some(field) => Some(vertex_radii(&tracts, field).with_context(|| name.clone())?),
+        None => None,
+    };
+
     let gpu = Gpu::headless()?;
     let mut geometry = LineGeometry::new(&gpu.device, &gpu.queue, &tracts.positions, &tracts.offsets)?;
     let bounds = geometry.bounds.with_context(|| format!("{name} has no finite points"))?;
+    if let Some(radius) = radii.as_deref() {
+        let attributes = VertexAttributes { radius: Some(radius), ..Default::default() };
+        geometry.set_attributes(&gpu.device, &gpu.queue, &tracts.positions, &tracts.offsets, &attributes)?;
+    }
     // Object-space AO once per method, uploaded as the geometry's attributes when a panel needs
     // another method's than the last.
     let mut volumes: Vec<(VolumeMethod, VertexVisibility)> = Vec::new();
@@ -241,7 +262,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 volumes.push((method, computed));
             }
             let (_, visibility) = volumes.iter().find(|(m, _)| *m == method).expect("computed above");
-            let octants = VertexAttributes { octants: Some(&visibility.octants), ..Default::default() };
+            let octants = VertexAttributes { octants: Some(&visibility.octants), radius: radii.as_deref() };
             geometry.set_attributes(&gpu.device, &gpu.queue, &tracts.positions, &tracts.offsets, &octants)?;
             attributes = Some(method);
         }
@@ -277,6 +298,16 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         args.output.display()
     );
     Ok(())
+}
+
+/// The per-vertex radii of `field` (one column; non-positive values take the chain's radius).
+fn vertex_radii(tracts: &lineao_tracts::Tractogram, field: &str) -> Result<Vec<f32>> {
+    let names: Vec<&str> = tracts.vertex_fields.iter().map(|f| f.name.as_str()).collect();
+    let found = tracts
+        .vertex_field(field)
+        .with_context(|| format!("no per-vertex field '{field}' (the file has: {})", names.join(", ")))?;
+    anyhow::ensure!(found.columns == 1, "per-vertex field '{field}' has {} columns, a radius needs 1", found.columns);
+    Ok(found.values.clone())
 }
 
 /// What every panel of one `render` shares.

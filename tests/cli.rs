@@ -68,17 +68,22 @@ fn vec3(v: &Value) -> [f32; 3] {
 
 #[test]
 fn render_and_dump_let_an_outside_tool_recompute_lineao() {
-    recompute_from_dump("paper", "full");
+    recompute_from_dump("paper", "full", "lines");
 }
 
 #[test]
 fn render_and_dump_let_an_outside_tool_recompute_the_reference_variant() {
-    recompute_from_dump("reference", "full");
+    recompute_from_dump("reference", "full", "lines");
 }
 
 #[test]
 fn render_and_dump_let_an_outside_tool_recompute_lineao_with_outer_level() {
-    recompute_from_dump("paper", "level");
+    recompute_from_dump("paper", "level", "lines");
+}
+
+#[test]
+fn render_and_dump_let_an_outside_tool_recompute_lineao_on_tubes() {
+    recompute_from_dump("paper", "full", "tubes");
 }
 
 /// `lineao render` at 200 × 150 on 60 000 vertices with `extra` options and `--dump`; returns
@@ -94,12 +99,26 @@ fn render_with_dump(name: &str, extra: &[&str]) -> (PathBuf, PathBuf) {
     (png, dump)
 }
 
-/// Renders with `--variant variant --dump`, then recomputes LineAO from the dumped files and
-/// `params.json` alone, as an outside implementation would.
-fn recompute_from_dump(variant: &str, outer: &str) {
+/// Renders with `--variant variant --dump` as `geometry` (lines or tubes), then recomputes LineAO
+/// from the dumped files and `params.json` alone, as an outside implementation would (for tubes
+/// with CONTRACT.md's r0(P) = 1.5 · z(P) · t_s / zoom_unit, t_s = 2 × `tube_radius_world`).
+fn recompute_from_dump(variant: &str, outer: &str, geometry: &str) {
     let (png, dump) = render_with_dump(
-        &format!("dump-{variant}-{outer}"),
-        &["--scene", "spiral", "--variant", variant, "--outer", outer, "--guard-max", "48"],
+        &format!("dump-{variant}-{outer}-{geometry}"),
+        &[
+            "--scene",
+            "spiral",
+            "--variant",
+            variant,
+            "--outer",
+            outer,
+            "--guard-max",
+            "48",
+            "--geometry",
+            geometry,
+            "--tube-radius",
+            "0.6",
+        ],
     );
 
     let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&png).unwrap()));
@@ -111,11 +130,13 @@ fn recompute_from_dump(variant: &str, outer: &str) {
         "paper" => &["r0_px", "delta0", "epsilon", "kd", "ks", "shininess"],
         _ => &["reference_radius_px", "zoom_fit"],
     };
+    let geometry_key = if geometry == "tubes" { "tube_radius_world" } else { "line_width_px" };
+    assert_eq!(params["geometry"], geometry);
     let common = [
+        geometry_key,
         "method",
         "variant",
         "geometry",
-        "line_width_px",
         "s_r",
         "s_h",
         "strength",
@@ -195,6 +216,7 @@ fn recompute_from_dump(variant: &str, outer: &str) {
         s_r,
         s_h,
         r0_px: get("r0_px"),
+        r0_zoom: 1.5 * 2.0 * get("tube_radius_world") / get("zoom_unit"),
         delta0: get("delta0"),
         epsilon: get("epsilon"),
         light_attenuation: params["light_attenuation"].as_bool().unwrap(),
@@ -210,7 +232,7 @@ fn recompute_from_dump(variant: &str, outer: &str) {
     let cpu_ao = reference::line_ao(&levels, &zoom, &triples(&noise), &triples(&samples), &p);
     let bound = if variant == "paper" { line_ao_flip_bound(s_r, s_h) } else { line_ao_reference_flip_bound(s_h) };
     let stats = check_policy(&gpu_ao, &cpu_ao, &levels[0], bound).unwrap();
-    println!("{variant}, outer = {outer}, recomputed from the dump: {stats}");
+    println!("{variant}, outer = {outer}, {geometry}, recomputed from the dump: {stats}");
     assert!(gpu_ao.data.iter().filter(|&&a| a > 0.1).count() > 1000);
 }
 
@@ -252,6 +274,7 @@ fn bench_json_is_the_contract() {
             "vo-line-5",
             "vo-area-1",
             "bilateral",
+            "tubes",
             "density-256",
             "sweep-256",
             "variance-volume-256"

@@ -39,6 +39,7 @@ use crate::passes::lines::{LineGeometry, LineRenderer};
 use crate::passes::nd_pyramid::NdPyramid;
 use crate::passes::ssao::Ssao;
 use crate::passes::ssao_blur::SsaoBlur;
+use crate::passes::tubes::TubeRenderer;
 use crate::passes::vo_area::VoArea;
 use crate::passes::vo_line::VoLine;
 use crate::passes::volume_ao::VolumeAo;
@@ -64,6 +65,8 @@ pub const PASS_NAMES: [&str; 11] = [
 pub struct AoChain {
     settings: ChainSettings,
     lines: LineRenderer,
+    /// Made when the settings ask for tubes.
+    tubes: Option<TubeRenderer>,
     pyramid: NdPyramid,
     line_ao: LineAo,
     ssao: Ssao,
@@ -91,6 +94,7 @@ impl AoChain {
         settings.validate()?;
         crate::gpu::validated(device, "creating the pass chain's pipelines", || AoChain {
             lines: LineRenderer::with_outputs(device, LineStyle::Quads, settings.volume.is_some()),
+            tubes: settings.tubes.as_ref().map(|_| TubeRenderer::new(device, settings.volume.is_some())),
             pyramid: NdPyramid::new(device),
             line_ao: LineAo::new(device, &settings.line_ao, &settings.lighting),
             ssao: Ssao::new(device, &settings.ssao),
@@ -143,10 +147,19 @@ impl AoChain {
                 self.vo_area.resize(device, targets);
             }
         }
-        if settings.volume.is_some() != self.lines.writes_octants() {
-            // Writing octants or not is a matter of the line pipelines.
-            self.lines = LineRenderer::with_outputs(device, LineStyle::Quads, settings.volume.is_some());
+        let octants = settings.volume.is_some();
+        if octants != self.lines.writes_octants() {
+            // Writing octants or not is a matter of the geometry pipelines.
+            self.lines = LineRenderer::with_outputs(device, LineStyle::Quads, octants);
             self.volume_ao = settings.volume.as_ref().map(|_| VolumeAo::new(device));
+        }
+        let tubes_match = match (&self.tubes, &settings.tubes) {
+            (Some(renderer), Some(_)) => renderer.writes_octants() == octants,
+            (None, None) => true,
+            _ => false,
+        };
+        if !tubes_match {
+            self.tubes = settings.tubes.as_ref().map(|_| TubeRenderer::new(device, octants));
         }
         // The pyramid's depth, whether moments and octants exist and what the composite shows
         // are bound at allocation.
@@ -247,8 +260,9 @@ impl AoChain {
                 // The widest hemisphere reads the deepest level, whose texels near the band's
                 // edge are filtered with clamp-to-edge: the band covers that reach too.
                 let deepest = s.line_ao.s_r - 1;
-                let radius = s.r0_px()
-                    + deepest as f32 * unguarded.zoom_max()
+                let r0 = s.r0();
+                let radius = r0.px
+                    + (r0.per_zoom + deepest as f32) * unguarded.zoom_max()
                     + camera::pyramid_reach(deepest)
                     + s.blur.as_ref().map_or(0.0, |b| b.radius_px as f32);
                 camera::guard_band(radius, s.line_ao.s_r, s.line_ao.guard_max_px)
@@ -299,9 +313,12 @@ impl AoChain {
         }
         let targets = self.targets.as_ref()?;
         let view = FrameView::new(camera, bounds, width, height, guard, s.zoom_unit);
-        self.lines.prepare(queue, &view, s.line_width_px, s.line_color, &s.lighting);
+        match (&self.tubes, &s.tubes) {
+            (Some(tubes), Some(t)) => tubes.prepare(queue, &view, t.radius_world, s.line_color, &s.lighting),
+            _ => self.lines.prepare(queue, &view, s.line_width_px, s.line_color, &s.lighting),
+        }
         match s.method {
-            AoMethod::LineAo => self.line_ao.prepare(queue, targets, &view, &s.line_ao, s.r0_px(), &s.lighting),
+            AoMethod::LineAo => self.line_ao.prepare(queue, targets, &view, &s.line_ao, s.r0(), &s.lighting),
             AoMethod::Ssao => self.ssao.prepare(queue, targets, &view, &s.ssao),
             AoMethod::VoLine => self.vo_line.prepare(queue, targets, &view, &s.vo),
             AoMethod::VoArea => self.vo_area.prepare(queue, targets, &view, &s.vo),
@@ -333,7 +350,11 @@ impl AoChain {
         }
         let span = |name| self.timer.as_ref().and_then(|t| t.span(name));
         encoder.push_debug_group("lineao");
-        self.lines.encode(encoder, targets, geometry, Load::Clear(self.settings.background), span("lines"));
+        let load = Load::Clear(self.settings.background);
+        match &self.tubes {
+            Some(tubes) => tubes.encode(encoder, targets, geometry, load, span("lines")),
+            None => self.lines.encode(encoder, targets, geometry, load, span("lines")),
+        }
         match self.settings.method {
             AoMethod::LineAo => {
                 if self.settings.levels() > 1 {

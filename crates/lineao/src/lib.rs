@@ -60,8 +60,8 @@ pub mod volume;
 pub use chain::AoChain;
 pub use gpu::Gpu;
 pub use settings::{
-    AoMethod, BilateralSettings, ChainSettings, DebugView, LineAoOuter, LineAoSettings, LineAoVariant, LineColor,
-    SsaoKernel, SsaoSettings, VoCombine, VoSettings, VolumeAoSettings,
+    AoMethod, BilateralSettings, ChainSettings, DebugView, LineAoOuter, LineAoSettings, LineAoVariant, LineColor, R0,
+    SsaoKernel, SsaoSettings, TubeSettings, VoCombine, VoSettings, VolumeAoSettings,
 };
 
 /// Pyramid levels (and so LineAO hemispheres) the shaders can bind.

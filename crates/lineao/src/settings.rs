@@ -328,6 +328,28 @@ pub enum LineColor {
     Constant([f32; 3]),
 }
 
+/// Streamlines as tubes (`lineao::passes::tubes`) instead of fixed-width lines.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TubeSettings {
+    /// Radius in world units (mm for tractograms) where the geometry carries no per-vertex
+    /// radius, > 0. LineAO's r0 follows it (paper Eq. 16).
+    pub radius_world: f32,
+}
+
+/// LineAO's first radius r0(P) = `px` + `per_zoom` · z(P) pixels: a constant for lines (1.5 ×
+/// the line width), 1.5 · t_s · z(P) for tubes of width t_s zoom units (paper Eq. 16).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct R0 {
+    pub px: f32,
+    pub per_zoom: f32,
+}
+
+impl From<f32> for R0 {
+    fn from(px: f32) -> R0 {
+        R0 { px, per_zoom: 0.0 }
+    }
+}
+
 /// Everything the pass chain needs to know besides the camera.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ChainSettings {
@@ -342,6 +364,8 @@ pub struct ChainSettings {
     pub lighting: Lighting,
     /// Line width in pixels, > 0. Default 2.
     pub line_width_px: f32,
+    /// Tubes instead of lines, or none. Default none.
+    pub tubes: Option<TubeSettings>,
     pub line_color: LineColor,
     /// Linear RGB of the background.
     pub background: [f32; 3],
@@ -363,6 +387,7 @@ impl Default for ChainSettings {
             volume: None,
             lighting: Lighting::default(),
             line_width_px: 2.0,
+            tubes: None,
             line_color: LineColor::Tangent,
             background: [1.0, 1.0, 1.0],
             strength: 1.0,
@@ -373,9 +398,17 @@ impl Default for ChainSettings {
 }
 
 impl ChainSettings {
-    /// r0 in pixels: the explicit value or 1.5 × the line width.
+    /// r0's constant part in pixels: the explicit value, or 1.5 × the line width (tubes: 0).
     pub fn r0_px(&self) -> f32 {
-        self.line_ao.r0_px.unwrap_or(1.5 * self.line_width_px)
+        let default = if self.tubes.is_some() { 0.0 } else { 1.5 * self.line_width_px };
+        self.line_ao.r0_px.unwrap_or(default)
+    }
+
+    /// r0(P) of LineAO (paper §3.2.3, Eq. 16): for tubes 1.5 · z(P) · t_s, t_s = 2 × the radius
+    /// in zoom units; an explicit `r0_px` replaces the default constant part.
+    pub fn r0(&self) -> R0 {
+        let per_zoom = self.tubes.as_ref().map_or(0.0, |t| 1.5 * 2.0 * t.radius_world / self.zoom_unit);
+        R0 { px: self.r0_px(), per_zoom }
     }
 
     /// Pyramid levels the chain needs: s_r for LineAO; one for plain lines and for the
@@ -399,6 +432,11 @@ impl ChainSettings {
         }
         if !(self.line_width_px.is_finite() && self.line_width_px > 0.0 && self.line_width_px <= 256.0) {
             return bad(format!("line width must be in (0, 256] px, got {}", self.line_width_px));
+        }
+        if let Some(tubes) = &self.tubes
+            && !(tubes.radius_world.is_finite() && tubes.radius_world > 0.0)
+        {
+            return bad(format!("the tube radius must be > 0 world units, got {}", tubes.radius_world));
         }
         if !(self.r0_px().is_finite() && self.r0_px() >= 0.0) {
             return bad(format!("r0 must be a finite number of pixels >= 0, got {}", self.r0_px()));

@@ -24,6 +24,7 @@ pub const FILES: &[(&str, &str)] = &[
     ("nd_pyramid.wgsl", include_str!("../shaders/nd_pyramid.wgsl")),
     ("ssao.wgsl", include_str!("../shaders/ssao.wgsl")),
     ("ssao_blur.wgsl", include_str!("../shaders/ssao_blur.wgsl")),
+    ("tubes.wgsl", include_str!("../shaders/tubes.wgsl")),
     ("vo_area.wgsl", include_str!("../shaders/vo_area.wgsl")),
     ("vo_line.wgsl", include_str!("../shaders/vo_line.wgsl")),
     ("volume_ao.wgsl", include_str!("../shaders/volume_ao.wgsl")),

@@ -48,6 +48,7 @@ fn light_weight_closed_form() {
         s_r: 3,
         s_h: 32,
         r0_px: 3.0,
+        r0_zoom: 0.0,
         delta0: 1e-4,
         epsilon: 1e-6,
         light_attenuation: true,

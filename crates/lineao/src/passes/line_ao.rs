@@ -75,7 +75,8 @@ pub struct LineAoUniform {
     /// Variant `reference`: radius_px / z_fit · (W, H) / max(W, H).
     pub reference_scale: [f32; 2],
     pub epsilon: f32,
-    pub _pad: u32,
+    /// r0's part per unit of zoom (tubes, Eq. 16): r0(P) = r0_px + r0_zoom · z(P).
+    pub r0_zoom: f32,
 }
 
 /// The `reference` variant's base radius per axis, in pixels per unit of zoom z(P) at d = 0.
@@ -270,18 +271,18 @@ impl LineAo {
         targets: &FrameTargets,
         view: &FrameView,
         settings: &LineAoSettings,
-        r0_px: f32,
+        r0: crate::R0,
         lighting: &Lighting,
     ) {
         let guard = targets.guard as i32;
         let uniform = LineAoUniform {
             levels: targets.levels_uniform(),
             noise_origin: [guard, guard],
-            r0_px,
+            r0_px: r0.px,
             delta0: settings.delta0,
             reference_scale: reference_scale(view, settings.reference_radius_px),
             epsilon: settings.epsilon,
-            _pad: 0,
+            r0_zoom: r0.per_zoom,
         };
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
         queue.write_buffer(&self.lighting, 0, bytemuck::bytes_of(&lighting.uniform()));

@@ -69,7 +69,7 @@ impl LinePoint {
     }
 }
 
-const POINT_SIZE: u64 = std::mem::size_of::<LinePoint>() as u64;
+pub(crate) const POINT_SIZE: u64 = std::mem::size_of::<LinePoint>() as u64;
 
 /// Default upper bound of one vertex buffer: below every adapter's buffer limit, and few
 /// enough chunks for the paper's 11 M-vertex tractogram (440 MB of strip).
@@ -250,7 +250,7 @@ pub struct LineAttributes {
     pub radius: f32,
 }
 
-const ATTRIBUTE_SIZE: u64 = std::mem::size_of::<LineAttributes>() as u64;
+pub(crate) const ATTRIBUTE_SIZE: u64 = std::mem::size_of::<LineAttributes>() as u64;
 
 impl LineGeometry {
     /// Uploads polylines `positions[offsets[i]..offsets[i + 1]]` (world units). Waits for the
@@ -358,6 +358,11 @@ impl LineGeometry {
         }
         device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| Error::Gpu(e.to_string()))?;
         Ok(())
+    }
+
+    /// Each chunk's strip buffer (padded), its vertex count and its attribute buffer.
+    pub(crate) fn chunk_buffers(&self) -> impl Iterator<Item = (&wgpu::Buffer, u32, Option<&wgpu::Buffer>)> {
+        self.chunks.iter().map(|c| (&c.vertices, c.count, c.attributes.as_ref()))
     }
 
     /// Whether [`LineGeometry::set_attributes`] gave every chunk attributes.

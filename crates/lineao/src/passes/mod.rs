@@ -10,6 +10,7 @@ pub mod moments;
 pub mod nd_pyramid;
 pub mod ssao;
 pub mod ssao_blur;
+pub mod tubes;
 pub mod vo_area;
 pub mod vo_line;
 pub mod volume_ao;

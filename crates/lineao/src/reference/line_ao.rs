@@ -18,6 +18,8 @@ pub struct LineAoParams {
     pub s_r: u32,
     pub s_h: u32,
     pub r0_px: f32,
+    /// Tubes (Eq. 16): r0(P) = r0_px + r0_zoom · z(P).
+    pub r0_zoom: f32,
     pub delta0: f32,
     pub epsilon: f32,
     pub light_attenuation: bool,
@@ -43,7 +45,8 @@ impl LineAoParams {
             reference_scale: crate::passes::line_ao::reference_scale(view, ao.reference_radius_px),
             s_r: ao.s_r,
             s_h: ao.s_h,
-            r0_px: settings.r0_px(),
+            r0_px: settings.r0().px,
+            r0_zoom: settings.r0().per_zoom,
             delta0: ao.delta0,
             epsilon: ao.epsilon,
             light_attenuation: ao.light_attenuation,
@@ -164,7 +167,7 @@ fn hemisphere(&Inputs { levels, zoom, noise, samples }: &Inputs, p: &LineAoParam
     let [cx, cy] = level_texel(pixel, [0.0, 0.0], scale, size);
     let centre = level.clamped(cx, cy);
     let n = Vec3::new(centre[0], centre[1], centre[2]);
-    let radius = p.r0_px + j as f32 * zoom.get(x, y);
+    let radius = p.r0_px + (p.r0_zoom + j as f32) * zoom.get(x, y);
     let delta_j = delta(j, p.s_r);
     let count = crate::noise::samples_on_hemisphere(p.s_h, j);
     let mut occlusion = 0.0f32;

@@ -8,6 +8,7 @@
 mod bilateral;
 mod line_ao;
 mod ssao;
+pub mod tubes;
 mod vo_area;
 mod vo_line;
 mod volume_ao;

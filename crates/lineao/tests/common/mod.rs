@@ -118,7 +118,7 @@ pub fn line_ao_on(
     pyramid.resize(d, &targets);
     let mut line_ao = LineAo::new(d, &settings.line_ao, &settings.lighting);
     line_ao.resize(d, &targets);
-    line_ao.prepare(q, &targets, &flat_view(w, h, guard), &settings.line_ao, settings.r0_px(), &settings.lighting);
+    line_ao.prepare(q, &targets, &flat_view(w, h, guard), &settings.line_ao, settings.r0(), &settings.lighting);
     let mut encoder = d.create_command_encoder(&Default::default());
     pyramid.encode(&mut encoder, &targets, None);
     line_ao.encode(&mut encoder, &targets, None);

@@ -1,0 +1,277 @@
+// Tube renderer: every segment a ray-cast rounded cone (two spheres of the ends' radii and the
+// cone tangent to both; a capsule for one radius) on a billboard that bounds its projection,
+// writing true depth, the surface's normal and the G-buffer of CONTRACT.md. Overlapping
+// billboards at the joints each ray-cast their own segment and the depth test keeps the nearest
+// hit, so a polyline renders as the exact union of its segments' solids: seamless joints.
+// `lineao::passes::tubes` documents the instancing; `lineao::reference::tubes` is the CPU side.
+#import shared/geometry.wgsl
+
+// The strip buffer read per instance with twice its stride: every left vertex (a point) and,
+// through a second binding 40 bytes ahead, the next point. Keep in sync with
+// `lineao::passes::lines::LinePoint`.
+struct Segment {
+    @location(0) a: vec3<f32>,
+    // xyz: unit world-space tangent; w: side and flags (`lineao::passes::lines::VertexFlags`).
+    @location(1) ta: vec4<f32>,
+    @location(2) b: vec3<f32>,
+    @location(3) tb: vec4<f32>,
+}
+
+// The attributes of both ends. Keep in sync with `lineao::passes::lines::LineAttributes`.
+struct SegmentAttributes {
+    @location(4) octants_a_lo: vec4<f32>,
+    @location(5) octants_a_hi: vec4<f32>,
+    @location(6) radius_a: f32,
+    @location(7) octants_b_lo: vec4<f32>,
+    @location(8) octants_b_hi: vec4<f32>,
+    @location(9) radius_b: f32,
+}
+
+struct TubeOut {
+    @builtin(position) clip: vec4<f32>,
+    // View-space ends and their radii, world units.
+    @location(0) @interpolate(flat) a: vec3<f32>,
+    @location(1) @interpolate(flat) b: vec3<f32>,
+    @location(2) @interpolate(flat) radii: vec2<f32>,
+    // Base colors and octant visibilities of both ends, mixed along the segment per pixel.
+    @location(3) @interpolate(flat) color_a: vec3<f32>,
+    @location(4) @interpolate(flat) color_b: vec3<f32>,
+    @location(5) @interpolate(flat) octants_a_lo: vec4<f32>,
+    @location(6) @interpolate(flat) octants_a_hi: vec4<f32>,
+    @location(7) @interpolate(flat) octants_b_lo: vec4<f32>,
+    @location(8) @interpolate(flat) octants_b_hi: vec4<f32>,
+    // The pixel's ray in view space, unnormalized: affine in screen space for either
+    // projection, so the rasterizer interpolates it exactly.
+    @location(9) ray_origin: vec3<f32>,
+    @location(10) ray_direction: vec3<f32>,
+}
+
+const FLAG_UNIT: f32 = 4000.0;
+const SEGMENT: u32 = 1u;
+
+fn flags(w: f32) -> u32 {
+    return u32(round(abs(w) * 32767.0 / FLAG_UNIT)) - 1u;
+}
+
+// Whether this instance is a segment: a left vertex where one starts, followed by the next
+// point's left vertex (a join's repeated vertices, or a run's last point, are none).
+fn is_segment(s: Segment) -> bool {
+    return s.ta.w > 0.0 && (flags(s.ta.w) & SEGMENT) != 0u && s.tb.w > 0.0;
+}
+
+// A bound of the screen radius in pixels of a sphere of radius `r` at view position `p`:
+// r f / (d − r) at depth d, stretched by (|p| / d)² toward the image's edges (a sphere off the
+// optical axis projects to an ellipse).
+fn screen_radius(p: vec3<f32>, r: f32) -> f32 {
+    if is_orthographic() {
+        return r * frame.f_px;
+    }
+    let d = -p.z;
+    if d <= r * 1.0001 {
+        return 2.0 * max(frame.viewport.x, frame.viewport.y);
+    }
+    let stretch = dot(p, p) / (d * d);
+    return r * frame.f_px / (d - r) * stretch;
+}
+
+fn to_pixels(clip: vec4<f32>) -> vec2<f32> {
+    return (clip.xy / clip.w * vec2<f32>(0.5, -0.5) + 0.5) * frame.viewport;
+}
+
+fn tube_vertex(vertex: u32, s: Segment, ra: f32, rb: f32) -> TubeOut {
+    var out: TubeOut;
+    let a = (frame.view * vec4<f32>(s.a, 1.0)).xyz;
+    let b = (frame.view * vec4<f32>(s.b, 1.0)).xyz;
+    out.a = a;
+    out.b = b;
+    out.radii = vec2<f32>(ra, rb);
+    out.color_a = base_color(s.ta.xyz);
+    out.color_b = base_color(s.tb.xyz);
+    // Not a segment, or an end behind the eye: a degenerate billboard (outside the clip volume).
+    if !is_segment(s) || (!is_orthographic() && (-a.z <= 0.0 || -b.z <= 0.0)) {
+        out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
+        return out;
+    }
+    // The billboard: the ends' disks on screen, hulled by a rectangle along the segment, one
+    // pixel wider all round. Corners 0..3 of the strip: (−, −), (−, +), (+, −), (+, +).
+    let clip_a = frame.proj * vec4<f32>(a, 1.0);
+    let clip_b = frame.proj * vec4<f32>(b, 1.0);
+    let pa = to_pixels(clip_a);
+    let pb = to_pixels(clip_b);
+    let reach_a = screen_radius(a, ra) + 1.0;
+    let reach_b = screen_radius(b, rb) + 1.0;
+    let along = select(vec2<f32>(1.0, 0.0), normalize(pb - pa), distance(pa, pb) > 1e-6);
+    let across = vec2<f32>(-along.y, along.x) * max(reach_a, reach_b);
+    let end = (vertex & 2u) != 0u;
+    let side = select(-1.0, 1.0, (vertex & 1u) != 0u);
+    let corner = select(pa - along * reach_a, pb + along * reach_b, end) + across * side;
+    // Back to clip space at the nearer end's depth: the fragment shader writes the true depth.
+    let near_clip = select(clip_b, clip_a, clip_a.z / clip_a.w < clip_b.z / clip_b.w);
+    let ndc = (corner / frame.viewport - 0.5) * vec2<f32>(2.0, -2.0);
+    out.clip = vec4<f32>(ndc, clamp(near_clip.z / near_clip.w, 0.0, 1.0), 1.0);
+    let near = frame.inv_proj * vec4<f32>(ndc, 0.0, 1.0);
+    let far = frame.inv_proj * vec4<f32>(ndc, 1.0, 1.0);
+    out.ray_origin = near.xyz / near.w;
+    out.ray_direction = far.xyz / far.w - out.ray_origin;
+    return out;
+}
+
+@vertex
+fn vs_tube(@builtin(vertex_index) vertex: u32, s: Segment) -> TubeOut {
+    var out = tube_vertex(vertex, s, frame.tube_radius, frame.tube_radius);
+    out.octants_a_lo = vec4<f32>(1.0);
+    out.octants_a_hi = vec4<f32>(1.0);
+    out.octants_b_lo = vec4<f32>(1.0);
+    out.octants_b_hi = vec4<f32>(1.0);
+    return out;
+}
+
+// With the geometry's attributes: per-vertex radii (0 = the frame's) and octant visibilities.
+@vertex
+fn vs_tube_attributes(@builtin(vertex_index) vertex: u32, s: Segment, at: SegmentAttributes) -> TubeOut {
+    let ra = select(frame.tube_radius, at.radius_a, at.radius_a > 0.0);
+    let rb = select(frame.tube_radius, at.radius_b, at.radius_b > 0.0);
+    var out = tube_vertex(vertex, s, ra, rb);
+    out.octants_a_lo = at.octants_a_lo;
+    out.octants_a_hi = at.octants_a_hi;
+    out.octants_b_lo = at.octants_b_lo;
+    out.octants_b_hi = at.octants_b_hi;
+    return out;
+}
+
+// The first hit of the ray ro + t rd (|rd| = 1) with the rounded cone between spheres (pa, ra)
+// and (pb, rb): (t, outward unit normal), or t < 0 for none. The body is the quadratic
+// k2 t² + 2 k1 t + k0 = 0 (either root may be the body's: squaring admits the mirrored cone
+// beyond the apex); the solid is convex, so its entry is the smallest t among the valid body
+// roots and the end spheres' entries. Derived in `lineao::reference::tubes::intersect_rounded_cone`;
+// keep the two in sync.
+fn intersect_rounded_cone(ro: vec3<f32>, rd: vec3<f32>, pa: vec3<f32>, pb: vec3<f32>, ra: f32, rb: f32) -> vec4<f32> {
+    let ba = pb - pa;
+    let oa = ro - pa;
+    let ob = ro - pb;
+    let rr = ra - rb;
+    let m0 = dot(ba, ba);
+    let m1 = dot(ba, oa);
+    let m2 = dot(ba, rd);
+    let m3 = dot(rd, oa);
+    let m5 = dot(oa, oa);
+    let m6 = dot(ob, rd);
+    let m7 = dot(ob, ob);
+    // x: t of the best hit so far (none: +inf), yzw: its normal.
+    var best = vec4<f32>(1e30, 0.0, 0.0, 0.0);
+    let d2 = m0 - rr * rr;
+    if d2 > 0.0 {
+        let k2 = d2 - m2 * m2;
+        let k1 = d2 * m3 - m1 * m2 + m2 * rr * ra;
+        let k0 = d2 * m5 - m1 * m1 + m1 * rr * ra * 2.0 - m0 * ra * ra;
+        let h = k1 * k1 - k0 * k2;
+        if h >= 0.0 && k2 != 0.0 {
+            let roots = array<f32, 2>((-sqrt(h) - k1) / k2, (sqrt(h) - k1) / k2);
+            // For k2 > 0 the first root enters the infinite cone, which holds the solid: on the
+            // body, it is the entry (the common case, decided without the spheres).
+            let y0 = m1 - ra * rr + roots[0] * m2;
+            if k2 > 0.0 && y0 > 0.0 && y0 < d2 {
+                return vec4<f32>(roots[0], normalize(d2 * (oa + roots[0] * rd) - ba * y0));
+            }
+            for (var i = 0; i < 2; i++) {
+                let t = roots[i];
+                let y = m1 - ra * rr + t * m2;
+                if y > 0.0 && y < d2 && t < best.x {
+                    best = vec4<f32>(t, normalize(d2 * (oa + t * rd) - ba * y));
+                }
+            }
+        }
+    }
+    // The end spheres' entries (a sphere holding the other leaves no body).
+    let h1 = m3 * m3 - m5 + ra * ra;
+    if h1 > 0.0 {
+        let t = -m3 - sqrt(h1);
+        if t < best.x {
+            best = vec4<f32>(t, (oa + t * rd) / ra);
+        }
+    }
+    let h2 = m6 * m6 - m7 + rb * rb;
+    if h2 > 0.0 {
+        let t = -m6 - sqrt(h2);
+        if t < best.x {
+            best = vec4<f32>(t, (ob + t * rd) / rb);
+        }
+    }
+    return select(best, vec4<f32>(-1.0), best.x >= 1e30);
+}
+
+struct TubeHit {
+    gbuffer: GBuffer,
+    // Position along the segment, 0 at a, 1 at b.
+    s: f32,
+    depth: f32,
+}
+
+// The pixel's ray, the hit and its G-buffer; discards a miss.
+fn tube_hit(in: TubeOut) -> TubeHit {
+    let ro = in.ray_origin;
+    let rd = normalize(in.ray_direction);
+    let hit = intersect_rounded_cone(ro, rd, in.a, in.b, in.radii.x, in.radii.y);
+    if hit.x < 0.0 {
+        discard;
+    }
+    let p = ro + hit.x * rd;
+    let n = hit.yzw;
+    let ab = in.b - in.a;
+    let s = clamp(dot(p - in.a, ab) / max(dot(ab, ab), 1e-30), 0.0, 1.0);
+
+    // Phong tubes: ambient (what LineAO darkens) and diffuse in the color, specular on top.
+    let v = -rd;
+    var diffuse = 0.0;
+    var specular = 0.0;
+    for (var k = 0u; k < lighting.count; k++) {
+        let light = lighting.lights[k];
+        diffuse += light.w * max(dot(n, light.xyz), 0.0);
+        specular += light.w * lighting.ks * clamped_pow(dot(n, normalize(light.xyz + v)), lighting.shininess);
+    }
+    let base = mix(in.color_a, in.color_b, s);
+    var out: TubeHit;
+    out.gbuffer.color = vec4<f32>(base * (1.0 - lighting.kd + lighting.kd * diffuse), 1.0);
+    out.gbuffer.nd = gbuffer_nd(p, n, frame.near, frame.far, is_orthographic());
+    out.gbuffer.zoom = gbuffer_zoom(p, frame.f_px, frame.zoom_unit, is_orthographic());
+    out.gbuffer.specular = specular;
+    out.s = s;
+    let clip = frame.proj * vec4<f32>(p, 1.0);
+    out.depth = clip.z / clip.w;
+    return out;
+}
+
+struct TubeFragment {
+    @builtin(frag_depth) depth: f32,
+    @location(0) color: vec4<f32>,
+    @location(1) nd: vec4<f32>,
+    @location(2) zoom: f32,
+    @location(3) specular: f32,
+}
+
+struct TubeFragmentOctants {
+    @builtin(frag_depth) depth: f32,
+    @location(0) color: vec4<f32>,
+    @location(1) nd: vec4<f32>,
+    @location(2) zoom: f32,
+    @location(3) specular: f32,
+    @location(4) octants: vec2<u32>,
+}
+
+@fragment
+fn fs_tube(in: TubeOut) -> TubeFragment {
+    let h = tube_hit(in);
+    let g = h.gbuffer;
+    return TubeFragment(h.depth, g.color, g.nd, g.zoom, g.specular);
+}
+
+@fragment
+fn fs_tube_octants(in: TubeOut) -> TubeFragmentOctants {
+    let h = tube_hit(in);
+    let g = with_octants(
+        h.gbuffer,
+        mix(in.octants_a_lo, in.octants_b_lo, h.s),
+        mix(in.octants_a_hi, in.octants_b_hi, h.s),
+    );
+    return TubeFragmentOctants(h.depth, g.color, g.nd, g.zoom, g.specular, g.octants);
+}
