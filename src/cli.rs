@@ -274,6 +274,13 @@ pub struct RenderArgs {
     /// Tubes: radius in world units [default: 0.5 mm].
     #[arg(long)]
     pub tube_radius: Option<f32>,
+    /// Context surface shown with the tracts (OBJ or glTF triangles, optionally gzipped); may be
+    /// given several times. It occludes the lines and is occluded, and the AO sees it.
+    #[arg(long = "surface", value_name = "MESH")]
+    pub surfaces: Vec<PathBuf>,
+    /// Linear RGB of the context surfaces.
+    #[arg(long, default_value = "0.8,0.8,0.8", value_parser = parse_vec3)]
+    pub surface_color: [f32; 3],
     /// Tubes: the file's per-vertex field holding each vertex's radius in world units (e.g. a
     /// TRX dpv or a .trk scalar); vertices without a positive value take --tube-radius.
     #[arg(long, requires = "file")]

@@ -8,12 +8,13 @@ use anyhow::{Context, Result};
 use glam::Vec3;
 use lineao::camera::{Bounds, Camera, Projection};
 use lineao::passes::lines::{LineGeometry, VertexAttributes};
+use lineao::passes::meshes::MeshGeometry;
 use lineao::volume::density::DensityOptions;
 use lineao::volume::sweep::SweepSettings;
 use lineao::volume::{ScalarForm, Sky, VertexVisibility, VolumeAoOptions, VolumeMethod};
 use lineao::{
     AoChain, AoMethod, BilateralSettings, ChainSettings, Gpu, LineAoOuter, LineAoSettings, LineAoVariant, LineColor,
-    SsaoKernel, SsaoSettings, TubeSettings, VoCombine, VoSettings, VolumeAoSettings,
+    SsaoKernel, SsaoSettings, SurfaceSettings, TubeSettings, VoCombine, VoSettings, VolumeAoSettings,
 };
 use lineao_tracts::scenes::ViewHint;
 
@@ -129,6 +130,7 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky) -> 
         line_width_px: args.line_width,
         tubes: (args.geometry == GeometryArg::Tubes)
             .then(|| TubeSettings { radius_world: tube_radius(args, zoom_unit) }),
+        surfaces: (!args.surfaces.is_empty()).then_some(SurfaceSettings { color: args.surface_color }),
         line_color: match args.color {
             ColorArg::Tangent => LineColor::Tangent,
             ColorArg::Constant(rgb) => LineColor::Constant(rgb),
@@ -229,6 +231,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         volume_options(VolumeMethod::Sweep).sweep.validate()?;
     }
 
+    let surfaces = args
+        .surfaces
+        .iter()
+        .map(|path| lineao_tracts::load_mesh(path).map_err(anyhow::Error::from))
+        .collect::<Result<Vec<_>>>()?;
     let radii = match &args.tube_radius_field {
         Some(field) => Some(vertex_radii(&tracts, field).with_context(|| name.clone())?),
         None => None,
@@ -236,7 +243,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 
     let gpu = Gpu::headless()?;
     let mut geometry = LineGeometry::new(&gpu.device, &gpu.queue, &tracts.positions, &tracts.offsets)?;
-    let bounds = geometry.bounds.with_context(|| format!("{name} has no finite points"))?;
+    let meshes = surfaces
+        .iter()
+        .map(|m| MeshGeometry::new(&gpu.device, &gpu.queue, &m.positions, &m.normals, &m.indices))
+        .collect::<Result<Vec<_>, _>>()?;
+    let bounds = meshes
+        .iter()
+        .filter_map(|m| m.bounds)
+        .fold(geometry.bounds.with_context(|| format!("{name} has no finite points"))?, |b, m| b.union(&m));
     if let Some(radius) = radii.as_deref() {
         let attributes = VertexAttributes { radius: Some(radius), ..Default::default() };
         geometry.set_attributes(&gpu.device, &gpu.queue, &tracts.positions, &tracts.offsets, &attributes)?;
@@ -271,7 +285,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             1 => dir.clone(),
             _ => dir.join(panel.label.replace(" (reference)", "-reference")),
         });
-        let frame = Frame { gpu: &gpu, geometry: &geometry, bounds, camera, args };
+        let meshes: Vec<&MeshGeometry> = meshes.iter().collect();
+        let frame = Frame { gpu: &gpu, geometry: &geometry, meshes: &meshes, bounds, camera, args };
         let volume = panel.volume.map(&volume_options);
         images.push(frame.render(panel, dump.as_deref(), volume.as_ref())?);
     }
@@ -314,6 +329,7 @@ fn vertex_radii(tracts: &lineao_tracts::Tractogram, field: &str) -> Result<Vec<f
 struct Frame<'a> {
     gpu: &'a Gpu,
     geometry: &'a LineGeometry,
+    meshes: &'a [&'a MeshGeometry],
     bounds: Bounds,
     camera: Camera,
     args: &'a RenderArgs,
@@ -335,7 +351,7 @@ impl Frame<'_> {
         let target = lineao::targets::Target::output(&gpu.device, "lineao::render::output", size, format);
         let mut encoder =
             gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::render") });
-        chain.encode(&mut encoder, self.geometry, &target.view);
+        chain.encode_with_meshes(&mut encoder, self.geometry, self.meshes, &target.view);
         let start = std::time::Instant::now();
         gpu.queue.submit([encoder.finish()]);
         if args.timings {

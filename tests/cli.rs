@@ -43,6 +43,8 @@ fn exit_codes() {
         (&["render", "--eye", "0,0,0", "--target", "0,0,0", "-o", png], "coincide"),
         (&["render", "--method", "ssao", "--ssao-kernel", "sphere", "--samples", "10", "-o", png], "sphere kernel"),
         (&["render", "--variant", "reference", "--outer", "level", "-o", png], "outer = level"),
+        (&["render", "--surface", "/nonexistent/hull.obj", "-o", png], "/nonexistent/hull.obj"),
+        (&["render", "--geometry", "tubes", "--tube-radius=-1", "-o", png], "tube radius"),
         (
             &["render", "--vertices", "2000", "--width", "64", "--height", "64", "-o", "/nonexistent/dir/x.png"],
             "/nonexistent/dir/x.png",
@@ -565,4 +567,24 @@ fn render_and_dump_let_an_outside_tool_recompute_object_space_ao() {
     let out = lineao(&["render", "--method", "sweep", "--sweep-alpha", "0", "-o", "/tmp/lineao-never.png"]);
     assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
     assert!(stderr(&out).contains("opacity"), "{}", stderr(&out));
+}
+
+/// `--surface` with the shared glTF sample's triangles, and `--geometry tubes`: one image each.
+#[test]
+fn surfaces_and_tubes_render() {
+    let dir = scratch("surfaces-tubes");
+    let mesh = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data/KhronosGroup+glTF-Sample-Models/2.0/MeshPrimitiveModes/glTF/MeshPrimitiveModes.gltf");
+    for (name, extra) in [
+        ("surface", vec!["--surface", mesh.to_str().unwrap(), "--surface-color", "0.9,0.7,0.5"]),
+        ("tubes", vec!["--geometry", "tubes", "--tube-radius", "0.8", "--method", "vo-line"]),
+    ] {
+        let png = dir.join(format!("{name}.png"));
+        let mut args = vec!["render", "--scene", "spiral", "--vertices", "5000", "--width", "96", "--height", "72"];
+        args.extend(extra);
+        args.extend(["-o", png.to_str().unwrap()]);
+        let out = lineao(&args);
+        assert_eq!(out.status.code(), Some(0), "{name}: {}", stderr(&out));
+        assert!(std::fs::metadata(&png).unwrap().len() > 100);
+    }
 }

@@ -22,16 +22,21 @@
 //!
 //! Any of them may be gzip-wrapped; the format is found from the content. Errors name the file,
 //! the byte offset and what was expected ([`Error`]); no header field sizes an allocation.
+//!
+//! Context surfaces (a brain hull shown with the tracts) load as a [`TriangleMesh`] from OBJ and
+//! glTF ([`load_mesh`]).
 
 mod error;
 pub mod formats;
 mod input;
 mod load;
+pub mod mesh;
 pub mod scenes;
 mod tractogram;
 
 pub use error::{Error, ErrorKind};
 pub use input::{Progress, ProgressFn};
 pub use load::{Compression, Format, LoadOptions, Loaded, load, load_from_bytes, load_with, parse_as, save};
+pub use mesh::{TriangleMesh, load_mesh};
 pub use scenes::{Scene, SceneKind, ViewHint};
 pub use tractogram::{Bounds, Field, Group, IDENTITY, Tractogram, VoxelSpace};

@@ -60,6 +60,20 @@ impl Bounds {
         let radius = finite().map(|p| p.distance(center)).fold(0.0f32, f32::max);
         Some(Bounds { center, radius: radius.max(1e-6) })
     }
+
+    /// The smallest sphere holding both spheres (for lines with context surfaces).
+    pub fn union(&self, other: &Bounds) -> Bounds {
+        let d = self.center.distance(other.center);
+        if d + other.radius <= self.radius {
+            return *self;
+        }
+        if d + self.radius <= other.radius {
+            return *other;
+        }
+        let radius = 0.5 * (d + self.radius + other.radius);
+        let center = self.center + (other.center - self.center) * ((radius - self.radius) / d);
+        Bounds { center, radius }
+    }
 }
 
 /// Everything about one frame's view that the passes need: matrices for the guard-banded

@@ -36,6 +36,7 @@ use crate::passes::composite::{Composite, Shown};
 use crate::passes::line_ao::LineAo;
 use crate::passes::lines::LineStyle;
 use crate::passes::lines::{LineGeometry, LineRenderer};
+use crate::passes::meshes::{MeshGeometry, MeshRenderer};
 use crate::passes::nd_pyramid::NdPyramid;
 use crate::passes::ssao::Ssao;
 use crate::passes::ssao_blur::SsaoBlur;
@@ -45,7 +46,7 @@ use crate::passes::vo_line::VoLine;
 use crate::passes::volume_ao::VolumeAo;
 use crate::settings::{AoMethod, ChainSettings, LineAoVariant};
 use crate::targets::{FrameTargets, Moments};
-use crate::timing::{PassTime, PassTimer};
+use crate::timing::{PassTime, PassTimer, Span};
 
 /// The spans of a timed frame, in chain order.
 pub const PASS_NAMES: [&str; 11] = [
@@ -67,6 +68,8 @@ pub struct AoChain {
     lines: LineRenderer,
     /// Made when the settings ask for tubes.
     tubes: Option<TubeRenderer>,
+    /// Made when the settings ask for context surfaces.
+    meshes: Option<MeshRenderer>,
     pyramid: NdPyramid,
     line_ao: LineAo,
     ssao: Ssao,
@@ -95,6 +98,7 @@ impl AoChain {
         crate::gpu::validated(device, "creating the pass chain's pipelines", || AoChain {
             lines: LineRenderer::with_outputs(device, LineStyle::Quads, settings.volume.is_some()),
             tubes: settings.tubes.as_ref().map(|_| TubeRenderer::new(device, settings.volume.is_some())),
+            meshes: settings.surfaces.as_ref().map(|_| MeshRenderer::new(device, settings.volume.is_some())),
             pyramid: NdPyramid::new(device),
             line_ao: LineAo::new(device, &settings.line_ao, &settings.lighting),
             ssao: Ssao::new(device, &settings.ssao),
@@ -160,6 +164,14 @@ impl AoChain {
         };
         if !tubes_match {
             self.tubes = settings.tubes.as_ref().map(|_| TubeRenderer::new(device, octants));
+        }
+        let meshes_match = match (&self.meshes, &settings.surfaces) {
+            (Some(renderer), Some(_)) => renderer.writes_octants() == octants,
+            (None, None) => true,
+            _ => false,
+        };
+        if !meshes_match {
+            self.meshes = settings.surfaces.as_ref().map(|_| MeshRenderer::new(device, octants));
         }
         // The pyramid's depth, whether moments and octants exist and what the composite shows
         // are bound at allocation.
@@ -317,6 +329,9 @@ impl AoChain {
             (Some(tubes), Some(t)) => tubes.prepare(queue, &view, t.radius_world, s.line_color, &s.lighting),
             _ => self.lines.prepare(queue, &view, s.line_width_px, s.line_color, &s.lighting),
         }
+        if let (Some(meshes), Some(surfaces)) = (&self.meshes, &s.surfaces) {
+            meshes.prepare(queue, &view, surfaces.color, &s.lighting);
+        }
         match s.method {
             AoMethod::LineAo => self.line_ao.prepare(queue, targets, &view, &s.line_ao, s.r0(), &s.lighting),
             AoMethod::Ssao => self.ssao.prepare(queue, targets, &view, &s.ssao),
@@ -344,6 +359,19 @@ impl AoChain {
     /// Records the frame into `encoder`, compositing into `target` (the visible size, the format
     /// given to `new`). Does nothing before the first `prepare` with a non-zero size.
     pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, geometry: &LineGeometry, target: &wgpu::TextureView) {
+        self.encode_with_meshes(encoder, geometry, &[], target);
+    }
+
+    /// [`AoChain::encode`] with context surfaces drawn after the lines into the same G-buffer
+    /// (with [`ChainSettings::surfaces`]; without them the meshes are not drawn). The frame's
+    /// `bounds` given to `prepare` should hold the meshes too.
+    pub fn encode_with_meshes(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        geometry: &LineGeometry,
+        meshes: &[&MeshGeometry],
+        target: &wgpu::TextureView,
+    ) {
         let Some(targets) = &self.targets else { return };
         if self.view.is_none() {
             return;
@@ -351,9 +379,17 @@ impl AoChain {
         let span = |name| self.timer.as_ref().and_then(|t| t.span(name));
         encoder.push_debug_group("lineao");
         let load = Load::Clear(self.settings.background);
+        // The lines' span covers the surfaces when there are any.
+        let (lines_span, meshes_span) = match (&self.meshes, meshes.is_empty()) {
+            (Some(_), false) => (span("lines").map(Span::begin_only), span("lines").map(Span::end_only)),
+            _ => (span("lines"), None),
+        };
         match &self.tubes {
-            Some(tubes) => tubes.encode(encoder, targets, geometry, load, span("lines")),
-            None => self.lines.encode(encoder, targets, geometry, load, span("lines")),
+            Some(tubes) => tubes.encode(encoder, targets, geometry, load, lines_span),
+            None => self.lines.encode(encoder, targets, geometry, load, lines_span),
+        }
+        if let (Some(renderer), false) = (&self.meshes, meshes.is_empty()) {
+            renderer.encode(encoder, targets, meshes, Load::Keep, meshes_span);
         }
         match self.settings.method {
             AoMethod::LineAo => {

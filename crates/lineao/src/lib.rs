@@ -61,7 +61,7 @@ pub use chain::AoChain;
 pub use gpu::Gpu;
 pub use settings::{
     AoMethod, BilateralSettings, ChainSettings, DebugView, LineAoOuter, LineAoSettings, LineAoVariant, LineColor, R0,
-    SsaoKernel, SsaoSettings, TubeSettings, VoCombine, VoSettings, VolumeAoSettings,
+    SsaoKernel, SsaoSettings, SurfaceSettings, TubeSettings, VoCombine, VoSettings, VolumeAoSettings,
 };
 
 /// Pyramid levels (and so LineAO hemispheres) the shaders can bind.

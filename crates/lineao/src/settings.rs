@@ -336,6 +336,19 @@ pub struct TubeSettings {
     pub radius_world: f32,
 }
 
+/// Context surfaces (`lineao::passes::meshes`) drawn with the lines.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SurfaceSettings {
+    /// Linear RGB of the surfaces. Default a light gray (0.8, 0.8, 0.8).
+    pub color: [f32; 3],
+}
+
+impl Default for SurfaceSettings {
+    fn default() -> Self {
+        SurfaceSettings { color: [0.8; 3] }
+    }
+}
+
 /// LineAO's first radius r0(P) = `px` + `per_zoom` · z(P) pixels: a constant for lines (1.5 ×
 /// the line width), 1.5 · t_s · z(P) for tubes of width t_s zoom units (paper Eq. 16).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -366,6 +379,9 @@ pub struct ChainSettings {
     pub line_width_px: f32,
     /// Tubes instead of lines, or none. Default none.
     pub tubes: Option<TubeSettings>,
+    /// Context surfaces drawn with the lines ([`crate::AoChain::encode_with_meshes`]), or none.
+    /// Default none.
+    pub surfaces: Option<SurfaceSettings>,
     pub line_color: LineColor,
     /// Linear RGB of the background.
     pub background: [f32; 3],
@@ -388,6 +404,7 @@ impl Default for ChainSettings {
             lighting: Lighting::default(),
             line_width_px: 2.0,
             tubes: None,
+            surfaces: None,
             line_color: LineColor::Tangent,
             background: [1.0, 1.0, 1.0],
             strength: 1.0,

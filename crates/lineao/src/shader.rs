@@ -20,6 +20,7 @@ pub const FILES: &[(&str, &str)] = &[
     ("composite.wgsl", include_str!("../shaders/composite.wgsl")),
     ("line_ao.wgsl", include_str!("../shaders/line_ao.wgsl")),
     ("lines.wgsl", include_str!("../shaders/lines.wgsl")),
+    ("meshes.wgsl", include_str!("../shaders/meshes.wgsl")),
     ("moments.wgsl", include_str!("../shaders/moments.wgsl")),
     ("nd_pyramid.wgsl", include_str!("../shaders/nd_pyramid.wgsl")),
     ("ssao.wgsl", include_str!("../shaders/ssao.wgsl")),

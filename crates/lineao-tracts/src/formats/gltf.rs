@@ -54,8 +54,9 @@ pub(crate) fn sniff(head: &[u8]) -> bool {
     text.trim_start().starts_with('{') && text.contains("\"asset\"")
 }
 
-/// `dir` is where external buffer files are looked up; `None` (bytes in memory) refuses them.
-pub(crate) fn read(bytes: &[u8], dir: Option<&Path>, limit: u64) -> Parse<Tractogram> {
+/// A parsed glTF document with its buffers loaded. `dir` is where external buffer files are
+/// looked up; `None` (bytes in memory) refuses them.
+pub(crate) fn open(bytes: &[u8], dir: Option<&Path>, limit: u64) -> Parse<(gltf::Document, Vec<Vec<u8>>)> {
     precheck(bytes)?;
     // The gltf crate has panicked on malformed input its validation should reject (found by our
     // fuzzer, see `precheck`); a panic there must not take the caller down.
@@ -99,11 +100,15 @@ pub(crate) fn read(bytes: &[u8], dir: Option<&Path>, limit: u64) -> Parse<Tracto
         }
         buffers.push(data);
     }
-    let mut t = Tractogram::new();
-    let mut triangles = 0usize;
-    let roots: Vec<gltf::Node> = match gltf.document.default_scene().or_else(|| gltf.document.scenes().next()) {
+    Ok((gltf.document, buffers))
+}
+
+/// Visits every mesh of the default scene's node tree (all root nodes when there is no scene)
+/// with its node's world transform.
+pub(crate) fn walk(document: &gltf::Document, mut visit: impl FnMut(&gltf::Mesh, Mat4) -> Parse<()>) -> Parse<()> {
+    let roots: Vec<gltf::Node> = match document.default_scene().or_else(|| document.scenes().next()) {
         Some(scene) => scene.nodes().collect(),
-        None => gltf.document.nodes().collect(),
+        None => document.nodes().collect(),
     };
     let mut stack: Vec<(gltf::Node, Mat4)> = roots.into_iter().map(|n| (n, Mat4::IDENTITY)).collect();
     let mut visited = 0usize;
@@ -116,7 +121,48 @@ pub(crate) fn read(bytes: &[u8], dir: Option<&Path>, limit: u64) -> Parse<Tracto
         for child in node.children() {
             stack.push((child, world));
         }
-        let Some(mesh) = node.mesh() else { continue };
+        if let Some(mesh) = node.mesh() {
+            visit(&mesh, world)?;
+        }
+    }
+    Ok(())
+}
+
+/// A primitive's positions in world space and its vertex indices (0..n without an index
+/// accessor), every index checked against the positions.
+pub(crate) fn primitive_vertices(
+    prim: &gltf::Primitive,
+    mesh: &gltf::Mesh,
+    world: Mat4,
+    buffers: &[Vec<u8>],
+) -> Parse<(Vec<[f32; 3]>, Vec<u32>)> {
+    use gltf::accessor::{DataType as D, Dimensions};
+    // The gltf crate's readers panic on accessors its validation lets through (wrong component
+    // types, views past the buffer): check what we read.
+    check_accessor(prim.get(&gltf::Semantic::Positions).as_ref(), buffers, &[D::F32], Dimensions::Vec3)?;
+    if prim.indices().is_some() {
+        check_accessor(prim.indices().as_ref(), buffers, &[D::U8, D::U16, D::U32], Dimensions::Scalar)?;
+    }
+    let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
+    let Some(positions) = reader.read_positions() else {
+        return bad(0, format!("POSITION data for a primitive of mesh {}", mesh.index()));
+    };
+    let points: Vec<[f32; 3]> = positions.map(|p| world.transform_point3(Vec3::from_array(p)).to_array()).collect();
+    let ids: Vec<u32> = match reader.read_indices() {
+        Some(i) => i.into_u32().collect(),
+        None => (0..points.len() as u32).collect(),
+    };
+    if let Some(&i) = ids.iter().find(|&&i| i as usize >= points.len()) {
+        return bad(0, format!("indices below {} in mesh {}, found {i}", points.len(), mesh.index()));
+    }
+    Ok((points, ids))
+}
+
+pub(crate) fn read(bytes: &[u8], dir: Option<&Path>, limit: u64) -> Parse<Tractogram> {
+    let (document, buffers) = open(bytes, dir, limit)?;
+    let mut t = Tractogram::new();
+    let mut triangles = 0usize;
+    walk(&document, |mesh, world| {
         for prim in mesh.primitives() {
             use gltf::mesh::Mode;
             let mode = prim.mode();
@@ -124,37 +170,7 @@ pub(crate) fn read(bytes: &[u8], dir: Option<&Path>, limit: u64) -> Parse<Tracto
                 triangles += 1;
                 continue;
             }
-            // The gltf crate's readers panic on accessors its validation lets through (wrong
-            // component types, views past the buffer): check the two we read.
-            let position = prim.get(&gltf::Semantic::Positions);
-            check_accessor(
-                position.as_ref(),
-                &buffers,
-                &[gltf::accessor::DataType::F32],
-                gltf::accessor::Dimensions::Vec3,
-            )?;
-            use gltf::accessor::DataType as D;
-            if prim.indices().is_some() {
-                check_accessor(
-                    prim.indices().as_ref(),
-                    &buffers,
-                    &[D::U8, D::U16, D::U32],
-                    gltf::accessor::Dimensions::Scalar,
-                )?;
-            }
-            let reader = prim.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
-            let Some(positions) = reader.read_positions() else {
-                return bad(0, format!("POSITION data for a line primitive of mesh {}", mesh.index()));
-            };
-            let points: Vec<[f32; 3]> =
-                positions.map(|p| world.transform_point3(Vec3::from_array(p)).to_array()).collect();
-            let ids: Vec<u32> = match reader.read_indices() {
-                Some(i) => i.into_u32().collect(),
-                None => (0..points.len() as u32).collect(),
-            };
-            if let Some(&i) = ids.iter().find(|&&i| i as usize >= points.len()) {
-                return bad(0, format!("indices below {} in mesh {}, found {i}", points.len(), mesh.index()));
-            }
+            let (points, ids) = primitive_vertices(&prim, mesh, world, &buffers)?;
             match mode {
                 Mode::LineStrip => t.push(ids.iter().map(|&i| points[i as usize])),
                 Mode::LineLoop => t.push(ids.iter().chain(ids.first()).map(|&i| points[i as usize])),
@@ -172,7 +188,8 @@ pub(crate) fn read(bytes: &[u8], dir: Option<&Path>, limit: u64) -> Parse<Tracto
                 }
             }
         }
-    }
+        Ok(())
+    })?;
     if t.streamlines() == 0 {
         return Err(ErrorKind::NoLines(format!("glTF with {triangles} non-line primitives and no line primitive")));
     }
@@ -180,13 +197,13 @@ pub(crate) fn read(bytes: &[u8], dir: Option<&Path>, limit: u64) -> Parse<Tracto
 }
 
 /// An accessor we read must exist, have the expected type and lie inside its buffer.
-fn check_accessor(
+pub(crate) fn check_accessor(
     accessor: Option<&gltf::Accessor>,
     buffers: &[Vec<u8>],
     types: &[gltf::accessor::DataType],
     dims: gltf::accessor::Dimensions,
 ) -> Parse<()> {
-    let Some(a) = accessor else { return bad(0, "a POSITION accessor on every line primitive") };
+    let Some(a) = accessor else { return bad(0, "a POSITION accessor on every primitive read") };
     if !types.contains(&a.data_type()) || a.dimensions() != dims {
         return bad(
             0,

@@ -6,6 +6,7 @@ pub mod bilateral;
 pub mod composite;
 pub mod line_ao;
 pub mod lines;
+pub mod meshes;
 pub mod moments;
 pub mod nd_pyramid;
 pub mod ssao;
