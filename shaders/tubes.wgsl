@@ -216,7 +216,8 @@ fn tube_hit(in: TubeOut) -> TubeHit {
         discard;
     }
     let p = ro + hit.x * rd;
-    let n = hit.yzw;
+    // Unit, as the ND map wants (an end sphere's (p − c) / r is only within rounding).
+    let n = normalize(hit.yzw);
     let ab = in.b - in.a;
     let s = clamp(dot(p - in.a, ab) / max(dot(ab, ab), 1e-30), 0.0, 1.0);
 

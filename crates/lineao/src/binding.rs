@@ -13,6 +13,10 @@ pub enum Slot {
     Texture,
     /// `texture_2d<u32>` read with `textureLoad`.
     UintTexture,
+    /// `texture_depth_2d`, or `texture_depth_multisampled_2d` when `multisampled`.
+    DepthTexture {
+        multisampled: bool,
+    },
     /// `texture_storage_2d<format, write>`.
     StorageTexture(wgpu::TextureFormat),
 }
@@ -45,6 +49,11 @@ pub fn layout(
                     sample_type: wgpu::TextureSampleType::Float { filterable: false },
                     view_dimension: wgpu::TextureViewDimension::D2,
                     multisampled: false,
+                },
+                Slot::DepthTexture { multisampled } => wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Depth,
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled,
                 },
                 Slot::UintTexture => wgpu::BindingType::Texture {
                     sample_type: wgpu::TextureSampleType::Uint,

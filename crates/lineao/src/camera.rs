@@ -137,6 +137,31 @@ impl FrameView {
         }
     }
 
+    /// The view of a host renderer's own `view` and `proj` matrices (wgpu clip space; any depth
+    /// convention: standard or reversed-Z, finite or infinite far plane) for a `width` × `height`
+    /// image without a guard band. The normalized depth range comes from `bounds` as for
+    /// [`FrameView::new`]; f_px = `proj[1][1]` · H / 2; the projection is orthographic when
+    /// its last row is (0, 0, 0, 1). The frustum must be symmetric.
+    pub fn from_matrices(view: Mat4, proj: Mat4, width: u32, height: u32, bounds: &Bounds, zoom_unit: f32) -> Self {
+        let c_z = view.transform_point3(bounds.center).z;
+        let r = bounds.radius;
+        let near = (-c_z - r).max(1e-3 * r);
+        let far = (-c_z + r).max(near * (1.0 + 1e-4) + 1e-6);
+        FrameView {
+            view,
+            proj,
+            width,
+            height,
+            guard: 0,
+            near,
+            far,
+            f_px: proj.y_axis.y * height.max(1) as f32 / 2.0,
+            zoom_unit,
+            orthographic: proj.row(3) == glam::Vec4::W,
+            scene_radius: r,
+        }
+    }
+
     /// Size of the guard-banded G-buffer.
     pub fn banded_size(&self) -> (u32, u32) {
         (self.width + 2 * self.guard, self.height + 2 * self.guard)

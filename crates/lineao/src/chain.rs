@@ -37,6 +37,7 @@ use crate::passes::line_ao::LineAo;
 use crate::passes::lines::LineStyle;
 use crate::passes::lines::{LineGeometry, LineRenderer};
 use crate::passes::meshes::{MeshGeometry, MeshRenderer};
+use crate::passes::nd_from_depth::{HostConfig, HostInputs, NdFromDepth};
 use crate::passes::nd_pyramid::NdPyramid;
 use crate::passes::ssao::Ssao;
 use crate::passes::ssao_blur::SsaoBlur;
@@ -70,6 +71,8 @@ pub struct AoChain {
     tubes: Option<TubeRenderer>,
     /// Made when the settings ask for context surfaces.
     meshes: Option<MeshRenderer>,
+    /// Made by [`AoChain::enable_host`].
+    host: Option<NdFromDepth>,
     pyramid: NdPyramid,
     line_ao: LineAo,
     ssao: Ssao,
@@ -99,6 +102,7 @@ impl AoChain {
             lines: LineRenderer::with_outputs(device, LineStyle::Quads, settings.volume.is_some()),
             tubes: settings.tubes.as_ref().map(|_| TubeRenderer::new(device, settings.volume.is_some())),
             meshes: settings.surfaces.as_ref().map(|_| MeshRenderer::new(device, settings.volume.is_some())),
+            host: None,
             pyramid: NdPyramid::new(device),
             line_ao: LineAo::new(device, &settings.line_ao, &settings.lighting),
             ssao: Ssao::new(device, &settings.ssao),
@@ -298,6 +302,20 @@ impl AoChain {
             return None;
         }
         let guard = self.guard_for(camera, bounds);
+        let view = FrameView::new(camera, bounds, width, height, guard, self.settings.zoom_unit);
+        self.prepare_view(device, queue, view)
+    }
+
+    /// [`AoChain::prepare`] for a view made elsewhere: a host's own matrices
+    /// ([`FrameView::from_matrices`], no guard band) for [`AoChain::encode_host`]. Its size must
+    /// be the chain's.
+    pub fn prepare_view(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, view: FrameView) -> Option<FrameView> {
+        let (width, height) = self.size;
+        if width == 0 || height == 0 || (view.width, view.height) != (width, height) {
+            self.view = None;
+            return None;
+        }
+        let guard = view.guard;
         let s = &self.settings;
         let levels = s.levels();
         let stale = self.targets.as_ref().is_none_or(|t| t.guard != guard || t.nd.len() != levels as usize);
@@ -324,7 +342,9 @@ impl AoChain {
             self.targets = Some(targets);
         }
         let targets = self.targets.as_ref()?;
-        let view = FrameView::new(camera, bounds, width, height, guard, s.zoom_unit);
+        if let Some(host) = &self.host {
+            host.prepare(queue, &view);
+        }
         match (&self.tubes, &s.tubes) {
             (Some(tubes), Some(t)) => tubes.prepare(queue, &view, t.radius_world, s.line_color, &s.lighting),
             _ => self.lines.prepare(queue, &view, s.line_width_px, s.line_color, &s.lighting),
@@ -354,6 +374,56 @@ impl AoChain {
         self.composite.prepare(queue, targets, strength, s.debug_view, view.zoom_max(), shown);
         self.view = Some(view);
         Some(view)
+    }
+
+    /// Makes the chain ready for a host renderer's own buffers ([`AoChain::encode_host`]): its
+    /// depth's samples and convention and whether it has normals. Host frames use
+    /// [`AoChain::prepare_view`] with the host's matrices.
+    pub fn enable_host(&mut self, device: &wgpu::Device, config: HostConfig) -> Result<(), Error> {
+        if config.depth_samples == 0 || config.depth_samples > 32 {
+            return Err(Error::InvalidSettings(format!(
+                "depth samples must be in 1..=32, got {}",
+                config.depth_samples
+            )));
+        }
+        if self.host.as_ref().is_none_or(|h| h.config() != config) {
+            self.host =
+                Some(crate::gpu::validated(device, "creating the host pass", || NdFromDepth::new(device, config))?);
+        }
+        Ok(())
+    }
+
+    /// Records a frame over a host renderer's own buffers (after [`AoChain::enable_host`] and
+    /// [`AoChain::prepare_view`]): the G-buffer derived from its depth, normals and color
+    /// ([`crate::passes::nd_from_depth`]), the method, and the composite into `target`; or only
+    /// the AO (`target` `None`), which the host then reads from [`AoChain::ao_view`].
+    pub fn encode_host(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        encoder: &mut wgpu::CommandEncoder,
+        inputs: &HostInputs,
+        target: Option<&wgpu::TextureView>,
+    ) {
+        let (Some(targets), Some(host), Some(_)) = (&self.targets, &self.host, &self.view) else { return };
+        let span = |name| self.timer.as_ref().and_then(|t| t.span(name));
+        encoder.push_debug_group("lineao");
+        host.encode(device, queue, encoder, targets, inputs, span("lines"));
+        self.encode_method(encoder, targets, &span);
+        if let Some(target) = target {
+            self.composite.encode(encoder, target, span("composite"));
+        }
+        if let Some(timer) = &self.timer {
+            timer.resolve(encoder);
+        }
+        encoder.pop_debug_group();
+    }
+
+    /// The occlusion the composite shows (after the blur when there is one): what a host that
+    /// lights its own pixels samples. `None` before the first `prepare`.
+    pub fn ao_view(&self) -> Option<&wgpu::TextureView> {
+        let targets = self.targets.as_ref()?;
+        Some(if self.settings.blur.is_some() { &targets.ao_blurred.view } else { &targets.ao.view })
     }
 
     /// Records the frame into `encoder`, compositing into `target` (the visible size, the format
@@ -391,6 +461,21 @@ impl AoChain {
         if let (Some(renderer), false) = (&self.meshes, meshes.is_empty()) {
             renderer.encode(encoder, targets, meshes, Load::Keep, meshes_span);
         }
+        self.encode_method(encoder, targets, &span);
+        self.composite.encode(encoder, target, span("composite"));
+        if let Some(timer) = &self.timer {
+            timer.resolve(encoder);
+        }
+        encoder.pop_debug_group();
+    }
+
+    /// The method, its blur and object-space AO over a G-buffer already written.
+    fn encode_method<'s>(
+        &'s self,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &FrameTargets,
+        span: &dyn Fn(&'static str) -> Option<Span<'s>>,
+    ) {
         match self.settings.method {
             AoMethod::LineAo => {
                 if self.settings.levels() > 1 {
@@ -412,11 +497,6 @@ impl AoChain {
         if let Some(pass) = &self.volume_ao {
             pass.encode(encoder, targets, span("volume-ao"));
         }
-        self.composite.encode(encoder, target, span("composite"));
-        if let Some(timer) = &self.timer {
-            timer.resolve(encoder);
-        }
-        encoder.pop_debug_group();
     }
 
     /// The targets of the last `prepare` (for readback, debugging, or a host's own passes).

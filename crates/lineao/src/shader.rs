@@ -22,6 +22,7 @@ pub const FILES: &[(&str, &str)] = &[
     ("lines.wgsl", include_str!("../shaders/lines.wgsl")),
     ("meshes.wgsl", include_str!("../shaders/meshes.wgsl")),
     ("moments.wgsl", include_str!("../shaders/moments.wgsl")),
+    ("nd_from_depth.wgsl", include_str!("../shaders/nd_from_depth.wgsl")),
     ("nd_pyramid.wgsl", include_str!("../shaders/nd_pyramid.wgsl")),
     ("ssao.wgsl", include_str!("../shaders/ssao.wgsl")),
     ("ssao_blur.wgsl", include_str!("../shaders/ssao_blur.wgsl")),
@@ -70,8 +71,15 @@ fn append(path: &str, out: &mut String, seen: &mut Vec<String>) {
 
 /// A shader module from the composed `path`, labelled `lineao::<path>`.
 pub fn module(device: &wgpu::Device, path: &str) -> wgpu::ShaderModule {
+    module_with(device, path, &[])
+}
+
+/// [`module`] with textual `replacements` (from, to) applied: a binding's type that override
+/// constants cannot change (e.g. `texture_depth_2d` → `texture_depth_multisampled_2d`).
+pub fn module_with(device: &wgpu::Device, path: &str, replacements: &[(&str, &str)]) -> wgpu::ShaderModule {
+    let source = replacements.iter().fold(compose(path), |s, (from, to)| s.replace(from, to));
     device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(&format!("lineao::{path}")),
-        source: wgpu::ShaderSource::Wgsl(Cow::Owned(compose(path))),
+        source: wgpu::ShaderSource::Wgsl(Cow::Owned(source)),
     })
 }

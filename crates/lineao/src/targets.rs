@@ -185,8 +185,10 @@ impl FrameTargets {
     pub fn new(device: &wgpu::Device, width: u32, height: u32, guard: u32, levels: u32) -> FrameTargets {
         use wgpu::TextureUsages as U;
         let size = (width + 2 * guard, height + 2 * guard);
-        // COPY_DST lets a host (or a test) write a G-buffer of its own into the targets.
+        // COPY_DST lets a host (or a test) write a G-buffer of its own into the targets, storage
+        // the pass that derives it from a host's depth.
         let attachment = U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC | U::COPY_DST;
+        let gbuffer = attachment | U::STORAGE_BINDING;
         let ao_usage = U::STORAGE_BINDING | U::TEXTURE_BINDING | U::COPY_SRC | U::COPY_DST;
         let level_usage = U::STORAGE_BINDING | U::TEXTURE_BINDING | U::COPY_SRC;
         let sizes = level_sizes(size, levels.max(1));
@@ -194,7 +196,7 @@ impl FrameTargets {
             .iter()
             .enumerate()
             .map(|(j, &level)| {
-                let usage = if j == 0 { attachment } else { level_usage };
+                let usage = if j == 0 { gbuffer } else { level_usage };
                 Target::new(device, &format!("lineao::FrameTargets::nd[{j}]"), level, ND_FORMAT, usage)
             })
             .collect();
@@ -206,10 +208,10 @@ impl FrameTargets {
         FrameTargets {
             size,
             guard,
-            color: Target::new(device, "lineao::FrameTargets::color", size, COLOR_FORMAT, attachment),
+            color: Target::new(device, "lineao::FrameTargets::color", size, COLOR_FORMAT, gbuffer),
             nd,
-            zoom: Target::new(device, "lineao::FrameTargets::zoom", size, ZOOM_FORMAT, attachment),
-            specular: Target::new(device, "lineao::FrameTargets::specular", size, SPECULAR_FORMAT, attachment),
+            zoom: Target::new(device, "lineao::FrameTargets::zoom", size, ZOOM_FORMAT, gbuffer),
+            specular: Target::new(device, "lineao::FrameTargets::specular", size, SPECULAR_FORMAT, gbuffer),
             depth: Target::new(device, "lineao::FrameTargets::depth", size, DEPTH_FORMAT, attachment),
             ao: Target::new(device, "lineao::FrameTargets::ao", size, AO_FORMAT, ao_usage),
             ao_raw: Target::new(device, "lineao::FrameTargets::ao_raw", size, AO_FORMAT, ao_usage),

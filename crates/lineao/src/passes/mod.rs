@@ -8,6 +8,7 @@ pub mod line_ao;
 pub mod lines;
 pub mod meshes;
 pub mod moments;
+pub mod nd_from_depth;
 pub mod nd_pyramid;
 pub mod ssao;
 pub mod ssao_blur;

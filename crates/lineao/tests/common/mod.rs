@@ -158,3 +158,119 @@ pub fn cameras_for_polylines() -> (Camera, Camera) {
     };
     (perspective, Camera { projection: lineao::camera::Projection::Orthographic { height: 110.0 }, ..perspective })
 }
+
+/// A minimal host renderer: `triangles` (world positions, three per triangle) into a new
+/// Depth32Float texture of `size` with `samples` per pixel, through `view_proj`, cleared to
+/// 1 (or 0 with `reversed_z`, testing Greater), as a renderer that is not ours would.
+pub fn host_depth(
+    gpu: &Gpu,
+    triangles: &[[f32; 3]],
+    view_proj: glam::Mat4,
+    size: (u32, u32),
+    samples: u32,
+    reversed_z: bool,
+) -> wgpu::Texture {
+    use wgpu::util::DeviceExt;
+    let d = &gpu.device;
+    let texture = d.create_texture(&wgpu::TextureDescriptor {
+        label: Some("test::host_depth"),
+        size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: samples,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Depth32Float,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        view_formats: &[],
+    });
+    let shader = d.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("test::host"),
+        source: wgpu::ShaderSource::Wgsl(
+            "@group(0) @binding(0) var<uniform> view_proj: mat4x4<f32>;
+             @vertex fn vs(@location(0) p: vec3<f32>) -> @builtin(position) vec4<f32> { return view_proj * vec4<f32>(p, 1.0); }"
+                .into(),
+        ),
+    });
+    let uniform = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: None,
+        contents: bytemuck::bytes_of(&view_proj.to_cols_array()),
+        usage: wgpu::BufferUsages::UNIFORM,
+    });
+    let vertices = d.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: None,
+        contents: bytemuck::cast_slice(triangles),
+        usage: wgpu::BufferUsages::VERTEX,
+    });
+    let pipeline = d.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("test::host"),
+        layout: None,
+        vertex: wgpu::VertexState {
+            module: &shader,
+            entry_point: Some("vs"),
+            compilation_options: Default::default(),
+            buffers: &[Some(wgpu::VertexBufferLayout {
+                array_stride: 12,
+                step_mode: wgpu::VertexStepMode::Vertex,
+                attributes: &wgpu::vertex_attr_array![0 => Float32x3],
+            })],
+        },
+        primitive: Default::default(),
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: wgpu::TextureFormat::Depth32Float,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(if reversed_z { wgpu::CompareFunction::Greater } else { wgpu::CompareFunction::Less }),
+            stencil: Default::default(),
+            bias: Default::default(),
+        }),
+        multisample: wgpu::MultisampleState { count: samples, ..Default::default() },
+        fragment: None,
+        multiview_mask: None,
+        cache: None,
+    });
+    let group = d.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() }],
+    });
+    let view = texture.create_view(&Default::default());
+    let mut encoder = d.create_command_encoder(&Default::default());
+    {
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("test::host"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &view,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(if reversed_z { 0.0 } else { 1.0 }),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &group, &[]);
+        pass.set_vertex_buffer(0, vertices.slice(..));
+        pass.draw(0..triangles.len() as u32, 0..1);
+    }
+    gpu.queue.submit([encoder.finish()]);
+    texture
+}
+
+/// A UV sphere of `radius` around `centre` as a triangle list (`rings` × 2 `rings` quads).
+pub fn sphere_triangles(centre: glam::Vec3, radius: f32, rings: usize) -> Vec<[f32; 3]> {
+    let point = |i: usize, j: usize| {
+        let (theta, phi) =
+            (std::f32::consts::PI * i as f32 / rings as f32, std::f32::consts::PI * j as f32 / rings as f32);
+        (centre + radius * glam::Vec3::new(theta.sin() * phi.cos(), theta.cos(), theta.sin() * phi.sin())).to_array()
+    };
+    let mut out = Vec::new();
+    for i in 0..rings {
+        for j in 0..2 * rings {
+            let (a, b, c, e) = (point(i, j), point(i + 1, j), point(i + 1, j + 1), point(i, j + 1));
+            out.extend([a, b, c, a, c, e]);
+        }
+    }
+    out
+}

@@ -1,0 +1,308 @@
+//! Embedding in a host renderer: the ND and zoom maps derived from a host's depth (and normals)
+//! against the ones our renderers write; reversed-Z and standard depth, MSAA and single
+//! samples, perspective and orthographic cameras against an analytic sphere; and the composite
+//! into the host's color formats.
+
+mod common;
+
+use common::{cameras_for_polylines, gpu, host_depth, is_geometry, polylines, sphere_triangles};
+use glam::{Mat4, Vec3, Vec4Swizzles};
+use lineao::camera::{Bounds, Camera, FrameView, Projection};
+use lineao::passes::lines::LineGeometry;
+use lineao::passes::nd_from_depth::{HostConfig, HostInputs, HostNormals};
+use lineao::reference::tubes::pixel_ray;
+use lineao::reference::{Image, NdImage};
+use lineao::verify::{read_f32, read_rgba};
+use lineao::{AoChain, AoMethod, ChainSettings, TubeSettings};
+
+/// What the host path leaves in the chain's targets.
+struct HostFrame {
+    nd: NdImage,
+    zoom: Image<f32>,
+    ao: Image<f32>,
+}
+
+/// Runs a chain with `settings` over a host's `depth` (and `normals`) seen through `view`.
+fn run_host(
+    gpu: &lineao::Gpu,
+    settings: ChainSettings,
+    config: HostConfig,
+    view: FrameView,
+    depth: &wgpu::TextureView,
+    normals: Option<&wgpu::TextureView>,
+) -> HostFrame {
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let mut chain = AoChain::new(d, common::OUTPUT_FORMAT, settings).unwrap();
+    chain.resize(view.width, view.height).unwrap();
+    chain.enable_host(d, config).unwrap();
+    chain.prepare_view(d, q, view).unwrap();
+    let mut encoder = d.create_command_encoder(&Default::default());
+    chain.encode_host(d, q, &mut encoder, &HostInputs { depth, normals, color: None }, None);
+    q.submit([encoder.finish()]);
+    let t = chain.targets().unwrap();
+    HostFrame {
+        nd: read_rgba(d, q, &t.nd[0]).unwrap(),
+        zoom: read_f32(d, q, &t.zoom).unwrap(),
+        ao: read_f32(d, q, &t.ao).unwrap(),
+    }
+}
+
+/// The angle between two normals, stable near 0 (acos of a dot product near 1 is not).
+fn angle(a: [f32; 4], b: [f32; 4]) -> f32 {
+    let (a, b) = (Vec3::new(a[0], a[1], a[2]).normalize(), Vec3::new(b[0], b[1], b[2]).normalize());
+    2.0 * (0.5 * a.distance(b)).min(1.0).asin()
+}
+
+fn percentile(mut v: Vec<f32>, p: f32) -> f32 {
+    v.sort_by(f32::total_cmp);
+    v[((v.len() - 1) as f32 * p) as usize]
+}
+
+#[test]
+fn maps_derived_from_depth_match_the_ones_the_renderers_write() {
+    let gpu = gpu();
+    let (positions, offsets) = polylines(25, 0.9);
+    let geometry = LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap();
+    let (perspective, orthographic) = cameras_for_polylines();
+    let size = (240u32, 180u32);
+    for (name, camera, tubes) in [
+        ("tubes, perspective", perspective, true),
+        ("tubes, orthographic", orthographic, true),
+        ("lines, perspective", perspective, false),
+    ] {
+        // Our renderer: tubes (true depth and normals) or lines, no guard band (method none).
+        let ours = ChainSettings {
+            method: AoMethod::None,
+            tubes: tubes.then_some(TubeSettings { radius_world: 2.5 }),
+            line_width_px: 4.0,
+            ..ChainSettings::default()
+        };
+        let (d, q) = (&gpu.device, &gpu.queue);
+        let mut chain = AoChain::new(d, common::OUTPUT_FORMAT, ours).unwrap();
+        chain.resize(size.0, size.1).unwrap();
+        let view = chain.prepare(d, q, &camera, &geometry.bounds.unwrap()).unwrap();
+        assert_eq!(view.guard, 0);
+        let output = lineao::targets::Target::output(d, "test::output", size, common::OUTPUT_FORMAT);
+        let mut encoder = d.create_command_encoder(&Default::default());
+        chain.encode(&mut encoder, &geometry, &output.view);
+        q.submit([encoder.finish()]);
+        let t = chain.targets().unwrap();
+        let (nd, zoom) = (read_rgba(d, q, &t.nd[0]).unwrap(), read_f32(d, q, &t.zoom).unwrap());
+
+        // The host path over that depth, with the same matrices.
+        let host_view = FrameView::from_matrices(view.view, view.proj, size.0, size.1, &geometry.bounds.unwrap(), 1.0);
+        assert_eq!((host_view.near, host_view.far, host_view.f_px), (view.near, view.far, view.f_px));
+        assert_eq!(host_view.orthographic, view.orthographic);
+        let derived = run_host(&gpu, ChainSettings::default(), HostConfig::default(), host_view, &t.depth.view, None);
+        let (mut worst_d, mut worst_zoom, mut angles) = (0.0f32, 0.0f32, Vec::new());
+        for i in 0..nd.data.len() {
+            assert_eq!(is_geometry(nd.data[i]), is_geometry(derived.nd.data[i]), "{name}: coverage at {i}");
+            if is_geometry(nd.data[i]) {
+                worst_d = worst_d.max((nd.data[i][3] - derived.nd.data[i][3]).abs());
+                worst_zoom = worst_zoom.max((zoom.data[i] / derived.zoom.data[i] - 1.0).abs());
+                angles.push(angle(nd.data[i], derived.nd.data[i]));
+            }
+        }
+        let (median, p75, p90) =
+            (percentile(angles.clone(), 0.5), percentile(angles.clone(), 0.75), percentile(angles.clone(), 0.9));
+        println!(
+            "{name}: {} pixels; worst |Δd| {worst_d:.1e}, zoom relative {worst_zoom:.1e}; normal angle from depth \
+             median {median:.3}, 75 % {p75:.3}, 90 % {p90:.3} rad",
+            angles.len()
+        );
+        assert!(angles.len() > 3000, "{name}");
+        assert!(worst_d < 1e-5 && worst_zoom < 1e-5, "{name}");
+        if tubes {
+            // Reconstructed from one-pixel differences of tubes 8 to 12 pixels wide: good inside,
+            // poor on the outer rim, where the surface turns away within a pixel (a host with
+            // thin geometry passes its normals, which are exact).
+            assert!(median < 0.06 && p75 < 0.2, "{name}");
+            // With the host's own normals (ours, as view-space floats) they are exact.
+            let normals = lineao::targets::Target::new(
+                d,
+                "test::normals",
+                size,
+                wgpu::TextureFormat::Rgba32Float,
+                wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            );
+            lineao::verify::write_target(q, &normals, &nd);
+            let config =
+                HostConfig { normals: Some(HostNormals { world_space: false, unorm: false }), ..Default::default() };
+            let given = run_host(&gpu, ChainSettings::default(), config, host_view, &t.depth.view, Some(&normals.view));
+            let worst = (0..nd.data.len())
+                .filter(|&i| is_geometry(nd.data[i]))
+                .map(|i| angle(nd.data[i], given.nd.data[i]))
+                .fold(0.0f32, f32::max);
+
+            assert!(worst < 1e-3, "{name}: host normals off by {worst}");
+            // LineAO over the derived G-buffer obscures the bundle.
+            assert!(given.ao.data.iter().filter(|&&a| a > 0.05).count() > 300, "{name}");
+        }
+    }
+}
+
+/// The reversed-Z (near at 1, far at 0) variant of a wgpu projection: z' = w − z.
+fn reversed(proj: Mat4) -> Mat4 {
+    let flip = Mat4::from_cols(
+        glam::Vec4::X,
+        glam::Vec4::Y,
+        glam::Vec4::new(0.0, 0.0, -1.0, 0.0),
+        glam::Vec4::new(0.0, 0.0, 1.0, 1.0),
+    );
+    flip * proj
+}
+
+#[test]
+fn reversed_z_msaa_and_both_projections_against_an_analytic_sphere() {
+    let gpu = gpu();
+    let (centre, radius) = (Vec3::new(1.0, -2.0, 0.0), 10.0f32);
+    let triangles = sphere_triangles(centre, radius, 64);
+    let bounds = Bounds { center: centre, radius };
+    let size = (200u32, 150u32);
+    let camera = Camera {
+        eye: Vec3::new(6.0, 9.0, 42.0),
+        target: centre,
+        up: Vec3::Y,
+        projection: Projection::Perspective { fov_y_deg: 45.0 },
+    };
+    let view_matrix = camera.view_matrix();
+    let aspect = size.0 as f32 / size.1 as f32;
+    use glam::camera::rh::proj::directx;
+    let perspective = directx::perspective(45f32.to_radians(), aspect, 5.0, 200.0);
+    let orthographic = directx::orthographic(-14.0 * aspect, 14.0 * aspect, -14.0, 14.0, 5.0, 200.0);
+    let mut results: Vec<(String, HostFrame)> = Vec::new();
+    for (projection_name, standard) in [("perspective", perspective), ("orthographic", orthographic)] {
+        for (reversed_z, samples) in [(false, 1), (true, 1), (false, 4), (true, 4)] {
+            let name = format!(
+                "{projection_name}, {}, {samples} sample(s)",
+                if reversed_z { "reversed-Z" } else { "standard" }
+            );
+            let proj = if reversed_z { reversed(standard) } else { standard };
+            let depth = host_depth(&gpu, &triangles, proj * view_matrix, size, samples, reversed_z);
+            let view = FrameView::from_matrices(view_matrix, proj, size.0, size.1, &bounds, 1.0);
+            let config = HostConfig { depth_samples: samples, reversed_z, normals: None };
+            let frame =
+                run_host(&gpu, ChainSettings::default(), config, view, &depth.create_view(&Default::default()), None);
+            // The analytic sphere along each pixel's ray (from the near plane: the standard
+            // projection's depth 0).
+            let inv_proj = standard.inverse();
+            let (mut angles, mut worst_d, mut worst_zoom, mut coverage_differs) = (Vec::new(), 0.0f32, 0.0f32, 0);
+            let sphere_view = (view_matrix * centre.extend(1.0)).xyz();
+            for y in 0..size.1 {
+                for x in 0..size.0 {
+                    let (o, dir) = pixel_ray(&view, inv_proj, [x, y]);
+                    let oc = o - sphere_view;
+                    let (b, c) = (oc.dot(dir), oc.dot(oc) - radius * radius);
+                    let hit = (b * b - c > 0.0).then(|| -b - (b * b - c).sqrt());
+                    let nd = frame.nd.get(x as usize, y as usize);
+                    match (hit, is_geometry(nd)) {
+                        (Some(t), true) => {
+                            let p = o + t * dir;
+                            let n = (p - sphere_view).normalize();
+                            angles.push(angle(nd, [n.x, n.y, n.z, 0.0]));
+                            // Where the ray grazes the sphere the mesh's polygonal outline is far
+                            // from it along the ray: depth is compared where it faces the eye.
+                            if -n.dot(dir) > 0.3 {
+                                worst_d = worst_d.max((nd[3] - view.normalized_depth(p.z)).abs());
+                                let zoom = if view.orthographic { view.f_px } else { view.f_px / -p.z };
+                                worst_zoom =
+                                    worst_zoom.max((frame.zoom.get(x as usize, y as usize) / zoom - 1.0).abs());
+                            }
+                        }
+                        (None, false) => {}
+                        _ => coverage_differs += 1,
+                    }
+                }
+            }
+            let (median, p95) = (percentile(angles.clone(), 0.5), percentile(angles.clone(), 0.95));
+            println!(
+                "{name}: {} pixels (coverage differs at {coverage_differs}); normal angle median {median:.4}, 95 % \
+                 {p95:.4} rad; worst |Δd| {worst_d:.1e}, zoom relative {worst_zoom:.1e}",
+                angles.len()
+            );
+            // The mesh is a 64-ring polygon: its facets tilt normals by up to ~π/64, and their sag
+            // (≈ 6e-3 units across a quad's diagonal) shows along a ray as sag / (n·v): up to
+            // 2e-3 of the 20-unit depth range at n·v ≥ 0.3.
+            assert!(angles.len() > 5000 && coverage_differs < angles.len() / 50, "{name}");
+            assert!(median < 0.03 && p95 < 0.1, "{name}");
+            assert!(worst_d < 2e-3 && worst_zoom < 2e-3, "{name}");
+            results.push((name, frame));
+        }
+    }
+    // Reversed-Z and standard depth give the same maps, up to depth precision.
+    for pair in results.chunks(2) {
+        let [(a, fa), (b, fb)] = pair else { unreachable!() };
+        let worst = fa.nd.data.iter().zip(&fb.nd.data).map(|(x, y)| (x[3] - y[3]).abs()).fold(0.0f32, f32::max);
+        println!("{a} vs {b}: worst |Δd| {worst:.1e}");
+        assert!(worst < 1e-4, "{a} vs {b}");
+    }
+}
+
+#[test]
+fn the_composite_writes_any_host_color_format() {
+    let gpu = gpu();
+    let (positions, offsets) = polylines(30, 0.1);
+    let (camera, _) = cameras_for_polylines();
+    let geometry = LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap();
+    let bounds = geometry.bounds.unwrap();
+    let size = (96u32, 72u32);
+    let render = |format: wgpu::TextureFormat| {
+        let (d, q) = (&gpu.device, &gpu.queue);
+        let mut chain = AoChain::new(d, format, ChainSettings::default()).unwrap();
+        chain.resize(size.0, size.1).unwrap();
+        chain.prepare(d, q, &camera, &bounds).unwrap();
+        let target = lineao::targets::Target::output(d, "test::output", size, format);
+        let mut encoder = d.create_command_encoder(&Default::default());
+        chain.encode(&mut encoder, &geometry, &target.view);
+        q.submit([encoder.finish()]);
+        lineao::readback::read_texture(d, q, &target.texture).unwrap().bytes
+    };
+    let reference: Vec<f32> = bytemuck::pod_collect_to_vec(&render(wgpu::TextureFormat::Rgba32Float));
+    let srgb = |v: f32| if v <= 0.04045 { v / 12.92 } else { ((v + 0.055) / 1.055).powf(2.4) };
+    for (format, tolerance) in [
+        (wgpu::TextureFormat::Rgba8Unorm, 1.0 / 255.0),
+        (wgpu::TextureFormat::Bgra8UnormSrgb, 0.02),
+        (wgpu::TextureFormat::Rgba16Float, 2e-3),
+        (wgpu::TextureFormat::Rgb10a2Unorm, 1.0 / 1023.0),
+    ] {
+        let bytes = render(format);
+        let decoded: Vec<[f32; 3]> = match format {
+            wgpu::TextureFormat::Rgba8Unorm => {
+                bytes.chunks(4).map(|p| [0, 1, 2].map(|c| p[c] as f32 / 255.0)).collect()
+            }
+            wgpu::TextureFormat::Bgra8UnormSrgb => {
+                bytes.chunks(4).map(|p| [2, 1, 0].map(|c| srgb(p[c] as f32 / 255.0))).collect()
+            }
+            wgpu::TextureFormat::Rgba16Float => bytemuck::pod_collect_to_vec::<u8, u16>(&bytes)
+                .chunks(4)
+                .map(|p| [0, 1, 2].map(|c| half_to_f32(p[c])))
+                .collect(),
+            _ => bytemuck::pod_collect_to_vec::<u8, u32>(&bytes)
+                .iter()
+                .map(|&p| [0, 10, 20].map(|shift| (p >> shift & 0x3ff) as f32 / 1023.0))
+                .collect(),
+        };
+        let worst = decoded
+            .iter()
+            .zip(reference.chunks(4))
+            // Unorm formats clamp to [0, 1]; a float format keeps the specular above 1.
+            .map(|(a, b)| {
+                let b = |c: usize| if format == wgpu::TextureFormat::Rgba16Float { b[c] } else { b[c].clamp(0.0, 1.0) };
+                (0..3).map(|c| (a[c] - b(c)).abs() / b(c).abs().max(1.0)).fold(0.0f32, f32::max)
+            })
+            .fold(0.0f32, f32::max);
+        println!("{format:?}: worst |Δ| {worst:.2e} against Rgba32Float");
+        assert!(worst <= tolerance * 1.01, "{format:?}: {worst}");
+    }
+}
+
+/// IEEE half to f32 (normal numbers and zero are all the composite writes).
+fn half_to_f32(h: u16) -> f32 {
+    let (sign, exponent, mantissa) = ((h >> 15) as u32, ((h >> 10) & 0x1f) as u32, (h & 0x3ff) as u32);
+    let value = if exponent == 0 {
+        mantissa as f32 * 2f32.powi(-24)
+    } else {
+        (1.0 + mantissa as f32 / 1024.0) * 2f32.powi(exponent as i32 - 15)
+    };
+    if sign == 1 { -value } else { value }
+}
