@@ -38,7 +38,7 @@ override NORMALS: u32 = 0u;
 @group(0) @binding(3) var host_color: texture_2d<f32>;
 @group(0) @binding(4) var nd_out: texture_storage_2d<rgba32float, write>;
 @group(0) @binding(5) var zoom_out: texture_storage_2d<r32float, write>;
-@group(0) @binding(6) var color_out: texture_storage_2d<rgba32float, write>;
+@group(0) @binding(6) var color_out: texture_storage_2d<rgba16float, write>;
 @group(0) @binding(7) var specular_out: texture_storage_2d<r32float, write>;
 
 // The pixel's depth. Under MSAA: background unless at least half the samples hold geometry,

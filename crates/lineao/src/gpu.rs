@@ -8,16 +8,18 @@
 use crate::Error;
 use crate::targets;
 
-/// The texture capabilities the passes rely on: the G-buffer is rendered into (`Rgba32Float`
-/// color and ND map, `R32Float` zoom and specular), the compute passes write storage textures
-/// (`R32Float` AO, `Rgba32Float` levels), every pass reads textures.
-const FORMAT_NEEDS: [(wgpu::TextureFormat, wgpu::TextureUsages); 3] = {
+/// The texture capabilities the passes rely on: the G-buffer is rendered into (`Rgba16Float`
+/// color, `Rgba32Float` ND map, `R32Float` zoom and specular), the compute passes write storage
+/// textures (`R32Float` AO, `Rgba32Float` levels, the G-buffer from a host's depth), every pass
+/// reads textures.
+const FORMAT_NEEDS: [(wgpu::TextureFormat, wgpu::TextureUsages); 4] = {
     use wgpu::TextureUsages as U;
     let all = U::RENDER_ATTACHMENT.union(U::STORAGE_BINDING).union(U::TEXTURE_BINDING);
     [
         (targets::ND_FORMAT, all),
         (targets::AO_FORMAT, all),
         (targets::DEPTH_FORMAT, U::RENDER_ATTACHMENT.union(U::TEXTURE_BINDING)),
+        (targets::COLOR_FORMAT, all),
     ]
 };
 

@@ -16,9 +16,26 @@ impl TextureData {
         bytemuck::pod_collect_to_vec(&self.bytes)
     }
 
-    /// The texels as [f32; 4] (Rgba32Float).
+    /// The texels as [f32; 4] (Rgba32Float, or Rgba16Float widened exactly).
     pub fn to_vec4(&self) -> Vec<[f32; 4]> {
+        if self.format == wgpu::TextureFormat::Rgba16Float {
+            let halves: Vec<u16> = bytemuck::pod_collect_to_vec(&self.bytes);
+            return halves.chunks_exact(4).map(|h| [0, 1, 2, 3].map(|c| f16_to_f32(h[c]))).collect();
+        }
         bytemuck::pod_collect_to_vec(&self.bytes)
+    }
+}
+
+/// An IEEE 754 half to f32 (exact: every half is an f32), subnormals, infinities and NaN
+/// included.
+pub fn f16_to_f32(h: u16) -> f32 {
+    let sign = if h & 0x8000 != 0 { -1.0 } else { 1.0 };
+    let (exponent, mantissa) = (i32::from((h >> 10) & 0x1f), f32::from(h & 0x3ff));
+    sign * match exponent {
+        0 => mantissa * 2f32.powi(-24),
+        31 if mantissa == 0.0 => f32::INFINITY,
+        31 => f32::NAN,
+        e => (1.0 + mantissa / 1024.0) * 2f32.powi(e - 15),
     }
 }
 

@@ -4,7 +4,7 @@
 //!
 //! | texture   | format        | content                                                    |
 //! |-----------|---------------|------------------------------------------------------------|
-//! | color     | Rgba32Float   | linear base color of the lines; background color elsewhere |
+//! | color     | Rgba16Float   | linear base color of the lines; background color elsewhere |
 //! | `nd[j]`   | Rgba32Float   | level j: view-space normal (xyz), normalized depth (w)     |
 //! | zoom      | R32Float      | z(P): pixels per `zoom_unit` at P; 0 on background          |
 //! | specular  | R32Float      | illuminated-lines specular, added in the composite         |
@@ -20,7 +20,10 @@
 //! ([`FrameTargets::with_moments`]); object-space AO adds `octants` and `volume_ao`
 //! ([`FrameTargets::with_volume`]).
 
-pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+/// Half floats: plenty for a color, and with it the G-buffer a geometry pass writes is 32 bytes
+/// per pixel, WebGPU's default `max_color_attachment_bytes_per_sample`, so the chain runs on a
+/// host's device opened with default limits (object-space AO's octants need 40).
+pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 pub const ND_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 pub const ZOOM_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 pub const SPECULAR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;

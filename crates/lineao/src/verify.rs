@@ -13,7 +13,7 @@ pub fn read_f32(device: &wgpu::Device, queue: &wgpu::Queue, target: &Target) -> 
     Ok(Image { width: data.width as usize, height: data.height as usize, data: data.to_f32() })
 }
 
-/// An Rgba32Float target (an ND level, color) as an image.
+/// An Rgba32Float or Rgba16Float target (an ND level, color) as an image.
 pub fn read_rgba(device: &wgpu::Device, queue: &wgpu::Queue, target: &Target) -> Result<NdImage, Error> {
     let data = read_texture(device, queue, &target.texture)?;
     Ok(Image { width: data.width as usize, height: data.height as usize, data: data.to_vec4() })

@@ -275,7 +275,7 @@ fn the_composite_writes_any_host_color_format() {
             }
             wgpu::TextureFormat::Rgba16Float => bytemuck::pod_collect_to_vec::<u8, u16>(&bytes)
                 .chunks(4)
-                .map(|p| [0, 1, 2].map(|c| half_to_f32(p[c])))
+                .map(|p| [0, 1, 2].map(|c| lineao::readback::f16_to_f32(p[c])))
                 .collect(),
             _ => bytemuck::pod_collect_to_vec::<u8, u32>(&bytes)
                 .iter()
@@ -294,15 +294,4 @@ fn the_composite_writes_any_host_color_format() {
         println!("{format:?}: worst |Δ| {worst:.2e} against Rgba32Float");
         assert!(worst <= tolerance * 1.01, "{format:?}: {worst}");
     }
-}
-
-/// IEEE half to f32 (normal numbers and zero are all the composite writes).
-fn half_to_f32(h: u16) -> f32 {
-    let (sign, exponent, mantissa) = ((h >> 15) as u32, ((h >> 10) & 0x1f) as u32, (h & 0x3ff) as u32);
-    let value = if exponent == 0 {
-        mantissa as f32 * 2f32.powi(-24)
-    } else {
-        (1.0 + mantissa as f32 / 1024.0) * 2f32.powi(exponent as i32 - 15)
-    };
-    if sign == 1 { -value } else { value }
 }
