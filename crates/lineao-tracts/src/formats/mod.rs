@@ -1,4 +1,4 @@
-//! One module per file format family; each parses from bytes or a [`crate::input::Reader`] and
+//! One module per file format family; each parses from bytes or from the crate's buffered reader and
 //! knows nothing about files, compression or progress (that is [`crate::load`]'s job).
 
 pub mod gltf;
