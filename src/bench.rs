@@ -17,7 +17,9 @@
 //!   0.56×);
 //! - `vo-area-1`: VO with one area sample, moments pyramid included (what the method costs);
 //! - `bilateral`: the separable bilateral blur (radius 4), which can follow any method;
-//! - `tubes`: the same streamlines as ray-cast tubes of radius 0.5 mm (against `lines`).
+//! - `tubes`: the same streamlines as ray-cast tubes of radius 0.5 mm (against `lines`);
+//! - `nd-from-depth`: the ND and zoom maps derived from the G-buffer's depth, as from a host
+//!   renderer's (what embedding costs besides the method).
 //!
 //! The object-space passes run on the CPU (`"on": "cpu"`), `--frames` times up to 3 (each takes
 //! seconds) without warm-up, on the scene's streamlines:
@@ -36,6 +38,7 @@ use lineao::passes::bilateral::Bilateral;
 use lineao::passes::composite::Composite;
 use lineao::passes::line_ao::{Evaluation, LineAo};
 use lineao::passes::lines::{GeometryOptions, LineGeometry, LineRenderer, LineStyle};
+use lineao::passes::nd_from_depth::{HostConfig, HostInputs, NdFromDepth};
 use lineao::passes::nd_pyramid::NdPyramid;
 use lineao::passes::ssao::Ssao;
 use lineao::passes::ssao_blur::SsaoBlur;
@@ -54,7 +57,7 @@ use serde_json::json;
 use crate::cli::BenchArgs;
 
 /// The GPU passes of one run, in CONTRACT.md's order.
-pub const GPU_PASSES: [&str; 15] = [
+pub const GPU_PASSES: [&str; 16] = [
     "lines",
     "lines-native-1px",
     "nd-pyramid",
@@ -70,6 +73,7 @@ pub const GPU_PASSES: [&str; 15] = [
     "vo-area-1",
     "bilateral",
     "tubes",
+    "nd-from-depth",
 ];
 
 /// The radius of pass `tubes` in zoom units (0.5 mm for tractograms).
@@ -101,6 +105,11 @@ struct Passes {
     area_targets: FrameTargets,
     bilateral: Bilateral,
     tubes: TubeRenderer,
+    /// The ND and zoom maps from the G-buffer's own depth, as from a host's (whose bind group
+    /// is made per frame, on the device).
+    nd_from_depth: NdFromDepth,
+    device: wgpu::Device,
+    queue: wgpu::Queue,
     output: Target,
 }
 
@@ -125,12 +134,16 @@ impl Passes {
             area_targets: FrameTargets::new(device, view.width, view.height, targets.guard, 1).with_moments(device),
             bilateral: Bilateral::new(device),
             tubes: TubeRenderer::new(device, false),
+            nd_from_depth: NdFromDepth::new(device, HostConfig::default()),
+            device: device.clone(),
+            queue: queue.clone(),
             output: Target::output(device, "lineao::bench::output", (view.width, view.height), format),
         };
         for renderer in [&passes.lines, &passes.lines_native] {
             renderer.prepare(queue, view, settings.line_width_px, settings.line_color, &settings.lighting);
         }
         passes.tubes.prepare(queue, view, TUBE_RADIUS * view.zoom_unit, settings.line_color, &settings.lighting);
+        passes.nd_from_depth.prepare(queue, view);
         passes.pyramid.resize(device, targets);
         for (pass, line_ao) in [
             (&mut passes.line_ao, &settings.line_ao),
@@ -206,6 +219,10 @@ impl Passes {
             }
             "bilateral" => self.bilateral.encode(encoder, targets, span),
             "tubes" => self.tubes.encode(encoder, targets, geometry, Load::Clear(background), span),
+            "nd-from-depth" => {
+                let inputs = HostInputs { depth: &targets.depth.view, normals: None, color: None };
+                self.nd_from_depth.encode(&self.device, &self.queue, encoder, targets, &inputs, span);
+            }
             _ => unreachable!("unknown bench pass {name}"),
         }
     }

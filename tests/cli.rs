@@ -277,6 +277,7 @@ fn bench_json_is_the_contract() {
             "vo-area-1",
             "bilateral",
             "tubes",
+            "nd-from-depth",
             "density-256",
             "sweep-256",
             "variance-volume-256"
