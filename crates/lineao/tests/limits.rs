@@ -115,3 +115,10 @@ fn what_the_device_cannot_do_is_a_clear_error() {
     // The device stays usable afterwards.
     assert!(AoChain::new(&gpu.device, wgpu::TextureFormat::Rgba8Unorm, ChainSettings::default()).is_ok());
 }
+
+#[test]
+fn a_chain_can_move_between_threads_and_be_shared() {
+    fn send_and_sync<T: Send + Sync>() {}
+    send_and_sync::<AoChain>();
+    send_and_sync::<LineGeometry>();
+}

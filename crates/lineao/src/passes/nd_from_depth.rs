@@ -98,7 +98,6 @@ pub struct NdFromDepth {
     uniform: wgpu::Buffer,
     /// Stands in for the normal and color textures a host does not have.
     placeholder: Target,
-    uniform_value: std::cell::Cell<HostUniform>,
 }
 
 impl NdFromDepth {
@@ -145,7 +144,6 @@ impl NdFromDepth {
             layout,
             uniform: binding::uniform_buffer::<HostUniform>(device, "lineao::NdFromDepth::uniform"),
             placeholder,
-            uniform_value: std::cell::Cell::new(bytemuck::Zeroable::zeroed()),
         }
     }
 
@@ -170,7 +168,6 @@ impl NdFromDepth {
             has_color: 0,
             _pad: [0; 3],
         };
-        self.uniform_value.set(uniform);
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
     }
 
@@ -185,12 +182,9 @@ impl NdFromDepth {
         inputs: &HostInputs,
         span: Option<Span>,
     ) {
-        let mut uniform = self.uniform_value.get();
-        if uniform.has_color != inputs.color.is_some() as u32 {
-            uniform.has_color = inputs.color.is_some() as u32;
-            self.uniform_value.set(uniform);
-            queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
-        }
+        // Whether a color comes with this frame: the uniform's one per-frame word.
+        let has_color = inputs.color.is_some() as u32;
+        queue.write_buffer(&self.uniform, std::mem::offset_of!(HostUniform, has_color) as u64, bytemuck::bytes_of(&has_color));
         let placeholder = &self.placeholder.view;
         let group = binding::group(
             device,
