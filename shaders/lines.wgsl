@@ -13,11 +13,13 @@ struct StripVertex {
     @location(1) t: vec4<f32>,
 }
 
-// Per-vertex octant visibilities (object-space AO) from the attribute stream. Keep in sync with
+// The attribute stream: octant visibilities (object-space AO) and the scalar of the colormap
+// (the radius at location 4 is the tubes'). Keep in sync with
 // `lineao::passes::lines::LineAttributes`.
 struct Attributes {
     @location(2) octants_lo: vec4<f32>,
     @location(3) octants_hi: vec4<f32>,
+    @location(5) scalar: f32,
 }
 
 struct VsOut {
@@ -54,42 +56,49 @@ fn push_sideways(clip: vec4<f32>, view_tangent: vec3<f32>, offset_px: f32) -> ve
     return vec4<f32>(clip.xy + offset_ndc * clip.w, clip.zw);
 }
 
-// Point `p` with tangent `t_world`, pushed `side` half line widths to its left (−1 right, 0 on it).
-fn line_vertex(p: vec3<f32>, t_world: vec3<f32>, side: f32) -> VsOut {
+// Point `p` with tangent `t_world` and scalar `scalar`, pushed `side` half line widths to its
+// left (−1 right, 0 on it).
+fn line_vertex(p: vec3<f32>, t_world: vec3<f32>, side: f32, scalar: f32) -> VsOut {
     var out: VsOut;
     let view_pos = frame.view * vec4<f32>(p, 1.0);
     let view_tangent = (frame.view * vec4<f32>(t_world, 0.0)).xyz;
     out.clip = push_sideways(frame.proj * view_pos, view_tangent, side * 0.5 * frame.line_width_px);
     out.view_pos = view_pos.xyz;
     out.view_tangent = view_tangent;
-    out.color = base_color(t_world);
+    out.color = base_color(t_world, scalar);
     return out;
 }
 
 // Fixed-width lines: the triangle strip.
 @vertex
 fn vs_main(v: StripVertex) -> VsOut {
-    return line_vertex(v.p, v.t.xyz, sign(v.t.w));
+    return line_vertex(v.p, v.t.xyz, sign(v.t.w), 0.0);
+}
+
+// Fixed-width lines with the attribute stream (the scalar's color), no octants.
+@vertex
+fn vs_attributes(v: StripVertex, a: Attributes) -> VsOut {
+    return line_vertex(v.p, v.t.xyz, sign(v.t.w), a.scalar);
 }
 
 // Native 1-px lines (an indexed `LineList` over the same vertices): the rasterizer's own thin
 // lines, the baseline the strip is measured against (`lineao bench`, pass `lines-native-1px`).
 @vertex
 fn vs_native(v: StripVertex) -> VsOut {
-    return line_vertex(v.p, v.t.xyz, 0.0);
+    return line_vertex(v.p, v.t.xyz, 0.0, 0.0);
 }
 
 // Fixed-width lines with the octant visibilities of the attribute stream.
 @vertex
 fn vs_octants(v: StripVertex, a: Attributes) -> VsOutOctants {
-    let b = line_vertex(v.p, v.t.xyz, sign(v.t.w));
+    let b = line_vertex(v.p, v.t.xyz, sign(v.t.w), a.scalar);
     return VsOutOctants(b.clip, b.view_pos, b.view_tangent, b.color, a.octants_lo, a.octants_hi);
 }
 
 // Fixed-width lines of geometry without attributes, into a G-buffer with octants: all visible.
 @vertex
 fn vs_visible(v: StripVertex) -> VsOutOctants {
-    let b = line_vertex(v.p, v.t.xyz, sign(v.t.w));
+    let b = line_vertex(v.p, v.t.xyz, sign(v.t.w), 0.0);
     return VsOutOctants(b.clip, b.view_pos, b.view_tangent, b.color, vec4<f32>(1.0), vec4<f32>(1.0));
 }
 

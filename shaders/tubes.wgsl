@@ -22,9 +22,11 @@ struct SegmentAttributes {
     @location(4) octants_a_lo: vec4<f32>,
     @location(5) octants_a_hi: vec4<f32>,
     @location(6) radius_a: f32,
+    @location(10) scalar_a: f32,
     @location(7) octants_b_lo: vec4<f32>,
     @location(8) octants_b_hi: vec4<f32>,
     @location(9) radius_b: f32,
+    @location(11) scalar_b: f32,
 }
 
 struct TubeOut {
@@ -78,15 +80,15 @@ fn to_pixels(clip: vec4<f32>) -> vec2<f32> {
     return (clip.xy / clip.w * vec2<f32>(0.5, -0.5) + 0.5) * frame.viewport;
 }
 
-fn tube_vertex(vertex: u32, s: Segment, ra: f32, rb: f32) -> TubeOut {
+fn tube_vertex(vertex: u32, s: Segment, ra: f32, rb: f32, scalar_a: f32, scalar_b: f32) -> TubeOut {
     var out: TubeOut;
     let a = (frame.view * vec4<f32>(s.a, 1.0)).xyz;
     let b = (frame.view * vec4<f32>(s.b, 1.0)).xyz;
     out.a = a;
     out.b = b;
     out.radii = vec2<f32>(ra, rb);
-    out.color_a = base_color(s.ta.xyz);
-    out.color_b = base_color(s.tb.xyz);
+    out.color_a = base_color(s.ta.xyz, scalar_a);
+    out.color_b = base_color(s.tb.xyz, scalar_b);
     // Not a segment, or an end behind the eye: a degenerate billboard (outside the clip volume).
     if !is_segment(s) || (!is_orthographic() && (-a.z <= 0.0 || -b.z <= 0.0)) {
         out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
@@ -118,7 +120,7 @@ fn tube_vertex(vertex: u32, s: Segment, ra: f32, rb: f32) -> TubeOut {
 
 @vertex
 fn vs_tube(@builtin(vertex_index) vertex: u32, s: Segment) -> TubeOut {
-    var out = tube_vertex(vertex, s, frame.tube_radius, frame.tube_radius);
+    var out = tube_vertex(vertex, s, frame.tube_radius, frame.tube_radius, 0.0, 0.0);
     out.octants_a_lo = vec4<f32>(1.0);
     out.octants_a_hi = vec4<f32>(1.0);
     out.octants_b_lo = vec4<f32>(1.0);
@@ -131,7 +133,7 @@ fn vs_tube(@builtin(vertex_index) vertex: u32, s: Segment) -> TubeOut {
 fn vs_tube_attributes(@builtin(vertex_index) vertex: u32, s: Segment, at: SegmentAttributes) -> TubeOut {
     let ra = select(frame.tube_radius, at.radius_a, at.radius_a > 0.0);
     let rb = select(frame.tube_radius, at.radius_b, at.radius_b > 0.0);
-    var out = tube_vertex(vertex, s, ra, rb);
+    var out = tube_vertex(vertex, s, ra, rb, at.scalar_a, at.scalar_b);
     out.octants_a_lo = at.octants_a_lo;
     out.octants_a_hi = at.octants_a_hi;
     out.octants_b_lo = at.octants_b_lo;

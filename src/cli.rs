@@ -367,9 +367,13 @@ pub struct RenderArgs {
     /// Upper bound of the guard band in pixels.
     #[arg(long, default_value_t = 128)]
     pub guard_max: u32,
-    /// Line color: `tangent` (|T| as RGB) or R,G,B in [0, 1].
+    /// Line color: `tangent` (|T| as RGB), R,G,B in [0, 1], or `field:NAME` (the file's
+    /// per-vertex field NAME through --colormap, its 2nd to 98th percentile spanning the map).
     #[arg(long, default_value = "tangent", value_parser = parse_color)]
     pub color: ColorArg,
+    /// The colormap of `--color field:NAME`.
+    #[arg(long, value_enum, default_value_t = ColormapArg::Viridis)]
+    pub colormap: ColormapArg,
     /// Background color R,G,B in [0, 1].
     #[arg(long, default_value = "1,1,1", value_parser = parse_vec3)]
     pub background: [f32; 3],
@@ -404,10 +408,12 @@ pub struct RenderArgs {
     pub timings: bool,
 }
 
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub enum ColorArg {
     Tangent,
     Constant([f32; 3]),
+    /// A per-vertex field of the file through --colormap.
+    Field(String),
 }
 
 fn parse_scene(s: &str) -> Result<SceneKind, String> {
@@ -422,7 +428,18 @@ fn parse_vec3(s: &str) -> Result<[f32; 3], String> {
 }
 
 fn parse_color(s: &str) -> Result<ColorArg, String> {
-    if s == "tangent" { Ok(ColorArg::Tangent) } else { parse_vec3(s).map(ColorArg::Constant) }
+    match s.strip_prefix("field:") {
+        Some(name) if !name.is_empty() => Ok(ColorArg::Field(name.to_string())),
+        _ if s == "tangent" => Ok(ColorArg::Tangent),
+        _ => parse_vec3(s).map(ColorArg::Constant),
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ColormapArg {
+    Viridis,
+    Gray,
+    Coolwarm,
 }
 
 fn parse_debug_view(s: &str) -> Result<lineao::DebugView, String> {

@@ -13,13 +13,14 @@ use lineao::volume::density::DensityOptions;
 use lineao::volume::sweep::SweepSettings;
 use lineao::volume::{ScalarForm, Sky, VertexVisibility, VolumeAoOptions, VolumeMethod};
 use lineao::{
-    AoChain, AoMethod, BilateralSettings, ChainSettings, Gpu, LineAoOuter, LineAoSettings, LineAoVariant, LineColor,
-    SsaoKernel, SsaoSettings, SurfaceSettings, TubeSettings, VoCombine, VoSettings, VolumeAoSettings,
+    AoChain, AoMethod, BilateralSettings, ChainSettings, Colormap, Gpu, LineAoOuter, LineAoSettings, LineAoVariant,
+    LineColor, SsaoKernel, SsaoSettings, SurfaceSettings, TubeSettings, VoCombine, VoSettings, VolumeAoSettings,
 };
 use lineao_tracts::scenes::ViewHint;
 
 use crate::cli::{
-    ColorArg, Combine, GeometryArg, Method, Outer, RenderArgs, SkyArg, SsaoKernelArg, Variant, VolumeNormal,
+    ColorArg, ColormapArg, Combine, GeometryArg, Method, Outer, RenderArgs, SkyArg, SsaoKernelArg, Variant,
+    VolumeNormal,
 };
 use crate::label::Rgba8;
 
@@ -131,9 +132,18 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky) -> 
         tubes: (args.geometry == GeometryArg::Tubes)
             .then(|| TubeSettings { radius_world: tube_radius(args, zoom_unit) }),
         surfaces: (!args.surfaces.is_empty()).then_some(SurfaceSettings { color: args.surface_color }),
-        line_color: match args.color {
+        line_color: match &args.color {
             ColorArg::Tangent => LineColor::Tangent,
-            ColorArg::Constant(rgb) => LineColor::Constant(rgb),
+            ColorArg::Constant(rgb) => LineColor::Constant(*rgb),
+            // The range comes from the data (`run` sets it).
+            ColorArg::Field(_) => LineColor::Scalar {
+                colormap: match args.colormap {
+                    ColormapArg::Viridis => Colormap::Viridis,
+                    ColormapArg::Gray => Colormap::Gray,
+                    ColormapArg::Coolwarm => Colormap::CoolWarm,
+                },
+                range: [0.0, 1.0],
+            },
         },
         background: args.background,
         strength: args.strength,
@@ -237,9 +247,22 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         .map(|path| lineao_tracts::load_mesh(path).map_err(anyhow::Error::from))
         .collect::<Result<Vec<_>>>()?;
     let radii = match &args.tube_radius_field {
-        Some(field) => Some(vertex_radii(&tracts, field).with_context(|| name.clone())?),
+        Some(field) => Some(vertex_field(&tracts, field).with_context(|| name.clone())?),
         None => None,
     };
+    let scalars = match &args.color {
+        ColorArg::Field(field) => Some(vertex_field(&tracts, field).with_context(|| name.clone())?),
+        _ => None,
+    };
+    let mut panels = panels;
+    if let Some(values) = &scalars {
+        let range = percentile_range(values);
+        for panel in &mut panels {
+            if let LineColor::Scalar { range: r, .. } = &mut panel.settings.line_color {
+                *r = range;
+            }
+        }
+    }
 
     let gpu = Gpu::headless()?;
     let mut geometry = LineGeometry::new(&gpu.device, &gpu.queue, &tracts.positions, &tracts.offsets)?;
@@ -251,8 +274,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         .iter()
         .filter_map(|m| m.bounds)
         .fold(geometry.bounds.with_context(|| format!("{name} has no finite points"))?, |b, m| b.union(&m));
-    if let Some(radius) = radii.as_deref() {
-        let attributes = VertexAttributes { radius: Some(radius), ..Default::default() };
+    if radii.is_some() || scalars.is_some() {
+        let attributes = VertexAttributes { radius: radii.as_deref(), scalar: scalars.as_deref(), octants: None };
         geometry.set_attributes(&gpu.device, &gpu.queue, &tracts.positions, &tracts.offsets, &attributes)?;
     }
     // Object-space AO once per method, uploaded as the geometry's attributes when a panel needs
@@ -276,7 +299,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 volumes.push((method, computed));
             }
             let (_, visibility) = volumes.iter().find(|(m, _)| *m == method).expect("computed above");
-            let octants = VertexAttributes { octants: Some(&visibility.octants), radius: radii.as_deref() };
+            let octants = VertexAttributes {
+                octants: Some(&visibility.octants),
+                radius: radii.as_deref(),
+                scalar: scalars.as_deref(),
+            };
             geometry.set_attributes(&gpu.device, &gpu.queue, &tracts.positions, &tracts.offsets, &octants)?;
             attributes = Some(method);
         }
@@ -315,14 +342,26 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     Ok(())
 }
 
-/// The per-vertex radii of `field` (one column; non-positive values take the chain's radius).
-fn vertex_radii(tracts: &lineao_tracts::Tractogram, field: &str) -> Result<Vec<f32>> {
+/// The values of the per-vertex field `field` (one column).
+pub fn vertex_field(tracts: &lineao_tracts::Tractogram, field: &str) -> Result<Vec<f32>> {
     let names: Vec<&str> = tracts.vertex_fields.iter().map(|f| f.name.as_str()).collect();
-    let found = tracts
-        .vertex_field(field)
-        .with_context(|| format!("no per-vertex field '{field}' (the file has: {})", names.join(", ")))?;
-    anyhow::ensure!(found.columns == 1, "per-vertex field '{field}' has {} columns, a radius needs 1", found.columns);
+    let found = tracts.vertex_field(field).with_context(|| {
+        let names = if names.is_empty() { "none".to_string() } else { names.join(", ") };
+        format!("no per-vertex field '{field}' (the file has: {names})")
+    })?;
+    anyhow::ensure!(found.columns == 1, "per-vertex field '{field}' has {} columns, not 1", found.columns);
     Ok(found.values.clone())
+}
+
+/// The 2nd and 98th percentiles of the finite `values` (robust to outliers), or [0, 1].
+pub fn percentile_range(values: &[f32]) -> [f32; 2] {
+    let mut finite: Vec<f32> = values.iter().copied().filter(|v| v.is_finite()).collect();
+    if finite.is_empty() {
+        return [0.0, 1.0];
+    }
+    finite.sort_by(f32::total_cmp);
+    let at = |p: f32| finite[((finite.len() - 1) as f32 * p).round() as usize];
+    [at(0.02), at(0.98)]
 }
 
 /// What every panel of one `render` shares.

@@ -16,12 +16,16 @@ struct GeometryUniform {
     zoom_unit: f32,
     line_width_px: f32,
     orthographic: u32,
-    // 0: tangent direction |T| (world axes as RGB), 1: constant color.
+    // 0: tangent direction |T| (world axes as RGB), 1: constant color, 2: the vertex's scalar
+    // through the colormap.
     color_mode: u32,
     // Tubes: the radius in world units where the geometry carries none.
     tube_radius: f32,
     _pad0: u32,
     _pad1: u32,
+    // Color mode 2: xy the scalars at the colormap's ends; its table of linear RGB.
+    scalar_range: vec4<f32>,
+    colormap: array<vec4<f32>, 16>,
 }
 
 @group(0) @binding(0) var<uniform> frame: GeometryUniform;
@@ -31,11 +35,18 @@ fn is_orthographic() -> bool {
     return frame.orthographic != 0u;
 }
 
-// The base color of a point with world-space tangent `t_world` (tangent color mode) or the
-// constant color.
-fn base_color(t_world: vec3<f32>) -> vec3<f32> {
+// The base color of a point with world-space tangent `t_world` and scalar `scalar`: |T| (tangent
+// color mode), the constant color, or the scalar through the colormap.
+fn base_color(t_world: vec3<f32>, scalar: f32) -> vec3<f32> {
     if frame.color_mode == 0u {
         return abs(t_world) / max(length(t_world), 1e-20);
+    }
+    if frame.color_mode == 2u {
+        let span = frame.scalar_range.y - frame.scalar_range.x;
+        let t = saturate(select(0.0, (scalar - frame.scalar_range.x) / span, span != 0.0));
+        let x = t * 15.0;
+        let k = min(u32(x), 14u);
+        return mix(frame.colormap[k].rgb, frame.colormap[k + 1u].rgb, x - f32(k));
     }
     return frame.constant_color.rgb;
 }

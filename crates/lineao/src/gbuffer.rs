@@ -30,6 +30,9 @@ pub struct GeometryUniform {
     pub color_mode: u32,
     pub tube_radius: f32,
     pub _pad: [u32; 2],
+    /// [`LineColor::Scalar`]: the scalar range mapped to the colormap's ends, and its table.
+    pub scalar_range: [f32; 4],
+    pub colormap: [[f32; 4]; crate::settings::COLORMAP_ENTRIES],
 }
 
 impl GeometryUniform {
@@ -38,6 +41,11 @@ impl GeometryUniform {
         let (color_mode, constant) = match color {
             LineColor::Tangent => (0, [0.0; 3]),
             LineColor::Constant(rgb) => (1, rgb),
+            LineColor::Scalar { .. } => (2, [0.0; 3]),
+        };
+        let (scalar_range, colormap) = match color {
+            LineColor::Scalar { colormap, range } => ([range[0], range[1], 0.0, 0.0], colormap.table()),
+            _ => ([0.0, 1.0, 0.0, 0.0], [[0.0; 4]; crate::settings::COLORMAP_ENTRIES]),
         };
         GeometryUniform {
             view: view.view.to_cols_array_2d(),
@@ -54,6 +62,8 @@ impl GeometryUniform {
             color_mode,
             tube_radius,
             _pad: [0; 2],
+            scalar_range,
+            colormap,
         }
     }
 }

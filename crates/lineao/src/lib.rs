@@ -60,8 +60,8 @@ pub mod volume;
 pub use chain::AoChain;
 pub use gpu::Gpu;
 pub use settings::{
-    AoMethod, BilateralSettings, ChainSettings, DebugView, LineAoOuter, LineAoSettings, LineAoVariant, LineColor, R0,
-    SsaoKernel, SsaoSettings, SurfaceSettings, TubeSettings, VoCombine, VoSettings, VolumeAoSettings,
+    AoMethod, BilateralSettings, ChainSettings, Colormap, DebugView, LineAoOuter, LineAoSettings, LineAoVariant,
+    LineColor, R0, SsaoKernel, SsaoSettings, SurfaceSettings, TubeSettings, VoCombine, VoSettings, VolumeAoSettings,
 };
 
 /// Pyramid levels (and so LineAO hemispheres) the shaders can bind.

@@ -321,3 +321,56 @@ fn native_lines_are_one_pixel_and_need_their_segments() {
     assert!(covered(true).iter().all(|&n| n == 2), "{:?}", covered(true));
     assert!(covered(false).iter().all(|&n| n == 0), "without native segments nothing is drawn");
 }
+
+#[test]
+fn scalar_colors_follow_the_colormap_table() {
+    // Parallel lines with constant scalars −5, 5, 10, 15 and 40 over the range [0, 20]: each
+    // shows the table's color at clamp(t) (the shader interpolates the 16 entries linearly),
+    // for lines and for tubes.
+    let gpu = gpu();
+    let scalars = [-5.0f32, 5.0, 10.0, 15.0, 40.0];
+    let mut positions = Vec::new();
+    let mut offsets = vec![0u64];
+    for (k, _) in scalars.iter().enumerate() {
+        let y = -20.0 + 10.0 * k as f32;
+        positions.extend([[-30.0, y, 0.0], [30.0, y, 0.0]]);
+        offsets.push(positions.len() as u64);
+    }
+    let per_vertex: Vec<f32> = scalars.iter().flat_map(|&s| [s, s]).collect();
+    let mut geometry = LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap();
+    let attributes = lineao::passes::lines::VertexAttributes { scalar: Some(&per_vertex), ..Default::default() };
+    geometry.set_attributes(&gpu.device, &gpu.queue, &positions, &offsets, &attributes).unwrap();
+    let table = lineao::Colormap::Viridis.table();
+    let expected = |s: f32| {
+        let x = (s / 20.0).clamp(0.0, 1.0) * 15.0;
+        let k = (x as usize).min(14);
+        let f = x - k as f32;
+        [0, 1, 2].map(|c| table[k][c] * (1.0 - f) + table[k + 1][c] * f)
+    };
+    let color = LineColor::Scalar { colormap: lineao::Colormap::Viridis, range: [0.0, 20.0] };
+    for tubes in [false, true] {
+        let settings = ChainSettings {
+            line_color: color,
+            tubes: tubes.then_some(lineao::TubeSettings { radius_world: 2.0 }),
+            lighting: lineao::lighting::Lighting { lights: vec![], ..Default::default() },
+            ..plain(5.0)
+        };
+        let frame = common::render_geometry(&gpu, &geometry, &perspective(), geometry.bounds.unwrap(), settings, SIZE);
+        let mut seen = [0usize; 5];
+        for (i, nd) in frame.nd[0].data.iter().enumerate() {
+            if !is_geometry(*nd) {
+                continue;
+            }
+            let c = frame.color.data[i];
+            // Which line: the one whose expected color this pixel shows (tubes darken theirs by
+            // the diffuse term without lights: 1 − kd).
+            let shade = if tubes { 0.7 } else { 1.0 };
+            let k = (0..5)
+                .find(|&k| (0..3).all(|ch| (c[ch] - shade * expected(scalars[k])[ch]).abs() < 2e-3))
+                .unwrap_or_else(|| panic!("tubes {tubes}: pixel {i} color {c:?} is no line's"));
+            seen[k] += 1;
+        }
+        // Every line shows; −5 and 0, 20 and 40 clamp to the ends.
+        assert!(seen.iter().all(|&n| n > 20), "tubes {tubes}: {seen:?}");
+    }
+}

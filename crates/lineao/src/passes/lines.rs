@@ -237,6 +237,8 @@ pub struct VertexAttributes<'a> {
     /// Tube radius per vertex, world units (> 0; others take the chain's radius): tubes of
     /// varying thickness ([`crate::passes::tubes`]). Lines ignore it.
     pub radius: Option<&'a [f32]>,
+    /// A scalar per vertex for [`crate::LineColor::Scalar`] (FA, curvature, …). `None`: 0.
+    pub scalar: Option<&'a [f32]>,
 }
 
 /// One strip vertex's attributes. Keep in sync with `Attributes` in `shaders/lines.wgsl` and
@@ -248,6 +250,8 @@ pub struct LineAttributes {
     pub octants: [u8; 8],
     /// Tube radius, world units; 0 = the chain's.
     pub radius: f32,
+    /// The colormap's scalar.
+    pub scalar: f32,
 }
 
 pub(crate) const ATTRIBUTE_SIZE: u64 = std::mem::size_of::<LineAttributes>() as u64;
@@ -329,8 +333,11 @@ impl LineGeometry {
                 self.streamlines
             )));
         }
-        let lengths =
-            [("octant visibilities", attributes.octants.map(<[_]>::len)), ("radii", attributes.radius.map(<[_]>::len))];
+        let lengths = [
+            ("octant visibilities", attributes.octants.map(<[_]>::len)),
+            ("radii", attributes.radius.map(<[_]>::len)),
+            ("scalars", attributes.scalar.map(<[_]>::len)),
+        ];
         for (what, len) in lengths {
             if let Some(len) = len.filter(|&len| len != positions.len()) {
                 return Err(Error::InvalidGeometry(format!("{len} {what} for {} vertices", positions.len())));
@@ -341,6 +348,7 @@ impl LineGeometry {
         let of = |i: usize| LineAttributes {
             octants: attributes.octants.map_or([255; 8], |o| o[i].map(unorm)),
             radius: attributes.radius.map_or(0.0, |r| radius(r[i])),
+            scalar: attributes.scalar.map_or(0.0, |s| s[i]),
         };
         let mut buffers = Vec::with_capacity(self.chunks.len());
         let mut upload = |values: &[LineAttributes]| {
@@ -441,6 +449,8 @@ pub enum LineStyle {
 pub struct LineRenderer {
     style: LineStyle,
     pipeline: wgpu::RenderPipeline,
+    /// With the geometry's attributes (the scalar's color), quads only.
+    attributes: Option<wgpu::RenderPipeline>,
     /// Writing `octants` too: from the geometry's attributes, and fully visible for geometry
     /// without them.
     octants: Option<OctantPipelines>,
@@ -480,7 +490,12 @@ impl LineRenderer {
     pub fn with_outputs(device: &wgpu::Device, style: LineStyle, octants: bool) -> LineRenderer {
         let bindings = GeometryBindings::new(device, "lineao::LineRenderer::bindings");
         let module = crate::shader::module(device, "lines.wgsl");
-        let octant_attributes = wgpu::vertex_attr_array![2 => Unorm8x4, 3 => Unorm8x4];
+        // Octants at 0 and 4, the scalar at 12 (the tubes' radius at 8 is skipped).
+        let octant_attributes = [
+            wgpu::VertexAttribute { format: wgpu::VertexFormat::Unorm8x4, offset: 0, shader_location: 2 },
+            wgpu::VertexAttribute { format: wgpu::VertexFormat::Unorm8x4, offset: 4, shader_location: 3 },
+            wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32, offset: 12, shader_location: 5 },
+        ];
         let strip = [Some(strip_layout(&STRIP_ATTRIBUTES))];
         let with_attributes = [Some(strip_layout(&STRIP_ATTRIBUTES)), Some(attribute_layout(&octant_attributes))];
         let topology = match style {
@@ -500,11 +515,13 @@ impl LineRenderer {
             LineStyle::Native1px => "vs_native",
         };
         let pipeline = create("lineao::LineRenderer::pipeline", vertex, "fs_main", &strip);
+        let attributes = (style == LineStyle::Quads)
+            .then(|| create("lineao::LineRenderer::attributes", "vs_attributes", "fs_main", &with_attributes));
         let octants = (octants && style == LineStyle::Quads).then(|| OctantPipelines {
             attributes: create("lineao::LineRenderer::octants", "vs_octants", "fs_octants", &with_attributes),
             visible: create("lineao::LineRenderer::visible", "vs_visible", "fs_octants", &strip),
         });
-        LineRenderer { style, pipeline, octants, bindings }
+        LineRenderer { style, pipeline, attributes, octants, bindings }
     }
 
     /// Whether this renderer writes the `octants` target.
@@ -536,11 +553,12 @@ impl LineRenderer {
         // The octants too when both the pipelines and the target exist.
         let octants = self.octants.as_ref().filter(|_| targets.octants.is_some());
         let mut pass = gbuffer::begin(encoder, "lineao::LineRenderer", targets, load, octants.is_some(), span);
-        let attributes = octants.is_some() && geometry.has_attributes();
-        pass.set_pipeline(match octants {
-            Some(pipelines) if attributes => &pipelines.attributes,
-            Some(pipelines) => &pipelines.visible,
-            None => &self.pipeline,
+        let attributes = geometry.has_attributes() && (octants.is_some() || self.attributes.is_some());
+        pass.set_pipeline(match (octants, &self.attributes) {
+            (Some(pipelines), _) if attributes => &pipelines.attributes,
+            (Some(pipelines), _) => &pipelines.visible,
+            (None, Some(pipeline)) if attributes => pipeline,
+            _ => &self.pipeline,
         });
         pass.set_bind_group(0, &self.bindings.group, &[]);
         for chunk in &geometry.chunks {

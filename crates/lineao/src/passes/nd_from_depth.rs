@@ -184,7 +184,11 @@ impl NdFromDepth {
     ) {
         // Whether a color comes with this frame: the uniform's one per-frame word.
         let has_color = inputs.color.is_some() as u32;
-        queue.write_buffer(&self.uniform, std::mem::offset_of!(HostUniform, has_color) as u64, bytemuck::bytes_of(&has_color));
+        queue.write_buffer(
+            &self.uniform,
+            std::mem::offset_of!(HostUniform, has_color) as u64,
+            bytemuck::bytes_of(&has_color),
+        );
         let placeholder = &self.placeholder.view;
         let group = binding::group(
             device,

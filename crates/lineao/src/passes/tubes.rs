@@ -47,8 +47,9 @@ impl TubeRenderer {
         let module = crate::shader::module(device, "tubes.wgsl");
         let point = |a, t| wgpu::vertex_attr_array![a => Float32x3, t => Snorm16x4];
         let (at_a, at_b) = (point(0, 1), point(2, 3));
-        let attribute = |lo, hi, r| wgpu::vertex_attr_array![lo => Unorm8x4, hi => Unorm8x4, r => Float32];
-        let (attr_a, attr_b) = (attribute(4, 5, 6), attribute(7, 8, 9));
+        let attribute =
+            |lo, hi, r, s| wgpu::vertex_attr_array![lo => Unorm8x4, hi => Unorm8x4, r => Float32, s => Float32];
+        let (attr_a, attr_b) = (attribute(4, 5, 6, 10), attribute(7, 8, 9, 11));
         let instance = |stride, attributes| {
             Some(wgpu::VertexBufferLayout {
                 array_stride: stride,
