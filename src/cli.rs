@@ -24,6 +24,74 @@ pub enum Command {
     Convert(ConvertArgs),
     /// Time every pass on a built-in scene (CONTRACT.md `lineao bench --json`).
     Bench(BenchArgs),
+    /// Open a window: orbit a tractogram and compare LineAO with the other methods side by side.
+    View(ViewArgs),
+}
+
+#[derive(Args, Debug)]
+pub struct ViewArgs {
+    /// Tractography file to open (any format `lineao info` reads); default a built-in scene.
+    #[arg(conflicts_with = "scene")]
+    pub file: Option<PathBuf>,
+    /// Built-in scene [default: bundles].
+    #[arg(long, value_parser = parse_scene)]
+    pub scene: Option<SceneKind>,
+    /// Approximate vertex count of the built-in scene [default: 400000].
+    #[arg(long)]
+    pub vertices: Option<usize>,
+    /// The method shown first (as `render --method`).
+    #[arg(long, default_value = "lineao", value_parser = parse_method)]
+    pub method: Method,
+    /// Start in compare mode with these two methods (e.g. `lineao,ssao`).
+    #[arg(long, value_name = "A,B", value_parser = parse_pair, conflicts_with = "method")]
+    pub compare: Option<[Method; 2]>,
+    /// Streamlines as lines or tubes.
+    #[arg(long, value_enum, default_value_t = GeometryArg::Lines)]
+    pub geometry: GeometryArg,
+    /// Parameters for dense tractography (the paper's) or sparse streamlines.
+    #[arg(long, value_enum, default_value_t = PresetArg::Dense)]
+    pub preset: PresetArg,
+    /// Line color: `tangent`, R,G,B in [0, 1], or `field:NAME` (see `render --color`).
+    #[arg(long, default_value = "tangent", value_parser = parse_color)]
+    pub color: ColorArg,
+    /// The colormap of `--color field:NAME`.
+    #[arg(long, value_enum, default_value_t = ColormapArg::Viridis)]
+    pub colormap: ColormapArg,
+    /// What to show: final, ao, normals, depth, zoom, or level:K.
+    #[arg(long, default_value = "final", value_parser = parse_debug_view)]
+    pub debug_view: lineao::DebugView,
+    /// Start with an orthographic camera.
+    #[arg(long)]
+    pub ortho: bool,
+    /// Show each pass's GPU time over the image.
+    #[arg(long)]
+    pub timings: bool,
+    /// Window size in points, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1400x900", value_parser = parse_size)]
+    pub size: [u32; 2],
+    /// Save the window as a PNG once N frames (--frames) have passed and the image is complete,
+    /// then exit: scripted use, and tests under Xvfb.
+    #[arg(long, value_name = "PNG")]
+    pub screenshot: Option<PathBuf>,
+    /// With --screenshot: UI frames to run at least before saving.
+    #[arg(long, default_value_t = 3, requires = "screenshot")]
+    pub frames: u32,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum PresetArg {
+    /// Whole-brain tractography: the paper's values.
+    Dense,
+    /// Few streamlines far apart: wider lines, every method reaching farther.
+    Sparse,
+}
+
+fn parse_size(s: &str) -> Result<[u32; 2], String> {
+    let parse = |p: &str| p.trim().parse::<u32>().ok().filter(|v| (64..=16384).contains(v));
+    match s.split_once(['x', 'X']).map(|(w, h)| (parse(w), parse(h))) {
+        Some((Some(w), Some(h))) => Ok([w, h]),
+        _ => Err(format!("expected WIDTHxHEIGHT between 64 and 16384, got '{s}'")),
+    }
 }
 
 #[derive(Args, Debug)]

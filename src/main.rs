@@ -11,6 +11,7 @@ mod info;
 mod label;
 mod output;
 mod render;
+mod view;
 
 use std::process::ExitCode;
 
@@ -28,6 +29,7 @@ fn main() -> ExitCode {
         cli::Command::Info(args) => info::run(&args),
         cli::Command::Convert(args) => info::convert(&args),
         cli::Command::BenchLoad(args) => bench_load::run(&args),
+        cli::Command::View(args) => view::run(&args),
     });
     match result {
         Ok(Ok(())) => ExitCode::SUCCESS,

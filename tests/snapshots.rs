@@ -6,6 +6,7 @@
 use std::path::{Path, PathBuf};
 
 mod common;
+use common::read_png;
 
 use glam::Vec3;
 use lineao::camera::{Camera, Projection};
@@ -31,15 +32,6 @@ fn write_png(path: &Path, (width, height): (u32, u32), rgba: &[u8]) {
     encoder.set_color(png::ColorType::Rgba);
     encoder.set_depth(png::BitDepth::Eight);
     encoder.write_header().unwrap().write_image_data(rgba).unwrap();
-}
-
-fn read_png(path: &Path) -> ((u32, u32), Vec<u8>) {
-    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()));
-    let mut reader = decoder.read_info().unwrap();
-    let mut buffer = vec![0; reader.output_buffer_size().unwrap()];
-    let info = reader.next_frame(&mut buffer).unwrap();
-    buffer.truncate(info.buffer_size());
-    ((info.width, info.height), buffer)
 }
 
 /// Compares a `size` image against the stored snapshot; returns a description of the failure.

@@ -195,6 +195,11 @@ impl AoChain {
         self.timer.is_some()
     }
 
+    /// Whether per-pass GPU timing is on.
+    pub fn timing(&self) -> bool {
+        self.timer.is_some()
+    }
+
     /// GPU time of each pass of the last submitted frame (waits for it), or `None` when timing
     /// is off. Passes the method skips are left out.
     pub fn pass_times(&self, device: &wgpu::Device) -> Result<Option<Vec<PassTime>>, Error> {

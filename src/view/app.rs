@@ -1,0 +1,580 @@
+//! The viewer window: a menu bar, the controls on the left, the rendered image in the middle
+//! (two methods split by a draggable divider in compare mode), a status bar below.
+//!
+//! Each UI frame turns the controls and the camera into a [`View`]; a view that differs from
+//! the last one requested goes to the render thread ([`super::worker`]), and finished frames
+//! come back as textures. The window never waits for the GPU: while a frame renders, the last
+//! one stays on screen (stretched if the window was resized) and input goes on.
+
+use std::path::PathBuf;
+use std::sync::mpsc::{self, Receiver, Sender};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use egui::emath::GuiRounding;
+use egui::{Align2, Color32, ColorImage, FontId, Key, PointerButton, Pos2, Rect, Sense, TextureHandle, Vec2};
+use egui_file_dialog::FileDialog;
+use lineao_tracts::SceneKind;
+
+use super::camera::OrbitCamera;
+use super::controls::{ColorMode, Controls, method_label};
+use super::worker::{self, Dataset, Frame, FromWorker, PREVIEW_VERTICES, Source, ToWorker, View};
+
+/// How long after the last camera motion frames stay previews.
+const MOTION_REST: Duration = Duration::from_millis(300);
+
+/// What the viewer opens with.
+pub struct Options {
+    pub source: Source,
+    pub controls: Controls,
+    pub orthographic: bool,
+    /// `--screenshot PNG --frames N`: save the window after N frames once the image is complete,
+    /// then close.
+    pub screenshot: Option<(PathBuf, u32)>,
+}
+
+/// How a session ended, for `--screenshot`'s exit status.
+#[derive(Debug, Default)]
+pub struct Outcome {
+    pub saved: Option<PathBuf>,
+    pub error: Option<String>,
+}
+
+/// A file being read.
+struct Loading {
+    name: String,
+    bytes: u64,
+    total: Option<u64>,
+}
+
+pub struct App {
+    /// `None` once dropped, which ends the render thread.
+    to_worker: Option<Sender<ToWorker>>,
+    render_thread: Option<std::thread::JoinHandle<()>>,
+    from_worker: Receiver<FromWorker>,
+    pub controls: Controls,
+    pub camera: Option<OrbitCamera>,
+    orthographic: bool,
+    pub dataset: Option<Dataset>,
+    loading: Option<Loading>,
+    /// What the render thread is busy with besides rendering (object-space AO).
+    busy: Option<String>,
+    pub error: Option<String>,
+    /// The last view sent to the render thread, and the frame on screen.
+    requested: Option<View>,
+    pub shown: Option<Box<Frame>>,
+    textures: Vec<TextureHandle>,
+    /// Compare mode: where the divider is, as a fraction of the image's width.
+    pub divider: f32,
+    last_motion: Option<Instant>,
+    /// Where the image is drawn (points).
+    pub image_rect: Option<Rect>,
+    open_dialog: FileDialog,
+    save_dialog: FileDialog,
+    screenshot: Option<(PathBuf, u32)>,
+    screenshot_requested: bool,
+    pub outcome: Arc<Mutex<Outcome>>,
+    frames: u64,
+}
+
+impl App {
+    pub fn new(cc: &eframe::CreationContext<'_>, options: Options) -> App {
+        let (to_worker, worker_rx) = mpsc::channel();
+        let (worker_tx, from_worker) = mpsc::channel();
+        let ctx = cc.egui_ctx.clone();
+        let render_thread = std::thread::Builder::new()
+            .name("lineao-render".into())
+            .spawn(move || worker::run(worker_rx, worker_tx, move || ctx.request_repaint()))
+            .expect("spawning the render thread");
+        let extensions = vec!["trk", "tck", "trx", "tsf", "vtk", "vtp", "gz", "gltf", "glb", "obj"];
+        let mut app = App {
+            to_worker: Some(to_worker),
+            render_thread: Some(render_thread),
+            from_worker,
+            controls: options.controls,
+            camera: None,
+            orthographic: options.orthographic,
+            dataset: None,
+            loading: None,
+            busy: None,
+            error: None,
+            requested: None,
+            shown: None,
+            textures: Vec::new(),
+            divider: 0.5,
+            last_motion: None,
+            image_rect: None,
+            open_dialog: FileDialog::new()
+                .title("Open a tractogram")
+                .add_file_filter_extensions("Tractograms and meshes", extensions)
+                .default_file_filter("Tractograms and meshes"),
+            save_dialog: FileDialog::new().title("Save a screenshot (PNG)").default_file_name("lineao-view.png"),
+            screenshot: options.screenshot,
+            screenshot_requested: false,
+            outcome: Arc::default(),
+            frames: 0,
+        };
+        app.load(options.source);
+        app
+    }
+
+    /// Opens a file or builds a scene (on the render thread).
+    pub fn load(&mut self, source: Source) {
+        let name = match &source {
+            Source::Scene { kind, .. } => format!("scene {}", kind.name()),
+            Source::File(path) => path.display().to_string(),
+        };
+        self.loading = Some(Loading { name, bytes: 0, total: None });
+        (self.dataset, self.shown, self.requested, self.error, self.busy) = (None, None, None, None, None);
+        self.send(ToWorker::Load(source));
+    }
+
+    fn send(&self, message: ToWorker) {
+        if let Some(to_worker) = &self.to_worker {
+            let _ = to_worker.send(message);
+        }
+    }
+
+    /// Whether what is on screen is complete: the newest view rendered, or an error shown.
+    pub fn settled(&self) -> bool {
+        if self.error.is_some() {
+            return true;
+        }
+        self.loading.is_none()
+            && self.requested.is_some()
+            && self.shown.as_ref().map(|f| &f.view) == self.requested.as_ref()
+    }
+
+    /// The message shown for a failure, if any.
+    fn fail(&mut self, message: String) {
+        if self.loading.take().is_some() {
+            (self.dataset, self.shown) = (None, None);
+        }
+        self.busy = None;
+        self.outcome.lock().expect("not poisoned").error = Some(message.clone());
+        self.error = Some(message);
+    }
+
+    fn receive(&mut self, ctx: &egui::Context) {
+        while let Ok(message) = self.from_worker.try_recv() {
+            match message {
+                FromWorker::Progress { bytes, total } => {
+                    if let Some(loading) = &mut self.loading {
+                        (loading.bytes, loading.total) = (bytes, total);
+                    }
+                }
+                FromWorker::Loaded(dataset) => {
+                    self.loading = None;
+                    let mut camera = OrbitCamera::from_hint(&dataset.hint);
+                    camera.orthographic = self.orthographic;
+                    self.camera = Some(camera);
+                    self.controls.set_zoom_unit(dataset.hint.zoom_unit);
+                    if let ColorMode::Field(name) = &self.controls.color
+                        && !dataset.fields.iter().any(|(f, _)| f == name)
+                    {
+                        self.controls.color = ColorMode::Tangent;
+                    }
+                    self.dataset = Some(dataset);
+                }
+                FromWorker::Frame(frame) if self.loading.is_none() => {
+                    self.busy = None;
+                    let (w, h) = (frame.size.0 as usize, frame.size.1 as usize);
+                    self.textures.truncate(frame.images.len());
+                    for (i, bytes) in frame.images.iter().enumerate() {
+                        let image = ColorImage::from_rgba_unmultiplied([w, h], bytes);
+                        match self.textures.get_mut(i) {
+                            Some(texture) => texture.set(image, egui::TextureOptions::LINEAR),
+                            None => self.textures.push(ctx.load_texture(
+                                format!("lineao-frame-{i}"),
+                                image,
+                                egui::TextureOptions::LINEAR,
+                            )),
+                        }
+                    }
+                    self.shown = Some(frame);
+                }
+                FromWorker::Frame(_) => {}
+                FromWorker::Busy(what) => self.busy = Some(what),
+                FromWorker::Error(message) => self.fail(message),
+            }
+        }
+    }
+
+    /// The view the controls and the camera describe, for an image of `size` pixels.
+    fn view(&self, size: (u32, u32)) -> Option<View> {
+        let (dataset, camera) = (self.dataset.as_ref()?, self.camera.as_ref()?);
+        let field = match &self.controls.color {
+            ColorMode::Field(name) => dataset.fields.iter().find(|(f, _)| f == name),
+            _ => None,
+        };
+        Some(View {
+            size,
+            camera: camera.camera(),
+            panels: self.controls.panels(camera.up, field.map(|(_, range)| *range)),
+            preview: self.moving() && dataset.vertices > PREVIEW_VERTICES,
+            timings: self.controls.timings,
+            scalar_field: field.map(|(name, _)| name.clone()),
+        })
+    }
+
+    fn moving(&self) -> bool {
+        self.last_motion.is_some_and(|t| t.elapsed() < MOTION_REST)
+    }
+
+    /// Sends the current view to the render thread if it is new.
+    fn request_render(&mut self, ctx: &egui::Context) {
+        let Some(rect) = self.image_rect else { return };
+        let ppp = ctx.pixels_per_point();
+        let size = ((rect.width() * ppp).round().max(1.0) as u32, (rect.height() * ppp).round().max(1.0) as u32);
+        let Some(view) = self.view(size) else { return };
+        if self.requested.as_ref() != Some(&view) {
+            self.error = None;
+            self.requested = Some(view.clone());
+            self.send(ToWorker::Render(view));
+        }
+        if self.moving() {
+            // Once the camera rests, the full-detail frame.
+            ctx.request_repaint_after(MOTION_REST);
+        }
+    }
+
+    fn menu(&mut self, ui: &mut egui::Ui) {
+        egui::Panel::top("menu").show(ui, |ui| {
+            egui::MenuBar::new().ui(ui, |ui| {
+                ui.menu_button("File", |ui| {
+                    if ui.button("Open…").clicked() {
+                        self.open_dialog.pick_file();
+                        ui.close();
+                    }
+                    ui.menu_button("Built-in scene", |ui| {
+                        for kind in SceneKind::ALL {
+                            if ui.button(kind.name()).clicked() {
+                                self.load(Source::Scene { kind, vertices: kind.default_vertices() });
+                                ui.close();
+                            }
+                        }
+                    });
+                    if ui.button("Save screenshot…").clicked() {
+                        self.save_dialog.save_file();
+                        ui.close();
+                    }
+                    if ui.button("Quit").clicked() {
+                        ui.ctx().send_viewport_cmd(egui::ViewportCommand::Close);
+                    }
+                });
+                ui.menu_button("View", |ui| {
+                    if ui.button("Reset view (R)").clicked() {
+                        if let Some(camera) = &mut self.camera {
+                            camera.reset();
+                        }
+                        ui.close();
+                    }
+                    if ui.checkbox(&mut self.orthographic, "Orthographic (O)").changed()
+                        && let Some(camera) = &mut self.camera
+                    {
+                        camera.orthographic = self.orthographic;
+                    }
+                    ui.checkbox(&mut self.controls.compare, "Compare side by side");
+                    ui.checkbox(&mut self.controls.timings, "GPU time per pass");
+                });
+                ui.separator();
+                if let Some(d) = &self.dataset {
+                    ui.label(format!("{} · {} streamlines · {} vertices", d.name, d.streamlines, d.vertices));
+                }
+            });
+        });
+    }
+
+    fn status_bar(&mut self, ui: &mut egui::Ui) {
+        egui::Panel::bottom("status").show(ui, |ui| {
+            ui.horizontal(|ui| {
+                if let Some(loading) = &self.loading {
+                    let mib = loading.bytes as f64 / (1 << 20) as f64;
+                    match loading.total.filter(|&t| t > 0) {
+                        Some(total) => {
+                            let fraction = loading.bytes as f32 / total as f32;
+                            let text = format!(
+                                "loading {}: {mib:.1} of {:.1} MiB",
+                                loading.name,
+                                total as f64 / (1 << 20) as f64
+                            );
+                            ui.add(egui::ProgressBar::new(fraction).text(text).desired_width(420.0));
+                        }
+                        None => {
+                            ui.spinner();
+                            ui.label(format!("loading {}: {mib:.1} MiB", loading.name));
+                        }
+                    }
+                } else if let Some(error) = &self.error {
+                    ui.colored_label(ui.visuals().error_fg_color, error);
+                } else if let Some(busy) = &self.busy {
+                    ui.spinner();
+                    ui.label(busy);
+                } else if !self.settled() && self.dataset.is_some() {
+                    ui.spinner();
+                    ui.label("rendering…");
+                } else if let Some(frame) = &self.shown {
+                    let (w, h) = frame.size;
+                    ui.label(format!("{w} × {h} px · {:.0} ms (render and read back)", frame.render_ms));
+                }
+            });
+        });
+    }
+
+    /// The image, the divider, the overlays, and the camera's input.
+    fn viewport(&mut self, ui: &mut egui::Ui) {
+        // On whole pixels, so that the frame's texels map 1:1 onto the screen's.
+        let rect = ui.available_rect_before_wrap().round_to_pixels(ui.pixels_per_point());
+        self.image_rect = Some(rect);
+        let response = ui.allocate_rect(rect, Sense::click_and_drag());
+        let painter = ui.painter_at(rect);
+        painter.rect_filled(rect, 0.0, Color32::from_gray(255));
+        let uv = |a: f32, b: f32| Rect::from_min_max(Pos2::new(a, 0.0), Pos2::new(b, 1.0));
+        let split = rect.left() + self.divider * rect.width();
+        match (&self.shown, &self.textures[..]) {
+            (Some(_), [only]) => {
+                painter.image(only.id(), rect, uv(0.0, 1.0), Color32::WHITE);
+            }
+            (Some(_), [left, right]) => {
+                let (l, r) = (
+                    Rect::from_x_y_ranges(rect.left()..=split, rect.y_range()),
+                    Rect::from_x_y_ranges(split..=rect.right(), rect.y_range()),
+                );
+                painter.image(left.id(), l, uv(0.0, self.divider), Color32::WHITE);
+                painter.image(right.id(), r, uv(self.divider, 1.0), Color32::WHITE);
+            }
+            _ => {
+                let text = match (&self.loading, &self.error) {
+                    (Some(_), _) => "loading…",
+                    (None, Some(_)) => {
+                        "Could not show this — see the message below.\nOpen a file (File ▸ Open…, or drop it here) or pick a built-in scene."
+                    }
+                    _ => "rendering…",
+                };
+                painter.text(
+                    rect.center(),
+                    Align2::CENTER_CENTER,
+                    text,
+                    FontId::proportional(16.0),
+                    Color32::DARK_GRAY,
+                );
+            }
+        }
+        if let Some(frame) = &self.shown {
+            let names: Vec<String> = frame.view.panels.iter().map(panel_label).collect();
+            if let [left, right] = &names[..] {
+                painter.line_segment(
+                    [Pos2::new(split, rect.top()), Pos2::new(split, rect.bottom())],
+                    (2.0, Color32::from_gray(40)),
+                );
+                badge(&painter, Pos2::new(split - 8.0, rect.top() + 8.0), Align2::RIGHT_TOP, left);
+                badge(&painter, Pos2::new(split + 8.0, rect.top() + 8.0), Align2::LEFT_TOP, right);
+            }
+            if self.controls.timings {
+                for (i, times) in frame.times.iter().enumerate() {
+                    let text = match times {
+                        Some(times) => {
+                            let mut lines: Vec<String> =
+                                times.iter().map(|t| format!("{:<12}{:8.2} ms", t.name, t.ms)).collect();
+                            lines.push(format!("{:<12}{:8.2} ms", "sum", times.iter().map(|t| t.ms).sum::<f64>()));
+                            lines.join("\n")
+                        }
+                        None => "no timestamp queries on this adapter".into(),
+                    };
+                    let (x, align) = if i == 0 {
+                        (rect.left() + 8.0, Align2::LEFT_BOTTOM)
+                    } else {
+                        (rect.right() - 8.0, Align2::RIGHT_BOTTOM)
+                    };
+                    badge(&painter, Pos2::new(x, rect.bottom() - 8.0), align, &text);
+                }
+            }
+            if frame.view.preview {
+                badge(
+                    &painter,
+                    Pos2::new(rect.center().x, rect.bottom() - 8.0),
+                    Align2::CENTER_BOTTOM,
+                    "preview: fewer streamlines, half resolution",
+                );
+            }
+        }
+        if ui.ctx().input(|i| !i.raw.hovered_files.is_empty()) {
+            painter.rect_filled(rect, 0.0, Color32::from_black_alpha(120));
+            painter.text(
+                rect.center(),
+                Align2::CENTER_CENTER,
+                "Drop to open",
+                FontId::proportional(24.0),
+                Color32::WHITE,
+            );
+        }
+
+        if self.controls.compare {
+            let handle = Rect::from_x_y_ranges(split - 5.0..=split + 5.0, rect.y_range());
+            let divider = ui
+                .interact(handle, ui.id().with("divider"), Sense::drag())
+                .on_hover_cursor(egui::CursorIcon::ResizeHorizontal);
+            if divider.dragged()
+                && let Some(pointer) = divider.interact_pointer_pos()
+            {
+                self.divider = ((pointer.x - rect.left()) / rect.width()).clamp(0.02, 0.98);
+            }
+        }
+        self.camera_input(ui, &response, rect);
+    }
+
+    fn camera_input(&mut self, ui: &egui::Ui, response: &egui::Response, rect: Rect) {
+        let Some(camera) = &mut self.camera else { return };
+        let before = *camera;
+        let delta = response.drag_delta();
+        let shift = ui.input(|i| i.modifiers.shift);
+        if response.dragged_by(PointerButton::Primary) && !shift {
+            camera.orbit(delta.x * 0.008, delta.y * 0.008);
+        } else if response.dragged_by(PointerButton::Secondary)
+            || response.dragged_by(PointerButton::Middle)
+            || (response.dragged_by(PointerButton::Primary) && shift)
+        {
+            camera.pan(delta.x, delta.y, rect.height());
+        }
+        if response.hovered() {
+            let (scroll, pinch) = ui.input(|i| (i.smooth_scroll_delta.y, i.zoom_delta()));
+            if scroll != 0.0 || pinch != 1.0 {
+                camera.zoom((-scroll * 0.0015).exp() / pinch);
+            }
+        }
+        if response.double_clicked() {
+            camera.reset();
+        }
+        if !ui.ctx().egui_wants_keyboard_input() {
+            let step = 5f32.to_radians();
+            ui.input(|i| {
+                let arrows = [
+                    (Key::ArrowLeft, -1.0, 0.0),
+                    (Key::ArrowRight, 1.0, 0.0),
+                    (Key::ArrowUp, 0.0, -1.0),
+                    (Key::ArrowDown, 0.0, 1.0),
+                ];
+                for (key, x, y) in arrows {
+                    if i.key_pressed(key) {
+                        if i.modifiers.shift {
+                            camera.pan(20.0 * x, 20.0 * y, rect.height())
+                        } else {
+                            camera.orbit(step * x, step * y)
+                        }
+                    }
+                }
+                if i.key_pressed(Key::Plus) || i.key_pressed(Key::Equals) {
+                    camera.zoom(0.9);
+                }
+                if i.key_pressed(Key::Minus) {
+                    camera.zoom(1.0 / 0.9);
+                }
+                if i.key_pressed(Key::R) {
+                    camera.reset();
+                }
+                if i.key_pressed(Key::O) {
+                    camera.orthographic = !camera.orthographic;
+                }
+            });
+            self.orthographic = camera.orthographic;
+        }
+        if *camera != before {
+            self.last_motion = Some(Instant::now());
+        }
+    }
+
+    /// Files from the dialogs and from drag-and-drop; screenshots requested and delivered.
+    fn files(&mut self, ctx: &egui::Context) {
+        self.open_dialog.update(ctx);
+        if let Some(path) = self.open_dialog.take_picked() {
+            self.load(Source::File(path));
+        }
+        self.save_dialog.update(ctx);
+        if let Some(path) = self.save_dialog.take_picked() {
+            ctx.send_viewport_cmd(egui::ViewportCommand::Screenshot(egui::UserData::new(path)));
+        }
+        let dropped = ctx.input(|i| i.raw.dropped_files.first().map(|f| f.path().to_path_buf()));
+        if let Some(path) = dropped {
+            self.load(Source::File(path));
+        }
+        let shots: Vec<(PathBuf, Arc<ColorImage>)> = ctx.input(|i| {
+            i.events
+                .iter()
+                .filter_map(|e| match e {
+                    egui::Event::Screenshot { user_data, image, .. } => {
+                        let path = user_data.data.as_ref()?.downcast_ref::<PathBuf>()?;
+                        Some((path.clone(), image.clone()))
+                    }
+                    _ => None,
+                })
+                .collect()
+        });
+        for (path, image) in shots {
+            let rgba: Vec<u8> = image.pixels.iter().flat_map(|c| c.to_array()).collect();
+            let [w, h] = image.size.map(|s| s as u32);
+            match crate::output::write_png(&path, w, h, &rgba) {
+                Ok(()) => self.outcome.lock().expect("not poisoned").saved = Some(path.clone()),
+                Err(e) => self.fail(format!("{e:#}")),
+            }
+            if self.screenshot.as_ref().is_some_and(|(p, _)| *p == path) {
+                ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+            }
+        }
+        // --screenshot: once N frames have passed and the image is complete.
+        if let Some((path, frames)) = &self.screenshot {
+            if !self.screenshot_requested && self.frames >= u64::from(*frames) && self.settled() {
+                self.screenshot_requested = true;
+                ctx.send_viewport_cmd(egui::ViewportCommand::Screenshot(egui::UserData::new(path.clone())));
+            }
+            ctx.request_repaint();
+        }
+    }
+}
+
+impl Drop for App {
+    /// Ends the render thread and waits for it: a process must not exit while another thread
+    /// still submits Vulkan work (lavapipe's teardown then corrupts its heap).
+    fn drop(&mut self) {
+        self.to_worker = None;
+        if let Some(thread) = self.render_thread.take() {
+            let _ = thread.join();
+        }
+    }
+}
+
+impl eframe::App for App {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        let ctx = ui.ctx().clone();
+        self.frames += 1;
+        self.receive(&ctx);
+        self.menu(ui);
+        self.status_bar(ui);
+        let fields = self.dataset.as_ref().map(|d| d.fields.clone()).unwrap_or_default();
+        egui::Panel::left("controls").default_size(300.0).show(ui, |ui| {
+            egui::ScrollArea::vertical().show(ui, |ui| self.controls.ui(ui, &fields));
+        });
+        egui::CentralPanel::no_frame().show(ui, |ui| self.viewport(ui));
+        self.request_render(&ctx);
+        self.files(&ctx);
+    }
+}
+
+/// What a panel's label says: its method, and LineAO's variant when it is the authors'.
+fn panel_label(panel: &worker::Panel) -> String {
+    let method = crate::cli::Method { screen: panel.settings.method, volume: panel.volume.as_ref().map(|v| v.method) };
+    let mut label = method_label(method);
+    if panel.settings.method == lineao::AoMethod::LineAo
+        && panel.settings.line_ao.variant == lineao::LineAoVariant::Reference
+    {
+        label += " (authors' code)";
+    }
+    label
+}
+
+/// Monospace text on a dark rounded box, `align`ed at `anchor`.
+fn badge(painter: &egui::Painter, anchor: Pos2, align: Align2, text: &str) {
+    let galley = painter.layout_no_wrap(text.to_string(), FontId::monospace(12.0), Color32::WHITE);
+    let rect = align.anchor_size(anchor, galley.size() + Vec2::new(12.0, 8.0));
+    painter.rect_filled(rect, 4.0, Color32::from_black_alpha(170));
+    painter.galley(rect.min + Vec2::new(6.0, 4.0), galley, Color32::WHITE);
+}

@@ -1,0 +1,492 @@
+//! The viewer's side panel: which method (or two, side by side), how lines look, and the chosen
+//! methods' parameters with the papers' defaults, a reset and two presets.
+//!
+//! Everything here is plain state turned into [`Panel`]s by [`Controls::panels`]; the worker
+//! renders what those say, so a control changes the picture by changing this state and nothing
+//! else.
+
+use egui::Ui;
+use glam::Vec3;
+use lineao::volume::{ScalarForm, Sky, VolumeAoOptions, VolumeMethod};
+use lineao::{
+    AoMethod, BilateralSettings, ChainSettings, Colormap, DebugView, LineAoOuter, LineAoVariant, LineColor, SsaoKernel,
+    TubeSettings, VoCombine, VolumeAoSettings,
+};
+
+use super::worker::Panel;
+use crate::cli::Method;
+
+/// The methods the selector offers, in the order `render --grid` shows them.
+pub const METHODS: [Method; 9] = {
+    const fn m(screen: AoMethod, volume: Option<VolumeMethod>) -> Method {
+        Method { screen, volume }
+    }
+    [
+        m(AoMethod::None, None),
+        m(AoMethod::LineAo, None),
+        m(AoMethod::VoLine, None),
+        m(AoMethod::VoArea, None),
+        m(AoMethod::Ssao, None),
+        m(AoMethod::None, Some(VolumeMethod::Sweep)),
+        m(AoMethod::None, Some(VolumeMethod::VarianceVolume)),
+        m(AoMethod::LineAo, Some(VolumeMethod::Sweep)),
+        m(AoMethod::LineAo, Some(VolumeMethod::VarianceVolume)),
+    ]
+};
+
+/// What the method selector calls a method.
+pub fn method_label(method: Method) -> String {
+    match (method.screen, method.volume) {
+        (AoMethod::None, None) => "none".into(),
+        (AoMethod::LineAo, None) => "LineAO".into(),
+        (AoMethod::VoLine, None) => "VO line".into(),
+        (AoMethod::VoArea, None) => "VO area".into(),
+        (AoMethod::Ssao, None) => "Crytek SSAO".into(),
+        (AoMethod::None, Some(VolumeMethod::Sweep)) => "occlusion sweep".into(),
+        (AoMethod::None, Some(VolumeMethod::VarianceVolume)) => "variance volume".into(),
+        (AoMethod::LineAo, Some(VolumeMethod::Sweep)) => "LineAO + sweep".into(),
+        (AoMethod::LineAo, Some(VolumeMethod::VarianceVolume)) => "LineAO + variance".into(),
+        _ => method.name(),
+    }
+}
+
+/// Lines of a width in pixels, or ray-cast tubes of a radius in world units.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Geometry {
+    Lines,
+    Tubes,
+}
+
+/// How lines are colored.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ColorMode {
+    /// |tangent| as RGB (the DEC map of tractography).
+    Tangent,
+    /// A per-vertex field of the file through the colormap.
+    Field(String),
+    /// One sRGB color.
+    Constant([u8; 3]),
+}
+
+/// The two parameter sets the presets choose between.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Preset {
+    /// Whole-brain tractography, hundreds of thousands of streamlines packed millimetres apart:
+    /// the paper's values (thin lines, three hemispheres, SSAO and VO spheres of 2 mm).
+    Dense,
+    /// A few hundred streamlines of a flow field, far apart: wider lines, and every method's
+    /// reach grown so that neighbours, not just a line's own body, occlude (four hemispheres, so
+    /// the outermost reaches twice as far; spheres of 6 units; a softer strength).
+    Sparse,
+}
+
+/// The methods' parameters. World-space lengths are in the data's units (mm for tractograms).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Params {
+    /// Line width, LineAO, SSAO, VO, blur, strength, zoom unit.
+    pub chain: ChainSettings,
+    pub tube_radius: f32,
+    /// Object-space AO (its `method` is set per panel).
+    pub volume: VolumeAoOptions,
+    /// Light only from above (the octants toward the camera's up), else from everywhere.
+    pub cloudy: bool,
+    pub volume_combine: VoCombine,
+}
+
+impl Params {
+    /// `preset`'s values for data whose zoom unit (1 mm for tractograms) is `zoom_unit` world
+    /// units.
+    pub fn preset(preset: Preset, zoom_unit: f32) -> Params {
+        let mut chain = ChainSettings { zoom_unit, ..ChainSettings::default() };
+        chain.ssao.radius_world *= zoom_unit;
+        chain.ssao.range_world *= zoom_unit;
+        chain.vo.radius_world *= zoom_unit;
+        let mut volume = VolumeAoOptions::default();
+        volume.density.occupancy_radius = 0.5 * zoom_unit;
+        let mut params =
+            Params { chain, tube_radius: 0.5 * zoom_unit, volume, cloudy: false, volume_combine: VoCombine::Product };
+        if preset == Preset::Sparse {
+            let c = &mut params.chain;
+            c.line_width_px = 3.0;
+            c.line_ao.s_r = 4;
+            c.line_ao.s_h = 24;
+            c.strength = 0.8;
+            c.ssao.radius_world = 6.0 * zoom_unit;
+            c.ssao.range_world = 6.0 * zoom_unit;
+            c.vo.radius_world = 6.0 * zoom_unit;
+            params.volume.density.occupancy_radius = zoom_unit;
+        }
+        params
+    }
+}
+
+/// The side panel's state.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Controls {
+    /// The left (or only) image's method, and the right one's in compare mode.
+    pub methods: [Method; 2],
+    pub compare: bool,
+    pub geometry: Geometry,
+    pub color: ColorMode,
+    pub colormap: Colormap,
+    /// Direction toward the light in view space: degrees around the view axis's vertical
+    /// (0 = straight at the viewer, positive to the right) and above the horizontal.
+    pub light_azimuth: f32,
+    pub light_elevation: f32,
+    pub debug_view: DebugView,
+    pub timings: bool,
+    pub params: Params,
+    pub preset: Preset,
+}
+
+impl Controls {
+    pub fn new(methods: [Method; 2], compare: bool, preset: Preset) -> Controls {
+        let light = lineao::lighting::Lighting::default().lights[0].dir.normalize();
+        Controls {
+            methods,
+            compare,
+            geometry: Geometry::Lines,
+            color: ColorMode::Tangent,
+            colormap: Colormap::Viridis,
+            light_azimuth: light.x.atan2(light.z).to_degrees(),
+            light_elevation: light.y.asin().to_degrees(),
+            debug_view: DebugView::Final,
+            timings: false,
+            params: Params::preset(preset, 1.0),
+            preset,
+        }
+    }
+
+    /// The data's zoom unit changed (a new file): the parameters take the preset's values in it.
+    pub fn set_zoom_unit(&mut self, zoom_unit: f32) {
+        self.params = Params::preset(self.preset, zoom_unit);
+    }
+
+    /// The panels to render: one, or two in compare mode. `up` is the camera's (a cloudy sky
+    /// comes from the world axis nearest to it), `range` the scalar field's colormap range.
+    pub fn panels(&self, up: Vec3, range: Option<[f32; 2]>) -> Vec<Panel> {
+        let count = if self.compare { 2 } else { 1 };
+        self.methods[..count].iter().map(|&method| self.panel(method, up, range)).collect()
+    }
+
+    fn panel(&self, method: Method, up: Vec3, range: Option<[f32; 2]>) -> Panel {
+        let p = &self.params;
+        let sky = if p.cloudy {
+            let axis = up.abs().max_position();
+            let mut direction = [0.0; 3];
+            direction[axis] = up[axis].signum();
+            Sky::Above(direction)
+        } else {
+            Sky::Uniform
+        };
+        let mut settings = p.chain.clone();
+        settings.method = method.screen;
+        settings.volume = method.volume.map(|_| VolumeAoSettings {
+            // The view-independent forms hold the sky already.
+            sky: if p.volume.form.is_none() { sky.weights() } else { [1.0; 8] },
+            combine: p.volume_combine,
+        });
+        settings.tubes = (self.geometry == Geometry::Tubes).then_some(TubeSettings { radius_world: p.tube_radius });
+        settings.line_color = match (&self.color, range) {
+            (ColorMode::Field(_), Some(range)) => LineColor::Scalar { colormap: self.colormap, range },
+            (ColorMode::Constant(rgb), _) => LineColor::Constant(rgb.map(|c| srgb_to_linear(c as f32 / 255.0))),
+            _ => LineColor::Tangent,
+        };
+        let (az, el) = (self.light_azimuth.to_radians(), self.light_elevation.to_radians());
+        settings.lighting.lights[0].dir = Vec3::new(el.cos() * az.sin(), el.sin(), el.cos() * az.cos());
+        // A pyramid level the method does not have shows its deepest.
+        settings.debug_view = match self.debug_view {
+            DebugView::Level(k) => DebugView::Level(k.min(settings.levels() - 1)),
+            view => view,
+        };
+        let volume = method.volume.map(|m| VolumeAoOptions { method: m, sky, ..p.volume.clone() });
+        Panel { settings, volume }
+    }
+
+    /// Draws the panel; `fields` are the file's one-column per-vertex fields.
+    pub fn ui(&mut self, ui: &mut Ui, fields: &[(String, [f32; 2])]) {
+        ui.heading("Method");
+        method_combo(ui, "method", &mut self.methods[0]);
+        ui.checkbox(&mut self.compare, "Compare side by side").on_hover_text("Drag the divider to move it");
+        if self.compare {
+            method_combo(ui, "method-right", &mut self.methods[1]);
+        }
+        ui.separator();
+
+        ui.heading("Lines");
+        ui.horizontal(|ui| {
+            ui.selectable_value(&mut self.geometry, Geometry::Lines, "Lines");
+            ui.selectable_value(&mut self.geometry, Geometry::Tubes, "Tubes");
+        });
+        let p = &mut self.params;
+        match self.geometry {
+            Geometry::Lines => {
+                ui.add(egui::Slider::new(&mut p.chain.line_width_px, 0.5..=8.0).text("width (px)"));
+            }
+            Geometry::Tubes => {
+                let max = 5.0 * p.chain.zoom_unit;
+                ui.add(
+                    egui::Slider::new(&mut p.tube_radius, 0.05 * p.chain.zoom_unit..=max)
+                        .logarithmic(true)
+                        .text("radius"),
+                );
+            }
+        }
+        self.color_ui(ui, fields);
+        ui.add(egui::Slider::new(&mut self.light_azimuth, -180.0..=180.0).text("light azimuth (°)"));
+        ui.add(egui::Slider::new(&mut self.light_elevation, -89.0..=89.0).text("light elevation (°)"));
+        ui.separator();
+
+        ui.heading("Parameters");
+        ui.horizontal(|ui| {
+            for (preset, label, hint) in [
+                (Preset::Dense, "Dense tractography", "The paper's values"),
+                (Preset::Sparse, "Sparse streamlines", "Wider lines, wider reach"),
+            ] {
+                if ui.selectable_label(self.preset == preset, label).on_hover_text(hint).clicked() {
+                    self.preset = preset;
+                    self.params = Params::preset(preset, self.params.chain.zoom_unit);
+                }
+            }
+        });
+        if ui.button("Reset to defaults").on_hover_text("The selected preset's values").clicked() {
+            self.params = Params::preset(self.preset, self.params.chain.zoom_unit);
+        }
+        let shown = if self.compare { &self.methods[..] } else { &self.methods[..1] };
+        let screen = |m: AoMethod| shown.iter().any(|s| s.screen == m);
+        let volume = shown.iter().any(|s| s.volume.is_some());
+        let p = &mut self.params;
+        ui.add(egui::Slider::new(&mut p.chain.strength, 0.0..=2.0).text("strength"));
+        if screen(AoMethod::LineAo) {
+            egui::CollapsingHeader::new("LineAO").default_open(true).show(ui, |ui| line_ao_ui(ui, &mut p.chain));
+        }
+        if screen(AoMethod::Ssao) {
+            egui::CollapsingHeader::new("Crytek SSAO").default_open(true).show(ui, |ui| ssao_ui(ui, &mut p.chain));
+        }
+        if screen(AoMethod::VoLine) || screen(AoMethod::VoArea) {
+            egui::CollapsingHeader::new("Volumetric Obscurance")
+                .default_open(true)
+                .show(ui, |ui| vo_ui(ui, &mut p.chain));
+        }
+        if volume {
+            egui::CollapsingHeader::new("Object-space AO").default_open(true).show(ui, |ui| volume_ui(ui, p));
+        }
+        let mut blur = p.chain.blur.is_some();
+        ui.checkbox(&mut blur, "Bilateral blur");
+        if blur != p.chain.blur.is_some() {
+            p.chain.blur = blur.then(BilateralSettings::default);
+        }
+        if let Some(b) = &mut p.chain.blur {
+            ui.add(egui::Slider::new(&mut b.radius_px, 1..=16).text("taps per side"));
+            let z = p.chain.zoom_unit;
+            ui.add(egui::Slider::new(&mut b.depth_sigma_world, 0.05 * z..=10.0 * z).logarithmic(true).text("depth σ"));
+        }
+        ui.separator();
+
+        ui.heading("Show");
+        let levels = if screen(AoMethod::LineAo) && p.chain.line_ao.variant == LineAoVariant::Paper {
+            p.chain.line_ao.s_r
+        } else {
+            1
+        };
+        let mut views = vec![
+            (DebugView::Final, "final image".to_string()),
+            (DebugView::Ao, "AO only".into()),
+            (DebugView::Normals, "normals".into()),
+            (DebugView::Depth, "depth".into()),
+            (DebugView::Zoom, "zoom map z(P)".into()),
+        ];
+        views.extend((0..levels).map(|k| (DebugView::Level(k), format!("pyramid level {k}"))));
+        let current =
+            views.iter().find(|(v, _)| *v == self.debug_view).map_or("final image".into(), |(_, l)| l.clone());
+        egui::ComboBox::from_id_salt("debug-view").selected_text(current).show_ui(ui, |ui| {
+            for (view, label) in views {
+                ui.selectable_value(&mut self.debug_view, view, label);
+            }
+        });
+        ui.checkbox(&mut self.timings, "GPU time per pass");
+    }
+
+    fn color_ui(&mut self, ui: &mut Ui, fields: &[(String, [f32; 2])]) {
+        let label = match &self.color {
+            ColorMode::Tangent => "direction".to_string(),
+            ColorMode::Field(name) => format!("field: {name}"),
+            ColorMode::Constant(_) => "constant".into(),
+        };
+        ui.horizontal(|ui| {
+            ui.label("Color");
+            egui::ComboBox::from_id_salt("color").selected_text(label).show_ui(ui, |ui| {
+                ui.selectable_value(&mut self.color, ColorMode::Tangent, "direction").on_hover_text(
+                    "|tangent| as RGB: left-right red, anterior-posterior green, superior-inferior blue",
+                );
+                for (name, _) in fields {
+                    ui.selectable_value(&mut self.color, ColorMode::Field(name.clone()), format!("field: {name}"));
+                }
+                if !matches!(self.color, ColorMode::Constant(_)) && ui.selectable_label(false, "constant").clicked() {
+                    self.color = ColorMode::Constant([200, 170, 120]);
+                }
+            });
+        });
+        match &mut self.color {
+            ColorMode::Field(_) => {
+                egui::ComboBox::from_id_salt("colormap").selected_text(self.colormap.name()).show_ui(ui, |ui| {
+                    for map in Colormap::ALL {
+                        ui.selectable_value(&mut self.colormap, map, map.name());
+                    }
+                });
+            }
+            ColorMode::Constant(rgb) => {
+                ui.color_edit_button_srgb(rgb);
+            }
+            ColorMode::Tangent => {}
+        }
+    }
+}
+
+fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+}
+
+fn method_combo(ui: &mut Ui, id: &str, method: &mut Method) {
+    egui::ComboBox::from_id_salt(id).selected_text(method_label(*method)).width(180.0).show_ui(ui, |ui| {
+        for m in METHODS {
+            ui.selectable_value(method, m, method_label(m));
+        }
+    });
+}
+
+/// A choice among a few values, as a row of buttons.
+fn choice<T: PartialEq + Copy + std::fmt::Display>(ui: &mut Ui, label: &str, value: &mut T, options: &[T]) {
+    ui.horizontal(|ui| {
+        ui.label(label);
+        for &option in options {
+            ui.selectable_value(value, option, option.to_string());
+        }
+    });
+}
+
+fn line_ao_ui(ui: &mut Ui, chain: &mut ChainSettings) {
+    let ao = &mut chain.line_ao;
+    ui.horizontal(|ui| {
+        ui.label("variant");
+        ui.selectable_value(&mut ao.variant, LineAoVariant::Paper, "paper");
+        ui.selectable_value(&mut ao.variant, LineAoVariant::Reference, "authors' code");
+    });
+    ui.add(egui::Slider::new(&mut ao.s_r, 1..=lineao::MAX_LEVELS).text("s_r hemispheres"));
+    ui.add(egui::Slider::new(&mut ao.s_h, 4..=128).logarithmic(true).text("s_h samples"));
+    let mut r0 = ao.r0_px.unwrap_or(1.5 * chain.line_width_px);
+    if ui.add(egui::Slider::new(&mut r0, 0.5..=16.0).text("r0 (px)")).changed() {
+        ao.r0_px = Some(r0);
+    }
+    // δ0 < (1/s_r)² (ChainSettings::validate).
+    let max = 0.9 / (ao.s_r * ao.s_r) as f32;
+    ao.delta0 = ao.delta0.min(max);
+    ui.add(egui::Slider::new(&mut ao.delta0, 1e-6..=max.min(1e-2)).logarithmic(true).text("δ0"));
+    ui.add(egui::Slider::new(&mut ao.epsilon, 1e-8..=1e-3).logarithmic(true).text("ε"));
+    ui.checkbox(&mut ao.light_attenuation, "light attenuation g_light");
+    if ao.variant == LineAoVariant::Paper {
+        ui.horizontal(|ui| {
+            ui.label("outer hemispheres");
+            ui.selectable_value(&mut ao.outer, LineAoOuter::Full, "every pixel");
+            ui.selectable_value(&mut ao.outer, LineAoOuter::Level, "level resolution");
+        });
+    } else {
+        ao.outer = LineAoOuter::Full;
+        ui.add(egui::Slider::new(&mut ao.reference_radius_px, 0.5..=8.0).text("base radius (px)"));
+    }
+}
+
+fn ssao_ui(ui: &mut Ui, chain: &mut ChainSettings) {
+    let (s, z) = (&mut chain.ssao, chain.zoom_unit);
+    ui.horizontal(|ui| {
+        ui.label("kernel");
+        ui.selectable_value(&mut s.kernel, SsaoKernel::Crytek, "Crytek");
+        ui.selectable_value(&mut s.kernel, SsaoKernel::Sphere, "VO sphere set");
+    });
+    match s.kernel {
+        SsaoKernel::Crytek => {
+            ui.add(egui::Slider::new(&mut s.samples, 8..=32).text("samples"));
+        }
+        SsaoKernel::Sphere => {
+            let counts = lineao::sample_sets::VO_SPHERE_SAMPLE_COUNTS;
+            if !counts.contains(&s.samples) {
+                s.samples = 16;
+            }
+            choice(ui, "samples", &mut s.samples, &counts);
+        }
+    }
+    ui.add(egui::Slider::new(&mut s.radius_world, 0.1 * z..=20.0 * z).logarithmic(true).text("radius"));
+    ui.add(egui::Slider::new(&mut s.range_world, 0.1 * z..=20.0 * z).logarithmic(true).text("range check"));
+}
+
+fn vo_ui(ui: &mut Ui, chain: &mut ChainSettings) {
+    let (vo, z) = (&mut chain.vo, chain.zoom_unit);
+    choice(ui, "line samples", &mut vo.samples, &lineao::sample_sets::VO_SAMPLE_COUNTS);
+    choice(ui, "area samples", &mut vo.area_samples, &lineao::sample_sets::VO_AREA_SAMPLE_COUNTS);
+    ui.add(egui::Slider::new(&mut vo.radius_world, 0.1 * z..=20.0 * z).logarithmic(true).text("radius"));
+    ui.checkbox(&mut vo.normal_clamp, "normal clamp (half sphere)");
+    ui.add(egui::Slider::new(&mut vo.thickness_world, 0.0..=10.0 * z).text("thickness (0 = off)"));
+}
+
+fn volume_ui(ui: &mut Ui, p: &mut Params) {
+    let v = &mut p.volume;
+    let z = p.chain.zoom_unit;
+    ui.add(egui::Slider::new(&mut v.density.resolution, 32..=256).text("voxels (longest axis)"))
+        .on_hover_text("Computed once per setting on the CPU: 1–3 s for 1 M vertices at 256");
+    ui.add(
+        egui::Slider::new(&mut v.density.occupancy_radius, 0.1 * z..=5.0 * z)
+            .logarithmic(true)
+            .text("occupancy radius"),
+    );
+    ui.add(egui::Slider::new(&mut v.sweep.alpha, 0.05..=1.0).text("sweep opacity α"));
+    ui.checkbox(&mut p.cloudy, "cloudy sky (light from above)");
+    let forms = [
+        (None, "per pixel (paper)"),
+        (Some(ScalarForm::AroundTangent), "around tangent"),
+        (Some(ScalarForm::NoGeometryTerm), "no geometry term"),
+    ];
+    ui.horizontal_wrapped(|ui| {
+        ui.label("normal");
+        for (form, label) in forms {
+            ui.selectable_value(&mut v.form, form, label);
+        }
+    });
+    ui.horizontal(|ui| {
+        ui.label("with screen space");
+        ui.selectable_value(&mut p.volume_combine, VoCombine::Product, "product");
+        ui.selectable_value(&mut p.volume_combine, VoCombine::Min, "darker");
+    });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_preset_and_method_gives_valid_settings() {
+        for preset in [Preset::Dense, Preset::Sparse] {
+            for zoom_unit in [1.0, 0.01] {
+                let mut controls = Controls::new([METHODS[1], METHODS[4]], true, preset);
+                controls.set_zoom_unit(zoom_unit);
+                for method in METHODS {
+                    controls.methods[1] = method;
+                    for geometry in [Geometry::Lines, Geometry::Tubes] {
+                        controls.geometry = geometry;
+                        controls.debug_view = DebugView::Level(2);
+                        for panel in controls.panels(Vec3::Z, Some([0.0, 1.0])) {
+                            panel.settings.validate().unwrap_or_else(|e| panic!("{preset:?} {method:?}: {e}"));
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn the_default_light_is_the_contracts() {
+        let controls = Controls::new([METHODS[1]; 2], false, Preset::Dense);
+        let panel = &controls.panels(Vec3::Z, None)[0];
+        let expected = lineao::lighting::Lighting::default().lights[0].dir.normalize();
+        assert!(panel.settings.lighting.lights[0].dir.distance(expected) < 1e-5);
+    }
+}

@@ -1,0 +1,97 @@
+//! `lineao view`: a window (eframe + egui on wgpu) to orbit a tractogram and see LineAO against
+//! the other methods, side by side on the same frame.
+//!
+//! - [`app`]: the window — menu, controls, image, divider, overlays, input.
+//! - [`controls`]: the side panel's state and widgets, turned into the chain's settings.
+//! - [`worker`]: the render thread with its own device, so that seconds-long lavapipe frames
+//!   never block input; previews while the camera moves.
+//! - [`camera`]: the orbit camera.
+
+mod app;
+mod camera;
+mod controls;
+#[cfg(test)]
+mod tests;
+mod worker;
+
+use anyhow::{Context, Result};
+
+use crate::cli::{ColorArg, ColormapArg, GeometryArg, PresetArg, ViewArgs};
+use controls::{ColorMode, Controls, Geometry, Preset};
+use worker::Source;
+
+/// The viewer's opening state from the command line.
+fn options(args: &ViewArgs) -> app::Options {
+    let source = match &args.file {
+        Some(path) => Source::File(path.clone()),
+        None => {
+            let kind = args.scene.unwrap_or(lineao_tracts::SceneKind::Bundles);
+            Source::Scene { kind, vertices: args.vertices.unwrap_or(kind.default_vertices()) }
+        }
+    };
+    let preset = match args.preset {
+        PresetArg::Dense => Preset::Dense,
+        PresetArg::Sparse => Preset::Sparse,
+    };
+    let (methods, compare) = match args.compare {
+        Some(pair) => (pair, true),
+        None => ([args.method, controls::METHODS[4]], false),
+    };
+    let mut controls = Controls::new(methods, compare, preset);
+    controls.geometry = match args.geometry {
+        GeometryArg::Lines => Geometry::Lines,
+        GeometryArg::Tubes => Geometry::Tubes,
+    };
+    controls.color = match &args.color {
+        ColorArg::Tangent => ColorMode::Tangent,
+        ColorArg::Constant(rgb) => ColorMode::Constant(rgb.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8)),
+        ColorArg::Field(name) => ColorMode::Field(name.clone()),
+    };
+    controls.colormap = match args.colormap {
+        ColormapArg::Viridis => lineao::Colormap::Viridis,
+        ColormapArg::Gray => lineao::Colormap::Gray,
+        ColormapArg::Coolwarm => lineao::Colormap::CoolWarm,
+    };
+    controls.debug_view = args.debug_view;
+    controls.timings = args.timings;
+    app::Options {
+        source,
+        controls,
+        orthographic: args.ortho,
+        screenshot: args.screenshot.clone().map(|path| (path, args.frames)),
+    }
+}
+
+pub fn run(args: &ViewArgs) -> Result<()> {
+    let options = options(args);
+    let screenshot = options.screenshot.clone();
+    let native = eframe::NativeOptions {
+        viewport: egui::ViewportBuilder::default()
+            .with_title("lineao")
+            .with_inner_size([args.size[0] as f32, args.size[1] as f32]),
+        renderer: eframe::Renderer::Wgpu,
+        ..Default::default()
+    };
+    let outcome = std::sync::Arc::new(std::sync::Mutex::new(app::Outcome::default()));
+    let shared = outcome.clone();
+    eframe::run_native(
+        "lineao",
+        native,
+        Box::new(move |cc| {
+            let mut app = app::App::new(cc, options);
+            app.outcome = shared;
+            Ok(Box::new(app))
+        }),
+    )
+    .map_err(|e| anyhow::anyhow!("{e}"))
+    .context("cannot open the viewer's window (no display? run under xvfb-run, or use `lineao render`)")?;
+    let outcome = outcome.lock().expect("not poisoned");
+    if let Some((path, _)) = screenshot {
+        if let Some(error) = &outcome.error {
+            anyhow::bail!("{error} (the screenshot {} shows it)", path.display());
+        }
+        anyhow::ensure!(outcome.saved.as_ref() == Some(&path), "the window closed before the screenshot was taken");
+        eprintln!("lineao: saved the window to {}", path.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,303 @@
+//! The viewer driven headlessly by egui's test harness (kittest): real input events, the real
+//! render thread on lavapipe, and the window's pixels rendered by egui's wgpu renderer and
+//! compared with the frames the render thread produced — so "the screen shows the render" is
+//! checked pixel by pixel, not assumed. `tests/view.rs` runs the binary itself under Xvfb.
+
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use egui::{Event, Modifiers, PointerButton, Pos2, Rect};
+use egui_kittest::Harness;
+use egui_kittest::kittest::Queryable;
+use lineao::AoMethod;
+use lineao_tracts::SceneKind;
+
+use super::app::{App, Options};
+use super::controls::{Controls, METHODS, Preset};
+use super::worker::{PREVIEW_VERTICES, Source};
+
+const SIZE: [f32; 2] = [1000.0, 640.0];
+
+fn options(source: Source, methods: [crate::cli::Method; 2], compare: bool) -> Options {
+    Options { source, controls: Controls::new(methods, compare, Preset::Dense), orthographic: false, screenshot: None }
+}
+
+fn scene(kind: SceneKind, vertices: usize) -> Source {
+    Source::Scene { kind, vertices }
+}
+
+fn harness(options: Options) -> Harness<'static, App> {
+    Harness::builder().with_size(SIZE).wgpu().build_eframe(move |cc| App::new(cc, options))
+}
+
+/// Steps the UI until the newest view is on screen (or an error is), then once more.
+fn settle(harness: &mut Harness<'_, App>) {
+    let deadline = Instant::now() + Duration::from_secs(300);
+    harness.step();
+    while !harness.state().settled() {
+        assert!(Instant::now() < deadline, "the viewer did not settle in 300 s");
+        std::thread::sleep(Duration::from_millis(10));
+        harness.step();
+    }
+    harness.step();
+}
+
+fn data(rel: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data").join(rel)
+}
+
+/// The fraction of the window's pixels in `region` that show `image` (RGBA8, `size`) drawn at
+/// `rect` within 2 levels: the app draws frames on whole pixels, one texel per pixel (points are
+/// pixels here).
+fn screen_vs_frame(screen: &image::RgbaImage, region: Rect, rect: Rect, image: &[u8], size: (u32, u32)) -> f32 {
+    let (mut matched, mut total) = (0usize, 0usize);
+    for y in region.top().ceil() as u32..region.bottom().floor() as u32 {
+        for x in region.left().ceil() as u32..region.right().floor() as u32 {
+            let (tx, ty) = (x - rect.left() as u32, y - rect.top() as u32);
+            let t = ((ty.min(size.1 - 1) * size.0 + tx.min(size.0 - 1)) * 4) as usize;
+            let s = screen.get_pixel(x, y).0;
+            matched += (0..3).all(|c| s[c].abs_diff(image[t + c]) <= 2) as usize;
+            total += 1;
+        }
+    }
+    matched as f32 / total as f32
+}
+
+/// Moves the pointer to `pos` and presses the primary button there.
+fn press_at(harness: &mut Harness<'_, App>, pos: Pos2) {
+    harness.event(Event::PointerMoved(pos));
+    harness.step();
+    button(harness, pos, true);
+}
+
+fn button(harness: &Harness<'_, App>, pos: Pos2, pressed: bool) {
+    let modifiers = Modifiers::NONE;
+    harness.event(Event::PointerButton { pos, button: PointerButton::Primary, pressed, modifiers });
+}
+
+fn mean_luminance(image: &[u8]) -> f64 {
+    image.chunks_exact(4).map(|p| p[0] as f64 + p[1] as f64 + p[2] as f64).sum::<f64>()
+        / (image.len() / 4) as f64
+        / 765.0
+}
+
+fn non_background(image: &[u8]) -> f64 {
+    image.chunks_exact(4).filter(|p| p[..3] != [255, 255, 255]).count() as f64 / (image.len() / 4) as f64
+}
+
+#[test]
+fn a_built_in_scene_is_on_screen_with_the_panel() {
+    let mut harness = harness(options(scene(SceneKind::Bundles, 60_000), [METHODS[1], METHODS[4]], false));
+    settle(&mut harness);
+    let app = harness.state();
+    assert!(app.error.is_none(), "{:?}", app.error);
+    let frame = app.shown.as_ref().expect("a frame");
+    let rect = app.image_rect.expect("laid out");
+    // The image fills the central area at its size in pixels.
+    assert_eq!(frame.size, (rect.width().round() as u32, rect.height().round() as u32));
+    assert!(non_background(&frame.images[0]) > 0.05, "the scene covers the image");
+    let image = frame.images[0].clone();
+    let size = frame.size;
+    // The panel: the method, the compare switch, the presets, the parameters of LineAO.
+    for label in
+        ["Compare side by side", "Dense tractography", "Reset to defaults", "s_r hemispheres", "GPU time per pass"]
+    {
+        assert!(harness.query_all_by_label(label).next().is_some(), "the panel shows '{label}'");
+    }
+    harness.get_by_label_contains(" streamlines · ");
+    let screen = harness.render().expect("the window renders");
+    let matched = screen_vs_frame(&screen, rect, rect, &image, size);
+    assert!(matched > 0.97, "{:.1} % of the window's pixels show the frame", 100.0 * matched);
+}
+
+#[test]
+fn the_viewer_renders_what_the_library_renders() {
+    // The render thread's frame against an AoChain driven directly, same settings and camera.
+    let mut harness = harness(options(scene(SceneKind::Spiral, 30_000), [METHODS[1], METHODS[4]], false));
+    settle(&mut harness);
+    let frame = harness.state().shown.as_ref().expect("a frame");
+    let gpu = lineao::Gpu::headless().unwrap();
+    let built = SceneKind::Spiral.build(1, 30_000);
+    let t = &built.tractogram;
+    let geometry = lineao::passes::lines::LineGeometry::new(&gpu.device, &gpu.queue, &t.positions, &t.offsets).unwrap();
+    let format = wgpu::TextureFormat::Rgba8UnormSrgb;
+    let mut chain = lineao::AoChain::new(&gpu.device, format, frame.view.panels[0].settings.clone()).unwrap();
+    chain.resize(frame.size.0, frame.size.1).unwrap();
+    chain.prepare(&gpu.device, &gpu.queue, &frame.view.camera, &geometry.bounds.unwrap());
+    let target = lineao::targets::Target::output(&gpu.device, "test", frame.size, format);
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    chain.encode(&mut encoder, &geometry, &target.view);
+    gpu.queue.submit([encoder.finish()]);
+    let direct = lineao::readback::read_texture(&gpu.device, &gpu.queue, &target.texture).unwrap().bytes;
+    let differing = direct.iter().zip(&frame.images[0]).filter(|(a, b)| a.abs_diff(**b) > 1).count();
+    assert!(differing * 1000 < direct.len(), "{differing} of {} bytes differ", direct.len());
+}
+
+#[test]
+fn compare_shows_two_methods_split_at_the_divider_which_drags() {
+    let mut harness = harness(options(scene(SceneKind::Bundles, 60_000), [METHODS[1], METHODS[4]], true));
+    settle(&mut harness);
+    let app = harness.state();
+    let frame = app.shown.as_ref().expect("a frame");
+    assert_eq!(frame.images.len(), 2);
+    assert_eq!(frame.view.panels[0].settings.method, AoMethod::LineAo);
+    assert_eq!(frame.view.panels[1].settings.method, AoMethod::Ssao);
+    assert_ne!(frame.images[0], frame.images[1], "two methods, two images");
+    let rect = app.image_rect.unwrap();
+    // Drag the divider from the middle to a quarter of the width.
+    let from = Pos2::new(rect.left() + 0.5 * rect.width(), rect.center().y);
+    let to = Pos2::new(rect.left() + 0.25 * rect.width(), rect.center().y);
+    press_at(&mut harness, from);
+    harness.step();
+    for k in 1..=8 {
+        harness.event(Event::PointerMoved(from + (to - from) * (k as f32 / 8.0)));
+        harness.step();
+    }
+    button(&harness, to, false);
+    harness.step();
+    let app = harness.state();
+    assert!((app.divider - 0.25).abs() < 0.01, "divider at {}", app.divider);
+    assert!(app.settled(), "moving the divider renders nothing new");
+    let frame = app.shown.as_ref().unwrap();
+    let (images, size) = (frame.images.clone(), frame.size);
+    let split = rect.left() + 0.25 * rect.width();
+    let left = Rect::from_x_y_ranges(rect.left()..=split - 4.0, rect.top() + 40.0..=rect.bottom());
+    let right = Rect::from_x_y_ranges(split + 4.0..=rect.right(), rect.top() + 40.0..=rect.bottom());
+    let screen = harness.render().unwrap();
+    let l = screen_vs_frame(&screen, left, rect, &images[0], size);
+    let r = screen_vs_frame(&screen, right, rect, &images[1], size);
+    assert!(l > 0.97 && r > 0.97, "left {l:.3}, right {r:.3} of the pixels show their method");
+    // And the other way round fails: the halves really differ.
+    let swapped = screen_vs_frame(&screen, right, rect, &images[0], size);
+    assert!(swapped < r, "LineAO's image does not also match the SSAO half ({swapped:.3})");
+}
+
+#[test]
+fn the_method_selector_switches_the_method() {
+    let mut harness = harness(options(scene(SceneKind::Bundles, 60_000), [METHODS[1], METHODS[4]], false));
+    settle(&mut harness);
+    let lineao = harness.state().shown.as_ref().unwrap().images[0].clone();
+    // Open the combo box showing "LineAO" and pick "none".
+    let combo =
+        harness.get_all_by_role(egui::accesskit::Role::ComboBox).find(|n| n.value().as_deref() == Some("LineAO"));
+    combo.expect("the method combo box showing LineAO").click();
+    harness.run_steps(2);
+    harness.get_by_label("none").click();
+    settle(&mut harness);
+    let frame = harness.state().shown.as_ref().unwrap();
+    assert_eq!(frame.view.panels[0].settings.method, AoMethod::None);
+    let none = &frame.images[0];
+    // Occlusion only darkens: without it the same view is brighter.
+    assert!(
+        mean_luminance(none) > mean_luminance(&lineao) + 0.005,
+        "{} vs {}",
+        mean_luminance(none),
+        mean_luminance(&lineao)
+    );
+}
+
+#[test]
+fn a_real_file_opens_and_a_bad_one_says_why() {
+    let path = data("niivue+niivue/packages/niivue/demos/images/stroke.trk.gz");
+    let mut harness = harness(options(Source::File(path.clone()), [METHODS[1], METHODS[4]], false));
+    settle(&mut harness);
+    let app = harness.state();
+    assert!(app.error.is_none(), "{:?}", app.error);
+    let dataset = app.dataset.as_ref().unwrap();
+    // FACTS.txt (nibabel): 36763 streamlines, 237468 points.
+    assert_eq!((dataset.streamlines, dataset.vertices), (36763, 237468));
+    assert!(non_background(&app.shown.as_ref().unwrap().images[0]) > 0.05);
+    harness.get_by_label_contains("stroke.trk.gz");
+
+    // A truncated copy: an error naming the file, shown in the window; no panic.
+    let dir = std::env::temp_dir().join(format!("lineao-view-test-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("truncated.trk");
+    let bytes = std::fs::read(data("dipy+dipy/dipy/data/files/tracks300.trk")).unwrap();
+    std::fs::write(&bad, &bytes[..1200]).unwrap();
+    harness.state_mut().load(Source::File(bad.clone()));
+    settle(&mut harness);
+    let error = harness.state().error.clone().expect("an error");
+    assert!(error.contains("truncated.trk"), "{error}");
+    assert!(harness.state().dataset.is_none() && harness.state().shown.is_none());
+    harness.get_by_label(&error);
+
+    // Dropping a good file onto the window opens it.
+    #[derive(Debug)]
+    struct Dropped(PathBuf);
+    impl egui::DroppedFile for Dropped {
+        fn path(&self) -> &Path {
+            &self.0
+        }
+        fn bytes(&self) -> Result<Vec<u8>, String> {
+            std::fs::read(&self.0).map_err(|e| e.to_string())
+        }
+    }
+    let good = data("dipy+dipy/dipy/data/files/tracks300.trk");
+    harness.input_mut().dropped_files.push(std::sync::Arc::new(Dropped(good)));
+    settle(&mut harness);
+    let app = harness.state();
+    assert!(app.error.is_none(), "{:?}", app.error);
+    assert_eq!(app.dataset.as_ref().map(|d| (d.streamlines, d.vertices)), Some((300, 14576)));
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn big_data_previews_while_the_camera_moves_without_blocking_input() {
+    let vertices = 2 * PREVIEW_VERTICES + 50_000;
+    let mut harness = harness(options(scene(SceneKind::Bundles, vertices), [METHODS[1], METHODS[4]], false));
+    settle(&mut harness);
+    let full = harness.state().shown.as_ref().unwrap().size;
+    let rect = harness.state().image_rect.unwrap();
+    let home = harness.state().camera.unwrap();
+    // Orbit by dragging on the image.
+    let start = rect.center();
+    press_at(&mut harness, start);
+    harness.step();
+    for k in 1..=5 {
+        harness.event(Event::PointerMoved(start + egui::vec2(12.0 * k as f32, 0.0)));
+        harness.step();
+        // The step that requested a frame returned before that frame exists: rendering runs
+        // beside the UI, not in it.
+        assert!(!harness.state().settled(), "step {k} waited for the render");
+    }
+    let moved = harness.state().camera.unwrap();
+    assert!((moved.yaw - home.yaw).abs() > 0.1, "the drag orbits the camera");
+    button(&harness, start, false);
+    // While moving: previews at half resolution of a subset of the streamlines.
+    let deadline = Instant::now() + Duration::from_secs(300);
+    while !harness.state().shown.as_ref().is_some_and(|f| f.view.preview) {
+        assert!(Instant::now() < deadline, "no preview frame");
+        std::thread::sleep(Duration::from_millis(5));
+        harness.step();
+    }
+    let preview = harness.state().shown.as_ref().unwrap();
+    assert_eq!(preview.size, ((full.0 / 2).max(1), (full.1 / 2).max(1)));
+    // At rest: full detail again.
+    std::thread::sleep(Duration::from_millis(400));
+    settle(&mut harness);
+    let last = harness.state().shown.as_ref().unwrap();
+    assert!(!last.view.preview);
+    assert_eq!(last.size, full);
+}
+
+#[test]
+fn keys_orbit_zoom_reset_and_switch_to_orthographic() {
+    let mut harness = harness(options(scene(SceneKind::Vortex, 20_000), [METHODS[0], METHODS[4]], false));
+    settle(&mut harness);
+    let home = harness.state().camera.unwrap();
+    harness.key_press(egui::Key::ArrowLeft);
+    harness.key_press(egui::Key::Minus);
+    harness.step();
+    let moved = harness.state().camera.unwrap();
+    assert!((moved.yaw - home.yaw).abs() > 0.05 && moved.distance > home.distance);
+    harness.key_press(egui::Key::R);
+    harness.key_press(egui::Key::O);
+    harness.step();
+    let reset = harness.state().camera.unwrap();
+    assert_eq!((reset.yaw, reset.distance), (home.yaw, home.distance));
+    assert!(reset.orthographic);
+    settle(&mut harness);
+    let frame = harness.state().shown.as_ref().unwrap();
+    assert!(matches!(frame.view.camera.projection, lineao::camera::Projection::Orthographic { .. }));
+}

@@ -1,0 +1,302 @@
+//! The viewer's render thread. It owns its own wgpu device (not the window's): one lavapipe frame
+//! of 11 M vertices takes seconds, and a queue runs its work in order, so on the window's queue a
+//! long LineAO submission would hold up every window frame behind it. Here the window keeps
+//! drawing and answering input while frames render; finished frames come back as RGBA images.
+//!
+//! Requests are coalesced: only the newest view is rendered, and a load drops pending renders.
+//! While the camera moves the app asks for *preview* frames: every k-th streamline (at most
+//! [`PREVIEW_VERTICES`] vertices) at half resolution — visibly coarser, and replaced by the full
+//! frame as soon as the camera rests.
+
+use std::path::PathBuf;
+use std::sync::mpsc::{Receiver, Sender, TryRecvError};
+
+use lineao::camera::Camera;
+use lineao::passes::lines::{LineGeometry, VertexAttributes};
+use lineao::timing::PassTime;
+use lineao::volume::{VertexVisibility, VolumeAoOptions};
+use lineao::{AoChain, ChainSettings, Gpu, LineColor};
+use lineao_tracts::{SceneKind, Tractogram, ViewHint};
+
+/// Vertices of a preview frame at most.
+pub const PREVIEW_VERTICES: usize = 250_000;
+
+/// What to show.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Source {
+    Scene { kind: SceneKind, vertices: usize },
+    File(PathBuf),
+}
+
+/// One image of a frame: the chain's settings, and the object-space AO it needs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Panel {
+    pub settings: ChainSettings,
+    pub volume: Option<VolumeAoOptions>,
+}
+
+/// A frame to render.
+#[derive(Clone, Debug, PartialEq)]
+pub struct View {
+    /// Pixels of the full-detail image.
+    pub size: (u32, u32),
+    pub camera: Camera,
+    /// One panel, or two (the split screen).
+    pub panels: Vec<Panel>,
+    pub preview: bool,
+    pub timings: bool,
+    /// The per-vertex field colored by [`LineColor::Scalar`], if any.
+    pub scalar_field: Option<String>,
+}
+
+pub enum ToWorker {
+    Load(Source),
+    Render(View),
+}
+
+/// What the app learns about a loaded dataset.
+#[derive(Clone, Debug)]
+pub struct Dataset {
+    pub name: String,
+    pub streamlines: usize,
+    pub vertices: usize,
+    pub hint: ViewHint,
+    /// One-column per-vertex fields, with their 2nd–98th percentile ranges.
+    pub fields: Vec<(String, [f32; 2])>,
+}
+
+/// A rendered frame.
+pub struct Frame {
+    pub view: View,
+    /// RGBA8 (sRGB) per panel, `size` each.
+    pub images: Vec<Vec<u8>>,
+    pub size: (u32, u32),
+    pub times: Vec<Option<Vec<PassTime>>>,
+    pub render_ms: f64,
+}
+
+pub enum FromWorker {
+    /// Loading: bytes read of the total, when known.
+    Progress {
+        bytes: u64,
+        total: Option<u64>,
+    },
+    Loaded(Dataset),
+    Frame(Box<Frame>),
+    /// Something takes a while (computing object-space AO).
+    Busy(String),
+    Error(String),
+}
+
+/// The loaded data on the GPU: full detail and the preview's subset.
+struct Scene {
+    tracts: Tractogram,
+    full: LineGeometry,
+    preview: Option<Preview>,
+    /// What the full geometry's attributes hold now (scalar field, object-space AO options).
+    attributes: (Option<String>, Option<VolumeAoOptions>),
+    /// Object-space AO computed so far, by options.
+    volumes: Vec<(VolumeAoOptions, VertexVisibility)>,
+}
+
+/// Every k-th streamline: its geometry, and which full-detail vertices it keeps.
+struct Preview {
+    geometry: LineGeometry,
+    positions: Vec<[f32; 3]>,
+    offsets: Vec<u64>,
+    kept: Vec<usize>,
+    attributes: (Option<String>, Option<VolumeAoOptions>),
+}
+
+/// Runs the worker until the app's sender is dropped. `repaint` asks the window for a frame
+/// when something arrives.
+pub fn run(rx: Receiver<ToWorker>, tx: Sender<FromWorker>, repaint: impl Fn() + Send + 'static) {
+    let send = |message: FromWorker| {
+        let _ = tx.send(message);
+        repaint();
+    };
+    let gpu = match Gpu::headless() {
+        Ok(gpu) => gpu,
+        Err(e) => {
+            send(FromWorker::Error(e.to_string()));
+            return;
+        }
+    };
+    let mut scene: Option<Scene> = None;
+    let mut chains: Vec<AoChain> = Vec::new();
+    loop {
+        // The next command, then whatever else is waiting: loads in order, the newest render.
+        let Ok(first) = rx.recv() else { return };
+        let mut pending = vec![first];
+        loop {
+            match rx.try_recv() {
+                Ok(command) => pending.push(command),
+                Err(TryRecvError::Empty) => break,
+                Err(TryRecvError::Disconnected) => return,
+            }
+        }
+        let last_load = pending.iter().rposition(|c| matches!(c, ToWorker::Load(_)));
+        let render =
+            pending.iter().rposition(|c| matches!(c, ToWorker::Render(_))).filter(|&r| last_load.is_none_or(|l| r > l));
+        if let Some(l) = last_load {
+            let ToWorker::Load(source) = &pending[l] else { unreachable!() };
+            scene = None;
+            match load(&gpu, source, &send) {
+                Ok((loaded, dataset)) => {
+                    scene = Some(loaded);
+                    send(FromWorker::Loaded(dataset));
+                }
+                Err(e) => send(FromWorker::Error(e)),
+            }
+        }
+        if let (Some(r), Some(scene)) = (render, scene.as_mut()) {
+            let ToWorker::Render(view) = &pending[r] else { unreachable!() };
+            match render_frame(&gpu, scene, &mut chains, view, &send) {
+                Ok(frame) => send(FromWorker::Frame(Box::new(frame))),
+                Err(e) => send(FromWorker::Error(e)),
+            }
+        }
+    }
+}
+
+fn load(gpu: &Gpu, source: &Source, send: &dyn Fn(FromWorker)) -> Result<(Scene, Dataset), String> {
+    let (name, tracts, hint) = match source {
+        Source::Scene { kind, vertices } => {
+            let scene = kind.build(1, *vertices);
+            (kind.name().to_string(), scene.tractogram, scene.view)
+        }
+        Source::File(path) => {
+            let mut report = |p: lineao_tracts::Progress| send(FromWorker::Progress { bytes: p.bytes, total: p.total });
+            let loaded =
+                lineao_tracts::load_with(path, &Default::default(), Some(&mut report)).map_err(|e| e.to_string())?;
+            if !loaded.tractogram.has_points() {
+                return Err(format!("{}: holds values without points", path.display()));
+            }
+            let hint = ViewHint::for_tractogram(&loaded.tractogram);
+            (path.display().to_string(), loaded.tractogram, hint)
+        }
+    };
+    let full = LineGeometry::new(&gpu.device, &gpu.queue, &tracts.positions, &tracts.offsets)
+        .map_err(|e| format!("{name}: {e}"))?;
+    if full.bounds.is_none() {
+        return Err(format!("{name}: no finite points"));
+    }
+    let fields = tracts
+        .vertex_fields
+        .iter()
+        .filter(|f| f.columns == 1)
+        .map(|f| (f.name.clone(), crate::render::percentile_range(&f.values)))
+        .collect();
+    let dataset = Dataset { name, streamlines: full.streamlines, vertices: full.vertices, hint, fields };
+    let scene = Scene { tracts, full, preview: None, attributes: (None, None), volumes: Vec::new() };
+    Ok((scene, dataset))
+}
+
+/// Every `k`-th streamline of `tracts`, with the indices of the vertices kept.
+fn subset(tracts: &Tractogram, k: usize) -> (Vec<[f32; 3]>, Vec<u64>, Vec<usize>) {
+    let (mut positions, mut offsets, mut kept) = (Vec::new(), vec![0u64], Vec::new());
+    for range in tracts.offsets.windows(2).step_by(k) {
+        let (a, b) = (range[0] as usize, range[1] as usize);
+        positions.extend_from_slice(&tracts.positions[a..b]);
+        kept.extend(a..b);
+        offsets.push(positions.len() as u64);
+    }
+    (positions, offsets, kept)
+}
+
+fn render_frame(
+    gpu: &Gpu,
+    scene: &mut Scene,
+    chains: &mut Vec<AoChain>,
+    view: &View,
+    send: &dyn Fn(FromWorker),
+) -> Result<Frame, String> {
+    let start = std::time::Instant::now();
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let preview = view.preview && scene.full.vertices > PREVIEW_VERTICES;
+    let size = if preview { ((view.size.0 / 2).max(1), (view.size.1 / 2).max(1)) } else { view.size };
+    if preview && scene.preview.is_none() {
+        let k = scene.full.vertices.div_ceil(PREVIEW_VERTICES);
+        let (positions, offsets, kept) = subset(&scene.tracts, k);
+        let geometry = LineGeometry::new(d, q, &positions, &offsets).map_err(|e| e.to_string())?;
+        scene.preview = Some(Preview { geometry, positions, offsets, kept, attributes: (None, None) });
+    }
+    let bounds = scene.full.bounds.expect("checked at load");
+    let scalars = match &view.scalar_field {
+        Some(name) => Some(scene.tracts.vertex_field(name).ok_or(format!("no field {name}"))?.values.clone()),
+        None => None,
+    };
+    let format = wgpu::TextureFormat::Rgba8UnormSrgb;
+    let target = lineao::targets::Target::output(d, "lineao::view::frame", size, format);
+    let (mut images, mut times) = (Vec::new(), Vec::new());
+    for (i, panel) in view.panels.iter().enumerate() {
+        // The geometry's attributes this panel needs: the scalar's field and object-space AO.
+        let wanted = (view.scalar_field.clone(), panel.volume.clone());
+        let visibility = match &panel.volume {
+            Some(options) => {
+                if !scene.volumes.iter().any(|(o, _)| o == options) {
+                    send(FromWorker::Busy(format!("computing {} …", options.method.name())));
+                    let t = &scene.tracts;
+                    let computed = lineao::volume::vertex_visibility(&t.positions, &t.offsets, options)
+                        .map_err(|e| e.to_string())?;
+                    // A few settings' worth: each holds 32 bytes per vertex.
+                    if scene.volumes.len() == 4 {
+                        scene.volumes.remove(0);
+                    }
+                    scene.volumes.push((options.clone(), computed));
+                }
+                scene.volumes.iter().find(|(o, _)| o == options).map(|(_, v)| v)
+            }
+            None => None,
+        };
+        let geometry = if preview {
+            let p = scene.preview.as_mut().expect("made above");
+            if p.attributes != wanted && (wanted.0.is_some() || wanted.1.is_some()) {
+                let pick = |values: &[f32]| p.kept.iter().map(|&k| values[k]).collect::<Vec<f32>>();
+                let octants: Option<Vec<[f32; 8]>> = visibility.map(|v| p.kept.iter().map(|&k| v.octants[k]).collect());
+                let scalar = scalars.as_deref().map(pick);
+                let attributes =
+                    VertexAttributes { octants: octants.as_deref(), scalar: scalar.as_deref(), radius: None };
+                p.geometry.set_attributes(d, q, &p.positions, &p.offsets, &attributes).map_err(|e| e.to_string())?;
+                p.attributes = wanted;
+            }
+            &p.geometry
+        } else {
+            if scene.attributes != wanted && (wanted.0.is_some() || wanted.1.is_some()) {
+                let t = &scene.tracts;
+                let attributes = VertexAttributes {
+                    octants: visibility.map(|v| v.octants.as_slice()),
+                    scalar: scalars.as_deref(),
+                    radius: None,
+                };
+                scene.full.set_attributes(d, q, &t.positions, &t.offsets, &attributes).map_err(|e| e.to_string())?;
+                scene.attributes = wanted;
+            }
+            &scene.full
+        };
+        let mut settings = panel.settings.clone();
+        if let (Some(visibility), Some(volume)) = (visibility, &mut settings.volume) {
+            volume.sky = visibility.sky;
+        }
+        if view.scalar_field.is_none() && matches!(settings.line_color, LineColor::Scalar { .. }) {
+            settings.line_color = LineColor::Tangent;
+        }
+        if chains.len() <= i {
+            chains.push(AoChain::new(d, format, settings.clone()).map_err(|e| e.to_string())?);
+        } else if chains[i].settings() != &settings {
+            chains[i].set_settings(d, settings).map_err(|e| e.to_string())?;
+        }
+        let chain = &mut chains[i];
+        if chain.timing() != view.timings {
+            chain.set_timing(d, q, view.timings);
+        }
+        chain.resize(size.0, size.1).map_err(|e| e.to_string())?;
+        chain.prepare(d, q, &view.camera, &bounds);
+        let mut encoder = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::view") });
+        chain.encode(&mut encoder, geometry, &target.view);
+        q.submit([encoder.finish()]);
+        times.push(if view.timings { chain.pass_times(d).map_err(|e| e.to_string())? } else { None });
+        images.push(lineao::readback::read_texture(d, q, &target.texture).map_err(|e| e.to_string())?.bytes);
+    }
+    Ok(Frame { view: view.clone(), images, size, times, render_ms: start.elapsed().as_secs_f64() * 1e3 })
+}

@@ -1,0 +1,103 @@
+//! `lineao view` as a user runs it: a real window on an X server (Xvfb, which `.ci/run` installs),
+//! drawn by eframe's wgpu renderer on lavapipe, saved by `--screenshot` after `--frames` and
+//! checked: the window's size, the control panel's colours on the left, the render in the
+//! middle (the scene's lines over the white background, LineAO and SSAO side by side), and a
+//! bad file's exit status and message. The in-process UI tests are in `src/view/tests.rs`.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+mod common;
+use common::{read_png, scratch};
+
+/// Runs `lineao view ARGS` under `xvfb-run`, at most 300 s.
+fn view(args: &[&str]) -> Output {
+    let xvfb = Command::new("xvfb-run").arg("--help").output();
+    assert!(
+        xvfb.is_ok(),
+        "xvfb-run is missing: install xvfb (`apt-get install xvfb xauth`, as .ci/run does) to test the viewer's window"
+    );
+    Command::new("timeout")
+        .args(["300", "xvfb-run", "-a", "-s", "-screen 0 1600x1000x24", env!("CARGO_BIN_EXE_lineao"), "view"])
+        .args(args)
+        .env("XDG_RUNTIME_DIR", std::env::temp_dir())
+        .output()
+        .unwrap()
+}
+
+fn stderr(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+/// The mean of `f` over the pixels in columns `x0..x1`, rows 60..height−60 (below the menu,
+/// above the status bar).
+fn region_mean(((w, h), rgba): &((u32, u32), Vec<u8>), x0: u32, x1: u32, f: impl Fn(&[u8]) -> f64) -> f64 {
+    let (mut sum, mut total) = (0.0, 0usize);
+    for y in 60..h - 60 {
+        for x in x0..x1.min(*w) {
+            sum += f(&rgba[((y * w + x) * 4) as usize..][..3]);
+            total += 1;
+        }
+    }
+    sum / total as f64
+}
+
+/// The fraction of pixels that are neither white nor a gray of egui's panels: the lines.
+fn lines_fraction(image: &((u32, u32), Vec<u8>), x0: u32, x1: u32) -> f64 {
+    region_mean(image, x0, x1, |p| (p[0].abs_diff(p[1]) >= 8 || p[1].abs_diff(p[2]) >= 8) as u8 as f64)
+}
+
+fn mean_luminance(image: &((u32, u32), Vec<u8>), x0: u32, x1: u32) -> f64 {
+    region_mean(image, x0, x1, |p| (p[0] as f64 + p[1] as f64 + p[2] as f64) / 765.0)
+}
+
+#[test]
+fn the_window_shows_the_panel_and_the_render_side_by_side() {
+    let dir = scratch("view_window");
+    let png = dir.join("window.png");
+    let out = view(&[
+        "--scene",
+        "bundles",
+        "--vertices",
+        "80000",
+        "--compare",
+        "lineao,ssao",
+        "--size",
+        "1000x640",
+        "--screenshot",
+        png.to_str().unwrap(),
+        "--frames",
+        "5",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let image = read_png(&png);
+    assert_eq!(image.0, (1000, 640));
+    // The control panel (egui's dark theme) on the left, the render's white background right.
+    let (panel, render) = (mean_luminance(&image, 0, 250), mean_luminance(&image, 360, 980));
+    assert!(panel < 0.3 && render > 0.6, "panel {panel:.2}, render {render:.2}");
+    // The render on the right of it, both halves of the split showing lines.
+    let (left, right) = (lines_fraction(&image, 360, 640), lines_fraction(&image, 700, 980));
+    assert!(left > 0.05 && right > 0.05, "lines on both sides: {left:.3}, {right:.3}");
+}
+
+#[test]
+fn a_real_file_opens_and_a_bad_one_exits_1_naming_it() {
+    let dir = scratch("view_files");
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data");
+    let file = data.join("dipy+dipy/dipy/data/files/tracks300.trk");
+    let png = dir.join("tracks300.png");
+    let out = view(&[file.to_str().unwrap(), "--size", "800x600", "--screenshot", png.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let image = read_png(&png);
+    assert_eq!(image.0, (800, 600));
+    assert!(lines_fraction(&image, 360, 780) > 0.02, "the tracts are on screen");
+
+    let bad = dir.join("broken.tck");
+    std::fs::write(&bad, b"mrtrix tracks\ncount: 3\ndatatype: Float32LE\nfile: . 9999\nEND\n").unwrap();
+    let shot = dir.join("broken.png");
+    let out = view(&[bad.to_str().unwrap(), "--size", "800x600", "--screenshot", shot.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert!(stderr(&out).contains("broken.tck"), "{}", stderr(&out));
+    // The window showed the message, and the screenshot has it.
+    assert_eq!(read_png(&shot).0, (800, 600));
+}
