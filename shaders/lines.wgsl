@@ -118,19 +118,20 @@ fn line_gbuffer(view_pos: vec3<f32>, view_tangent: vec3<f32>, color: vec3<f32>) 
     let c = gbuffer_eye_direction(view_pos, is_orthographic());
     let n = gbuffer_line_normal(t, c);
 
-    // Illuminated lines (Zöckler et al. 1996, Mallo et al. 2005): the specular maximum over the
-    // circle of normals of an infinitesimal cylinder, added on top of LineAO (paper §3.3).
+    // Illuminated lines (paper §3.3): Zöckler's specular on top of LineAO, or Mallo et al.'s
+    // cylinder-averaged diffuse and specular (`lineao::lighting`).
+    var diffuse = 0.0;
     var specular = 0.0;
-    let v_t = dot(c, t);
     for (var s = 0u; s < lighting.count; s++) {
         let light = lighting.lights[s];
-        let l_t = dot(light.xyz, t);
-        let cos_rv = sqrt(max(1.0 - l_t * l_t, 0.0)) * sqrt(max(1.0 - v_t * v_t, 0.0)) - l_t * v_t;
-        specular += light.w * lighting.ks * clamped_pow(cos_rv, lighting.shininess);
+        let lit = illuminated_line(lighting.line_shading, light.xyz, c, t, lighting.shininess);
+        diffuse += light.w * lit.x;
+        specular += light.w * lighting.ks * lit.y;
     }
+    let shaded = select(color, color * (1.0 - lighting.kd + lighting.kd * diffuse), lighting.line_shading == 1u);
 
     var out: GBuffer;
-    out.color = vec4<f32>(color, 1.0);
+    out.color = vec4<f32>(shaded, 1.0);
     out.nd = vec4<f32>(n, gbuffer_depth(view_pos, frame.near, frame.far));
     out.zoom = gbuffer_zoom(view_pos, frame.f_px, frame.zoom_unit, is_orthographic());
     out.specular = specular;

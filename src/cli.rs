@@ -51,6 +51,9 @@ pub struct ViewArgs {
     /// Parameters for dense tractography (the paper's) or sparse streamlines.
     #[arg(long, value_enum, default_value_t = PresetArg::Dense)]
     pub preset: PresetArg,
+    /// How lines are lit (as `render --line-shading`).
+    #[arg(long, value_enum, default_value_t = LineShadingArg::Specular)]
+    pub line_shading: LineShadingArg,
     /// Line color: `tangent`, R,G,B in [0, 1], or `field:NAME` (see `render --color`).
     #[arg(long, default_value = "tangent", value_parser = parse_color)]
     pub color: ColorArg,
@@ -201,6 +204,23 @@ pub enum GeometryArg {
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum LineShadingArg {
+    /// Zöckler's maximum-principle specular added to the AO-darkened color (the paper's §3.3).
+    Specular,
+    /// Mallo et al.'s cylinder-averaged diffuse and specular.
+    Cylinder,
+}
+
+impl LineShadingArg {
+    pub fn shading(self) -> lineao::lighting::LineShading {
+        match self {
+            LineShadingArg::Specular => lineao::lighting::LineShading::Specular,
+            LineShadingArg::Cylinder => lineao::lighting::LineShading::CylinderAveraged,
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum SkyArg {
     /// Light from every direction.
     Uniform,
@@ -342,6 +362,11 @@ pub struct RenderArgs {
     /// Tubes: radius in world units [default: 0.5 mm].
     #[arg(long)]
     pub tube_radius: Option<f32>,
+    /// Lines: the illuminated-lines specular on top of the AO (`specular`, the paper's), or
+    /// diffuse and specular averaged over the visible half of the line's cylinder (`cylinder`:
+    /// Mallo et al. 2005).
+    #[arg(long, value_enum, default_value_t = LineShadingArg::Specular)]
+    pub line_shading: LineShadingArg,
     /// Context surface shown with the tracts (OBJ or glTF triangles, optionally gzipped); may be
     /// given several times. It occludes the lines and is occluded, and the AO sees it.
     #[arg(long = "surface", value_name = "MESH")]

@@ -13,6 +13,9 @@
 //! `sweep_alpha` or `variance` ({`levels`, `iso`, `offset`}), and with a screen-space method
 //! `volume_combine`. `method` is then `sweep`, `variance-volume` or e.g. `lineao+sweep`;
 //! `ao.npy` is `volume_ao.npy` alone, the screen-space method's otherwise.
+//!
+//! Lines (not tubes) also write `line_shading` (`specular` or `cylinder`, `--line-shading`), our
+//! extension too.
 
 use std::fs::File;
 use std::io::BufWriter;
@@ -102,7 +105,7 @@ pub fn write(
         &mut params,
         match &s.tubes {
             Some(tubes) => json!({"tube_radius_world": tubes.radius_world}),
-            None => json!({"line_width_px": s.line_width_px}),
+            None => json!({"line_width_px": s.line_width_px, "line_shading": s.lighting.line_shading.name()}),
         },
     );
     if s.method == AoMethod::LineAo {

@@ -129,6 +129,10 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky) -> 
             },
         },
         line_width_px: args.line_width,
+        lighting: lineao::lighting::Lighting {
+            line_shading: args.line_shading.shading(),
+            ..lineao::lighting::Lighting::default()
+        },
         tubes: (args.geometry == GeometryArg::Tubes)
             .then(|| TubeSettings { radius_world: tube_radius(args, zoom_unit) }),
         surfaces: (!args.surfaces.is_empty()).then_some(SurfaceSettings { color: args.surface_color }),
@@ -149,7 +153,6 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky) -> 
         strength: args.strength,
         debug_view: args.debug_view,
         zoom_unit: args.zoom_unit.unwrap_or(zoom_unit),
-        ..ChainSettings::default()
     }
 }
 

@@ -9,9 +9,60 @@ struct Lighting {
     kd: f32,
     ks: f32,
     shininess: f32,
+    // 0: the maximum-principle specular only, 1: cylinder-averaged diffuse and specular.
+    line_shading: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
 }
 
 // max(x, 0)^alpha, defined as 0 at x <= 0 (pow(0, a) is implementation-defined in WGSL).
 fn clamped_pow(x: f32, alpha: f32) -> f32 {
     return select(0.0, pow(x, alpha), x > 0.0);
+}
+
+// Illuminated lines (`lineao::lighting` derives both): for unit l, v toward the light and the
+// eye and unit tangent t, (diffuse, specular) before intensity and kd/ks. Shading 0: Zöckler's
+// maximum principle (diffuse 0); 1: Mallo et al.'s average over the visible half cylinder
+// (diffuse in closed form, specular by 16-point Gauss-Legendre around the highlight).
+fn illuminated_line(shading: u32, l: vec3<f32>, v: vec3<f32>, t: vec3<f32>, n: f32) -> vec2<f32> {
+    let l_t = dot(l, t);
+    let v_t = dot(v, t);
+    let peak = sqrt(max(1.0 - l_t * l_t, 0.0)) * sqrt(max(1.0 - v_t * v_t, 0.0)) - l_t * v_t;
+    if shading == 0u {
+        return vec2<f32>(0.0, clamped_pow(peak, n));
+    }
+    let l_perp = l - l_t * t;
+    let v_perp = v - v_t * t;
+    let a = length(l_perp);
+    let b = length(v_perp);
+    let ab = a * b;
+    let cos_alpha = select(0.0, clamp(dot(l_perp, v_perp) / ab, -1.0, 1.0), ab > 1e-8);
+    let alpha = acos(cos_alpha);
+    let pi = 3.14159265358979;
+    let diffuse = 0.25 * a * (sqrt(1.0 - cos_alpha * cos_alpha) + (pi - alpha) * cos_alpha);
+    // The visible, lit arc around the highlight is u in [-c, c]; g reaches 0 at the root; the
+    // highlight's width is sigma.
+    let c = 0.5 * (pi - alpha);
+    let root = 0.5 * acos(clamp(l_t * v_t / ab, -1.0, 1.0));
+    let h = select(c, min(min(c, root), 5.0 * sqrt(max(peak, 0.0) / (4.0 * n * ab))), ab > 1e-12);
+    // 16-point Gauss-Legendre on [-h, h]: the positive nodes (x) and weights (y), the integrand
+    // being even.
+    var nodes = array<vec2<f32>, 8>(
+        vec2<f32>(0.09501251, 0.18945061),
+        vec2<f32>(0.28160355, 0.18260342),
+        vec2<f32>(0.45801678, 0.16915652),
+        vec2<f32>(0.61787624, 0.14959599),
+        vec2<f32>(0.7554044, 0.12462897),
+        vec2<f32>(0.8656312, 0.09515851),
+        vec2<f32>(0.94457503, 0.06225352),
+        vec2<f32>(0.9894009, 0.02715246),
+    );
+    var integral = 0.0;
+    for (var i = 0; i < 8; i++) {
+        let u = h * nodes[i].x;
+        integral += nodes[i].y * clamped_pow(ab * cos(2.0 * u) - l_t * v_t, n) * cos(u);
+    }
+    let half = sqrt((1.0 + cos_alpha) * 0.5);
+    return vec2<f32>(diffuse, half * h * integral);
 }

@@ -7,6 +7,7 @@
 
 use egui::Ui;
 use glam::Vec3;
+use lineao::lighting::LineShading;
 use lineao::volume::{ScalarForm, Sky, VolumeAoOptions, VolumeMethod};
 use lineao::{
     AoMethod, BilateralSettings, ChainSettings, Colormap, DebugView, LineAoOuter, LineAoVariant, LineColor, SsaoKernel,
@@ -127,6 +128,8 @@ pub struct Controls {
     pub methods: [Method; 2],
     pub compare: bool,
     pub geometry: Geometry,
+    /// How lines are lit (tubes are Phong-shaded).
+    pub line_shading: LineShading,
     pub color: ColorMode,
     pub colormap: Colormap,
     /// Direction toward the light in view space: degrees around the view axis's vertical
@@ -146,6 +149,7 @@ impl Controls {
             methods,
             compare,
             geometry: Geometry::Lines,
+            line_shading: LineShading::Specular,
             color: ColorMode::Tangent,
             colormap: Colormap::Viridis,
             light_azimuth: light.x.atan2(light.z).to_degrees(),
@@ -194,6 +198,7 @@ impl Controls {
         };
         let (az, el) = (self.light_azimuth.to_radians(), self.light_elevation.to_radians());
         settings.lighting.lights[0].dir = Vec3::new(el.cos() * az.sin(), el.sin(), el.cos() * az.cos());
+        settings.lighting.line_shading = self.line_shading;
         // A pyramid level the method does not have shows its deepest.
         settings.debug_view = match self.debug_view {
             DebugView::Level(k) => DebugView::Level(k.min(settings.levels() - 1)),
@@ -222,6 +227,13 @@ impl Controls {
         match self.geometry {
             Geometry::Lines => {
                 ui.add(egui::Slider::new(&mut p.chain.line_width_px, 0.5..=8.0).text("width (px)"));
+                ui.horizontal(|ui| {
+                    ui.label("lit");
+                    ui.selectable_value(&mut self.line_shading, LineShading::Specular, "specular")
+                        .on_hover_text("Illuminated lines' highlight on top of the AO (the paper's)");
+                    ui.selectable_value(&mut self.line_shading, LineShading::CylinderAveraged, "cylinder")
+                        .on_hover_text("Diffuse and specular averaged around the line (Mallo et al. 2005)");
+                });
             }
             Geometry::Tubes => {
                 let max = 5.0 * p.chain.zoom_unit;

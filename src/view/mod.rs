@@ -42,6 +42,7 @@ fn options(args: &ViewArgs) -> app::Options {
         GeometryArg::Lines => Geometry::Lines,
         GeometryArg::Tubes => Geometry::Tubes,
     };
+    controls.line_shading = args.line_shading.shading();
     controls.color = match &args.color {
         ColorArg::Tangent => ColorMode::Tangent,
         ColorArg::Constant(rgb) => ColorMode::Constant(rgb.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8)),

@@ -8,6 +8,7 @@ use common::{Frame, gpu, is_geometry, render};
 use glam::Vec3;
 use lineao::camera::FrameView;
 use lineao::camera::{Bounds, Camera, Projection};
+use lineao::lighting::{LineShading, illuminated_line};
 use lineao::passes::lines::{GeometryOptions, LineGeometry, LineRenderer, LineStyle};
 use lineao::targets::FrameTargets;
 use lineao::{AoMethod, ChainSettings, LineColor};
@@ -206,36 +207,52 @@ fn colors_and_specular() {
     let gpu = gpu();
     let s2 = std::f32::consts::FRAC_1_SQRT_2;
     let diagonal: &[[f32; 3]] = &[[-30.0, -30.0, 0.0], [30.0, 30.0, 0.0]];
-    let frame = lines(&gpu, &[diagonal], &perspective(), plain(3.0));
-    let mut checked = 0;
-    for (i, nd) in frame.nd[0].data.iter().enumerate() {
-        let (x, y) = (i % SIZE.0 as usize, i / SIZE.0 as usize);
-        let color = frame.color.data[i];
-        if !is_geometry(*nd) {
-            assert_eq!(color, [1.0, 1.0, 1.0, 1.0], "background color at ({x}, {y})");
-            assert_eq!(frame.specular.data[i], 0.0);
-            continue;
+    for shading in [LineShading::Specular, LineShading::CylinderAveraged] {
+        let mut settings = plain(3.0);
+        settings.lighting.line_shading = shading;
+        let frame = lines(&gpu, &[diagonal], &perspective(), settings);
+        let mut checked = 0;
+        for (i, nd) in frame.nd[0].data.iter().enumerate() {
+            let (x, y) = (i % SIZE.0 as usize, i / SIZE.0 as usize);
+            let color = frame.color.data[i];
+            if !is_geometry(*nd) {
+                assert_eq!(color, [1.0, 1.0, 1.0, 1.0], "background color at ({x}, {y})");
+                assert_eq!(frame.specular.data[i], 0.0);
+                continue;
+            }
+            checked += 1;
+            // V toward the eye from the pixel's view position; T and L as given.
+            let depth = frame.view.near + nd[3] * (frame.view.far - frame.view.near);
+            let (px, py) = (x as f32 + 0.5 - 100.0, 50.0 - (y as f32 + 0.5));
+            let f_px = 50.0 / 20f32.to_radians().tan();
+            let p = Vec3::new(px / f_px * depth, py / f_px * depth, -depth);
+            let t = Vec3::new(s2, s2, 0.0);
+            let (v, l) = (-p.normalize(), Vec3::new(-0.4, 0.6, 0.7).normalize());
+            // Specular: Zöckler's ks · (√(1−(L·T)²)·√(1−(V·T)²) − (L·T)(V·T))^α, worked out here;
+            // cylinder-averaged: the library's closed form (checked against quadrature below).
+            let (lt, vt) = (l.dot(t), v.dot(t));
+            let zoeckler = ((1.0 - lt * lt).sqrt() * (1.0 - vt * vt).sqrt() - lt * vt).max(0.0).powf(32.0);
+            let (diffuse, specular) = match shading {
+                LineShading::Specular => (None, zoeckler),
+                LineShading::CylinderAveraged => {
+                    let (d, s) = illuminated_line(shading, l, v, t, 32.0);
+                    assert!(s <= zoeckler + 1e-6, "the average never exceeds the maximum");
+                    (Some(d), s)
+                }
+            };
+            let expected = 0.4 * specular;
+            assert!(
+                (frame.specular.data[i] - expected).abs() < 2e-3,
+                "{shading:?} ({x}, {y}): {} vs {expected}",
+                frame.specular.data[i]
+            );
+            // |T| as RGB (x and y of a 45° tangent), times 1 − kd + kd · diffuse when averaged.
+            let shade = diffuse.map_or(1.0, |d| 1.0 - 0.3 + 0.3 * d);
+            let want = [s2 * shade, s2 * shade, 0.0];
+            assert!((0..3).all(|c| (color[c] - want[c]).abs() < 2e-3), "{shading:?}: {color:?} vs {want:?}");
         }
-        checked += 1;
-        // |T| as RGB: x and y components of a 45° tangent.
-        assert!((color[0] - s2).abs() < 1e-3 && (color[1] - s2).abs() < 1e-3 && color[2].abs() < 1e-3, "{color:?}");
-        // Illuminated lines: ks · I · (√(1−(L·T)²)·√(1−(V·T)²) − (L·T)(V·T))^α, V toward the eye.
-        let depth = frame.view.near + nd[3] * (frame.view.far - frame.view.near);
-        let (px, py) = (x as f32 + 0.5 - 100.0, 50.0 - (y as f32 + 0.5));
-        let f_px = 50.0 / 20f32.to_radians().tan();
-        let p = Vec3::new(px / f_px * depth, py / f_px * depth, -depth);
-        let t = Vec3::new(s2, s2, 0.0);
-        let (v, l) = (-p.normalize(), Vec3::new(-0.4, 0.6, 0.7).normalize());
-        let (lt, vt) = (l.dot(t), v.dot(t));
-        let cos = (1.0 - lt * lt).sqrt() * (1.0 - vt * vt).sqrt() - lt * vt;
-        let expected = 0.4 * cos.max(0.0).powf(32.0);
-        assert!(
-            (frame.specular.data[i] - expected).abs() < 2e-3,
-            "({x}, {y}): {} vs {expected}",
-            frame.specular.data[i]
-        );
+        assert!(checked > 100);
     }
-    assert!(checked > 100);
     let constant = ChainSettings { line_color: LineColor::Constant([0.2, 0.4, 0.6]), ..plain(3.0) };
     let frame = lines(&gpu, &[diagonal], &perspective(), constant);
     let line_colors: Vec<_> =
@@ -373,4 +390,70 @@ fn scalar_colors_follow_the_colormap_table() {
         // Every line shows; −5 and 0, 20 and 40 clamp to the ends.
         assert!(seen.iter().all(|&n| n > 20), "tubes {tubes}: {seen:?}");
     }
+}
+
+/// Mallo et al.'s average over the visible half cylinder by quadrature (20 000 midpoints): N(θ)
+/// around `t` from V⊥, weighted by N·V⊥; the Phong specular only where N·L > 0.
+fn cylinder_quadrature(l: Vec3, v: Vec3, t: Vec3, n: f32) -> (f64, f64) {
+    let e1 = (v - v.dot(t) * t).normalize();
+    let e2 = t.cross(e1);
+    let steps = 20_000;
+    let (mut weight, mut diffuse, mut specular) = (0.0f64, 0.0f64, 0.0f64);
+    for k in 0..steps {
+        let theta = -std::f64::consts::FRAC_PI_2 + std::f64::consts::PI * (k as f64 + 0.5) / steps as f64;
+        let normal = e1 * theta.cos() as f32 + e2 * theta.sin() as f32;
+        let w = theta.cos();
+        let n_l = normal.dot(l) as f64;
+        let r = 2.0 * normal.dot(l) * normal - l;
+        weight += w;
+        diffuse += w * n_l.max(0.0);
+        if n_l > 0.0 {
+            specular += w * (r.dot(v) as f64).max(0.0).powf(n as f64);
+        }
+    }
+    (diffuse / weight, specular / weight)
+}
+
+#[test]
+fn cylinder_averaged_lighting_matches_quadrature() {
+    // Directions spread over the sphere (a Fibonacci lattice), every triple of some of them.
+    let dirs: Vec<Vec3> = (0..24)
+        .map(|k| {
+            let z = 1.0 - 2.0 * (k as f32 + 0.5) / 24.0;
+            let phi = k as f32 * 2.399_963;
+            Vec3::new((1.0 - z * z).sqrt() * phi.cos(), (1.0 - z * z).sqrt() * phi.sin(), z)
+        })
+        .collect();
+    let (mut worst_diffuse, mut worst_specular) = (0.0f64, 0.0f64);
+    for (i, &t) in dirs.iter().enumerate().step_by(3) {
+        for &l in &dirs {
+            for &v in dirs.iter().skip(i % 2).step_by(2) {
+                // Viewed end-on the visible half is ill-defined (and covers no pixels); lit along
+                // the line, N·L = 0 everywhere and the lit arc is degenerate.
+                if v.dot(t).abs() > 0.98 || l.dot(t).abs() > 0.999 {
+                    continue;
+                }
+                for n in [8.0, 32.0] {
+                    let (d, s) = illuminated_line(LineShading::CylinderAveraged, l, v, t, n);
+                    let (qd, qs) = cylinder_quadrature(l, v, t, n);
+                    worst_diffuse = worst_diffuse.max((d as f64 - qd).abs());
+                    if (s as f64 - qs).abs() > 1e-3 {
+                        let (lp, vp) = (l - l.dot(t) * t, v - v.dot(t) * t);
+                        eprintln!(
+                            "n {n} a {:.3} b {:.3} cos_alpha {:.3} lt {:.3} vt {:.3}: {s:.5} vs {qs:.5}",
+                            lp.length(),
+                            vp.length(),
+                            lp.normalize().dot(vp.normalize()),
+                            l.dot(t),
+                            v.dot(t)
+                        );
+                    }
+                    worst_specular = worst_specular.max((s as f64 - qs).abs());
+                }
+            }
+        }
+    }
+    eprintln!("worst |Δ| against quadrature: diffuse {worst_diffuse:.2e}, specular {worst_specular:.2e}");
+    assert!(worst_diffuse < 1e-5, "the diffuse average is exact: {worst_diffuse}");
+    assert!(worst_specular < 2e-5, "Gauss–Legendre around the highlight: {worst_specular}");
 }
