@@ -8,7 +8,7 @@
 //! with l_t = L·T and v_t = V·T, the best reflection is R·V = √(1−l_t²)·√(1−v_t²) − l_t·v_t.
 //! That specular is what the paper adds on top of LineAO (§3.3, [`LineShading::Specular`]).
 //!
-//! Mallo et al. (2005, the paper's [13]) treat the line as a cylinder too thin to resolve and
+//! Mallo et al. (2005, the paper's reference 13) treat the line as a cylinder too thin to resolve and
 //! average the lighting over its visible half, each normal weighted by the width it covers on
 //! screen (N·V⊥). With N(θ) around T, L⊥ and V⊥ the parts of L and V perpendicular to T and α the
 //! angle between them, N·L = |L⊥| cos(θ − α) and the weight cos θ over θ ∈ [−π/2, π/2] give
