@@ -78,10 +78,11 @@ pub struct App {
 }
 
 impl App {
-    pub fn new(cc: &eframe::CreationContext<'_>, options: Options) -> App {
+    /// The viewer on `ctx`, whose repaint the render thread requests when a frame is ready.
+    pub fn new(ctx: &egui::Context, options: Options) -> App {
         let (to_worker, worker_rx) = mpsc::channel();
         let (worker_tx, from_worker) = mpsc::channel();
-        let ctx = cc.egui_ctx.clone();
+        let ctx = ctx.clone();
         let render_thread = std::thread::Builder::new()
             .name("lineao-render".into())
             .spawn(move || worker::run(worker_rx, worker_tx, move || ctx.request_repaint()))
@@ -544,6 +545,14 @@ impl Drop for App {
 
 impl eframe::App for App {
     fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        self.show(ui);
+    }
+}
+
+impl App {
+    /// One UI frame: menu, status bar, controls and the viewport, in `ui` (the window's, or a
+    /// test harness's).
+    pub fn show(&mut self, ui: &mut egui::Ui) {
         let ctx = ui.ctx().clone();
         self.frames += 1;
         self.receive(&ctx);

@@ -79,7 +79,7 @@ pub fn run(args: &ViewArgs) -> Result<()> {
         "lineao",
         native,
         Box::new(move |cc| {
-            let mut app = app::App::new(cc, options);
+            let mut app = app::App::new(&cc.egui_ctx, options);
             app.outcome = shared;
             Ok(Box::new(app))
         }),

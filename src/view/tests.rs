@@ -26,8 +26,12 @@ fn scene(kind: SceneKind, vertices: usize) -> Source {
     Source::Scene { kind, vertices }
 }
 
+/// The app in egui's harness, rendered by egui's wgpu renderer. The harness steps the UI itself
+/// (`settle` polls), so the render thread's repaint requests go to a context of their own; the
+/// eframe window around the app is `tests/view.rs`'s.
 fn harness(options: Options) -> Harness<'static, App> {
-    Harness::builder().with_size(SIZE).wgpu().build_eframe(move |cc| App::new(cc, options))
+    let app = App::new(&egui::Context::default(), options);
+    Harness::builder().with_size(SIZE).wgpu().build_ui_state(|ui, app: &mut App| app.show(ui), app)
 }
 
 /// Steps the UI until the newest view is on screen (or an error is), then once more.
