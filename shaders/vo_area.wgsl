@@ -13,7 +13,6 @@
 #import shared/vo.wgsl
 #import shared/moments.wgsl
 
-override SAMPLES: u32 = 1u;
 override RADII: u32 = 1u;
 
 @group(0) @binding(0) var<uniform> params: VoUniform;
@@ -60,7 +59,7 @@ fn obscurance(pixel: vec2<u32>, here: vec4<f32>, depth: f32, zoom: f32, u: vec2<
     let lod_sphere = log2(scale);
     let g = vo_plane(here.xyz);
     var sums = vec2<f32>(0.0);
-    for (var i = 0u; i < SAMPLES; i++) {
+    for (var i = 0u; i < params.samples; i++) {
         let sample = tables[i];
         let s = vo_reflect(sample.xy, u);
         let at = vec2<f32>(f32(pixel.x) + s.x * scale, f32(pixel.y) - s.y * scale);

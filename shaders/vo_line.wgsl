@@ -11,7 +11,6 @@
 #import shared/nd.wgsl
 #import shared/vo.wgsl
 
-override SAMPLES: u32 = 9u;
 override RADII: u32 = 1u;
 
 @group(0) @binding(0) var<uniform> params: VoUniform;
@@ -32,7 +31,7 @@ fn obscurance(pixel: vec2<u32>, here: vec4<f32>, depth: f32, zoom: f32, u: vec2<
     let clamp_on = params.normal_clamp != 0u;
     let last = vec2<f32>(textureDimensions(nd0)) - 1.0;
     var sums = vec2<f32>(0.0);
-    for (var i = 0u; i < SAMPLES; i++) {
+    for (var i = 0u; i < params.samples; i++) {
         let sample = tables[i];
         let s = vo_reflect(sample.xy, u);
         let at = vec2<f32>(f32(pixel.x) + 0.5 + s.x * scale, f32(pixel.y) + 0.5 - s.y * scale);

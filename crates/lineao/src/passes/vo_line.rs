@@ -52,7 +52,9 @@ pub struct VoUniform {
     pub combine: u32,
     pub max_level: f32,
     pub sigma_floor: f32,
-    pub _pad: [u32; 2],
+    /// The number of samples in the tables (set by the pass that owns them).
+    pub samples: u32,
+    pub _pad: u32,
 }
 
 impl VoUniform {
@@ -70,7 +72,8 @@ impl VoUniform {
             combine: (settings.combine == VoCombine::Min) as u32,
             max_level: max_level as f32,
             sigma_floor: crate::reference::vo_sigma_floor(view.near, view.far),
-            _pad: [0; 2],
+            samples: 0,
+            _pad: 0,
         }
     }
 }
@@ -107,7 +110,7 @@ impl VoCore {
         let layout = binding::layout(device, label, wgpu::ShaderStages::COMPUTE, &slots);
         let radii = 1 + settings.radius2_world.is_some() as u32;
         let entry = shader.trim_end_matches(".wgsl");
-        let constants = [("SAMPLES", samples.len() as f64), ("RADII", radii as f64)];
+        let constants = [("RADII", radii as f64)];
         let pipeline = binding::compute_pipeline(device, label, &layout, shader, entry, &constants);
         let tile: Vec<[f32; 4]> = noise::vo_noise(settings.noise_seed).iter().map(|u| [u[0], u[1], 0.0, 0.0]).collect();
         VoCore {
@@ -141,8 +144,10 @@ impl VoCore {
         self.group = Some(binding::group(device, self.label, &self.layout, &resources));
     }
 
+    /// Writes `uniform` with the sample count of this pass's tables.
     pub(crate) fn prepare(&self, queue: &wgpu::Queue, uniform: &VoUniform) {
-        queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(uniform));
+        let uniform = VoUniform { samples: self.key.0, ..*uniform };
+        queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
     }
 
     pub(crate) fn encode(&self, encoder: &mut wgpu::CommandEncoder, targets: &FrameTargets, span: Option<Span>) {
