@@ -21,6 +21,21 @@ fn clamped_pow(x: f32, alpha: f32) -> f32 {
     return select(0.0, pow(x, alpha), x > 0.0);
 }
 
+// clamped_pow for a whole exponent 1 <= n < 512 by squaring. Called with a constant n, the
+// loop unrolls and the bit tests fold away: five multiplies for n = 32, where pow is
+// exp2(n log2 x) in a software rasterizer's polynomials.
+fn whole_pow(x: f32, n: u32) -> f32 {
+    var result = 1.0;
+    var power = max(x, 0.0);
+    for (var bit = 0u; bit < 9u; bit++) {
+        if ((n >> bit) & 1u) != 0u {
+            result *= power;
+        }
+        power *= power;
+    }
+    return result;
+}
+
 // Illuminated lines (`lineao::lighting` derives both): for unit l, v toward the light and the
 // eye and unit tangent t, (diffuse, specular) before intensity and kd/ks. Shading 0: Zöckler's
 // maximum principle (diffuse 0); 1: Mallo et al.'s average over the visible half cylinder

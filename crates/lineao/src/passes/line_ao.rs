@@ -108,6 +108,8 @@ struct Shape {
     noise_seed: u32,
     light_attenuation: bool,
     lights: u32,
+    /// The shininess as a whole number in 1..512, else 0 (`SHININESS_WHOLE` in the shader).
+    shininess_whole: u32,
 }
 
 impl Shape {
@@ -120,8 +122,14 @@ impl Shape {
             noise_seed: settings.noise_seed,
             light_attenuation: settings.light_attenuation,
             lights: lighting.lights.len().min(crate::lighting::MAX_LIGHTS) as u32,
+            shininess_whole: whole_exponent(lighting.shininess),
         }
     }
+}
+
+/// `alpha` when it is a whole number the shader raises by squaring (1..512), else 0.
+fn whole_exponent(alpha: f32) -> u32 {
+    if alpha.fract() == 0.0 && (1.0..512.0).contains(&alpha) { alpha as u32 } else { 0 }
 }
 
 /// R2 as the variant uses it: ⌈s_h/(j+1)⌉ samples on hemisphere j (`paper`), or s_h on each
@@ -188,6 +196,7 @@ impl LineAo {
             ("REFERENCE", (shape.variant == LineAoVariant::Reference) as u32 as f64),
             ("LIGHTS", shape.lights as f64),
             ("OUTER_LEVEL", outer_level as u32 as f64),
+            ("SHININESS_WHOLE", shape.shininess_whole as f64),
         ];
         let pipeline = binding::compute_pipeline(
             device,
