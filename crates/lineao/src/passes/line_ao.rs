@@ -122,14 +122,9 @@ impl Shape {
             noise_seed: settings.noise_seed,
             light_attenuation: settings.light_attenuation,
             lights: lighting.lights.len().min(crate::lighting::MAX_LIGHTS) as u32,
-            shininess_whole: whole_exponent(lighting.shininess),
+            shininess_whole: crate::reference::whole_exponent(lighting.shininess),
         }
     }
-}
-
-/// `alpha` when it is a whole number the shader raises by squaring (1..512), else 0.
-fn whole_exponent(alpha: f32) -> u32 {
-    if alpha.fract() == 0.0 && (1.0..512.0).contains(&alpha) { alpha as u32 } else { 0 }
 }
 
 /// R2 as the variant uses it: ⌈s_h/(j+1)⌉ samples on hemisphere j (`paper`), or s_h on each

@@ -85,6 +85,33 @@ fn clamped_pow(x: f32, alpha: f32) -> f32 {
     if x > 0.0 { x.powf(alpha) } else { 0.0 }
 }
 
+/// `alpha` when it is a whole number in 1..512, which the shader raises by squaring (a pipeline
+/// constant, `SHININESS_WHOLE`), else 0 (it calls `pow`).
+pub fn whole_exponent(alpha: f32) -> u32 {
+    if alpha.fract() == 0.0 && (1.0..512.0).contains(&alpha) { alpha as u32 } else { 0 }
+}
+
+/// max(x, 0)^n for a whole 1 ≤ n < 512 by squaring, multiplied in the shader's order
+/// (`whole_pow` in `shaders/shared/lighting.wgsl`).
+pub fn whole_pow(x: f32, n: u32) -> f32 {
+    let (mut result, mut power) = (1.0f32, x.max(0.0));
+    for bit in 0..9 {
+        if (n >> bit) & 1 != 0 {
+            result *= power;
+        }
+        power *= power;
+    }
+    result
+}
+
+/// The specular power of g_light as the shader takes it: by squaring for a whole shininess.
+fn specular_pow(x: f32, alpha: f32) -> f32 {
+    match whole_exponent(alpha) {
+        0 => clamped_pow(x, alpha),
+        n => whole_pow(x, n),
+    }
+}
+
 /// g_light (Eq. 14–15) for normal `n` and direction ω.
 pub fn light_weight(p: &LineAoParams, n: Vec3, omega: Vec3) -> f32 {
     if !p.light_attenuation {
@@ -95,7 +122,7 @@ pub fn light_weight(p: &LineAoParams, n: Vec3, omega: Vec3) -> f32 {
         let half_sum = light.dir + omega;
         let half_len = half_sum.length();
         let n_h = if half_len > 1e-12 { n.dot(half_sum) / half_len } else { 0.0 };
-        reflected += light.intensity * (p.kd * n.dot(light.dir).max(0.0) + p.ks * clamped_pow(n_h, p.shininess));
+        reflected += light.intensity * (p.kd * n.dot(light.dir).max(0.0) + p.ks * specular_pow(n_h, p.shininess));
     }
     1.0 - reflected.min(1.0)
 }
@@ -255,7 +282,7 @@ pub fn occluder_light(p: &LineAoParams, n_o: Vec3, omega: Vec3) -> f32 {
             let half_sum = light.dir + omega;
             let half_len = half_sum.length();
             let n_h = if half_len > 1e-12 { n_o.dot(half_sum) / half_len } else { 0.0 };
-            light.intensity * (n_o.dot(light.dir).max(0.0) + clamped_pow(n_h, 100.0))
+            light.intensity * (n_o.dot(light.dir).max(0.0) + whole_pow(n_h, 100))
         })
         .sum()
 }
@@ -331,4 +358,28 @@ pub fn line_ao(
         let far: f32 = outer.iter().map(|o| upsample_outer(o, [w, h], x, y)).sum();
         (near + far).clamp(0.0, 1.0)
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Squaring agrees with `powf` to a few ulps for every whole exponent the shader squares, and
+    /// a shininess that is not whole in 1..512 keeps `pow`.
+    #[test]
+    fn whole_pow_is_pow() {
+        let mut worst = 0.0f32;
+        for n in 1..512u32 {
+            for k in 1..=64 {
+                let x = 0.9 + 0.1 * k as f32 / 64.0;
+                let exact = (x as f64).powi(n as i32);
+                worst = worst.max(((whole_pow(x, n) as f64 - exact) / exact).abs() as f32);
+            }
+            assert_eq!(whole_pow(-0.5, n), 0.0);
+            assert_eq!(whole_pow(0.0, n), 0.0);
+        }
+        assert!(worst < 2e-5, "relative error {worst}");
+        assert_eq!(whole_exponent(32.0), 32);
+        assert_eq!([whole_exponent(32.5), whole_exponent(0.0), whole_exponent(512.0)], [0; 3]);
+    }
 }

@@ -16,7 +16,7 @@ mod volume_ao;
 pub use bilateral::bilateral;
 pub use line_ao::{
     LineAoParams, OUTER_DEPTH_TOLERANCE, delta, depth_weight, hermite, light_weight, line_ao, line_ao_pixel,
-    representative_pixel, upsample_outer,
+    representative_pixel, upsample_outer, whole_exponent, whole_pow,
 };
 pub use ssao::{SSAO_EPSILON, SsaoParams, ViewParams, ssao, ssao_blur, ssao_pixel};
 pub use vo_area::{MomentsImage, moments_pyramid, moments_trilinear, vo_area, vo_sigma_floor};
