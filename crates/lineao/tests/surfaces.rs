@@ -3,28 +3,18 @@
 
 mod common;
 
-use common::{gpu, is_geometry};
+use common::{Frame, gpu, is_geometry, render_scene};
 use glam::Vec3;
 use lineao::camera::{Camera, Projection};
 use lineao::passes::lines::LineGeometry;
 use lineao::passes::meshes::MeshGeometry;
-use lineao::reference::{self, NdImage};
-use lineao::verify::{check_policy, line_ao_flip_bound, read_f32, read_rgba};
-use lineao::{AoChain, AoMethod, ChainSettings, SurfaceSettings};
+use lineao::reference;
+use lineao::verify::{check_policy, line_ao_flip_bound};
+use lineao::{AoMethod, ChainSettings, SurfaceSettings};
 
 /// A square of half-size `s` in the plane z = `z`, facing +z (two triangles).
 fn square(s: f32, z: f32) -> ([[f32; 3]; 4], [[f32; 3]; 4], [u32; 6]) {
     ([[-s, -s, z], [s, -s, z], [s, s, z], [-s, s, z]], [[0.0, 0.0, 1.0]; 4], [0, 1, 2, 0, 2, 3])
-}
-
-struct Frame {
-    view: lineao::camera::FrameView,
-    color: NdImage,
-    nd: Vec<NdImage>,
-    zoom: reference::Image<f32>,
-    specular: reference::Image<f32>,
-    depth: reference::Image<f32>,
-    ao: reference::Image<f32>,
 }
 
 fn render(
@@ -34,25 +24,8 @@ fn render(
     settings: ChainSettings,
     camera: &Camera,
 ) -> Frame {
-    let (d, q) = (&gpu.device, &gpu.queue);
-    let mut chain = AoChain::new(d, common::OUTPUT_FORMAT, settings).unwrap();
-    chain.resize(160, 120).unwrap();
     let bounds = lines.bounds.unwrap().union(&mesh.bounds.unwrap());
-    let view = chain.prepare(d, q, camera, &bounds).unwrap();
-    let output = lineao::targets::Target::output(d, "test::output", (160, 120), common::OUTPUT_FORMAT);
-    let mut encoder = d.create_command_encoder(&Default::default());
-    chain.encode_with_meshes(&mut encoder, lines, &[mesh], &output.view);
-    q.submit([encoder.finish()]);
-    let t = chain.targets().unwrap();
-    Frame {
-        view,
-        color: read_rgba(d, q, &t.color).unwrap(),
-        nd: t.nd.iter().map(|level| read_rgba(d, q, level).unwrap()).collect(),
-        zoom: read_f32(d, q, &t.zoom).unwrap(),
-        specular: read_f32(d, q, &t.specular).unwrap(),
-        depth: read_f32(d, q, &t.depth).unwrap(),
-        ao: read_f32(d, q, &t.ao).unwrap(),
-    }
+    render_scene(gpu, lines, &[mesh], camera, bounds, settings, (160, 120))
 }
 
 fn camera(projection: Projection) -> Camera {

@@ -5,14 +5,14 @@
 
 mod common;
 
-use common::{cameras_for_polylines, gpu, is_geometry, polylines};
+use common::{Frame, cameras_for_polylines, gpu, is_geometry, polylines, render_geometry};
 use glam::{Mat4, Vec3, Vec4Swizzles};
 use lineao::camera::{Camera, FrameView, Projection};
 use lineao::passes::lines::{GeometryOptions, LineGeometry, VertexAttributes};
+use lineao::reference;
 use lineao::reference::tubes::{intersect_rounded_cone, pixel_ray, rounded_cone_distance, rounded_cone_normal};
-use lineao::reference::{self, Image, NdImage};
-use lineao::verify::{check_policy, line_ao_flip_bound, read_f32, read_rgba};
-use lineao::{AoChain, AoMethod, ChainSettings, TubeSettings};
+use lineao::verify::{check_policy, line_ao_flip_bound};
+use lineao::{AoMethod, ChainSettings, TubeSettings};
 
 fn random(k: u32, stream: u32) -> f32 {
     lineao::noise::uniform(21, stream, k)
@@ -78,36 +78,15 @@ fn the_intersection_agrees_with_sphere_tracing_the_exact_distance() {
     assert!(checked > 1000 && misses > 1000);
 }
 
-/// Renders polylines as tubes through the chain (LineAO off) and reads the G-buffer back.
-struct TubeFrame {
-    view: FrameView,
-    nd: NdImage,
-    zoom: Image<f32>,
-    depth: Image<f32>,
-}
-
+/// Renders polylines as tubes through the chain and reads the targets back.
 fn render_tubes(
     gpu: &lineao::Gpu,
     geometry: &LineGeometry,
     camera: &Camera,
     settings: ChainSettings,
     size: (u32, u32),
-) -> TubeFrame {
-    let (d, q) = (&gpu.device, &gpu.queue);
-    let mut chain = AoChain::new(d, common::OUTPUT_FORMAT, settings).unwrap();
-    chain.resize(size.0, size.1).unwrap();
-    let view = chain.prepare(d, q, camera, &geometry.bounds.unwrap()).unwrap();
-    let output = lineao::targets::Target::output(d, "test::output", size, common::OUTPUT_FORMAT);
-    let mut encoder = d.create_command_encoder(&Default::default());
-    chain.encode(&mut encoder, geometry, &output.view);
-    q.submit([encoder.finish()]);
-    let t = chain.targets().unwrap();
-    TubeFrame {
-        view,
-        nd: read_rgba(d, q, &t.nd[0]).unwrap(),
-        zoom: read_f32(d, q, &t.zoom).unwrap(),
-        depth: read_f32(d, q, &t.depth).unwrap(),
-    }
+) -> Frame {
+    render_geometry(gpu, geometry, camera, geometry.bounds.unwrap(), settings, size)
 }
 
 fn tubes(radius: f32) -> ChainSettings {
@@ -124,13 +103,13 @@ struct Expected {
 
 /// Per pixel: the GPU's G-buffer against `expected` (or no geometry). Errors of the f32 ray grow
 /// as 1/(n·v) toward a silhouette, so the tolerances do too.
-fn compare_gbuffer(name: &str, frame: &TubeFrame, expected: impl Fn([u32; 2]) -> Option<Expected>) {
+fn compare_gbuffer(name: &str, frame: &Frame, expected: impl Fn([u32; 2]) -> Option<Expected>) {
     let (mut both, mut coverage_differs, mut off) = (0, 0, 0);
     let (mut worst_depth, mut worst_d, mut worst_zoom) = (0.0f32, 0.0f32, 0.0f32);
     let (proj, inv_proj) = (frame.view.proj, frame.view.proj.inverse());
-    for y in 0..frame.nd.height {
-        for x in 0..frame.nd.width {
-            let nd = frame.nd.get(x, y);
+    for y in 0..frame.nd[0].height {
+        for x in 0..frame.nd[0].width {
+            let nd = frame.nd[0].get(x, y);
             match (is_geometry(nd), expected([x as u32, y as u32])) {
                 (true, Some(Expected { point: p, normals })) => {
                     both += 1;
@@ -304,7 +283,7 @@ fn curved_tubes_of_varying_radius_are_the_union_of_their_segments() {
         }
         let frame = render_tubes(&gpu, &geometry, &camera, tubes(1.5), (240, 180));
         let hits = nearest_hits(&frame.view, &positions, &offsets, &used);
-        let width = frame.nd.width;
+        let width = frame.nd[0].width;
         compare_gbuffer(name, &frame, |[x, y]| {
             hits[y as usize * width + x as usize]
                 .as_ref()
@@ -363,18 +342,8 @@ fn tubes_carry_the_octant_visibilities_to_object_space_ao() {
     geometry.set_attributes(&gpu.device, &gpu.queue, &positions, &offsets, &attributes).unwrap();
     let (camera, _) = cameras_for_polylines();
     let settings = ChainSettings { volume: Some(Default::default()), ..tubes(1.2) };
-    let (d, q) = (&gpu.device, &gpu.queue);
-    let mut chain = AoChain::new(d, common::OUTPUT_FORMAT, settings).unwrap();
-    chain.resize(160, 120).unwrap();
-    chain.prepare(d, q, &camera, &geometry.bounds.unwrap()).unwrap();
-    let output = lineao::targets::Target::output(d, "test::output", (160, 120), common::OUTPUT_FORMAT);
-    let mut encoder = d.create_command_encoder(&Default::default());
-    chain.encode(&mut encoder, &geometry, &output.view);
-    q.submit([encoder.finish()]);
-    let t = chain.targets().unwrap();
-    let nd = read_rgba(d, q, &t.nd[0]).unwrap();
-    let packed: Image<[u32; 2]> = lineao::verify::read_image(d, q, t.octants.as_ref().unwrap()).unwrap();
-    let volume_ao = read_f32(d, q, t.volume_ao.as_ref().unwrap()).unwrap();
+    let frame = render_tubes(&gpu, &geometry, &camera, settings, (160, 120));
+    let (nd, packed, volume_ao) = (&frame.nd[0], frame.octants.unwrap(), frame.volume_ao.unwrap());
     let mut pixels = 0;
     for i in (0..nd.data.len()).filter(|&i| is_geometry(nd.data[i])) {
         assert_eq!(reference::unpack_octants(packed.data[i]), [c; 8]);

@@ -309,54 +309,25 @@ fn chebyshev_is_exact_for_two_values_and_soft_shadows_fall_behind_occluders() {
 
 mod common;
 
-use common::{cameras_for_polylines, gpu, is_geometry, polylines};
+use common::{Frame, cameras_for_polylines, gpu, is_geometry, polylines, render_geometry};
 use lineao::camera::Camera;
 use lineao::passes::lines::{GeometryOptions, LineGeometry, VertexAttributes};
 use lineao::passes::volume_ao::view_to_world;
 use lineao::reference::{self, Image};
-use lineao::verify::{compare, read_f32, read_image, read_rgba};
-use lineao::{AoChain, AoMethod, ChainSettings, VoCombine, VolumeAoSettings};
+use lineao::verify::compare;
+use lineao::{AoMethod, ChainSettings, VoCombine, VolumeAoSettings};
 
-/// A chain frame with object-space AO, read back: ND, octants, volume_ao, ao and the output.
-struct VolumeFrame {
-    view: lineao::camera::FrameView,
-    guard: usize,
-    color: reference::NdImage,
-    specular: Image<f32>,
-    nd: reference::NdImage,
-    octants: Image<[u32; 2]>,
-    volume_ao: Image<f32>,
-    ao: Image<f32>,
-    output: reference::NdImage,
-}
-
+/// A chain frame with object-space AO (the geometry's attributes), every target read back.
 fn render_volume(
     gpu: &lineao::Gpu,
     geometry: &LineGeometry,
     camera: &Camera,
     settings: ChainSettings,
     size: (u32, u32),
-) -> VolumeFrame {
-    let (d, q) = (&gpu.device, &gpu.queue);
-    let mut chain = AoChain::new(d, common::OUTPUT_FORMAT, settings).unwrap();
-    chain.resize(size.0, size.1).unwrap();
-    let view = chain.prepare(d, q, camera, &geometry.bounds.unwrap()).unwrap();
-    let output = lineao::targets::Target::output(d, "test::output", size, common::OUTPUT_FORMAT);
-    let mut encoder = d.create_command_encoder(&Default::default());
-    chain.encode(&mut encoder, geometry, &output.view);
-    q.submit([encoder.finish()]);
-    let t = chain.targets().unwrap();
-    VolumeFrame {
-        view,
-        guard: t.guard as usize,
-        color: read_rgba(d, q, &t.color).unwrap(),
-        specular: read_f32(d, q, &t.specular).unwrap(),
-        nd: read_rgba(d, q, &t.nd[0]).unwrap(),
-        octants: read_image(d, q, t.octants.as_ref().unwrap()).unwrap(),
-        volume_ao: read_f32(d, q, t.volume_ao.as_ref().unwrap()).unwrap(),
-        ao: read_f32(d, q, &t.ao).unwrap(),
-        output: read_rgba(d, q, &output).unwrap(),
-    }
+) -> Frame {
+    let frame = render_geometry(gpu, geometry, camera, geometry.bounds.unwrap(), settings, size);
+    assert!(frame.octants.is_some() && frame.volume_ao.is_some(), "object-space AO is on");
+    frame
 }
 
 /// Polylines with octant visibilities from the sweep over their own density volume.
@@ -390,19 +361,20 @@ fn the_gpu_agrees_with_the_cpu_reference_on_rendered_lines() {
             ..ChainSettings::default()
         };
         let f = render_volume(&gpu, &geometry, &camera, settings.clone(), (200, 150));
-        let cpu = reference::volume_ao(&f.nd, &f.octants, &table, view_to_world(&f.view), sky.weights());
-        let stats = compare(&f.volume_ao, &cpu, 1e-4, |_, _| true);
+        let (volume_ao, octants) = (f.volume_ao.as_ref().unwrap(), f.octants.as_ref().unwrap());
+        let cpu = reference::volume_ao(&f.nd[0], octants, &table, view_to_world(&f.view), sky.weights());
+        let stats = compare(volume_ao, &cpu, 1e-4, |_, _| true);
         println!("{name}: {stats}");
         assert!(stats.worst < 1e-4, "{name}: {stats}");
         // The octants come from the geometry: some pixels dark, some lit.
         let geometry_pixels: Vec<f32> =
-            (0..f.nd.data.len()).filter(|&i| is_geometry(f.nd.data[i])).map(|i| f.volume_ao.data[i]).collect();
+            (0..f.nd[0].data.len()).filter(|&i| is_geometry(f.nd[0].data[i])).map(|i| volume_ao.data[i]).collect();
         let dark = geometry_pixels.iter().filter(|&&a| a > 0.3).count();
         assert!(dark > 50 && dark < geometry_pixels.len() - 50, "{name}: {dark} of {}", geometry_pixels.len());
         // The composite shows it alone or combined with the method's.
-        let volume = |x, y| (method != AoMethod::None).then(|| (f.volume_ao.get(x, y), combine));
+        let volume = |x, y| (method != AoMethod::None).then(|| (volume_ao.get(x, y), combine));
         let shown = Image::from_fn(f.ao.width, f.ao.height, |x, y| match method {
-            AoMethod::None => f.volume_ao.get(x, y),
+            AoMethod::None => volume_ao.get(x, y),
             _ => reference::combine_ao(f.ao.get(x, y), volume(x, y)),
         });
         let expected = reference::composite(&f.color, &f.specular, &shown, f.guard, settings.strength);
@@ -438,20 +410,21 @@ fn a_constant_visibility_gives_the_hemisphere_sky_in_closed_form() {
             ..ChainSettings::default()
         };
         let f = render_volume(&gpu, &geometry, &camera, settings, (160, 120));
+        let (volume_ao, octants) = (f.volume_ao.as_ref().unwrap(), f.octants.as_ref().unwrap());
         let to_world = view_to_world(&f.view);
         let (mut worst, mut pixels) = (0.0f32, 0);
-        for (i, nd) in f.nd.data.iter().enumerate() {
+        for (i, nd) in f.nd[0].data.iter().enumerate() {
             if !is_geometry(*nd) {
-                assert_eq!(f.volume_ao.data[i], 0.0);
+                assert_eq!(volume_ao.data[i], 0.0);
                 continue;
             }
-            assert_eq!(reference::unpack_octants(f.octants.data[i]), [c; 8]);
+            assert_eq!(reference::unpack_octants(octants.data[i]), [c; 8]);
             let n = (to_world * Vec3::new(nd[0], nd[1], nd[2])).normalize();
             let expected = match sky {
                 Sky::Cloudy => 1.0 - c * (1.0 + n.z) / 2.0,
                 _ => 1.0 - c,
             };
-            worst = worst.max((f.volume_ao.data[i] - expected).abs());
+            worst = worst.max((volume_ao.data[i] - expected).abs());
             pixels += 1;
         }
         println!("{sky:?}: {pixels} pixels, worst |Δ| {worst:.2e} against the closed form");
@@ -478,7 +451,13 @@ fn attributes_split_with_the_strip_and_bad_attributes_are_errors() {
     let (positions, offsets) = polylines(40, 0.3);
     let mut plain = LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap();
     let c = render_volume(&gpu, &plain, &camera, settings, (120, 90));
-    assert!(c.nd.data.iter().zip(&c.volume_ao.data).all(|(nd, &ao)| !is_geometry(*nd) || ao.abs() < 1e-6));
+    assert!(
+        c.nd[0]
+            .data
+            .iter()
+            .zip(&c.volume_ao.as_ref().unwrap().data)
+            .all(|(nd, &ao)| !is_geometry(*nd) || ao.abs() < 1e-6)
+    );
     // Wrong lengths are errors naming what differs.
     let short = vec![[1.0; 8]; positions.len() - 1];
     let error = plain

@@ -5,6 +5,7 @@
 use lineao::camera::{Bounds, Camera, FrameView};
 use lineao::passes::line_ao::LineAo;
 use lineao::passes::lines::LineGeometry;
+use lineao::passes::meshes::MeshGeometry;
 use lineao::passes::nd_pyramid::NdPyramid;
 use lineao::reference::{Image, NdImage};
 use lineao::targets::{FrameTargets, Target};
@@ -37,6 +38,10 @@ pub struct Frame {
     pub moments: Vec<lineao::reference::MomentsImage>,
     /// The composite's output (Rgba32Float, linear), visible size.
     pub output: NdImage,
+    /// Object-space AO's packed octant visibilities and occlusion per pixel (with
+    /// `ChainSettings::volume`).
+    pub octants: Option<Image<[u32; 2]>>,
+    pub volume_ao: Option<Image<f32>>,
 }
 
 pub const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
@@ -61,6 +66,19 @@ pub fn render_geometry(
     camera: &Camera,
     bounds: Bounds,
     settings: ChainSettings,
+    size: (u32, u32),
+) -> Frame {
+    render_scene(gpu, geometry, &[], camera, bounds, settings, size)
+}
+
+/// [`render_geometry`] with context surfaces (`meshes`) drawn into the same G-buffer.
+pub fn render_scene(
+    gpu: &Gpu,
+    geometry: &LineGeometry,
+    meshes: &[&MeshGeometry],
+    camera: &Camera,
+    bounds: Bounds,
+    settings: ChainSettings,
     (width, height): (u32, u32),
 ) -> Frame {
     let mut chain = AoChain::new(&gpu.device, OUTPUT_FORMAT, settings).unwrap();
@@ -68,7 +86,7 @@ pub fn render_geometry(
     let view = chain.prepare(&gpu.device, &gpu.queue, camera, &bounds).unwrap();
     let output = Target::output(&gpu.device, "test::output", (width, height), OUTPUT_FORMAT);
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    chain.encode(&mut encoder, geometry, &output.view);
+    chain.encode_with_meshes(&mut encoder, geometry, meshes, &output.view);
     gpu.queue.submit([encoder.finish()]);
     let t = chain.targets().unwrap();
     let (d, q) = (&gpu.device, &gpu.queue);
@@ -85,6 +103,8 @@ pub fn render_geometry(
         ao_blurred: read_f32(d, q, &t.ao_blurred).unwrap(),
         moments: t.moments.as_ref().map(|m| lineao::verify::read_moments(d, q, m).unwrap()).unwrap_or_default(),
         output: read_rgba(d, q, &output).unwrap(),
+        octants: t.octants.as_ref().map(|o| lineao::verify::read_image(d, q, o).unwrap()),
+        volume_ao: t.volume_ao.as_ref().map(|v| read_f32(d, q, v).unwrap()),
     }
 }
 
