@@ -31,16 +31,10 @@ fn mesh_gbuffer(in: MeshOut) -> GBuffer {
     out.nd = gbuffer_nd(in.view_pos, normalize(in.view_normal), frame.near, frame.far, is_orthographic());
     let n = out.nd.xyz;
     let v = gbuffer_eye_direction(in.view_pos, is_orthographic());
-    var diffuse = 0.0;
-    var specular = 0.0;
-    for (var k = 0u; k < lighting.count; k++) {
-        let light = lighting.lights[k];
-        diffuse += light.w * max(dot(n, light.xyz), 0.0);
-        specular += light.w * lighting.ks * clamped_pow(dot(n, normalize(light.xyz + v)), lighting.shininess);
-    }
-    out.color = vec4<f32>(frame.constant_color.rgb * (1.0 - lighting.kd + lighting.kd * diffuse), 1.0);
+    let lit = phong(n, v);
+    out.color = vec4<f32>(frame.constant_color.rgb * (1.0 - lighting.kd + lighting.kd * lit.x), 1.0);
     out.zoom = gbuffer_zoom(in.view_pos, frame.f_px, frame.zoom_unit, is_orthographic());
-    out.specular = specular;
+    out.specular = lit.y;
     return out;
 }
 

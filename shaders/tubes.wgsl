@@ -224,20 +224,13 @@ fn tube_hit(in: TubeOut) -> TubeHit {
     let s = clamp(dot(p - in.a, ab) / max(dot(ab, ab), 1e-30), 0.0, 1.0);
 
     // Phong tubes: ambient (what LineAO darkens) and diffuse in the color, specular on top.
-    let v = -rd;
-    var diffuse = 0.0;
-    var specular = 0.0;
-    for (var k = 0u; k < lighting.count; k++) {
-        let light = lighting.lights[k];
-        diffuse += light.w * max(dot(n, light.xyz), 0.0);
-        specular += light.w * lighting.ks * clamped_pow(dot(n, normalize(light.xyz + v)), lighting.shininess);
-    }
+    let lit = phong(n, -rd);
     let base = mix(in.color_a, in.color_b, s);
     var out: TubeHit;
-    out.gbuffer.color = vec4<f32>(base * (1.0 - lighting.kd + lighting.kd * diffuse), 1.0);
+    out.gbuffer.color = vec4<f32>(base * (1.0 - lighting.kd + lighting.kd * lit.x), 1.0);
     out.gbuffer.nd = gbuffer_nd(p, n, frame.near, frame.far, is_orthographic());
     out.gbuffer.zoom = gbuffer_zoom(p, frame.f_px, frame.zoom_unit, is_orthographic());
-    out.gbuffer.specular = specular;
+    out.gbuffer.specular = lit.y;
     out.s = s;
     let clip = frame.proj * vec4<f32>(p, 1.0);
     out.depth = clip.z / clip.w;

@@ -35,6 +35,19 @@ fn is_orthographic() -> bool {
     return frame.orthographic != 0u;
 }
 
+// Phong lighting of a surface with unit normal n seen along unit v (toward the eye): the
+// (diffuse, specular) sums over the lights, before kd and with ks (meshes, tubes).
+fn phong(n: vec3<f32>, v: vec3<f32>) -> vec2<f32> {
+    var diffuse = 0.0;
+    var specular = 0.0;
+    for (var k = 0u; k < lighting.count; k++) {
+        let light = lighting.lights[k];
+        diffuse += light.w * max(dot(n, light.xyz), 0.0);
+        specular += light.w * lighting.ks * clamped_pow(dot(n, normalize(light.xyz + v)), lighting.shininess);
+    }
+    return vec2<f32>(diffuse, specular);
+}
+
 // The base color of a point with world-space tangent `t_world` and scalar `scalar`: |T| (tangent
 // color mode), the constant color, or the scalar through the colormap.
 fn base_color(t_world: vec3<f32>, scalar: f32) -> vec3<f32> {
