@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{Frame, cameras_for_polylines, gpu, is_geometry, polylines, render_geometry};
+use common::{Frame, cameras_for_polylines, gpu, is_geometry, polylines, polylines_with_octants, render_geometry};
 use glam::{Mat4, Vec3, Vec4Swizzles};
 use lineao::camera::{Camera, FrameView, Projection};
 use lineao::passes::lines::{GeometryOptions, LineGeometry, VertexAttributes};
@@ -334,12 +334,8 @@ fn lineao_on_tubes_takes_r0_from_the_zoom_and_matches_its_cpu_reference() {
 #[test]
 fn tubes_carry_the_octant_visibilities_to_object_space_ao() {
     let gpu = gpu();
-    let (positions, offsets) = polylines(20, 0.5);
     let c = 102.0 / 255.0;
-    let octants = vec![[c; 8]; positions.len()];
-    let mut geometry = LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap();
-    let attributes = VertexAttributes { octants: Some(&octants), ..Default::default() };
-    geometry.set_attributes(&gpu.device, &gpu.queue, &positions, &offsets, &attributes).unwrap();
+    let geometry = polylines_with_octants(&gpu, 20, 0.5, c);
     let (camera, _) = cameras_for_polylines();
     let settings = ChainSettings { volume: Some(Default::default()), ..tubes(1.2) };
     let frame = render_tubes(&gpu, &geometry, &camera, settings, (160, 120));

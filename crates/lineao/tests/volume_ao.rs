@@ -309,7 +309,7 @@ fn chebyshev_is_exact_for_two_values_and_soft_shadows_fall_behind_occluders() {
 
 mod common;
 
-use common::{Frame, cameras_for_polylines, gpu, is_geometry, polylines, render_geometry};
+use common::{Frame, cameras_for_polylines, gpu, is_geometry, polylines, polylines_with_octants, render_geometry};
 use lineao::camera::Camera;
 use lineao::passes::lines::{GeometryOptions, LineGeometry, VertexAttributes};
 use lineao::passes::volume_ao::view_to_world;
@@ -396,12 +396,8 @@ fn a_constant_visibility_gives_the_hemisphere_sky_in_closed_form() {
     // (1 + n_z)/2 in world space, so ao = 1 − c (1 + n_z)/2 — through the view-to-world
     // rotation, the octahedral table and the sky weights.
     let gpu = gpu();
-    let (positions, offsets) = polylines(30, 1.1);
     let c = 153.0 / 255.0;
-    let octants = vec![[c; 8]; positions.len()];
-    let mut geometry = LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap();
-    let attributes = VertexAttributes { octants: Some(&octants), ..Default::default() };
-    geometry.set_attributes(&gpu.device, &gpu.queue, &positions, &offsets, &attributes).unwrap();
+    let geometry = polylines_with_octants(&gpu, 30, 1.1, c);
     let (camera, _) = cameras_for_polylines();
     for sky in [Sky::Uniform, Sky::Cloudy] {
         let settings = ChainSettings {

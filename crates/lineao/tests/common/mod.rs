@@ -147,6 +147,17 @@ pub fn line_ao_on(
     (levels, read_f32(d, q, &targets.ao).unwrap())
 }
 
+/// [`polylines`] on the GPU, every vertex seeing `c` of each octant (object-space AO's
+/// attribute).
+pub fn polylines_with_octants(gpu: &Gpu, count: usize, seed: f32, c: f32) -> LineGeometry {
+    let (positions, offsets) = polylines(count, seed);
+    let octants = vec![[c; 8]; positions.len()];
+    let mut geometry = LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap();
+    let attributes = lineao::passes::lines::VertexAttributes { octants: Some(&octants), ..Default::default() };
+    geometry.set_attributes(&gpu.device, &gpu.queue, &positions, &offsets, &attributes).unwrap();
+    geometry
+}
+
 pub fn is_geometry(nd: [f32; 4]) -> bool {
     nd[..3] != [0.0; 3]
 }
