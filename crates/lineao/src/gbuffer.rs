@@ -129,7 +129,13 @@ pub(crate) fn pipeline(
             compilation_options: Default::default(),
             buffers: spec.buffers,
         },
-        primitive: wgpu::PrimitiveState { topology: spec.topology, ..Default::default() },
+        primitive: wgpu::PrimitiveState {
+            topology: spec.topology,
+            // Index strips end at u32::MAX (the lines' alternating strip).
+            strip_index_format: (spec.topology == wgpu::PrimitiveTopology::TriangleStrip)
+                .then_some(wgpu::IndexFormat::Uint32),
+            ..Default::default()
+        },
         depth_stencil: Some(wgpu::DepthStencilState {
             format: targets::DEPTH_FORMAT,
             depth_write_enabled: Some(true),

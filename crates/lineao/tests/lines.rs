@@ -457,3 +457,97 @@ fn cylinder_averaged_lighting_matches_quadrature() {
     assert!(worst_diffuse < 1e-5, "the diffuse average is exact: {worst_diffuse}");
     assert!(worst_specular < 2e-5, "Gauss–Legendre around the highlight: {worst_specular}");
 }
+
+/// Dense smooth streamlines (the case the alternating strip is for: 1 000 points each) and
+/// coarse ones with sharp corners, crossing, in front of the perspective camera.
+fn dense_and_coarse() -> (Vec<[f32; 3]>, Vec<u64>) {
+    let mut positions = Vec::new();
+    let mut offsets = vec![0u64];
+    for k in 0..60 {
+        let phase = k as f32 * 0.37;
+        positions.extend((0..1000).map(|i| {
+            let s = i as f32 / 999.0;
+            [-45.0 + 90.0 * s, 30.0 * (phase + 4.0 * s).sin(), 20.0 * (phase * 2.0 + 3.0 * s).cos()]
+        }));
+        offsets.push(positions.len() as u64);
+    }
+    for k in 0..6 {
+        let y = -30.0 + 12.0 * k as f32;
+        positions.extend((0..9).map(|i| [-40.0 + 10.0 * i as f32, y + 8.0 * (i % 2) as f32, 10.0 - 3.0 * k as f32]));
+        offsets.push(positions.len() as u64);
+    }
+    (positions, offsets)
+}
+
+/// The G-buffer's ND map of `geometry` drawn by `style` for `cam`, and whether it alternated.
+fn draw(
+    gpu: &lineao::Gpu,
+    geometry: &LineGeometry,
+    style: LineStyle,
+    cam: &Camera,
+) -> (lineao::reference::NdImage, bool) {
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let view = FrameView::new(cam, &bounds().unwrap(), SIZE.0, SIZE.1, 0, 1.0);
+    let targets = FrameTargets::new(d, SIZE.0, SIZE.1, 0, 1);
+    let renderer = LineRenderer::with_style(d, style);
+    let s = plain(2.0);
+    renderer.prepare(q, &view, s.line_width_px, s.line_color, &s.lighting);
+    let mut encoder = d.create_command_encoder(&Default::default());
+    renderer.encode(&mut encoder, &targets, geometry, lineao::gbuffer::Load::Clear(s.background), None);
+    q.submit([encoder.finish()]);
+    (lineao::verify::read_rgba(d, q, &targets.nd[0]).unwrap(), renderer.alternates(geometry))
+}
+
+#[test]
+fn the_alternating_strip_stays_within_half_a_pixel_of_the_full_strip() {
+    let gpu = gpu();
+    let (positions, offsets) = dense_and_coarse();
+    let geometry = LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap();
+    let (full, _) = draw(&gpu, &geometry, LineStyle::FullStrip, &perspective());
+    let (alternating, alternated) = draw(&gpu, &geometry, LineStyle::Quads, &perspective());
+    assert!(alternated, "this view is far enough for the alternating strip");
+    let covered = |image: &lineao::reference::NdImage, x: usize, y: usize| is_geometry(image.get(x, y));
+    let near = |image: &lineao::reference::NdImage, x: usize, y: usize| {
+        (x.saturating_sub(1)..(x + 2).min(SIZE.0 as usize))
+            .any(|i| (y.saturating_sub(1)..(y + 2).min(SIZE.1 as usize)).any(|j| covered(image, i, j)))
+    };
+    let (mut both, mut moved, mut far, mut same_depth) = (0, 0, 0, 0);
+    for y in 0..SIZE.1 as usize {
+        for x in 0..SIZE.0 as usize {
+            match (covered(&full, x, y), covered(&alternating, x, y)) {
+                (true, true) => {
+                    both += 1;
+                    same_depth += ((full.get(x, y)[3] - alternating.get(x, y)[3]).abs() < 1e-3) as usize;
+                }
+                (true, false) => {
+                    moved += 1;
+                    far += !near(&alternating, x, y) as usize;
+                }
+                (false, true) => {
+                    moved += 1;
+                    far += !near(&full, x, y) as usize;
+                }
+                (false, false) => {}
+            }
+        }
+    }
+    println!("covered by both {both}, by one {moved}, farther than a pixel {far}, same depth {same_depth}");
+    // Edges move by less than a pixel: a pixel covered by one strip only touches the other's.
+    assert_eq!(far, 0);
+    assert!(moved as f64 <= 0.02 * both as f64, "{moved} of {both} pixels changed coverage");
+    assert!(same_depth as f64 >= 0.98 * both as f64, "{same_depth} of {both} pixels kept their depth");
+}
+
+#[test]
+fn close_up_the_full_strip_is_drawn() {
+    let gpu = gpu();
+    let (positions, offsets) = dense_and_coarse();
+    let geometry = LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap();
+    // The depth range starts 2 units ahead (the bounds reach z = 50): a world unit can cover
+    // over 100 px there.
+    let close = Camera { eye: Vec3::new(0.0, 0.0, 52.0), ..perspective() };
+    let (full, _) = draw(&gpu, &geometry, LineStyle::FullStrip, &close);
+    let (quads, alternated) = draw(&gpu, &geometry, LineStyle::Quads, &close);
+    assert!(!alternated);
+    assert!(full.data == quads.data, "the same strip, the same pixels");
+}

@@ -16,9 +16,24 @@
 //! Measured with `lineao bench` (1 M vertices, 1280 × 1024, lavapipe): the strip is 1.6× faster
 //! than one instanced 4-vertex quad per segment, whose per-instance cost dominated.
 //!
+//! **The alternating strip.** The full strip costs two vertices and two triangles per segment,
+//! where the rasterizer's own lines cost one vertex and one line (`lineao bench`: 1.41×
+//! `lines-native-1px`). An index strip over the same vertex buffer takes one side per point,
+//! left and right by turns (L0 R0 L1 R2 L3 R4 …, both sides at a run's ends): one vertex and one
+//! triangle per segment (1.10×). Its left edge then runs from L1 to L3, past where L2 would be:
+//! straight lines come out exact, a bend at point i moves the skipped edge by about the distance
+//! δ_i of P_i from the chord P_(i−1) P_(i+1), and the turn of the tangents shifts the offsets.
+//! So a point keeps both sides where δ_i exceeds a tolerance τ (world units, a fixed share of
+//! the geometry's bounding radius) or its tangent turns more than 20° from a neighbour's, and a
+//! frame uses the alternating strip only where τ times the most pixels a world unit can cover in
+//! it is at most a quarter pixel and lines are at most 8 px wide: every edge within about half a
+//! pixel of the full strip's. Zoomed in closer, the full strip is drawn.
+//!
 //! Per pixel it writes the G-buffer of CONTRACT.md: base color, the ND map (n = (T × C) × T
 //! normalized, facing the eye; normalized linear depth), the zoom map, the illuminated-lines
 //! specular and hardware depth.
+
+use std::sync::atomic::{AtomicU32, Ordering};
 
 use glam::Vec3;
 
@@ -138,6 +153,8 @@ struct Chunk {
     vertices: wgpu::Buffer,
     count: u32,
     segments: Option<(wgpu::Buffer, u32)>,
+    /// The alternating strip's indices into `vertices` (see the module documentation).
+    alternating: (wgpu::Buffer, u32),
     attributes: Option<wgpu::Buffer>,
 }
 
@@ -146,6 +163,9 @@ pub struct LineGeometry {
     chunks: Vec<Chunk>,
     /// Strip vertices per chunk at most (even).
     per_chunk: usize,
+    /// How far (world units) a point may lie from the chord of its neighbours and still have
+    /// one side in the alternating strip.
+    tolerance: f32,
     /// Bounding sphere of the finite points; `None` when there are none.
     pub bounds: Option<Bounds>,
     pub vertices: usize,
@@ -283,6 +303,8 @@ impl LineGeometry {
         // of padding follow. The attribute stream splits at the same vertices, so its buffers
         // must fit the same count.
         let per_chunk = (limit / POINT_SIZE).saturating_sub(2).max(4) as usize & !1;
+        let bounds = Bounds::of_points(positions);
+        let tolerance = bounds.map_or(0.0, |b| b.radius * TOLERANCE_PER_RADIUS);
         let mut chunks = Vec::new();
         let mut failed = None;
         let mut upload = |vertices: &[LinePoint]| {
@@ -290,6 +312,7 @@ impl LineGeometry {
                 vertices: upload_padded(device, queue, "lineao::LineGeometry::strip", vertices),
                 count: vertices.len() as u32,
                 segments: options.native_lines.then(|| native_segments(device, queue, vertices)),
+                alternating: alternating_buffer(device, queue, vertices, tolerance),
                 attributes: None,
             };
             if let Err(e) = device.poll(wgpu::PollType::wait_indefinitely()) {
@@ -306,7 +329,8 @@ impl LineGeometry {
         Ok(LineGeometry {
             chunks,
             per_chunk,
-            bounds: Bounds::of_points(positions),
+            tolerance,
+            bounds,
             vertices: positions.len(),
             streamlines: offsets.len() - 1,
         })
@@ -400,6 +424,106 @@ fn native_segments(device: &wgpu::Device, queue: &wgpu::Queue, vertices: &[LineP
     (buffer, indices.len() as u32)
 }
 
+/// τ over the bounding radius: a view that shows the whole bounding sphere across 2 000 px
+/// covers about 2 000 / (2 radius) px per world unit, so τ is about 0.12 px there.
+const TOLERANCE_PER_RADIUS: f32 = 1.0 / 8192.0;
+/// The cosine of the largest turn between neighbouring tangents that keeps one side (20°).
+const MAX_TURN_COS: f32 = 0.9397;
+/// The alternating strip's budget: τ on screen, and the widest lines (a turn of 20° moves a
+/// skipped offset by at most (1 − cos 20°) · width / 2 ≈ 0.24 px at 8 px).
+const MAX_TOLERANCE_PX: f32 = 0.25;
+const MAX_ALTERNATING_WIDTH_PX: f32 = 8.0;
+/// Ends an index strip; the next index starts a new one.
+const RESTART: u32 = u32::MAX;
+
+/// The alternating strip over a chunk's strip `vertices` (see the module documentation): per
+/// run of segments, both sides of its first point, then one side per point by turns, both sides
+/// where the point lies more than `tolerance` from the chord of its neighbours or its tangent
+/// turns more than 20° from theirs, both sides of its last point; runs separated by restarts.
+/// Points are the pairs at even positions (left, right); a pair that starts on the right side is
+/// the join between two polylines.
+pub(crate) fn alternating_strip(vertices: &[LinePoint], tolerance: f32) -> Vec<u32> {
+    let points = vertices.len() / 2;
+    let is_point = |k: usize| vertices[2 * k].side_and_flags().0 > 0;
+    let continues = |k: usize| vertices[2 * k].side_and_flags().1 & VertexFlags::SEGMENT != 0;
+    let position = |k: usize| Vec3::from_array(vertices[2 * k].position);
+    let tangent = |k: usize| {
+        let [x, y, z, _] = vertices[2 * k].tangent;
+        Vec3::new(x as f32, y as f32, z as f32).normalize_or_zero()
+    };
+    let bends = |k: usize| {
+        let (a, p, b) = (position(k - 1), position(k), position(k + 1));
+        let chord = b - a;
+        let t = if chord.length_squared() > 0.0 {
+            ((p - a).dot(chord) / chord.length_squared()).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let t_k = tangent(k);
+        p.distance(a + t * chord) > tolerance
+            || t_k.dot(tangent(k - 1)) < MAX_TURN_COS
+            || t_k.dot(tangent(k + 1)) < MAX_TURN_COS
+    };
+    let mut out = Vec::with_capacity(points + points / 8);
+    let mut k = 0;
+    while k < points {
+        if !is_point(k) {
+            k += 1;
+            continue;
+        }
+        let first = k;
+        while k + 1 < points && continues(k) && is_point(k + 1) {
+            k += 1;
+        }
+        let last = k;
+        k += 1;
+        if last == first {
+            continue;
+        }
+        if !out.is_empty() {
+            out.push(RESTART);
+        }
+        // Sides by turns: after both sides of a point the same side comes next.
+        let mut left = true;
+        let mut side = |point: usize, out: &mut Vec<u32>| {
+            out.push((2 * point + !left as usize) as u32);
+            left = !left;
+        };
+        for point in first..=last {
+            side(point, &mut out);
+            if point == first || point == last || bends(point) {
+                side(point, &mut out);
+            }
+        }
+    }
+    out
+}
+
+/// The index buffer of [`alternating_strip`] and its length.
+fn alternating_buffer(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    vertices: &[LinePoint],
+    tolerance: f32,
+) -> (wgpu::Buffer, u32) {
+    let indices = alternating_strip(vertices, tolerance);
+    let contents = if indices.is_empty() { &[RESTART][..] } else { &indices };
+    let buffer = upload_buffer(device, queue, "lineao::LineGeometry::alternating", wgpu::BufferUsages::INDEX, contents);
+    (buffer, indices.len() as u32)
+}
+
+/// The most pixels one world unit can cover in `view` (at the near end of its depth range,
+/// off axis up to the viewport's corners): the Jacobian of (f x / z, f y / z) has norm at most
+/// f / z · √(1 + (x² + y²) / z²).
+fn max_px_per_world(view: &FrameView) -> f32 {
+    if view.orthographic {
+        return view.f_px;
+    }
+    let guard = 2.0 * view.guard as f32;
+    let half_diagonal = 0.5 * (view.width as f32 + guard).hypot(view.height as f32 + guard) / view.f_px;
+    view.f_px / view.near * (1.0 + half_diagonal * half_diagonal).sqrt()
+}
+
 /// A vertex buffer of `values` and two more copies of the last (see the module documentation).
 fn upload_padded<T: bytemuck::Pod>(
     device: &wgpu::Device,
@@ -435,9 +559,13 @@ fn upload_buffer<T: bytemuck::Pod>(
 /// How segments are rasterized.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum LineStyle {
-    /// Screen-aligned quads of the chain's line width (the paper's fixed-width lines).
+    /// Screen-aligned quads of the chain's line width (the paper's fixed-width lines), from the
+    /// alternating strip where it stays within about half a pixel of the full one (see the
+    /// module documentation), else the full strip.
     #[default]
     Quads,
+    /// Quads always from the full strip: both sides of every point.
+    FullStrip,
     /// The rasterizer's native 1-pixel lines (an indexed `LineList` over the same vertices),
     /// ignoring the line width: the cheapest way to put segments on screen, and the baseline
     /// `lineao bench` measures quads against. Needs geometry uploaded with
@@ -455,6 +583,9 @@ pub struct LineRenderer {
     /// without them.
     octants: Option<OctantPipelines>,
     bindings: GeometryBindings,
+    /// The frame's [`max_px_per_world`] (f32 bits) when the alternating strip may be drawn
+    /// (∞ otherwise), from [`LineRenderer::prepare`].
+    px_per_world: AtomicU32,
 }
 
 /// The pipelines of a geometry pass that also writes the `octants` target.
@@ -499,7 +630,7 @@ impl LineRenderer {
         let strip = [Some(strip_layout(&STRIP_ATTRIBUTES))];
         let with_attributes = [Some(strip_layout(&STRIP_ATTRIBUTES)), Some(attribute_layout(&octant_attributes))];
         let topology = match style {
-            LineStyle::Quads => wgpu::PrimitiveTopology::TriangleStrip,
+            LineStyle::Quads | LineStyle::FullStrip => wgpu::PrimitiveTopology::TriangleStrip,
             LineStyle::Native1px => wgpu::PrimitiveTopology::LineList,
         };
         let create = |label, vertex, fragment, buffers| {
@@ -511,17 +642,25 @@ impl LineRenderer {
             )
         };
         let vertex = match style {
-            LineStyle::Quads => "vs_main",
+            LineStyle::Quads | LineStyle::FullStrip => "vs_main",
             LineStyle::Native1px => "vs_native",
         };
         let pipeline = create("lineao::LineRenderer::pipeline", vertex, "fs_main", &strip);
-        let attributes = (style == LineStyle::Quads)
-            .then(|| create("lineao::LineRenderer::attributes", "vs_attributes", "fs_main", &with_attributes));
-        let octants = (octants && style == LineStyle::Quads).then(|| OctantPipelines {
+        let quads = style != LineStyle::Native1px;
+        let attributes =
+            quads.then(|| create("lineao::LineRenderer::attributes", "vs_attributes", "fs_main", &with_attributes));
+        let octants = (octants && quads).then(|| OctantPipelines {
             attributes: create("lineao::LineRenderer::octants", "vs_octants", "fs_octants", &with_attributes),
             visible: create("lineao::LineRenderer::visible", "vs_visible", "fs_octants", &strip),
         });
-        LineRenderer { style, pipeline, attributes, octants, bindings }
+        LineRenderer {
+            style,
+            pipeline,
+            attributes,
+            octants,
+            bindings,
+            px_per_world: AtomicU32::new(f32::INFINITY.to_bits()),
+        }
     }
 
     /// Whether this renderer writes the `octants` target.
@@ -538,6 +677,15 @@ impl LineRenderer {
         lighting: &Lighting,
     ) {
         self.bindings.write(queue, &GeometryUniform::new(view, color, line_width_px, 0.0), lighting);
+        let scale = if line_width_px <= MAX_ALTERNATING_WIDTH_PX { max_px_per_world(view) } else { f32::INFINITY };
+        self.px_per_world.store(scale.to_bits(), Ordering::Relaxed);
+    }
+
+    /// Whether [`LineRenderer::encode`] draws `geometry` from the alternating strip in the frame
+    /// of the last [`LineRenderer::prepare`].
+    pub fn alternates(&self, geometry: &LineGeometry) -> bool {
+        let scale = f32::from_bits(self.px_per_world.load(Ordering::Relaxed));
+        self.style == LineStyle::Quads && geometry.tolerance * scale <= MAX_TOLERANCE_PX
     }
 
     /// Draws `geometry` into the G-buffer, clearing it first or over earlier passes (`load`),
@@ -561,13 +709,19 @@ impl LineRenderer {
             _ => &self.pipeline,
         });
         pass.set_bind_group(0, &self.bindings.group, &[]);
+        let alternates = self.alternates(geometry);
         for chunk in &geometry.chunks {
             pass.set_vertex_buffer(0, chunk.vertices.slice(..));
             if let (true, Some(buffer)) = (attributes, &chunk.attributes) {
                 pass.set_vertex_buffer(1, buffer.slice(..));
             }
             match (self.style, &chunk.segments) {
-                (LineStyle::Quads, _) => pass.draw(0..chunk.count, 0..1),
+                (LineStyle::Quads, _) if alternates => {
+                    let (indices, count) = &chunk.alternating;
+                    pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
+                    pass.draw_indexed(0..*count, 0, 0..1);
+                }
+                (LineStyle::Quads | LineStyle::FullStrip, _) => pass.draw(0..chunk.count, 0..1),
                 (LineStyle::Native1px, Some((indices, count))) => {
                     pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
                     pass.draw_indexed(0..*count, 0, 0..1);
@@ -575,5 +729,57 @@ impl LineRenderer {
                 (LineStyle::Native1px, None) => {}
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The strip vertices of `polylines`.
+    fn strip(polylines: &[&[[f32; 3]]]) -> Vec<LinePoint> {
+        let positions: Vec<[f32; 3]> = polylines.iter().flat_map(|line| line.iter().copied()).collect();
+        let mut offsets = vec![0u64];
+        for line in polylines {
+            offsets.push(offsets.last().unwrap() + line.len() as u64);
+        }
+        let mut vertices = Vec::new();
+        strip_vertices(&positions, &offsets, |v, _| vertices.push(v));
+        vertices
+    }
+
+    #[test]
+    fn a_straight_run_takes_one_side_per_point_by_turns() {
+        let line: Vec<[f32; 3]> = (0..5).map(|i| [i as f32, 0.0, 0.0]).collect();
+        // L0 R0 | L1 R2 L3 | R4 L4 (L_k = 2k, R_k = 2k + 1): one triangle per segment and one more.
+        assert_eq!(alternating_strip(&strip(&[&line]), 1e-3), [0, 1, 2, 5, 6, 9, 8]);
+    }
+
+    #[test]
+    fn bends_keep_both_sides_and_polylines_restart() {
+        // A right angle at point 2, then a second polyline: the join's two vertices (10 and 11)
+        // are skipped, and the runs are separate strips.
+        let bent = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [2.0, 1.0, 0.0], [2.0, 2.0, 0.0]];
+        let straight = [[0.0, 5.0, 0.0], [1.0, 5.0, 0.0], [2.0, 5.0, 0.0]];
+        let vertices = strip(&[&bent, &straight]);
+        assert_eq!(vertices.len(), 2 * 8 + 2);
+        let indices = alternating_strip(&vertices, 1e-3);
+        // The corner and its neighbours (their tangents turn 45°) keep both sides: the full strip.
+        assert_eq!(&indices[..11], [0, 1, 2, 3, 4, 5, 6, 7, 8, 9, RESTART]);
+        assert_eq!(&indices[11..], [12, 13, 14, 17, 16]);
+        // A gentle bend within the tolerance keeps one side.
+        let gentle = [[0.0, 0.0, 0.0], [1.0, 0.001, 0.0], [2.0, 0.0, 0.0]];
+        assert_eq!(alternating_strip(&strip(&[&gentle]), 1e-2), [0, 1, 2, 5, 4]);
+        assert_eq!(alternating_strip(&strip(&[&gentle]), 1e-4), [0, 1, 2, 3, 4, 5]);
+    }
+
+    #[test]
+    fn runs_split_at_non_finite_points_and_single_points_draw_nothing() {
+        let line = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [f32::NAN, 0.0, 0.0], [3.0, 0.0, 0.0], [4.0, 0.0, 0.0]];
+        let vertices = strip(&[&line]);
+        let indices = alternating_strip(&vertices, 1e-3);
+        assert_eq!(indices.iter().filter(|&&i| i == RESTART).count(), 1);
+        assert!(indices.iter().all(|&i| i == RESTART || (i as usize) < vertices.len()));
+        assert!(alternating_strip(&strip(&[&[[0.0; 3]]]), 1e-3).is_empty());
     }
 }
