@@ -21,8 +21,8 @@ struct GeometryUniform {
     color_mode: u32,
     // Tubes: the radius in world units where the geometry carries none.
     tube_radius: f32,
-    _pad0: u32,
-    _pad1: u32,
+    // 2 / viewport: NDC units per pixel.
+    ndc_per_px: vec2<f32>,
     // Color mode 2: xy the scalars at the colormap's ends; its table of linear RGB.
     scalar_range: vec4<f32>,
     colormap: array<vec4<f32>, 16>,

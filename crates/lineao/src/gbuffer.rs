@@ -29,7 +29,8 @@ pub struct GeometryUniform {
     pub orthographic: u32,
     pub color_mode: u32,
     pub tube_radius: f32,
-    pub _pad: [u32; 2],
+    /// NDC units per pixel: 2 / viewport (the lines' sideways offsets, without a division).
+    pub ndc_per_px: [f32; 2],
     /// [`LineColor::Scalar`]: the scalar range mapped to the colormap's ends, and its table.
     pub scalar_range: [f32; 4],
     pub colormap: [[f32; 4]; crate::settings::COLORMAP_ENTRIES],
@@ -61,7 +62,7 @@ impl GeometryUniform {
             orthographic: view.orthographic as u32,
             color_mode,
             tube_radius,
-            _pad: [0; 2],
+            ndc_per_px: [2.0 / w as f32, 2.0 / h as f32],
             scalar_range,
             colormap,
         }
