@@ -271,19 +271,25 @@ impl Rgb for [f32; 4] {
     }
 }
 
-#[test]
-fn chunked_buffers_render_identically() {
-    let gpu = gpu();
+/// `count` wavy streamlines of `points` points each across x = ±45.
+fn waves(count: usize, points: usize) -> (Vec<[f32; 3]>, Vec<u64>) {
     let mut positions = Vec::new();
     let mut offsets = vec![0u64];
-    for k in 0..40 {
+    for k in 0..count {
         let phase = k as f32 * 0.37;
-        positions.extend((0..30).map(|i| {
-            let s = i as f32 / 29.0;
+        positions.extend((0..points).map(|i| {
+            let s = i as f32 / (points - 1) as f32;
             [-45.0 + 90.0 * s, 30.0 * (phase + 4.0 * s).sin(), 20.0 * (phase * 2.0 + 3.0 * s).cos()]
         }));
         offsets.push(positions.len() as u64);
     }
+    (positions, offsets)
+}
+
+#[test]
+fn chunked_buffers_render_identically() {
+    let gpu = gpu();
+    let (positions, offsets) = waves(40, 30);
     let whole = LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap();
     // 97 × 20 bytes hold 96 strip vertices (chunks keep an even length): chunk borders fall
     // inside streamlines and between them.
@@ -461,16 +467,7 @@ fn cylinder_averaged_lighting_matches_quadrature() {
 /// Dense smooth streamlines (the case the alternating strip is for: 1 000 points each) and
 /// coarse ones with sharp corners, crossing, in front of the perspective camera.
 fn dense_and_coarse() -> (Vec<[f32; 3]>, Vec<u64>) {
-    let mut positions = Vec::new();
-    let mut offsets = vec![0u64];
-    for k in 0..60 {
-        let phase = k as f32 * 0.37;
-        positions.extend((0..1000).map(|i| {
-            let s = i as f32 / 999.0;
-            [-45.0 + 90.0 * s, 30.0 * (phase + 4.0 * s).sin(), 20.0 * (phase * 2.0 + 3.0 * s).cos()]
-        }));
-        offsets.push(positions.len() as u64);
-    }
+    let (mut positions, mut offsets) = waves(60, 1000);
     for k in 0..6 {
         let y = -30.0 + 12.0 * k as f32;
         positions.extend((0..9).map(|i| [-40.0 + 10.0 * i as f32, y + 8.0 * (i % 2) as f32, 10.0 - 3.0 * k as f32]));
@@ -504,8 +501,20 @@ fn the_alternating_strip_stays_within_half_a_pixel_of_the_full_strip() {
     let (positions, offsets) = dense_and_coarse();
     let geometry = LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap();
     let (full, _) = draw(&gpu, &geometry, LineStyle::FullStrip, &perspective());
-    let (alternating, alternated) = draw(&gpu, &geometry, LineStyle::Quads, &perspective());
-    assert!(alternated, "this view is far enough for the alternating strip");
+    // Also split into 15 buffers: each chunk's alternating strip keeps both sides at its borders.
+    let options = GeometryOptions { chunk_bytes: 8192 * 20, ..Default::default() };
+    let chunked = LineGeometry::with_options(&gpu.device, &gpu.queue, &positions, &offsets, options).unwrap();
+    assert_eq!(chunked.chunk_count(), 15);
+    for geometry in [&geometry, &chunked] {
+        let (alternating, alternated) = draw(&gpu, geometry, LineStyle::Quads, &perspective());
+        assert!(alternated, "this view is far enough for the alternating strip");
+        within_a_pixel(&full, &alternating);
+    }
+}
+
+/// Checks that `alternating` covers what `full` does but for edges moved by less than a pixel,
+/// at the same depth.
+fn within_a_pixel(full: &lineao::reference::NdImage, alternating: &lineao::reference::NdImage) {
     let covered = |image: &lineao::reference::NdImage, x: usize, y: usize| is_geometry(image.get(x, y));
     let near = |image: &lineao::reference::NdImage, x: usize, y: usize| {
         (x.saturating_sub(1)..(x + 2).min(SIZE.0 as usize))
@@ -514,18 +523,18 @@ fn the_alternating_strip_stays_within_half_a_pixel_of_the_full_strip() {
     let (mut both, mut moved, mut far, mut same_depth) = (0, 0, 0, 0);
     for y in 0..SIZE.1 as usize {
         for x in 0..SIZE.0 as usize {
-            match (covered(&full, x, y), covered(&alternating, x, y)) {
+            match (covered(full, x, y), covered(alternating, x, y)) {
                 (true, true) => {
                     both += 1;
                     same_depth += ((full.get(x, y)[3] - alternating.get(x, y)[3]).abs() < 1e-3) as usize;
                 }
                 (true, false) => {
                     moved += 1;
-                    far += !near(&alternating, x, y) as usize;
+                    far += !near(alternating, x, y) as usize;
                 }
                 (false, true) => {
                     moved += 1;
-                    far += !near(&full, x, y) as usize;
+                    far += !near(full, x, y) as usize;
                 }
                 (false, false) => {}
             }
