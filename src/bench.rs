@@ -6,6 +6,8 @@
 //! run give the ratios the numbers are judged by:
 //!
 //! - `lines-native-1px`: the same segments as the rasterizer's native 1-px `LineList`;
+//! - `lines-full-strip`: the same lines always from the full strip (both sides of every point),
+//!   against which `lines` shows what its alternating strip saves;
 //! - `lineao-tap-floor`: the LineAO shader with the same sample addresses that only sums the
 //!   fetched depths ([`Evaluation::TapFloor`]);
 //! - `lineao-chain`: pyramid + LineAO in one span (what a frame pays for the occlusion);
@@ -57,9 +59,10 @@ use serde_json::json;
 use crate::cli::BenchArgs;
 
 /// The GPU passes of one run, in CONTRACT.md's order.
-pub const GPU_PASSES: [&str; 16] = [
+pub const GPU_PASSES: [&str; 17] = [
     "lines",
     "lines-native-1px",
+    "lines-full-strip",
     "nd-pyramid",
     "lineao",
     "lineao-tap-floor",
@@ -91,6 +94,7 @@ pub fn is_pass(name: &str) -> bool {
 struct Passes {
     lines: LineRenderer,
     lines_native: LineRenderer,
+    lines_full: LineRenderer,
     pyramid: NdPyramid,
     line_ao: LineAo,
     tap_floor: LineAo,
@@ -121,6 +125,7 @@ impl Passes {
         let mut passes = Passes {
             lines: LineRenderer::new(device),
             lines_native: LineRenderer::with_style(device, LineStyle::Native1px),
+            lines_full: LineRenderer::with_style(device, LineStyle::FullStrip),
             pyramid: NdPyramid::new(device),
             line_ao: LineAo::new(device, &settings.line_ao, &settings.lighting),
             tap_floor: LineAo::with_evaluation(device, &settings.line_ao, &settings.lighting, Evaluation::TapFloor),
@@ -139,7 +144,7 @@ impl Passes {
             queue: queue.clone(),
             output: Target::output(device, "lineao::bench::output", (view.width, view.height), format),
         };
-        for renderer in [&passes.lines, &passes.lines_native] {
+        for renderer in [&passes.lines, &passes.lines_native, &passes.lines_full] {
             renderer.prepare(queue, view, settings.line_width_px, settings.line_color, &settings.lighting);
         }
         passes.tubes.prepare(queue, view, TUBE_RADIUS * view.zoom_unit, settings.line_color, &settings.lighting);
@@ -194,6 +199,7 @@ impl Passes {
         match name {
             "lines" => self.lines.encode(encoder, targets, geometry, Load::Clear(background), span),
             "lines-native-1px" => self.lines_native.encode(encoder, targets, geometry, Load::Clear(background), span),
+            "lines-full-strip" => self.lines_full.encode(encoder, targets, geometry, Load::Clear(background), span),
             "nd-pyramid" => self.pyramid.encode(encoder, targets, span),
             "lineao" => self.line_ao.encode(encoder, targets, span),
             "lineao-tap-floor" => self.tap_floor.encode(encoder, targets, span),
@@ -258,8 +264,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let timer = if args.no_timestamps { None } else { PassTimer::new(device, queue, &GPU_PASSES) };
 
     let mut times: Vec<Vec<f64>> = vec![Vec::new(); GPU_PASSES.len()];
-    // Quads last among the line passes, so the G-buffer the later passes read is the chain's.
-    let order = std::iter::once("lines-native-1px").chain(GPU_PASSES.into_iter().filter(|p| *p != "lines-native-1px"));
+    // `lines` last among the line passes, so the G-buffer the later passes read is the chain's.
+    let first = ["lines-native-1px", "lines-full-strip"];
+    let order = first.into_iter().chain(GPU_PASSES.into_iter().filter(|p| !first.contains(p)));
     // The G-buffer and pyramid every later pass reads, also when `--passes` leaves them out.
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::bench") });
     passes.encode("lines", &mut encoder, targets, &geometry, settings.background, None);
@@ -401,6 +408,7 @@ fn print_table(report: &serde_json::Value, passes: &[serde_json::Value]) {
     for (a, b) in [
         ("lineao", "lineao-tap-floor"),
         ("lines", "lines-native-1px"),
+        ("lines-full-strip", "lines-native-1px"),
         ("lineao-chain", "ssao-16-chain"),
         ("lineao-level", "lineao"),
         ("lineao-chain-level", "ssao-16-chain"),

@@ -264,6 +264,7 @@ fn bench_json_is_the_contract() {
         [
             "lines",
             "lines-native-1px",
+            "lines-full-strip",
             "nd-pyramid",
             "lineao",
             "lineao-tap-floor",
