@@ -4,7 +4,8 @@
 // Every point comes twice (left, right; the sign of tangent.w); the vertex shader pushes it half
 // a line width sideways, perpendicular to the screen direction of its *vertex* tangent, so
 // consecutive segments share their join corners exactly: joins without gaps or overlaps.
-// `lineao::passes::lines` builds the strip.
+// `lineao::passes::lines` builds the strip, and the alternating index strip over it that takes
+// one side per point where that stays within half a pixel (the same shaders draw both).
 #import shared/geometry.wgsl
 
 struct StripVertex {
