@@ -419,9 +419,14 @@ fn native_segments(device: &wgpu::Device, queue: &wgpu::Queue, vertices: &[LineP
     };
     let indices: Vec<u32> =
         (0..vertices.len().saturating_sub(2)).filter(|&i| starts(i)).flat_map(|i| [i as u32, i as u32 + 2]).collect();
-    let contents = if indices.is_empty() { &[0u32, 0][..] } else { &indices };
-    let buffer = upload_buffer(device, queue, "lineao::LineGeometry::segments", wgpu::BufferUsages::INDEX, contents);
-    (buffer, indices.len() as u32)
+    index_buffer(device, queue, "lineao::LineGeometry::segments", &indices)
+}
+
+/// An index buffer of `indices` (one unused index when there are none: buffers are never
+/// empty) and their count.
+fn index_buffer(device: &wgpu::Device, queue: &wgpu::Queue, label: &str, indices: &[u32]) -> (wgpu::Buffer, u32) {
+    let contents = if indices.is_empty() { &[0][..] } else { indices };
+    (upload_buffer(device, queue, label, wgpu::BufferUsages::INDEX, contents), indices.len() as u32)
 }
 
 /// τ over the bounding radius: a view that shows the whole bounding sphere across 2 000 px
@@ -447,9 +452,10 @@ pub(crate) fn alternating_strip(vertices: &[LinePoint], tolerance: f32) -> Vec<u
     let is_point = |k: usize| vertices[2 * k].side_and_flags().0 > 0;
     let continues = |k: usize| vertices[2 * k].side_and_flags().1 & VertexFlags::SEGMENT != 0;
     let position = |k: usize| Vec3::from_array(vertices[2 * k].position);
+    // Unit tangents as snorm16 (their rounding, 3e-5, is far below the turn's threshold).
     let tangent = |k: usize| {
         let [x, y, z, _] = vertices[2 * k].tangent;
-        Vec3::new(x as f32, y as f32, z as f32).normalize_or_zero()
+        Vec3::new(x as f32, y as f32, z as f32) / 32767.0
     };
     let bends = |k: usize| {
         let (a, p, b) = (position(k - 1), position(k), position(k + 1));
@@ -506,10 +512,7 @@ fn alternating_buffer(
     vertices: &[LinePoint],
     tolerance: f32,
 ) -> (wgpu::Buffer, u32) {
-    let indices = alternating_strip(vertices, tolerance);
-    let contents = if indices.is_empty() { &[RESTART][..] } else { &indices };
-    let buffer = upload_buffer(device, queue, "lineao::LineGeometry::alternating", wgpu::BufferUsages::INDEX, contents);
-    (buffer, indices.len() as u32)
+    index_buffer(device, queue, "lineao::LineGeometry::alternating", &alternating_strip(vertices, tolerance))
 }
 
 /// The most pixels one world unit can cover in `view` (at the near end of its depth range,
