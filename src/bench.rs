@@ -34,7 +34,7 @@
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use lineao::camera::FrameView;
+use lineao::camera::{FrameView, Projection};
 use lineao::gbuffer::Load;
 use lineao::passes::bilateral::Bilateral;
 use lineao::passes::composite::Composite;
@@ -247,7 +247,11 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         zoom_unit: scene.view.zoom_unit,
         ..ChainSettings::default()
     };
-    let camera = crate::render::camera_from_hint(&scene.view);
+    let mut camera = crate::render::camera_from_hint(&scene.view);
+    if let Some(fov_y_deg) = args.fov {
+        camera.projection = Projection::Perspective { fov_y_deg };
+    }
+    crate::render::validate_camera(&camera)?;
     let gpu = Gpu::headless()?;
     let (device, queue) = (&gpu.device, &gpu.queue);
     let options = GeometryOptions { native_lines: true, ..Default::default() };

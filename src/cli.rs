@@ -118,6 +118,11 @@ pub struct BenchArgs {
     /// Untimed frames first (pipeline compilation, caches).
     #[arg(long, default_value_t = 3)]
     pub warmup: u32,
+    /// Vertical field of view in degrees [default: the scene's]. A narrower one fills more of
+    /// the frame with lines (on lavapipe the screen-space passes cost more per pixel with lines
+    /// than per background pixel).
+    #[arg(long)]
+    pub fov: Option<f32>,
     /// Disable LineAO's light attenuation (g_light = 1).
     #[arg(long)]
     pub no_light_attenuation: bool,

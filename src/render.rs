@@ -429,7 +429,7 @@ pub fn camera_from_hint(hint: &ViewHint) -> Camera {
     }
 }
 
-fn validate_camera(camera: &Camera) -> Result<()> {
+pub(crate) fn validate_camera(camera: &Camera) -> Result<()> {
     let forward = camera.target - camera.eye;
     anyhow::ensure!(forward.length() > 0.0, "the camera's eye and target coincide");
     anyhow::ensure!(

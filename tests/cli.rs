@@ -293,6 +293,9 @@ fn bench_json_is_the_contract() {
     }
     assert_eq!(lineao(&["bench", "--frames", "0"]).status.code(), Some(2));
     assert_eq!(lineao(&["bench", "--passes", "lines,warp-drive"]).status.code(), Some(2));
+    let out = lineao(&["bench", "--fov", "180", "--passes", "lines"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr(&out).contains("--fov must be in (0, 180) degrees, got 180"), "{}", stderr(&out));
 
     // The CPU fallback (adapters without timestamp queries), on a subset of the passes.
     let report = bench_report(&[
@@ -307,6 +310,8 @@ fn bench_json_is_the_contract() {
         "0",
         "--passes",
         "lines,lineao",
+        "--fov",
+        "15",
     ]);
     assert_eq!(report["timestamps"], false);
     let passes = report["passes"].as_array().unwrap();
