@@ -210,7 +210,7 @@ impl AoChain {
             (AoMethod::Ssao, _) => &["ssao", "ssao-blur"],
             (AoMethod::VoLine, _) => &["vo-line"],
             (AoMethod::VoArea, _) => &["moments", "vo-area"],
-            (AoMethod::None, _) => &[],
+            (AoMethod::None | AoMethod::RayTraced, _) => &[],
         };
         let blur: &[&str] =
             if self.settings.blur.is_some() && self.settings.method != AoMethod::None { &["blur"] } else { &[] };
@@ -256,7 +256,8 @@ impl AoChain {
     pub fn guard_for(&self, camera: &Camera, bounds: &Bounds) -> u32 {
         let s = &self.settings;
         match (s.method, s.line_ao.variant) {
-            (AoMethod::None, _) => 0,
+            // The ray-traced truth reads no neighbours on screen.
+            (AoMethod::None | AoMethod::RayTraced, _) => 0,
             // The sphere's radius in pixels where it is largest (at the near plane), plus the
             // blur's 2 px.
             // The bilateral blur reaches its radius further.
@@ -362,7 +363,7 @@ impl AoChain {
             AoMethod::Ssao => self.ssao.prepare(queue, targets, &view, &s.ssao),
             AoMethod::VoLine => self.vo_line.prepare(queue, targets, &view, &s.vo),
             AoMethod::VoArea => self.vo_area.prepare(queue, targets, &view, &s.vo),
-            AoMethod::None => {}
+            AoMethod::None | AoMethod::RayTraced => {}
         }
         if let Some(blur) = &s.blur {
             self.bilateral.prepare(queue, &view, blur);
@@ -474,6 +475,16 @@ impl AoChain {
         encoder.pop_debug_group();
     }
 
+    /// Records only the composite of the last prepared frame over the targets as they are: for a
+    /// caller that wrote its own occlusion into `targets().ao` after the frame's G-buffer was
+    /// rendered ([`AoMethod::RayTraced`]: the ray-traced truth). Does nothing before the first
+    /// `prepare` with a non-zero size.
+    pub fn encode_composite(&self, encoder: &mut wgpu::CommandEncoder, target: &wgpu::TextureView) {
+        if self.targets.is_some() && self.view.is_some() {
+            self.composite.encode(encoder, target, None);
+        }
+    }
+
     /// The method, its blur and object-space AO over a G-buffer already written.
     fn encode_method<'s>(
         &'s self,
@@ -494,7 +505,8 @@ impl AoChain {
             }
             AoMethod::VoLine => self.vo_line.encode(encoder, targets, span("vo-line")),
             AoMethod::VoArea => self.vo_area.encode(encoder, targets, span("moments"), span("vo-area")),
-            AoMethod::None => {}
+            // The caller writes `ao` (see `encode_composite`).
+            AoMethod::None | AoMethod::RayTraced => {}
         }
         if self.settings.blur.is_some() && self.settings.method != AoMethod::None {
             self.bilateral.encode(encoder, targets, span("blur"));

@@ -16,6 +16,9 @@
 //!   Obscurance) — the [`Bilateral`](passes::bilateral::Bilateral) blur and the
 //!   [`Composite`](passes::composite::Composite), each usable alone.
 //! - [`mod@reference`]: the CPU reference of each pass.
+//! - [`truth`]: the ground truth — ambient occlusion ray traced on the geometry the frame shows
+//!   (a BVH over rounded cones and triangles), and the [`truth::metrics`] that score a method
+//!   against it.
 //!
 //! The G-buffer contract (the ND map, the zoom map, normalized depth) is in [`targets`] and
 //! [`camera`]; CONTRACT.md in the repository is the full specification.
@@ -54,6 +57,7 @@ pub mod settings;
 pub mod shader;
 pub mod targets;
 pub mod timing;
+pub mod truth;
 pub mod verify;
 pub mod volume;
 
@@ -84,4 +88,6 @@ pub enum Error {
     Gpu(String),
     #[error("the GPU cannot run lineao: {0}")]
     Unsupported(String),
+    #[error("stopped before it finished")]
+    Cancelled,
 }

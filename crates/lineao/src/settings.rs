@@ -16,6 +16,10 @@ pub enum AoMethod {
     VoLine,
     /// Volumetric Obscurance with area samples over a pyramid of depth moments (§4.2).
     VoArea,
+    /// Ray-traced AO, the ground truth ([`crate::truth`]): computed outside the chain from its
+    /// G-buffer and written into `targets().ao` before [`crate::AoChain::encode_composite`]. The
+    /// chain itself runs no method pass and needs no guard band.
+    RayTraced,
 }
 
 impl AoMethod {
@@ -27,16 +31,18 @@ impl AoMethod {
             AoMethod::Ssao => "ssao",
             AoMethod::VoLine => "vo-line",
             AoMethod::VoArea => "vo-area",
+            AoMethod::RayTraced => "raytraced",
         }
     }
 
-    /// Every method, in the order `--grid` shows them.
+    /// Every screen-space method, in the order `--grid` shows them (not the ray-traced truth,
+    /// which is computed outside the chain).
     pub const ALL: [AoMethod; 5] =
         [AoMethod::None, AoMethod::LineAo, AoMethod::VoLine, AoMethod::VoArea, AoMethod::Ssao];
 
-    /// The method called `name` (`none`, `lineao`, `ssao`, `vo-line`, `vo-area`).
+    /// The method called `name` (`none`, `lineao`, `ssao`, `vo-line`, `vo-area`, `raytraced`).
     pub fn from_name(name: &str) -> Option<AoMethod> {
-        AoMethod::ALL.into_iter().find(|m| m.name() == name)
+        AoMethod::ALL.into_iter().chain([AoMethod::RayTraced]).find(|m| m.name() == name)
     }
 }
 

@@ -1,0 +1,228 @@
+//! How far an AO map is from the truth, over the pixels of a mask (the visible geometry).
+//!
+//! Per map: the bias (mean of method − truth), mean |Δ|, RMSE, Pearson's correlation and SSIM;
+//! and the best single scale s, the least-squares fit of s · ao to the truth
+//! (s = Σ a t / Σ a²), with bias, mean |Δ|, RMSE and SSIM again for s · ao — so a method that is
+//! only too strong (a good correlation, s < 1) is told apart from one that is wrong (a poor
+//! correlation whatever s).
+//!
+//! **SSIM** as Wang, Bovik, Sheikh and Simoncelli (IEEE TIP 2004) define it: an 11 × 11 Gaussian
+//! window of σ = 1.5 (truncated at 3.5 σ), C1 = (0.01 L)², C2 = (0.03 L)² with L = 1, population
+//! (not sample) variances; the map is computed on the whole image, reflecting at its borders,
+//! and averaged over the mask. On the interior of an image this is what scikit-image's
+//! `structural_similarity(a, b, gaussian_weights=True, sigma=1.5, use_sample_covariance=False,
+//! data_range=1)` computes; the tests check numbers from it.
+
+use crate::reference::Image;
+
+/// Half the SSIM window's side: ⌊3.5 σ + 0.5⌋ for σ = 1.5.
+pub const SSIM_RADIUS: usize = 5;
+pub const SSIM_SIGMA: f64 = 1.5;
+pub const SSIM_C1: f64 = 0.01 * 0.01;
+pub const SSIM_C2: f64 = 0.03 * 0.03;
+
+/// The error measures of one map.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Errors {
+    pub bias: f64,
+    pub mean_abs: f64,
+    pub rmse: f64,
+    pub ssim: f64,
+}
+
+/// A method's AO against the truth.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Scores {
+    /// Pixels compared.
+    pub pixels: usize,
+    pub mean_method: f64,
+    pub mean_truth: f64,
+    /// Pearson's correlation (0 when either map is constant).
+    pub correlation: f64,
+    /// The map as it is.
+    pub raw: Errors,
+    /// The best single scale s, and the errors of s · ao.
+    pub scale: f64,
+    pub scaled: Errors,
+}
+
+/// Scores `method` against `truth` (same size) over the pixels where `mask` holds.
+pub fn score(method: &Image<f32>, truth: &Image<f32>, mask: &[bool]) -> Scores {
+    assert_eq!((method.width, method.height), (truth.width, truth.height), "maps of different sizes");
+    assert_eq!(mask.len(), truth.data.len(), "a mask of another size");
+    let pairs =
+        || method.data.iter().zip(&truth.data).zip(mask).filter(|(_, m)| **m).map(|((&a, &t), _)| (a as f64, t as f64));
+    let pixels = pairs().count();
+    if pixels == 0 {
+        return Scores::default();
+    }
+    let n = pixels as f64;
+    let (sa, st) = pairs().fold((0.0, 0.0), |(sa, st), (a, t)| (sa + a, st + t));
+    let (ma, mt) = (sa / n, st / n);
+    let (mut saa, mut stt, mut sat, mut raw_at, mut raw_aa) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    for (a, t) in pairs() {
+        saa += (a - ma) * (a - ma);
+        stt += (t - mt) * (t - mt);
+        sat += (a - ma) * (t - mt);
+        raw_at += a * t;
+        raw_aa += a * a;
+    }
+    let correlation = if saa > 0.0 && stt > 0.0 { sat / (saa * stt).sqrt() } else { 0.0 };
+    let scale = if raw_aa > 0.0 { raw_at / raw_aa } else { 0.0 };
+    let errors = |s: f64| {
+        let (mut bias, mut abs, mut sq) = (0.0, 0.0, 0.0);
+        for (a, t) in pairs() {
+            let d = s * a - t;
+            bias += d;
+            abs += d.abs();
+            sq += d * d;
+        }
+        let scaled = Image {
+            width: method.width,
+            height: method.height,
+            data: method.data.iter().map(|&a| (s * a as f64) as f32).collect(),
+        };
+        Errors { bias: bias / n, mean_abs: abs / n, rmse: (sq / n).sqrt(), ssim: mean_ssim(&scaled, truth, mask) }
+    };
+    Scores { pixels, mean_method: ma, mean_truth: mt, correlation, raw: errors(1.0), scale, scaled: errors(scale) }
+}
+
+/// The SSIM map of `a` against `b` (module doc).
+pub fn ssim_map(a: &Image<f32>, b: &Image<f32>) -> Image<f32> {
+    let (w, h) = (a.width, a.height);
+    let weights: Vec<f64> = {
+        let raw: Vec<f64> = (0..=2 * SSIM_RADIUS)
+            .map(|i| {
+                let x = i as f64 - SSIM_RADIUS as f64;
+                (-x * x / (2.0 * SSIM_SIGMA * SSIM_SIGMA)).exp()
+            })
+            .collect();
+        let sum: f64 = raw.iter().sum();
+        raw.iter().map(|v| v / sum).collect()
+    };
+    // scipy's `reflect`: d c b a | a b c d.
+    let reflect = |i: i64, n: usize| -> usize {
+        let n = n as i64;
+        let mut i = i;
+        loop {
+            if i < 0 {
+                i = -i - 1;
+            } else if i >= n {
+                i = 2 * n - i - 1;
+            } else {
+                return i as usize;
+            }
+        }
+    };
+    let blur = |f: &dyn Fn(usize) -> f64| -> Vec<f64> {
+        let mut rows = vec![0.0; w * h];
+        for y in 0..h {
+            for x in 0..w {
+                let mut s = 0.0;
+                for (k, wk) in weights.iter().enumerate() {
+                    s += wk * f(y * w + reflect(x as i64 + k as i64 - SSIM_RADIUS as i64, w));
+                }
+                rows[y * w + x] = s;
+            }
+        }
+        let mut out = vec![0.0; w * h];
+        for y in 0..h {
+            for x in 0..w {
+                let mut s = 0.0;
+                for (k, wk) in weights.iter().enumerate() {
+                    s += wk * rows[reflect(y as i64 + k as i64 - SSIM_RADIUS as i64, h) * w + x];
+                }
+                out[y * w + x] = s;
+            }
+        }
+        out
+    };
+    let (av, bv) = (&a.data, &b.data);
+    let ua = blur(&|i| av[i] as f64);
+    let ub = blur(&|i| bv[i] as f64);
+    let uaa = blur(&|i| (av[i] as f64).powi(2));
+    let ubb = blur(&|i| (bv[i] as f64).powi(2));
+    let uab = blur(&|i| av[i] as f64 * bv[i] as f64);
+    let data = (0..w * h)
+        .map(|i| {
+            let (va, vb, vab) = (uaa[i] - ua[i] * ua[i], ubb[i] - ub[i] * ub[i], uab[i] - ua[i] * ub[i]);
+            (((2.0 * ua[i] * ub[i] + SSIM_C1) * (2.0 * vab + SSIM_C2))
+                / ((ua[i] * ua[i] + ub[i] * ub[i] + SSIM_C1) * (va + vb + SSIM_C2))) as f32
+        })
+        .collect();
+    Image { width: w, height: h, data }
+}
+
+/// The mean SSIM over the mask's pixels (1 for identical maps).
+pub fn mean_ssim(a: &Image<f32>, b: &Image<f32>, mask: &[bool]) -> f64 {
+    let map = ssim_map(a, b);
+    let (sum, count) =
+        map.data.iter().zip(mask).filter(|(_, m)| **m).fold((0.0, 0usize), |(s, c), (&v, _)| (s + v as f64, c + 1));
+    if count == 0 { 0.0 } else { sum / count as f64 }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn image(w: usize, h: usize, f: impl Fn(usize, usize) -> f32) -> Image<f32> {
+        Image::from_fn(w, h, f)
+    }
+
+    #[test]
+    fn identical_maps_score_perfectly() {
+        let a = image(40, 30, |x, y| ((x * 7 + y * 3) % 11) as f32 / 11.0);
+        let mask = vec![true; 1200];
+        let s = score(&a, &a, &mask);
+        assert_eq!(s.raw.rmse, 0.0);
+        assert_eq!(s.raw.bias, 0.0);
+        assert!((s.raw.ssim - 1.0).abs() < 1e-9);
+        assert!((s.correlation - 1.0).abs() < 1e-12);
+        assert!((s.scale - 1.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_known_scale_and_offset_are_recovered() {
+        let truth = image(32, 32, |x, y| 0.1 + 0.8 * ((x + 2 * y) % 17) as f32 / 17.0);
+        let mask: Vec<bool> = (0..32 * 32).map(|i| i % 3 != 0).collect();
+        // Twice the truth: s = 1/2 exactly, and after it no error.
+        let doubled = Image { data: truth.data.iter().map(|t| 2.0 * t).collect(), ..truth.clone() };
+        let s = score(&doubled, &truth, &mask);
+        assert!((s.scale - 0.5).abs() < 1e-7, "{}", s.scale);
+        assert!(s.scaled.rmse < 1e-7 && s.scaled.bias.abs() < 1e-7);
+        assert!((s.raw.bias - s.mean_truth).abs() < 1e-6, "bias {} = the truth's mean", s.raw.bias);
+        // An offset: the bias and RMSE are the offset.
+        let shifted = Image { data: truth.data.iter().map(|t| t + 0.125).collect(), ..truth.clone() };
+        let s = score(&shifted, &truth, &mask);
+        assert!((s.raw.bias - 0.125).abs() < 1e-6 && (s.raw.rmse - 0.125).abs() < 1e-6);
+        assert!((s.raw.mean_abs - 0.125).abs() < 1e-6);
+        assert!((s.correlation - 1.0).abs() < 1e-9);
+        // Negated around the mean: correlation −1.
+        let flipped = Image { data: truth.data.iter().map(|t| 1.0 - t).collect(), ..truth.clone() };
+        assert!((score(&flipped, &truth, &mask).correlation + 1.0).abs() < 1e-9);
+    }
+
+    /// A fixed pair of 24 × 20 images scored by scikit-image 0.26.0
+    /// (`structural_similarity(a, b, gaussian_weights=True, sigma=1.5,
+    /// use_sample_covariance=False, data_range=1.0)`, whose mean leaves out 5 pixels at each
+    /// border), with a and b made as below in numpy (float64 of these f32 values).
+    #[test]
+    fn ssim_equals_an_independent_implementation() {
+        let (w, h) = (24, 20);
+        let a = image(w, h, |x, y| (((x * 13 + y * 7) % 23) as f32 / 22.0) * 0.7 + 0.1 * (y as f32 / 19.0));
+        let b = image(w, h, |x, y| {
+            let v = a.get(x, y) * 0.8 + 0.15 * (((x * 5 + y * 11) % 9) as f32 / 8.0);
+            v.min(1.0)
+        });
+        let interior: Vec<bool> = (0..w * h)
+            .map(|i| {
+                let (x, y) = (i % w, i / w);
+                (5..w - 5).contains(&x) && (5..h - 5).contains(&y)
+            })
+            .collect();
+        let ssim = mean_ssim(&a, &b, &interior);
+        assert!((ssim - SKIMAGE_SSIM).abs() < 1e-5, "ours {ssim}, scikit-image {SKIMAGE_SSIM}");
+    }
+
+    const SKIMAGE_SSIM: f64 = 0.946_633_248_898_704_7;
+}
