@@ -26,6 +26,76 @@ pub enum Command {
     Bench(BenchArgs),
     /// Open a window: orbit a tractogram and compare LineAO with the other methods side by side.
     View(ViewArgs),
+    /// Score AO methods against the ray-traced truth on one G-buffer (table, --json, -o grid).
+    Score(Box<ScoreArgs>),
+}
+
+#[derive(Args, Debug)]
+pub struct ScoreArgs {
+    /// The frame to score on: a file or --scene, the camera, the geometry and every method
+    /// setting as for `render`; -o writes a labelled grid (per method its AO, the truth, the
+    /// signed error).
+    #[command(flatten)]
+    pub render: RenderArgs,
+    /// Methods to score, comma-separated (`lineao`, `lineao-reference`, `vo-line`, `vo-area`,
+    /// `ssao`, `raytraced` = the truth again with another --ray-seed) [default: all of them].
+    #[arg(long, value_delimiter = ',', value_parser = parse_score_method)]
+    pub methods: Vec<ScoreMethod>,
+    /// Print JSON (CONTRACT.md `lineao score --json`) instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// A method `score` compares with the truth.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ScoreMethod {
+    pub method: lineao::AoMethod,
+    pub variant: lineao::LineAoVariant,
+}
+
+impl ScoreMethod {
+    pub const ALL: [ScoreMethod; 6] = [
+        ScoreMethod::paper(lineao::AoMethod::LineAo),
+        ScoreMethod { method: lineao::AoMethod::LineAo, variant: lineao::LineAoVariant::Reference },
+        ScoreMethod::paper(lineao::AoMethod::VoLine),
+        ScoreMethod::paper(lineao::AoMethod::VoArea),
+        ScoreMethod::paper(lineao::AoMethod::Ssao),
+        ScoreMethod::paper(lineao::AoMethod::RayTraced),
+    ];
+
+    const fn paper(method: lineao::AoMethod) -> ScoreMethod {
+        ScoreMethod { method, variant: lineao::LineAoVariant::Paper }
+    }
+
+    pub fn name(&self) -> &'static str {
+        match (self.method, self.variant) {
+            (lineao::AoMethod::LineAo, lineao::LineAoVariant::Reference) => "lineao-reference",
+            (method, _) => method.name(),
+        }
+    }
+}
+
+fn parse_score_method(s: &str) -> Result<ScoreMethod, String> {
+    ScoreMethod::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| {
+        let names: Vec<_> = ScoreMethod::ALL.iter().map(|m| m.name()).collect();
+        format!("unknown method '{s}' (one of {})", names.join(", "))
+    })
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum FalloffArg {
+    /// Binary AO: the fraction of rays that hit within the distance.
+    None,
+    /// Obscurance: the mean of 1 − t/R over hits.
+    Linear,
+}
+
+fn parse_distance(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        Ok(v) => Err(format!("must be positive and finite, got {v}")),
+        Err(e) => Err(format!("'{s}': {e}")),
+    }
 }
 
 #[derive(Args, Debug)]
@@ -316,7 +386,7 @@ pub struct ConvertArgs {
     pub output: PathBuf,
 }
 
-#[derive(Args, Debug)]
+#[derive(Args, Clone, Debug)]
 pub struct RenderArgs {
     /// Tractography file to render (any format `lineao info` reads) instead of a built-in scene.
     pub file: Option<PathBuf>,
@@ -351,9 +421,9 @@ pub struct RenderArgs {
     /// level's resolution, upsampled depth-aware (`level`: faster).
     #[arg(long, value_enum, default_value_t = Outer::Full)]
     pub outer: Outer,
-    /// Output PNG.
-    #[arg(short, long, default_value = "lineao.png")]
-    pub output: PathBuf,
+    /// Output PNG [default: lineao.png; `score`: no grid].
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
     #[arg(long, default_value_t = 1280, value_parser = clap::value_parser!(u32).range(1..=8192))]
     pub width: u32,
     #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=8192))]
@@ -498,6 +568,20 @@ pub struct RenderArgs {
     /// darker of the two (`min`).
     #[arg(long, value_enum, default_value_t = Combine::Product)]
     pub volume_combine: Combine,
+    /// Ray-traced AO (`--method raytraced`, `score`): rays per geometry pixel. 256 is LineVis's
+    /// reference count: a standard error of at most 0.03 per pixel.
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
+    pub rays: u32,
+    /// Ray-traced AO: how far a ray looks, world units. 2 is the reach VO and SSAO sample by
+    /// default and that of LineAO's widest hemisphere (r0 + 2 z(P) px).
+    #[arg(long, default_value_t = 2.0, value_parser = parse_distance)]
+    pub ao_distance: f32,
+    /// Ray-traced AO: binary (`none`) or obscurance with a linear falloff (`linear`).
+    #[arg(long, value_enum, default_value_t = FalloffArg::None)]
+    pub ao_falloff: FalloffArg,
+    /// Ray-traced AO: seed of the per-pixel scrambled ray sequence.
+    #[arg(long, default_value_t = 1)]
+    pub ray_seed: u32,
     /// Write the method's inputs and output as .npy files and params.json into this folder.
     #[arg(long)]
     pub dump: Option<PathBuf>,

@@ -241,3 +241,28 @@ pub fn write(
     std::fs::write(&path, text + "\n").with_context(|| format!("cannot write {}", path.display()))?;
     Ok(())
 }
+
+/// The ray-traced truth's part of a dump (method `raytraced`; `ao.npy` holds its AO already):
+/// `ao_stderr.npy` and the `params.json` keys `rays`, `ao_distance_world`, `ao_falloff`,
+/// `ray_seed`, and our `buried_share` and `ray_epsilon_world`.
+pub fn write_truth(dir: &Path, truth: &lineao::truth::Truth, settings: &lineao::truth::TruthSettings) -> Result<()> {
+    let (w, h) = (truth.stderr.width as u64, truth.stderr.height as u64);
+    write_npy(dir, "ao_stderr.npy", &[h, w], &truth.stderr.data)?;
+    let path = dir.join("params.json");
+    let text = std::fs::read_to_string(&path).with_context(|| format!("cannot read {}", path.display()))?;
+    let mut params: serde_json::Value = serde_json::from_str(&text)?;
+    merge(
+        &mut params,
+        json!({
+            "rays": settings.rays,
+            "ao_distance_world": settings.distance_world,
+            "ao_falloff": settings.falloff.name(),
+            "ray_seed": settings.seed,
+            "ray_epsilon_world": lineao::truth::EPSILON_PER_DISTANCE * settings.distance_world as f64,
+            "buried_share": truth.buried_share(),
+        }),
+    );
+    let text = serde_json::to_string_pretty(&params)?;
+    std::fs::write(&path, text + "\n").with_context(|| format!("cannot write {}", path.display()))?;
+    Ok(())
+}

@@ -11,6 +11,8 @@ mod info;
 mod label;
 mod output;
 mod render;
+mod score;
+mod truth;
 mod view;
 
 use std::process::ExitCode;
@@ -30,6 +32,7 @@ fn main() -> ExitCode {
         cli::Command::Convert(args) => info::convert(&args),
         cli::Command::BenchLoad(args) => bench_load::run(&args),
         cli::Command::View(args) => view::run(&args),
+        cli::Command::Score(args) => score::run(&args),
     });
     match result {
         Ok(Ok(())) => ExitCode::SUCCESS,

@@ -158,16 +158,16 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky) -> 
 
 /// What one image of the output shows: a label, the chain's settings and the object-space
 /// method whose visibilities the geometry must carry.
-struct Panel {
-    label: String,
+pub struct Panel {
+    pub label: String,
     /// The method's name (`params.json` `method`).
-    name: String,
-    settings: ChainSettings,
-    volume: Option<VolumeMethod>,
+    pub name: String,
+    pub settings: ChainSettings,
+    pub volume: Option<VolumeMethod>,
 }
 
 impl Panel {
-    fn new(method: Method, settings: ChainSettings) -> Panel {
+    pub fn new(method: Method, settings: ChainSettings) -> Panel {
         let name = method.name();
         let mut label = name.clone();
         if method.screen == AoMethod::LineAo && settings.line_ao.variant == LineAoVariant::Reference {
@@ -204,82 +204,117 @@ fn panels(args: &RenderArgs, zoom_unit: f32, sky: Sky) -> Vec<Panel> {
     all
 }
 
-pub fn run(args: &RenderArgs) -> Result<()> {
-    let (name, tracts, hint) = match &args.file {
-        Some(path) => {
-            let loaded = crate::info::load(path)?;
-            if !loaded.tractogram.has_points() {
-                anyhow::bail!(
-                    "{}: a .{} holds values without points; render its .tck",
-                    path.display(),
-                    loaded.format.name()
-                );
+/// What every panel of a `render` (or `score`) shares: the data on the CPU and on the GPU, and
+/// the camera.
+pub struct Session {
+    pub name: String,
+    pub tracts: lineao_tracts::Tractogram,
+    pub hint: ViewHint,
+    pub camera: Camera,
+    pub sky: Sky,
+    pub surfaces: Vec<lineao_tracts::TriangleMesh>,
+    pub radii: Option<Vec<f32>>,
+    pub scalars: Option<Vec<f32>>,
+    pub gpu: Gpu,
+    pub geometry: LineGeometry,
+    pub meshes: Vec<MeshGeometry>,
+    pub bounds: Bounds,
+}
+
+impl Session {
+    /// Loads the file (or builds the scene) and the surfaces, checks the camera, and uploads
+    /// the geometry.
+    pub fn open(args: &RenderArgs) -> Result<Session> {
+        let (name, tracts, hint) = match &args.file {
+            Some(path) => {
+                let loaded = crate::info::load(path)?;
+                if !loaded.tractogram.has_points() {
+                    anyhow::bail!(
+                        "{}: a .{} holds values without points; render its .tck",
+                        path.display(),
+                        loaded.format.name()
+                    );
+                }
+                let hint = ViewHint::for_tractogram(&loaded.tractogram);
+                (path.display().to_string(), loaded.tractogram, hint)
             }
-            let hint = ViewHint::for_tractogram(&loaded.tractogram);
-            (path.display().to_string(), loaded.tractogram, hint)
+            None => {
+                let vertices = args.vertices.unwrap_or(args.scene.default_vertices());
+                let scene = args.scene.build(args.seed, vertices);
+                (scene.kind.name().to_string(), scene.tractogram, scene.view)
+            }
+        };
+        let camera = Camera {
+            eye: Vec3::from_array(args.eye.unwrap_or(hint.eye)),
+            target: Vec3::from_array(args.target.unwrap_or(hint.target)),
+            up: Vec3::from_array(args.up.unwrap_or(hint.up)),
+            projection: match (args.ortho, args.fov) {
+                (Some(height), _) => Projection::Orthographic { height },
+                (None, fov) => Projection::Perspective { fov_y_deg: fov.unwrap_or(hint.fov_y_deg) },
+            },
+        };
+        validate_camera(&camera)?;
+        let sky = sky(args, camera.up);
+        let surfaces = args
+            .surfaces
+            .iter()
+            .map(|path| lineao_tracts::load_mesh(path).map_err(anyhow::Error::from))
+            .collect::<Result<Vec<_>>>()?;
+        let radii = match &args.tube_radius_field {
+            Some(field) => Some(vertex_field(&tracts, field).with_context(|| name.clone())?),
+            None => None,
+        };
+        let scalars = match &args.color {
+            ColorArg::Field(field) => Some(vertex_field(&tracts, field).with_context(|| name.clone())?),
+            _ => None,
+        };
+        let gpu = Gpu::headless()?;
+        let mut geometry = LineGeometry::new(&gpu.device, &gpu.queue, &tracts.positions, &tracts.offsets)?;
+        let meshes = surfaces
+            .iter()
+            .map(|m| MeshGeometry::new(&gpu.device, &gpu.queue, &m.positions, &m.normals, &m.indices))
+            .collect::<Result<Vec<_>, _>>()?;
+        let bounds = meshes
+            .iter()
+            .filter_map(|m| m.bounds)
+            .fold(geometry.bounds.with_context(|| format!("{name} has no finite points"))?, |b, m| b.union(&m));
+        if radii.is_some() || scalars.is_some() {
+            let attributes = VertexAttributes { radius: radii.as_deref(), scalar: scalars.as_deref(), octants: None };
+            geometry.set_attributes(&gpu.device, &gpu.queue, &tracts.positions, &tracts.offsets, &attributes)?;
         }
-        None => {
-            let vertices = args.vertices.unwrap_or(args.scene.default_vertices());
-            let scene = args.scene.build(args.seed, vertices);
-            (scene.kind.name().to_string(), scene.tractogram, scene.view)
-        }
-    };
-    let camera = Camera {
-        eye: Vec3::from_array(args.eye.unwrap_or(hint.eye)),
-        target: Vec3::from_array(args.target.unwrap_or(hint.target)),
-        up: Vec3::from_array(args.up.unwrap_or(hint.up)),
-        projection: match (args.ortho, args.fov) {
-            (Some(height), _) => Projection::Orthographic { height },
-            (None, fov) => Projection::Perspective { fov_y_deg: fov.unwrap_or(hint.fov_y_deg) },
-        },
-    };
-    validate_camera(&camera)?;
-    let sky = sky(args, camera.up);
-    let panels = panels(args, hint.zoom_unit, sky);
-    for panel in &panels {
-        panel.settings.validate().with_context(|| panel.label.clone())?;
+        Ok(Session { name, tracts, hint, camera, sky, surfaces, radii, scalars, gpu, geometry, meshes, bounds })
     }
-    let volume_options = |method| volume_options(args, method, sky, hint.zoom_unit);
+
+    /// The chain's settings for `method` from the command line, the colour range from the data.
+    pub fn settings(&self, args: &RenderArgs, method: Method) -> ChainSettings {
+        let mut settings = settings(args, method, self.hint.zoom_unit, self.sky);
+        self.fit_color_range(&mut settings);
+        settings
+    }
+
+    fn fit_color_range(&self, settings: &mut ChainSettings) {
+        if let (Some(values), LineColor::Scalar { range, .. }) = (&self.scalars, &mut settings.line_color) {
+            *range = percentile_range(values);
+        }
+    }
+
+    /// What the truth is traced against.
+    pub fn truth_scene(&self) -> crate::truth::Scene<'_> {
+        crate::truth::Scene { tracts: &self.tracts, surfaces: &self.surfaces, radii: self.radii.as_deref() }
+    }
+}
+
+pub fn run(args: &RenderArgs) -> Result<()> {
+    let mut session = Session::open(args)?;
+    let mut panels = panels(args, session.hint.zoom_unit, session.sky);
+    for panel in &mut panels {
+        panel.settings.validate().with_context(|| panel.label.clone())?;
+        session.fit_color_range(&mut panel.settings);
+    }
+    let (sky, zoom_unit) = (session.sky, session.hint.zoom_unit);
+    let volume_options = |method| volume_options(args, method, sky, zoom_unit);
     if panels.iter().any(|p| p.volume.is_some()) {
         volume_options(VolumeMethod::Sweep).sweep.validate()?;
-    }
-
-    let surfaces = args
-        .surfaces
-        .iter()
-        .map(|path| lineao_tracts::load_mesh(path).map_err(anyhow::Error::from))
-        .collect::<Result<Vec<_>>>()?;
-    let radii = match &args.tube_radius_field {
-        Some(field) => Some(vertex_field(&tracts, field).with_context(|| name.clone())?),
-        None => None,
-    };
-    let scalars = match &args.color {
-        ColorArg::Field(field) => Some(vertex_field(&tracts, field).with_context(|| name.clone())?),
-        _ => None,
-    };
-    let mut panels = panels;
-    if let Some(values) = &scalars {
-        let range = percentile_range(values);
-        for panel in &mut panels {
-            if let LineColor::Scalar { range: r, .. } = &mut panel.settings.line_color {
-                *r = range;
-            }
-        }
-    }
-
-    let gpu = Gpu::headless()?;
-    let mut geometry = LineGeometry::new(&gpu.device, &gpu.queue, &tracts.positions, &tracts.offsets)?;
-    let meshes = surfaces
-        .iter()
-        .map(|m| MeshGeometry::new(&gpu.device, &gpu.queue, &m.positions, &m.normals, &m.indices))
-        .collect::<Result<Vec<_>, _>>()?;
-    let bounds = meshes
-        .iter()
-        .filter_map(|m| m.bounds)
-        .fold(geometry.bounds.with_context(|| format!("{name} has no finite points"))?, |b, m| b.union(&m));
-    if radii.is_some() || scalars.is_some() {
-        let attributes = VertexAttributes { radius: radii.as_deref(), scalar: scalars.as_deref(), octants: None };
-        geometry.set_attributes(&gpu.device, &gpu.queue, &tracts.positions, &tracts.offsets, &attributes)?;
     }
     // Object-space AO once per method, uploaded as the geometry's attributes when a panel needs
     // another method's than the last.
@@ -288,11 +323,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut images = Vec::new();
     for panel in &panels {
         if let Some(method) = panel.volume.filter(|&m| attributes != Some(m)) {
+            let tracts = &session.tracts;
             if !volumes.iter().any(|(m, _)| *m == method) {
                 let start = std::time::Instant::now();
                 let computed =
                     lineao::volume::vertex_visibility(&tracts.positions, &tracts.offsets, &volume_options(method))
-                        .with_context(|| format!("{name}: {}", method.name()))?;
+                        .with_context(|| format!("{}: {}", session.name, method.name()))?;
                 eprintln!(
                     "lineao: {} at {} voxels along the longest axis: {:.2} s on the CPU",
                     method.name(),
@@ -304,10 +340,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             let (_, visibility) = volumes.iter().find(|(m, _)| *m == method).expect("computed above");
             let octants = VertexAttributes {
                 octants: Some(&visibility.octants),
-                radius: radii.as_deref(),
-                scalar: scalars.as_deref(),
+                radius: session.radii.as_deref(),
+                scalar: session.scalars.as_deref(),
             };
-            geometry.set_attributes(&gpu.device, &gpu.queue, &tracts.positions, &tracts.offsets, &octants)?;
+            let gpu = &session.gpu;
+            session.geometry.set_attributes(&gpu.device, &gpu.queue, &tracts.positions, &tracts.offsets, &octants)?;
             attributes = Some(method);
         }
         // One method dumps into DIR itself, several into DIR/<label>/.
@@ -315,10 +352,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             1 => dir.clone(),
             _ => dir.join(panel.label.replace(" (reference)", "-reference")),
         });
-        let meshes: Vec<&MeshGeometry> = meshes.iter().collect();
-        let frame = Frame { gpu: &gpu, geometry: &geometry, meshes: &meshes, bounds, camera, args };
         let volume = panel.volume.map(&volume_options);
-        images.push(frame.render(panel, dump.as_deref(), volume.as_ref())?);
+        images.push(session.render(args, panel, dump.as_deref(), volume.as_ref())?.image);
     }
     let (width, height) = (args.width, args.height);
     let image = match &images[..] {
@@ -331,16 +366,17 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             crate::label::grid(&labelled, 3)
         }
     };
-    crate::output::write_png(&args.output, image.width, image.height, &image.data)?;
+    let output = args.output.clone().unwrap_or_else(|| "lineao.png".into());
+    crate::output::write_png(&output, image.width, image.height, &image.data)?;
     let methods: Vec<&str> = panels.iter().map(|p| p.label.as_str()).collect();
     eprintln!(
         "lineao: {} ({} streamlines, {} vertices) with {} at {width} x {height} on {} -> {}",
-        name,
-        geometry.streamlines,
-        geometry.vertices,
+        session.name,
+        session.geometry.streamlines,
+        session.geometry.vertices,
         methods.join(", "),
-        gpu.describe(),
-        args.output.display()
+        session.gpu.describe(),
+        output.display()
     );
     Ok(())
 }
@@ -367,21 +403,25 @@ pub fn percentile_range(values: &[f32]) -> [f32; 2] {
     [at(0.02), at(0.98)]
 }
 
-/// What every panel of one `render` shares.
-struct Frame<'a> {
-    gpu: &'a Gpu,
-    geometry: &'a LineGeometry,
-    meshes: &'a [&'a MeshGeometry],
-    bounds: Bounds,
-    camera: Camera,
-    args: &'a RenderArgs,
+/// One rendered panel: the image, and the chain that made it (its targets hold the frame).
+pub struct Rendered {
+    pub image: Rgba8,
+    pub chain: AoChain,
 }
 
-impl Frame<'_> {
+impl Session {
     /// Renders `panel` to sRGB bytes (with `--timings`, prints its passes; with `dump`, writes
-    /// its inputs and output there, with `volume`'s settings when it has object-space AO).
-    fn render(&self, panel: &Panel, dump: Option<&Path>, volume: Option<&VolumeAoOptions>) -> Result<Rgba8> {
-        let (gpu, args) = (self.gpu, self.args);
+    /// its inputs and output there, with `volume`'s settings when it has object-space AO). The
+    /// ray-traced method renders the G-buffer, traces the truth on the CPU, writes it into the
+    /// chain's `ao` and composites.
+    pub fn render(
+        &self,
+        args: &RenderArgs,
+        panel: &Panel,
+        dump: Option<&Path>,
+        volume: Option<&VolumeAoOptions>,
+    ) -> Result<Rendered> {
+        let gpu = &self.gpu;
         let format = wgpu::TextureFormat::Rgba8UnormSrgb;
         let mut chain = AoChain::new(&gpu.device, format, panel.settings.clone())?;
         if args.timings {
@@ -393,7 +433,8 @@ impl Frame<'_> {
         let target = lineao::targets::Target::output(&gpu.device, "lineao::render::output", size, format);
         let mut encoder =
             gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::render") });
-        chain.encode_with_meshes(&mut encoder, self.geometry, self.meshes, &target.view);
+        let meshes: Vec<&MeshGeometry> = self.meshes.iter().collect();
+        chain.encode_with_meshes(&mut encoder, &self.geometry, &meshes, &target.view);
         let start = std::time::Instant::now();
         gpu.queue.submit([encoder.finish()]);
         if args.timings {
@@ -411,11 +452,47 @@ impl Frame<'_> {
                 None => eprintln!("lineao: {label}: frame {wall_ms:.2} ms (CPU wall time: no timestamp queries)"),
             }
         }
+        let truth = if panel.settings.method == AoMethod::RayTraced {
+            let truth = self.trace(&chain, &crate::truth::settings(args))?;
+            let targets = chain.targets().context("nothing was rendered")?;
+            lineao::verify::write_target(&gpu.queue, &targets.ao, &truth.ao);
+            let mut encoder = gpu
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::render::composite") });
+            chain.encode_composite(&mut encoder, &target.view);
+            gpu.queue.submit([encoder.finish()]);
+            Some(truth)
+        } else {
+            None
+        };
         let image = lineao::readback::read_texture(&gpu.device, &gpu.queue, &target.texture)?;
         if let Some(dir) = dump {
             crate::dump::write(dir, gpu, &chain, &self.camera, &panel.name, volume)?;
+            if let Some(truth) = &truth {
+                crate::dump::write_truth(dir, truth, &crate::truth::settings(args))?;
+            }
         }
-        Ok(Rgba8 { width: args.width, height: args.height, data: image.bytes })
+        let image = Rgba8 { width: args.width, height: args.height, data: image.bytes };
+        Ok(Rendered { image, chain })
+    }
+
+    /// The truth on `chain`'s last frame, with a line on stderr saying what it cost.
+    pub fn trace(&self, chain: &AoChain, settings: &lineao::truth::TruthSettings) -> Result<lineao::truth::Truth> {
+        let start = std::time::Instant::now();
+        let bvh = crate::truth::bvh(chain, &self.truth_scene())?;
+        let built = start.elapsed().as_secs_f64();
+        let truth = crate::truth::trace(&self.gpu, chain, &bvh, settings)?;
+        let seconds = start.elapsed().as_secs_f64() - built;
+        eprintln!(
+            "lineao: ray traced {} rays over {} geometry pixels in {seconds:.1} s ({:.0} k rays/s; BVH {built:.2} s, {} \
+             MB); {:.1} % of the pixels buried in another line",
+            truth.rays,
+            truth.geometry_pixels,
+            truth.rays as f64 / seconds.max(1e-9) / 1e3,
+            bvh.bytes() >> 20,
+            100.0 * truth.buried_share()
+        );
+        Ok(truth)
     }
 }
 

@@ -1,0 +1,300 @@
+//! `lineao score`: every method's AO next to the ray-traced truth on one G-buffer.
+//!
+//! The truth is traced on the G-buffer of a chain without a guard band; each method renders the
+//! same view (its own guard band around the same visible pixels), and its AO — what darkens the
+//! image, clamp(strength · ao, 0, 1) after the method's own blur — is compared over the visible
+//! pixels that are geometry in both. VO methods are compared with the VO truth (the occupied
+//! share of the ball, half or whole as `--no-normal-clamp` says), every other method with the
+//! ray-traced AO. `raytraced` is the truth traced again with the next `--ray-seed`: how close
+//! two truths are, the bar no method can pass.
+
+use anyhow::{Context, Result};
+use lineao::reference::Image;
+use lineao::truth::metrics::{self, Scores};
+use lineao::truth::{Truth, TruthSettings, VoBall};
+use lineao::{AoMethod, ChainSettings};
+use serde_json::json;
+
+use crate::cli::{Method, ScoreArgs, ScoreMethod};
+use crate::label::Rgba8;
+use crate::render::{Panel, Session};
+
+/// One method's scores.
+pub struct Row {
+    pub method: ScoreMethod,
+    /// What it is compared with: `ao`, `vo-half` or `vo-whole`.
+    pub truth: &'static str,
+    pub scores: Scores,
+    /// SSIM of the composited image's luminance against the composite with the truth's AO.
+    pub image_ssim: f64,
+    /// Its AO over the visible frame, for the grid.
+    pub ao: Image<f32>,
+}
+
+/// The truth of one view and every method's scores.
+pub struct Report {
+    pub truth: Truth,
+    pub truth_seconds: f64,
+    /// The visible truth (AO, and VO where asked).
+    pub ao: Image<f32>,
+    pub vo: Option<Image<f32>>,
+    pub mask: Vec<bool>,
+    pub rows: Vec<Row>,
+}
+
+/// The methods' chain settings: the command line's, the method and variant set.
+pub fn method_settings(session: &Session, args: &crate::cli::RenderArgs, m: ScoreMethod) -> ChainSettings {
+    let mut settings = session.settings(args, Method { screen: m.method, volume: None });
+    settings.line_ao.variant = m.variant;
+    settings.blur = None;
+    settings
+}
+
+/// The visible `width` × `height` window of a guard-banded image.
+fn crop(image: &Image<f32>, guard: usize, width: usize, height: usize) -> Image<f32> {
+    Image::from_fn(width, height, |x, y| image.get(x + guard, y + guard))
+}
+
+/// Scores `methods` on `session`'s view.
+pub fn score(session: &Session, args: &crate::cli::RenderArgs, methods: &[ScoreMethod]) -> Result<Report> {
+    let gpu = &session.gpu;
+    let (w, h) = (args.width as usize, args.height as usize);
+    let vo_ball = if args.no_normal_clamp { VoBall::Whole } else { VoBall::Half };
+    let wants_vo = methods.iter().any(|m| matches!(m.method, AoMethod::VoLine | AoMethod::VoArea));
+    let truth_settings = TruthSettings { vo: wants_vo.then_some(vo_ball), ..crate::truth::settings(args) };
+
+    // The truth's G-buffer: a chain without a method (and so without a guard band).
+    let quiet = crate::cli::RenderArgs { timings: false, dump: None, ..args.clone() };
+    let plain = ScoreMethod { method: AoMethod::None, variant: Default::default() };
+    let panel = Panel::new(Method { screen: AoMethod::None, volume: None }, method_settings(session, args, plain));
+    let rendered = session.render(&quiet, &panel, None, None)?;
+    let start = std::time::Instant::now();
+    let truth = session.trace(&rendered.chain, &truth_settings)?;
+    let truth_seconds = start.elapsed().as_secs_f64();
+    let truth_targets = rendered.chain.targets().context("nothing was rendered")?;
+    let nd = lineao::verify::read_rgba(&gpu.device, &gpu.queue, &truth_targets.nd[0])?;
+    let color = lineao::readback::read_texture(&gpu.device, &gpu.queue, &truth_targets.color.texture)?.to_vec4();
+    let specular = lineao::verify::read_f32(&gpu.device, &gpu.queue, &truth_targets.specular)?;
+    let geometry = |image: &lineao::reference::NdImage, x: usize, y: usize| {
+        let t = image.get(x, y);
+        t[0] != 0.0 || t[1] != 0.0 || t[2] != 0.0
+    };
+    anyhow::ensure!(truth.geometry_pixels > 0, "{}: no geometry in view", session.name);
+    let ao_truth = truth.ao.clone();
+    let vo_truth = truth.vo.clone();
+    let strength = args.strength;
+    let composite = |ao: &Image<f32>| -> Image<f32> {
+        Image::from_fn(w, h, |x, y| {
+            let c = color[y * w + x];
+            let a = ao.get(x, y).clamp(0.0, 1.0);
+            let luminance = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+            srgb(luminance * (1.0 - a) + specular.get(x, y))
+        })
+    };
+
+    let mut rows = Vec::new();
+    let mut mask = vec![false; w * h];
+    for y in 0..h {
+        for x in 0..w {
+            mask[y * w + x] = geometry(&nd, x, y);
+        }
+    }
+    for &m in methods {
+        let (target_truth, truth_name) = match m.method {
+            AoMethod::VoLine | AoMethod::VoArea => (
+                vo_truth.as_ref().context("the VO truth")?,
+                if vo_ball == VoBall::Half { "vo-half" } else { "vo-whole" },
+            ),
+            _ => (&ao_truth, "ao"),
+        };
+        let ao = if m.method == AoMethod::RayTraced {
+            let again = TruthSettings { seed: truth_settings.seed.wrapping_add(1), vo: None, ..truth_settings.clone() };
+            session.trace(&rendered.chain, &again)?.ao
+        } else {
+            let settings = method_settings(session, args, m);
+            let panel = Panel::new(Method { screen: m.method, volume: None }, settings);
+            let out = session.render(&quiet, &panel, None, None)?;
+            let targets = out.chain.targets().context("nothing was rendered")?;
+            let shown = out
+                .chain
+                .ao_view()
+                .map(|_| if out.chain.settings().blur.is_some() { &targets.ao_blurred } else { &targets.ao });
+            let raw = lineao::verify::read_f32(&gpu.device, &gpu.queue, shown.context("no AO")?)?;
+            let method_nd = lineao::verify::read_rgba(&gpu.device, &gpu.queue, &targets.nd[0])?;
+            let guard = targets.guard as usize;
+            // Both G-buffers must show geometry at a compared pixel.
+            for y in 0..h {
+                for x in 0..w {
+                    mask[y * w + x] &= geometry(&method_nd, x + guard, y + guard);
+                }
+            }
+            let cropped = crop(&raw, guard, w, h);
+            Image { data: cropped.data.iter().map(|a| (strength * a).clamp(0.0, 1.0)).collect(), ..cropped }
+        };
+        rows.push((m, truth_name, target_truth.clone(), ao));
+    }
+    let rows = rows
+        .into_iter()
+        .map(|(method, truth_name, target, ao)| {
+            let scores = metrics::score(&ao, &target, &mask);
+            let all = vec![true; w * h];
+            let image_ssim = metrics::mean_ssim(&composite(&ao), &composite(&ao_truth), &all);
+            Row { method, truth: truth_name, scores, image_ssim, ao }
+        })
+        .collect();
+    Ok(Report { truth, truth_seconds, ao: ao_truth, vo: vo_truth, mask, rows })
+}
+
+/// sRGB encoding of a linear value in [0, 1].
+fn srgb(v: f32) -> f32 {
+    let v = v.clamp(0.0, 1.0);
+    if v <= 0.003_130_8 { 12.92 * v } else { 1.055 * v.powf(1.0 / 2.4) - 0.055 }
+}
+
+pub fn run(args: &ScoreArgs) -> Result<()> {
+    let render = &args.render;
+    let methods = if args.methods.is_empty() { ScoreMethod::ALL.to_vec() } else { args.methods.clone() };
+    let session = Session::open(render)?;
+    let report = score(&session, render, &methods)?;
+    let truth = &report.truth;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&to_json(&session, render, &report))?);
+    } else {
+        println!(
+            "{}: {} x {}, {} geometry pixels, {} rays to {} ({} falloff), truth mean {:.3}, {:.1} % buried",
+            session.name,
+            render.width,
+            render.height,
+            truth.geometry_pixels,
+            render.rays,
+            render.ao_distance,
+            truth_settings_falloff(render),
+            report.rows.first().map_or(0.0, |r| r.scores.mean_truth),
+            100.0 * truth.buried_share()
+        );
+        println!(
+            "{:<17} {:>8} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} | {:>6} {:>7} {:>7} {:>7} | {:>9}",
+            "method",
+            "truth",
+            "mean",
+            "bias",
+            "mean|Δ|",
+            "RMSE",
+            "corr",
+            "SSIM",
+            "scale",
+            "bias",
+            "RMSE",
+            "SSIM",
+            "image SSIM"
+        );
+        for row in &report.rows {
+            let s = &row.scores;
+            println!(
+                "{:<17} {:>8} {:>7.3} {:>+7.3} {:>7.3} {:>7.3} {:>7.3} {:>7.3} | {:>6.3} {:>+7.3} {:>7.3} {:>7.3} | {:>9.3}",
+                row.method.name(),
+                row.truth,
+                s.mean_method,
+                s.raw.bias,
+                s.raw.mean_abs,
+                s.raw.rmse,
+                s.correlation,
+                s.raw.ssim,
+                s.scale,
+                s.scaled.bias,
+                s.scaled.rmse,
+                s.scaled.ssim,
+                row.image_ssim
+            );
+        }
+    }
+    if let Some(path) = &render.output {
+        let image = grid(&report);
+        crate::output::write_png(path, image.width, image.height, &image.data)?;
+        eprintln!("lineao: score grid -> {}", path.display());
+    }
+    Ok(())
+}
+
+fn truth_settings_falloff(args: &crate::cli::RenderArgs) -> &'static str {
+    crate::truth::settings(args).falloff.name()
+}
+
+/// CONTRACT.md's `lineao score --json` object.
+pub fn to_json(session: &Session, args: &crate::cli::RenderArgs, report: &Report) -> serde_json::Value {
+    let errors = |e: &metrics::Errors| json!({"bias": e.bias, "mean_abs": e.mean_abs, "rmse": e.rmse, "ssim": e.ssim});
+    let settings = crate::truth::settings(args);
+    json!({
+        "scene": session.name,
+        "width": args.width,
+        "height": args.height,
+        "rays": settings.rays,
+        "ao_distance_world": settings.distance_world,
+        "ao_falloff": settings.falloff.name(),
+        "ray_seed": settings.seed,
+        "geometry_pixels": report.truth.geometry_pixels,
+        "compared_pixels": report.mask.iter().filter(|m| **m).count(),
+        "buried_share": report.truth.buried_share(),
+        "truth_seconds": report.truth_seconds,
+        "methods": report.rows.iter().map(|row| {
+            let s = &row.scores;
+            let mut value = errors(&s.raw);
+            if let Some(object) = value.as_object_mut() {
+                object.extend([
+                    ("method".to_string(), json!(row.method.name())),
+                    ("truth".to_string(), json!(row.truth)),
+                    ("pixels".to_string(), json!(s.pixels)),
+                    ("mean".to_string(), json!(s.mean_method)),
+                    ("truth_mean".to_string(), json!(s.mean_truth)),
+                    ("correlation".to_string(), json!(s.correlation)),
+                    ("scale".to_string(), json!(s.scale)),
+                    ("scaled".to_string(), errors(&s.scaled)),
+                    ("image_ssim".to_string(), json!(row.image_ssim)),
+                ]);
+            }
+            value
+        }).collect::<Vec<_>>(),
+    })
+}
+
+/// A gray AO map (white = open, black = occluded) with background in light blue.
+fn gray(ao: &Image<f32>, mask: &[bool]) -> Rgba8 {
+    let mut data = Vec::with_capacity(ao.data.len() * 4);
+    for (a, &m) in ao.data.iter().zip(mask) {
+        let v = (255.0 * (1.0 - a.clamp(0.0, 1.0))).round() as u8;
+        data.extend(if m { [v, v, v, 255] } else { [210, 225, 240, 255] });
+    }
+    Rgba8 { width: ao.width as u32, height: ao.height as u32, data }
+}
+
+/// Signed error: red where the method is darker than the truth, blue where lighter, white
+/// where equal (full colour at |Δ| = 0.5).
+fn error_map(ao: &Image<f32>, truth: &Image<f32>, mask: &[bool]) -> Rgba8 {
+    let mut data = Vec::with_capacity(ao.data.len() * 4);
+    for ((a, t), &m) in ao.data.iter().zip(&truth.data).zip(mask) {
+        let d = ((a - t) * 2.0).clamp(-1.0, 1.0);
+        let fade = (255.0 * (1.0 - d.abs())).round() as u8;
+        data.extend(match (m, d >= 0.0) {
+            (false, _) => [210, 225, 240, 255],
+            (true, true) => [255, fade, fade, 255],
+            (true, false) => [fade, fade, 255, 255],
+        });
+    }
+    Rgba8 { width: ao.width as u32, height: ao.height as u32, data }
+}
+
+/// Per method: its AO, the truth it is compared with, the signed error — a row each.
+fn grid(report: &Report) -> Rgba8 {
+    let mut tiles: Vec<(String, Rgba8)> = Vec::new();
+    for row in &report.rows {
+        let truth = match row.truth {
+            "ao" => &report.ao,
+            _ => report.vo.as_ref().unwrap_or(&report.ao),
+        };
+        tiles.push((row.method.name().to_string(), gray(&row.ao, &report.mask)));
+        tiles.push((format!("truth ({})", row.truth), gray(truth, &report.mask)));
+        tiles.push((format!("{} - truth", row.method.name()), error_map(&row.ao, truth, &report.mask)));
+    }
+    let labelled: Vec<(&str, &Rgba8)> = tiles.iter().map(|(l, t)| (l.as_str(), t)).collect();
+    crate::label::grid(&labelled, 3)
+}
