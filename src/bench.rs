@@ -29,7 +29,12 @@
 //! - `sweep-256`: voxelizing, the eight occlusion sweeps and every vertex's octant visibilities
 //!   (what `--method sweep` costs once per dataset);
 //! - `variance-volume-256`: the moments pyramid and every vertex's octant visibilities, on the
-//!   density volume of the run (what `--method variance-volume` adds to voxelizing).
+//!   density volume of the run (what `--method variance-volume` adds to voxelizing);
+//! - `bvh-build-1m`: the ground truth's BVH over the scene's lines as sphere-swept segments
+//!   (1 M vertices at the default size), on all cores;
+//! - `raytraced-cpu-64`: the CPU truth with 64 rays per geometry pixel of the bench's frame
+//!   (binary AO to 2 mm), on all cores; the table adds rays per second per core and the BVH's
+//!   bytes per segment.
 
 use std::time::Instant;
 
@@ -83,7 +88,8 @@ pub const GPU_PASSES: [&str; 17] = [
 const TUBE_RADIUS: f32 = 0.5;
 
 /// The CPU passes, after the GPU's.
-pub const CPU_PASSES: [&str; 3] = ["density-256", "sweep-256", "variance-volume-256"];
+pub const CPU_PASSES: [&str; 5] =
+    ["density-256", "sweep-256", "variance-volume-256", "bvh-build-1m", "raytraced-cpu-64"];
 
 /// Whether `name` is a pass of the benchmark.
 pub fn is_pass(name: &str) -> bool {
@@ -323,6 +329,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     for (name, ms) in object_space_times(&tractogram.positions, &tractogram.offsets, runs, &selected)? {
         passes.push(summary(name, "cpu", ms));
     }
+    for (name, ms) in ray_tracing_times(&gpu, &chain, &view, tractogram, runs, &selected)? {
+        passes.push(summary(name, "cpu", ms));
+    }
     let info = gpu.adapter.get_info();
     let report = json!({
         "adapter": info.name,
@@ -381,6 +390,66 @@ fn object_space_times(
             Ok(())
         })?;
         out.push(("variance-volume-256", ms));
+    }
+    Ok(out)
+}
+
+/// Times of the ground truth's CPU passes on the bench's frame (its G-buffer as the chain's
+/// `lines` left it).
+fn ray_tracing_times(
+    gpu: &Gpu,
+    chain: &AoChain,
+    view: &FrameView,
+    tractogram: &lineao_tracts::Tractogram,
+    runs: u32,
+    selected: &dyn Fn(&str) -> bool,
+) -> Result<Vec<(&'static str, Vec<f64>)>> {
+    use lineao::truth::{Bvh, TruthSettings};
+    let mut out = Vec::new();
+    if !selected("bvh-build-1m") && !selected("raytraced-cpu-64") {
+        return Ok(out);
+    }
+    let width = chain.settings().line_width_px;
+    let build =
+        || Bvh::build(lineao::truth::line_cones(&tractogram.positions, &tractogram.offsets, view, width), Vec::new());
+    let mut bvh = build();
+    eprintln!(
+        "lineao: BVH of {} segments: {} bytes, {:.1} bytes per segment",
+        bvh.cones.len(),
+        bvh.bytes(),
+        bvh.bytes() as f64 / bvh.cones.len().max(1) as f64
+    );
+    if selected("bvh-build-1m") {
+        let mut ms = Vec::new();
+        for _ in 0..runs {
+            drop(bvh);
+            let start = Instant::now();
+            bvh = build();
+            ms.push(start.elapsed().as_secs_f64() * 1e3);
+        }
+        out.push(("bvh-build-1m", ms));
+    }
+    if selected("raytraced-cpu-64") {
+        let targets = chain.targets().context("the chain allocated no targets")?;
+        let nd = lineao::verify::read_rgba(&gpu.device, &gpu.queue, &targets.nd[0])?;
+        let frame = lineao::truth::Frame { nd: &nd, view, lines: true };
+        let settings = TruthSettings { rays: 64, ..TruthSettings::default() };
+        let cancel = std::sync::atomic::AtomicBool::new(false);
+        let mut ms = Vec::new();
+        for _ in 0..runs {
+            let start = Instant::now();
+            let truth = lineao::truth::compute(&bvh, &frame, &settings, &|_, _| {}, &cancel)?;
+            let seconds = start.elapsed().as_secs_f64();
+            ms.push(seconds * 1e3);
+            let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+            eprintln!(
+                "lineao: raytraced-cpu-64: {} rays over {} geometry pixels, {:.2} M rays/s per core ({cores} cores)",
+                truth.rays,
+                truth.geometry_pixels,
+                truth.rays as f64 / seconds / cores as f64 / 1e6
+            );
+        }
+        out.push(("raytraced-cpu-64", ms));
     }
     Ok(out)
 }

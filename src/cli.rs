@@ -44,6 +44,18 @@ pub struct ScoreArgs {
     /// Print JSON (CONTRACT.md `lineao score --json`) instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// Calibrate: search each method's main parameters and strength for the least RMSE against
+    /// the truth over every built-in scene and every tractogram under --data, --views cameras
+    /// each; fit on half the views, report on the other half.
+    #[arg(long)]
+    pub fit: bool,
+    /// --fit: the folder searched for tractograms.
+    #[arg(long, default_value = "../shared/data", requires = "fit")]
+    pub data: PathBuf,
+    /// --fit: cameras per scene, orbiting the scene's own about its up axis (even ones fit, odd
+    /// ones report).
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(2..=64), requires = "fit")]
+    pub views: u32,
 }
 
 /// A method `score` compares with the truth.
@@ -119,7 +131,7 @@ pub struct ViewArgs {
     #[arg(long, value_enum, default_value_t = GeometryArg::Lines)]
     pub geometry: GeometryArg,
     /// Parameters for dense tractography (the paper's) or sparse streamlines.
-    #[arg(long, value_enum, default_value_t = PresetArg::Dense)]
+    #[arg(long, value_enum, default_value_t = PresetArg::Calibrated)]
     pub preset: PresetArg,
     /// How lines are lit (as `render --line-shading`).
     #[arg(long, value_enum, default_value_t = LineShadingArg::Specular)]
@@ -153,6 +165,8 @@ pub struct ViewArgs {
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum PresetArg {
+    /// Each method's strength and reach fitted to the ray-traced truth (`score --fit`).
+    Calibrated,
     /// Whole-brain tractography: the paper's values.
     Dense,
     /// Few streamlines far apart: wider lines, every method reaching farther.
@@ -471,9 +485,9 @@ pub struct RenderArgs {
     /// World units per zoom unit of z(P) [default: the scene's, 1 mm].
     #[arg(long)]
     pub zoom_unit: Option<f32>,
-    /// LineAO s_r: hemispheres and pyramid levels (1..=5).
-    #[arg(long, default_value_t = 3)]
-    pub s_r: u32,
+    /// LineAO s_r: hemispheres and pyramid levels (1..=5) [default: the preset's; paper 3].
+    #[arg(long)]
+    pub s_r: Option<u32>,
     /// LineAO s_h: samples on the first hemisphere.
     #[arg(long, default_value_t = 32)]
     pub s_h: u32,
@@ -481,8 +495,9 @@ pub struct RenderArgs {
     #[arg(long)]
     pub r0: Option<f32>,
     /// Variant `reference`: base radius in pixels at the home zoom (the authors' u_lineAORadius).
-    #[arg(long, default_value_t = 2.0)]
-    pub reference_radius: f32,
+    /// [default: the preset's; paper 2]
+    #[arg(long)]
+    pub reference_radius: Option<f32>,
     /// SSAO: point samples in the sphere (8..=32) [default: 16]; vo-line: line samples (5, 7,
     /// 9, 12, 13 or 16) [default: 9]; vo-area: area samples (1 or a line count) [default: 1].
     #[arg(long)]
@@ -508,9 +523,10 @@ pub struct RenderArgs {
     /// VO: thickness model, world units (0 = off).
     #[arg(long, default_value_t = 0.0)]
     pub thickness: f32,
-    /// SSAO and VO: sphere radius in world units (mm for tractograms).
-    #[arg(long, default_value_t = 2.0)]
-    pub radius: f32,
+    /// SSAO and VO: sphere radius in world units (mm for tractograms) [default: the preset's;
+    /// paper 2].
+    #[arg(long)]
+    pub radius: Option<f32>,
     /// SSAO: range check in world units [default: the radius].
     #[arg(long)]
     pub ssao_range: Option<f32>,
@@ -523,9 +539,13 @@ pub struct RenderArgs {
     /// LineAO ε: occluded iff Δd > ε.
     #[arg(long, default_value_t = 1e-6)]
     pub epsilon: f32,
-    /// AO strength in the composite.
-    #[arg(long, default_value_t = 1.0)]
-    pub strength: f32,
+    /// AO strength in the composite [default: the preset's for the method; paper 1].
+    #[arg(long)]
+    pub strength: Option<f32>,
+    /// Parameter set: `calibrated` (each method's strength and reach fitted to the ray-traced
+    /// truth, `lineao score --fit`) or `paper` (the papers' values). Explicit options win.
+    #[arg(long, default_value = "calibrated", value_parser = parse_preset)]
+    pub preset: lineao::Preset,
     /// Disable LineAO's light attenuation (g_light = 1).
     #[arg(long)]
     pub no_light_attenuation: bool,
@@ -596,6 +616,10 @@ pub enum ColorArg {
     Constant([f32; 3]),
     /// A per-vertex field of the file through --colormap.
     Field(String),
+}
+
+fn parse_preset(s: &str) -> Result<lineao::Preset, String> {
+    lineao::Preset::from_name(s).ok_or_else(|| format!("unknown preset '{s}' (paper, calibrated)"))
 }
 
 fn parse_scene(s: &str) -> Result<SceneKind, String> {

@@ -7,6 +7,7 @@ mod bench;
 mod bench_load;
 mod cli;
 mod dump;
+mod fit;
 mod info;
 mod label;
 mod output;

@@ -83,13 +83,13 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky) -> 
     // --samples counts the chosen method's samples; the others keep their defaults.
     let samples = |m: AoMethod, default: u32| args.samples.filter(|_| method == m).unwrap_or(default);
     let vo_default = VoSettings::default();
-    ChainSettings {
+    let mut settings = ChainSettings {
         method,
         volume,
         vo: VoSettings {
             samples: samples(AoMethod::VoLine, vo_default.samples),
             area_samples: samples(AoMethod::VoArea, vo_default.area_samples),
-            radius_world: args.radius,
+            radius_world: vo_default.radius_world,
             radius2_world: args.radius2,
             combine: combine(args.combine),
             normal_clamp: !args.no_normal_clamp,
@@ -98,8 +98,8 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky) -> 
         },
         ssao: SsaoSettings {
             samples: samples(AoMethod::Ssao, SsaoSettings::default().samples),
-            radius_world: args.radius,
-            range_world: args.ssao_range.unwrap_or(args.radius),
+            radius_world: SsaoSettings::default().radius_world,
+            range_world: SsaoSettings::default().range_world,
             noise_seed: args.noise_seed,
             kernel: match args.ssao_kernel {
                 SsaoKernelArg::Crytek => SsaoKernel::Crytek,
@@ -110,7 +110,7 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky) -> 
             .bilateral
             .then_some(BilateralSettings { radius_px: args.bilateral_radius, depth_sigma_world: args.bilateral_sigma }),
         line_ao: LineAoSettings {
-            s_r: args.s_r,
+            s_r: LineAoSettings::default().s_r,
             s_h: args.s_h,
             r0_px: args.r0,
             delta0: args.delta0,
@@ -122,7 +122,7 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky) -> 
                 Variant::Paper => LineAoVariant::Paper,
                 Variant::Reference => LineAoVariant::Reference,
             },
-            reference_radius_px: args.reference_radius,
+            reference_radius_px: LineAoSettings::default().reference_radius_px,
             outer: match args.outer {
                 Outer::Full => LineAoOuter::Full,
                 Outer::Level => LineAoOuter::Level,
@@ -150,10 +150,33 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky) -> 
             },
         },
         background: args.background,
-        strength: args.strength,
+        strength: 1.0,
         debug_view: args.debug_view,
         zoom_unit: args.zoom_unit.unwrap_or(zoom_unit),
     }
+    .with_preset(args.preset);
+    // What the command line names explicitly wins over the preset.
+    if let Some(strength) = args.strength {
+        settings.strength = strength;
+    }
+    if let Some(s_r) = args.s_r {
+        settings.line_ao.s_r = s_r;
+    }
+    if let Some(r0) = args.r0 {
+        settings.line_ao.r0_px = Some(r0);
+    }
+    if let Some(radius) = args.reference_radius {
+        settings.line_ao.reference_radius_px = radius;
+    }
+    if let Some(radius) = args.radius {
+        settings.vo.radius_world = radius;
+        settings.ssao.radius_world = radius;
+        settings.ssao.range_world = radius;
+    }
+    if let Some(range) = args.ssao_range {
+        settings.ssao.range_world = range;
+    }
+    settings
 }
 
 /// What one image of the output shows: a label, the chain's settings and the object-space

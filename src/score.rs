@@ -50,9 +50,61 @@ pub fn method_settings(session: &Session, args: &crate::cli::RenderArgs, m: Scor
     settings
 }
 
-/// The visible `width` × `height` window of a guard-banded image.
-fn crop(image: &Image<f32>, guard: usize, width: usize, height: usize) -> Image<f32> {
-    Image::from_fn(width, height, |x, y| image.get(x + guard, y + guard))
+/// A method's occlusion over the visible window, before the composite's strength, and which
+/// visible pixels its G-buffer shows geometry at.
+pub struct MethodAo {
+    pub ao: Image<f32>,
+    pub geometry: Vec<bool>,
+}
+
+/// Renders `settings` on `session`'s view in `chain` (made on first use, then only changed
+/// where the settings differ: the fit renders hundreds of settings) and reads back its AO —
+/// after the method's own blur — over the visible `width` × `height` window.
+pub fn raw_ao(
+    session: &Session,
+    chain: &mut Option<lineao::AoChain>,
+    settings: ChainSettings,
+    width: u32,
+    height: u32,
+) -> Result<MethodAo> {
+    let gpu = &session.gpu;
+    let chain = match chain {
+        Some(chain) => {
+            chain.set_settings(&gpu.device, settings)?;
+            chain
+        }
+        None => {
+            let format = wgpu::TextureFormat::Rgba8UnormSrgb;
+            let mut made = lineao::AoChain::new(&gpu.device, format, settings)?;
+            made.resize(width, height)?;
+            chain.insert(made)
+        }
+    };
+    chain.prepare(&gpu.device, &gpu.queue, &session.camera, &session.bounds);
+    let target = lineao::targets::Target::output(
+        &gpu.device,
+        "lineao::score::output",
+        (width, height),
+        wgpu::TextureFormat::Rgba8UnormSrgb,
+    );
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    let meshes: Vec<&lineao::passes::meshes::MeshGeometry> = session.meshes.iter().collect();
+    chain.encode_with_meshes(&mut encoder, &session.geometry, &meshes, &target.view);
+    gpu.queue.submit([encoder.finish()]);
+    let targets = chain.targets().context("nothing was rendered")?;
+    let shown = if chain.settings().blur.is_some() { &targets.ao_blurred } else { &targets.ao };
+    let raw = lineao::verify::read_f32(&gpu.device, &gpu.queue, shown)?;
+    let nd = lineao::verify::read_rgba(&gpu.device, &gpu.queue, &targets.nd[0])?;
+    let guard = targets.guard as usize;
+    let (w, h) = (width as usize, height as usize);
+    let ao = Image::from_fn(w, h, |x, y| raw.get(x + guard, y + guard));
+    let geometry = (0..w * h)
+        .map(|i| {
+            let t = nd.get(i % w + guard, i / w + guard);
+            t[0] != 0.0 || t[1] != 0.0 || t[2] != 0.0
+        })
+        .collect();
+    Ok(MethodAo { ao, geometry })
 }
 
 /// Scores `methods` on `session`'s view.
@@ -82,7 +134,7 @@ pub fn score(session: &Session, args: &crate::cli::RenderArgs, methods: &[ScoreM
     anyhow::ensure!(truth.geometry_pixels > 0, "{}: no geometry in view", session.name);
     let ao_truth = truth.ao.clone();
     let vo_truth = truth.vo.clone();
-    let strength = args.strength;
+    let strength_of = |m: ScoreMethod| method_settings(session, args, m).strength;
     let composite = |ao: &Image<f32>| -> Image<f32> {
         Image::from_fn(w, h, |x, y| {
             let c = color[y * w + x];
@@ -111,25 +163,11 @@ pub fn score(session: &Session, args: &crate::cli::RenderArgs, methods: &[ScoreM
             let again = TruthSettings { seed: truth_settings.seed.wrapping_add(1), vo: None, ..truth_settings.clone() };
             session.trace(&rendered.chain, &again)?.ao
         } else {
-            let settings = method_settings(session, args, m);
-            let panel = Panel::new(Method { screen: m.method, volume: None }, settings);
-            let out = session.render(&quiet, &panel, None, None)?;
-            let targets = out.chain.targets().context("nothing was rendered")?;
-            let shown = out
-                .chain
-                .ao_view()
-                .map(|_| if out.chain.settings().blur.is_some() { &targets.ao_blurred } else { &targets.ao });
-            let raw = lineao::verify::read_f32(&gpu.device, &gpu.queue, shown.context("no AO")?)?;
-            let method_nd = lineao::verify::read_rgba(&gpu.device, &gpu.queue, &targets.nd[0])?;
-            let guard = targets.guard as usize;
-            // Both G-buffers must show geometry at a compared pixel.
-            for y in 0..h {
-                for x in 0..w {
-                    mask[y * w + x] &= geometry(&method_nd, x + guard, y + guard);
-                }
-            }
-            let cropped = crop(&raw, guard, w, h);
-            Image { data: cropped.data.iter().map(|a| (strength * a).clamp(0.0, 1.0)).collect(), ..cropped }
+            let mut chain = None;
+            let view = raw_ao(session, &mut chain, method_settings(session, args, m), args.width, args.height)?;
+            mask.iter_mut().zip(&view.geometry).for_each(|(m, g)| *m &= g);
+            let strength = strength_of(m);
+            Image { data: view.ao.data.iter().map(|a| (strength * a).clamp(0.0, 1.0)).collect(), ..view.ao }
         };
         rows.push((m, truth_name, target_truth.clone(), ao));
     }
@@ -153,6 +191,9 @@ fn srgb(v: f32) -> f32 {
 
 pub fn run(args: &ScoreArgs) -> Result<()> {
     let render = &args.render;
+    if args.fit {
+        return crate::fit::run(args);
+    }
     let methods = if args.methods.is_empty() { ScoreMethod::ALL.to_vec() } else { args.methods.clone() };
     let session = Session::open(render)?;
     let report = score(&session, render, &methods)?;

@@ -281,11 +281,14 @@ fn bench_json_is_the_contract() {
             "nd-from-depth",
             "density-256",
             "sweep-256",
-            "variance-volume-256"
+            "variance-volume-256",
+            "bvh-build-1m",
+            "raytraced-cpu-64"
         ]
     );
     for p in passes {
-        let cpu_pass = ["density-256", "sweep-256", "variance-volume-256"].contains(&p["name"].as_str().unwrap());
+        let cpu_pass = ["density-256", "sweep-256", "variance-volume-256", "bvh-build-1m", "raytraced-cpu-64"]
+            .contains(&p["name"].as_str().unwrap());
         assert_eq!(p["on"], if cpu_pass { "cpu" } else { on });
         let ms = |k: &str| p[k].as_f64().unwrap();
         assert!(0.0 <= ms("ms_min") && ms("ms_min") <= ms("ms_median") && ms("ms_median") <= ms("ms_max"), "{p}");
@@ -594,4 +597,146 @@ fn surfaces_and_tubes_render() {
         assert_eq!(out.status.code(), Some(0), "{name}: {}", stderr(&out));
         assert!(std::fs::metadata(&png).unwrap().len() > 100);
     }
+}
+
+/// The ray-traced truth's command-line checks: bad values exit 2 with the reason.
+#[test]
+fn truth_options_are_checked() {
+    for (bad, needle) in [
+        (&["render", "--method", "raytraced", "--rays", "0"][..], "rays"),
+        (&["render", "--method", "raytraced", "--ao-distance=-1"], "positive"),
+        (&["render", "--method", "raytraced", "--ao-distance", "nan"], "positive"),
+        (&["render", "--method", "raytraced", "--ao-distance", "inf"], "positive"),
+        (&["score", "--ao-distance", "0"], "positive"),
+        (&["score", "--methods", "magic"], "unknown method"),
+        (&["render", "--preset", "fancy"], "unknown preset"),
+    ] {
+        let out = lineao(bad);
+        assert_eq!(out.status.code(), Some(2), "{bad:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains(needle), "{bad:?}: {}", stderr(&out));
+    }
+}
+
+/// A lone, gently curved polyline facing the camera occludes nothing: its own segment and its
+/// neighbours never occlude its surface, and no origin is buried. (A sharp zigzag does occlude
+/// itself: segment k + 2 is another part of the line, a few millimetres away.)
+#[test]
+fn a_lone_line_has_no_truth_ao() {
+    let dir = scratch("lone_line");
+    let mut tracts = lineao_tracts::Tractogram::new();
+    tracts.positions = (0..40).map(|i| [i as f32 * 1.5, (i as f32 * 0.35).sin() * 0.8, 0.0]).collect();
+    tracts.offsets = vec![0, 40];
+    let file = dir.join("curve.tck");
+    lineao_tracts::save(&tracts, &file).unwrap();
+    let dump = dir.join("dump");
+    let out = lineao(&[
+        "render",
+        file.to_str().unwrap(),
+        "--method",
+        "raytraced",
+        "--rays",
+        "64",
+        "--line-width",
+        "4",
+        "--eye",
+        "29,0,70",
+        "--target",
+        "29,0,0",
+        "--up",
+        "0,1,0",
+        "--width",
+        "160",
+        "--height",
+        "120",
+        "-o",
+        dir.join("x.png").to_str().unwrap(),
+        "--dump",
+        dump.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let (shape, ao) = read_npy(&dump.join("ao.npy"));
+    let (_, nd) = read_npy(&dump.join("nd_0.npy"));
+    assert_eq!(shape, [120, 160]);
+    let geometry = nd.chunks(4).filter(|t| t[..3] != [0.0; 3]).count();
+    assert!(geometry > 200, "{geometry} line pixels");
+    let worst = ao.iter().cloned().fold(0.0f32, f32::max);
+    assert_eq!(worst, 0.0, "a lone line occludes itself");
+    let params: Value = serde_json::from_str(&std::fs::read_to_string(dump.join("params.json")).unwrap()).unwrap();
+    assert_eq!(params["method"], "raytraced");
+    assert_eq!(params["rays"], 64);
+    assert_eq!(params["ao_distance_world"], 2.0);
+    assert_eq!(params["ao_falloff"], "none");
+    assert_eq!(params["ray_seed"], 1);
+    assert_eq!(params["buried_share"], 0.0);
+    assert!(dump.join("ao_stderr.npy").exists());
+}
+
+/// `score` on a built-in scene: the truth traced again with another seed agrees with the truth
+/// better than any screen-space method; the JSON carries every method; the truth is deterministic
+/// for a seed (two runs, the same numbers).
+#[test]
+fn score_ranks_the_truth_first() {
+    let dir = scratch("score");
+    let grid = dir.join("grid.png");
+    let args = [
+        "score",
+        "--vertices",
+        "30000",
+        "--width",
+        "200",
+        "--height",
+        "160",
+        "--rays",
+        "64",
+        "--json",
+        "-o",
+        grid.to_str().unwrap(),
+    ];
+    let out = lineao(&args);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let report: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let methods = report["methods"].as_array().unwrap();
+    let names: Vec<&str> = methods.iter().map(|m| m["method"].as_str().unwrap()).collect();
+    assert_eq!(names, ["lineao", "lineao-reference", "vo-line", "vo-area", "ssao", "raytraced"]);
+    let correlation =
+        |name: &str| methods.iter().find(|m| m["method"] == name).unwrap()["correlation"].as_f64().unwrap();
+    let truth = correlation("raytraced");
+    assert!(truth > 0.9, "the truth against itself: {truth}");
+    for name in &names[..5] {
+        assert!(correlation(name) < truth, "{name}: {} vs the truth's {truth}", correlation(name));
+    }
+    for m in methods {
+        for key in ["bias", "mean_abs", "rmse", "ssim", "scale", "image_ssim", "pixels", "mean", "truth_mean"] {
+            assert!(m[key].is_number(), "{key} of {}", m["method"]);
+        }
+        assert!(
+            m["scaled"]["rmse"].as_f64().unwrap() <= m["rmse"].as_f64().unwrap() + 1e-9 || m["method"] == "raytraced"
+        );
+    }
+    assert!(report["buried_share"].as_f64().unwrap() < 0.2);
+    assert_eq!(common::read_png(&grid).0, (3 * 200, 6 * 160));
+    let again = lineao(&args);
+    let again: Value = serde_json::from_slice(&again.stdout).unwrap();
+    assert_eq!(report["methods"][0]["truth_mean"], again["methods"][0]["truth_mean"]);
+}
+
+#[test]
+fn score_without_geometry_in_view_says_so() {
+    let out = lineao(&[
+        "score",
+        "--vertices",
+        "2000",
+        "--width",
+        "64",
+        "--height",
+        "48",
+        "--eye",
+        "0,0,500",
+        "--target",
+        "0,0,1000",
+        "--up",
+        "0,1,0",
+    ]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert!(stderr(&out).contains("no geometry in view"), "{}", stderr(&out));
 }

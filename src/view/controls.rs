@@ -72,6 +72,10 @@ pub enum ColorMode {
 /// The two parameter sets the presets choose between.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Preset {
+    /// lineao's calibrated values (`lineao::Preset::Calibrated`): each method's strength and
+    /// reach fitted to the ray-traced truth. The strength slider then holds LineAO's, and the
+    /// other methods keep their calibrated strength relative to it.
+    Calibrated,
     /// Whole-brain tractography, hundreds of thousands of streamlines packed millimetres apart:
     /// the paper's values (thin lines, three hemispheres, SSAO and VO spheres of 2 mm).
     Dense,
@@ -106,6 +110,9 @@ impl Params {
         volume.density.occupancy_radius = 0.5 * zoom_unit;
         let mut params =
             Params { chain, tube_radius: 0.5 * zoom_unit, volume, cloudy: false, volume_combine: VoCombine::Product };
+        if preset == Preset::Calibrated {
+            params.chain = params.chain.with_preset(lineao::Preset::Calibrated);
+        }
         if preset == Preset::Sparse {
             let c = &mut params.chain;
             c.line_width_px = 3.0;
@@ -185,6 +192,14 @@ impl Controls {
         };
         let mut settings = p.chain.clone();
         settings.method = method.screen;
+        if self.preset == Preset::Calibrated {
+            // The slider holds LineAO's calibrated strength; another method keeps its own
+            // calibrated strength relative to it.
+            let calibrated = |method| {
+                ChainSettings { method, ..ChainSettings::default() }.with_preset(lineao::Preset::Calibrated).strength
+            };
+            settings.strength *= calibrated(method.screen) / calibrated(AoMethod::LineAo);
+        }
         settings.volume = method.volume.map(|_| VolumeAoSettings {
             // The view-independent forms hold the sky already.
             sky: if p.volume.form.is_none() { sky.weights() } else { [1.0; 8] },
@@ -252,6 +267,7 @@ impl Controls {
         ui.heading("Parameters");
         ui.horizontal(|ui| {
             for (preset, label, hint) in [
+                (Preset::Calibrated, "Calibrated", "Strength and reach fitted to the ray-traced truth"),
                 (Preset::Dense, "Dense tractography", "The paper's values"),
                 (Preset::Sparse, "Sparse streamlines", "Wider lines, wider reach"),
             ] {

@@ -30,6 +30,7 @@ fn options(args: &ViewArgs) -> app::Options {
         }
     };
     let preset = match args.preset {
+        PresetArg::Calibrated => Preset::Calibrated,
         PresetArg::Dense => Preset::Dense,
         PresetArg::Sparse => Preset::Sparse,
     };

@@ -65,7 +65,8 @@ pub use chain::AoChain;
 pub use gpu::Gpu;
 pub use settings::{
     AoMethod, BilateralSettings, ChainSettings, Colormap, DebugView, LineAoOuter, LineAoSettings, LineAoVariant,
-    LineColor, R0, SsaoKernel, SsaoSettings, SurfaceSettings, TubeSettings, VoCombine, VoSettings, VolumeAoSettings,
+    LineColor, Preset, R0, SsaoKernel, SsaoSettings, SurfaceSettings, TubeSettings, VoCombine, VoSettings,
+    VolumeAoSettings,
 };
 
 /// Pyramid levels (and so LineAO hemispheres) the shaders can bind.

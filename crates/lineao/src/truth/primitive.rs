@@ -7,6 +7,11 @@
 //!
 //! Positions are stored as f32 (what the frame drew); every intersection is computed in f64
 //! *relative to the ray's origin*, so coordinates near 1e5 keep their sub-micrometre detail.
+//!
+//! The cone's algebra is that of `reference::tubes::intersect_rounded_cone`, which stays apart on
+//! purpose: it follows the tube shader's f32 arithmetic step by step to prove the shader, while
+//! this one is the truth's — f64, an interval (t_min, t_max) and every root kept, so rays from
+//! inside a volume meet its surface too.
 
 use glam::{DVec3, Vec3};
 

@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# Reproduces the README's table "How far each method is from the truth": `lineao score --json`
+# on the built-in scenes and the real tractograms of ../shared/data, at R = 2 mm (the default)
+# and R = 5 mm, 640 × 512, 256 rays, each method at the preset's values (calibrated by default;
+# PRESET=paper for the papers'). Prints a Markdown table (python3 formats the JSON).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+data=../shared/data
+preset=${PRESET:-calibrated}
+sources=(--scene=bundles --scene=spiral --scene=vortex
+  "$data/niivue+niivue/packages/niivue/demos/images/stroke.trk.gz"
+  "$data/niivue+niivue/packages/niivue/demos/images/sub-01_ses-01_dwi_space-RASMM_model-probCSD_algo-AFQ_tractography.trx"
+  "$data/SlicerDMRI+whitematteranalysis/tests/test_atlas_results/atlas1.vtp"
+  "$data/dipy+dipy/dipy/data/files/tracks300.trk")
+cargo build --release --quiet
+echo "| data | R | method | truth | mean | truth mean | bias | RMSE | corr. | SSIM | scale | image SSIM |"
+echo "|---|---:|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"
+for source in "${sources[@]}"; do
+  for distance in 2 5; do
+    ./target/release/lineao score "$source" --width 640 --height 512 --rays 256 --ao-distance "$distance" \
+      --preset "$preset" --json 2>/dev/null | python3 -c '
+import json, os, sys
+r = json.load(sys.stdin)
+name = os.path.basename(r["scene"])
+for m in r["methods"]:
+    print(f"| {name} | {r[\"ao_distance_world\"]:g} | {m[\"method\"]} | {m[\"truth\"]} | {m[\"mean\"]:.3f} | {m[\"truth_mean\"]:.3f} "
+          f"| {m[\"bias\"]:+.3f} | {m[\"rmse\"]:.3f} | {m[\"correlation\"]:.3f} | {m[\"ssim\"]:.3f} | {m[\"scale\"]:.2f} | {m[\"image_ssim\"]:.3f} |")
+'
+  done
+done
