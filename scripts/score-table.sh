@@ -13,18 +13,20 @@ sources=(--scene=bundles --scene=spiral --scene=vortex
   "$data/SlicerDMRI+whitematteranalysis/tests/test_atlas_results/atlas1.vtp"
   "$data/dipy+dipy/dipy/data/files/tracks300.trk")
 cargo build --release --quiet
+format='
+import json, os, sys
+r = json.load(sys.stdin)
+name = os.path.basename(r["scene"])
+for m in r["methods"]:
+    print("| %s | %g | %s | %s | %.3f | %.3f | %+.3f | %.3f | %.3f | %.3f | %.2f | %.3f |" % (
+        name, r["ao_distance_world"], m["method"], m["truth"], m["mean"], m["truth_mean"], m["bias"],
+        m["rmse"], m["correlation"], m["ssim"], m["scale"], m["image_ssim"]))
+'
 echo "| data | R | method | truth | mean | truth mean | bias | RMSE | corr. | SSIM | scale | image SSIM |"
 echo "|---|---:|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"
 for source in "${sources[@]}"; do
   for distance in 2 5; do
     ./target/release/lineao score "$source" --width 640 --height 512 --rays 256 --ao-distance "$distance" \
-      --preset "$preset" --json 2>/dev/null | python3 -c '
-import json, os, sys
-r = json.load(sys.stdin)
-name = os.path.basename(r["scene"])
-for m in r["methods"]:
-    print(f"| {name} | {r[\"ao_distance_world\"]:g} | {m[\"method\"]} | {m[\"truth\"]} | {m[\"mean\"]:.3f} | {m[\"truth_mean\"]:.3f} "
-          f"| {m[\"bias\"]:+.3f} | {m[\"rmse\"]:.3f} | {m[\"correlation\"]:.3f} | {m[\"ssim\"]:.3f} | {m[\"scale\"]:.2f} | {m[\"image_ssim\"]:.3f} |")
-'
+      --preset "$preset" --json 2>/dev/null | python3 -c "$format"
   done
 done
