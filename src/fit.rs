@@ -17,7 +17,7 @@ use glam::Quat;
 use lineao::truth::{TruthSettings, VoBall};
 use lineao::{AoMethod, ChainSettings, LineAoVariant};
 
-use crate::cli::{Method, RenderArgs, ScoreArgs};
+use crate::cli::{Method, RenderArgs, ScoreArgs, ScoreMethod};
 use crate::render::Session;
 use crate::score::raw_ao;
 
@@ -28,9 +28,7 @@ struct Candidate {
 }
 
 struct Family {
-    name: &'static str,
-    method: AoMethod,
-    variant: LineAoVariant,
+    method: ScoreMethod,
     /// The first candidate is the paper's (our defaults').
     candidates: Vec<Candidate>,
 }
@@ -73,32 +71,14 @@ fn families(line_width: f32) -> Vec<Family> {
         s.ssao.range_world = r;
     };
     let reference = |s: &mut ChainSettings, r: f32| s.line_ao.reference_radius_px = r;
+    let family = |method, variant, candidates| Family { method: ScoreMethod { method, variant }, candidates };
+    let paper = LineAoVariant::Paper;
     vec![
-        Family { name: "lineao", method: AoMethod::LineAo, variant: LineAoVariant::Paper, candidates: lineao },
-        Family {
-            name: "lineao-reference",
-            method: AoMethod::LineAo,
-            variant: LineAoVariant::Reference,
-            candidates: radii(2.0, &[1.0, 3.0], reference),
-        },
-        Family {
-            name: "vo-line",
-            method: AoMethod::VoLine,
-            variant: LineAoVariant::Paper,
-            candidates: radii(2.0, &[1.0, 1.5, 3.0], vo),
-        },
-        Family {
-            name: "vo-area",
-            method: AoMethod::VoArea,
-            variant: LineAoVariant::Paper,
-            candidates: radii(2.0, &[1.0, 3.0], vo),
-        },
-        Family {
-            name: "ssao",
-            method: AoMethod::Ssao,
-            variant: LineAoVariant::Paper,
-            candidates: radii(2.0, &[1.0, 1.5, 3.0], ssao),
-        },
+        family(AoMethod::LineAo, paper, lineao),
+        family(AoMethod::LineAo, LineAoVariant::Reference, radii(2.0, &[1.0, 3.0], reference)),
+        family(AoMethod::VoLine, paper, radii(2.0, &[1.0, 1.5, 3.0], vo)),
+        family(AoMethod::VoArea, paper, radii(2.0, &[1.0, 3.0], vo)),
+        family(AoMethod::Ssao, paper, radii(2.0, &[1.0, 1.5, 3.0], ssao)),
     ]
 }
 
@@ -185,15 +165,13 @@ pub fn run(args: &ScoreArgs) -> Result<()> {
                 let mut maps = Vec::new();
                 let mut mask = gbuffer.geometry.clone();
                 for candidate in &family.candidates {
-                    let mut settings = session.settings(source, Method { screen: family.method, volume: None });
-                    settings.line_ao.variant = family.variant;
-                    settings.blur = None;
+                    let mut settings = crate::score::method_settings(&session, source, family.method);
                     (candidate.apply)(&mut settings);
                     let view = raw_ao(&session, &mut chain, settings, source.width, source.height)?;
                     mask.iter_mut().zip(&view.geometry).for_each(|(m, g)| *m &= g);
                     maps.push(view.ao.data);
                 }
-                let target = match family.method {
+                let target = match family.method.method {
                     AoMethod::VoLine | AoMethod::VoArea => truth.vo.as_ref().expect("asked for"),
                     _ => &truth.ao,
                 };
@@ -247,11 +225,11 @@ fn report(families: &[Family], views: &[View]) {
         }
         let (_, c, s) = if best_readable.0.is_finite() { best_readable } else { best };
         if !best_readable.0.is_finite() {
-            eprintln!("lineao: {}: no setting keeps every tractogram's mean within 0.1", family.name);
+            eprintln!("lineao: {}: no setting keeps every tractogram's mean within 0.1", family.method.name());
         }
         println!(
             "| {} | {} | {:.2} | {:.4} | {:.4} | {:.4} | {:.4} |",
-            family.name,
+            family.method.name(),
             family.candidates[c].label,
             s,
             error(&mut fit(), c, s),

@@ -171,12 +171,13 @@ pub fn score(session: &Session, args: &crate::cli::RenderArgs, methods: &[ScoreM
         };
         rows.push((m, truth_name, target_truth.clone(), ao));
     }
+    let all = vec![true; w * h];
+    let true_image = composite(&ao_truth);
     let rows = rows
         .into_iter()
         .map(|(method, truth_name, target, ao)| {
             let scores = metrics::score(&ao, &target, &mask);
-            let all = vec![true; w * h];
-            let image_ssim = metrics::mean_ssim(&composite(&ao), &composite(&ao_truth), &all);
+            let image_ssim = metrics::mean_ssim(&composite(&ao), &true_image, &all);
             Row { method, truth: truth_name, scores, image_ssim, ao }
         })
         .collect();
