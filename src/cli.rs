@@ -536,6 +536,10 @@ pub struct RenderArgs {
     /// LineAO δ0.
     #[arg(long, default_value_t = 1e-4)]
     pub delta0: f32,
+    /// LineAO: scale of the falloff δ(j) = scale · (1 − j/s_r)², in (0, 1]; below 1 occluders
+    /// far in front (in normalized depth) stop counting [default: the preset's; paper 1].
+    #[arg(long)]
+    pub delta_scale: Option<f32>,
     /// LineAO ε: occluded iff Δd > ε.
     #[arg(long, default_value_t = 1e-6)]
     pub epsilon: f32,

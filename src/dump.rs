@@ -132,6 +132,7 @@ pub fn write(
             LineAoVariant::Paper => json!({
                 "r0_px": s.r0().px,
                 "delta0": ao.delta0,
+                "delta_scale": ao.delta_scale,
                 "epsilon": ao.epsilon,
                 "kd": s.lighting.kd,
                 "ks": s.lighting.ks,

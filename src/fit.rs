@@ -35,27 +35,22 @@ struct Family {
 
 fn families(line_width: f32) -> Vec<Family> {
     let c = |label: String, apply: Box<dyn Fn(&mut ChainSettings)>| Candidate { label, apply };
+    // The paper's first, then s_r × r0 (multiples of the line width) × the scale of δ(j).
     let mut lineao = Vec::new();
-    for (s_r, k) in [
-        (3, 1.5f32),
-        (1, 1.5),
-        (2, 1.5),
-        (4, 1.5),
-        (3, 1.0),
-        (3, 2.0),
-        (3, 3.0),
-        (2, 1.0),
-        (2, 3.0),
-        (1, 1.0),
-        (1, 3.0),
-        (1, 5.0),
-    ] {
+    let paper = (3, 1.5f32, 1.0f32);
+    let grid = [1, 2, 3].into_iter().flat_map(|s_r| {
+        [1.0f32, 1.5, 3.0]
+            .into_iter()
+            .flat_map(move |k| [1.0f32, 0.3, 0.1, 0.03].into_iter().map(move |delta| (s_r, k, delta)))
+    });
+    for (s_r, k, delta_scale) in std::iter::once(paper).chain(grid.filter(|&c| c != paper)) {
         let r0 = k * line_width;
         lineao.push(c(
-            format!("s_r {s_r}, r0 {r0} px"),
+            format!("s_r {s_r}, r0 {r0} px, δ scale {delta_scale}"),
             Box::new(move |s: &mut ChainSettings| {
                 s.line_ao.s_r = s_r;
                 s.line_ao.r0_px = Some(r0);
+                s.line_ao.delta_scale = delta_scale;
             }),
         ));
     }

@@ -114,6 +114,7 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky) -> 
             s_h: args.s_h,
             r0_px: args.r0,
             delta0: args.delta0,
+            delta_scale: LineAoSettings::default().delta_scale,
             epsilon: args.epsilon,
             light_attenuation: !args.no_light_attenuation,
             noise_seed: args.noise_seed,
@@ -164,6 +165,9 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky) -> 
     }
     if let Some(r0) = args.r0 {
         settings.line_ao.r0_px = Some(r0);
+    }
+    if let Some(scale) = args.delta_scale {
+        settings.line_ao.delta_scale = scale;
     }
     if let Some(radius) = args.reference_radius {
         settings.line_ao.reference_radius_px = radius;

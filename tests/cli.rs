@@ -129,7 +129,7 @@ fn recompute_from_dump(variant: &str, outer: &str, geometry: &str) {
 
     let params: Value = serde_json::from_str(&std::fs::read_to_string(dump.join("params.json")).unwrap()).unwrap();
     let variant_keys: &[&str] = match variant {
-        "paper" => &["r0_px", "delta0", "epsilon", "kd", "ks", "shininess"],
+        "paper" => &["r0_px", "delta0", "delta_scale", "epsilon", "kd", "ks", "shininess"],
         _ => &["reference_radius_px", "zoom_fit"],
     };
     let geometry_key = if geometry == "tubes" { "tube_radius_world" } else { "line_width_px" };
@@ -220,6 +220,7 @@ fn recompute_from_dump(variant: &str, outer: &str, geometry: &str) {
         r0_px: get("r0_px"),
         r0_zoom: 1.5 * 2.0 * get("tube_radius_world") / get("zoom_unit"),
         delta0: get("delta0"),
+        delta_scale: get("delta_scale"),
         epsilon: get("epsilon"),
         light_attenuation: params["light_attenuation"].as_bool().unwrap(),
         lights,

@@ -406,8 +406,9 @@ fn line_ao_ui(ui: &mut Ui, chain: &mut ChainSettings) {
     if ui.add(egui::Slider::new(&mut r0, 0.5..=16.0).text("r0 (px)")).changed() {
         ao.r0_px = Some(r0);
     }
-    // δ0 < (1/s_r)² (ChainSettings::validate).
-    let max = 0.9 / (ao.s_r * ao.s_r) as f32;
+    ui.add(egui::Slider::new(&mut ao.delta_scale, 1e-3..=1.0).logarithmic(true).text("δ scale"));
+    // δ0 < δ scale · (1/s_r)² (ChainSettings::validate).
+    let max = 0.9 * ao.delta_scale / (ao.s_r * ao.s_r) as f32;
     ao.delta0 = ao.delta0.min(max);
     ui.add(egui::Slider::new(&mut ao.delta0, 1e-6..=max.min(1e-2)).logarithmic(true).text("δ0"));
     ui.add(egui::Slider::new(&mut ao.epsilon, 1e-8..=1e-3).logarithmic(true).text("ε"));

@@ -81,6 +81,11 @@ pub struct LineAoSettings {
     pub r0_px: Option<f32>,
     /// δ0, the depth difference below which an occluder counts fully. Default 1e-4.
     pub delta0: f32,
+    /// Scale of the falloff δ(j) = delta_scale · (1 − j/s_r)² (Eq. 11), in (0, 1]: the depth
+    /// difference (normalized depth) beyond which hemisphere j's occluders no longer count. The
+    /// paper's 1 lets anything in front count, however far; smaller values keep occlusion local
+    /// in depth. Default 1 (paper).
+    pub delta_scale: f32,
     /// ε: occluded iff Δd > ε. Default 1e-6 (CONTRACT.md departs from Eq. 8's Δd ≥ 0).
     pub epsilon: f32,
     /// Light attenuation g_light of Eq. 15; off means g_light = 1.
@@ -125,6 +130,7 @@ impl Default for LineAoSettings {
             s_h: 32,
             r0_px: None,
             delta0: 1e-4,
+            delta_scale: 1.0,
             epsilon: 1e-6,
             light_attenuation: true,
             noise_seed: 1,
@@ -527,9 +533,10 @@ impl Preset {
 /// (docs/ground-truth.md has the table, fit and held-out).
 struct Calibrated {
     strength: f32,
-    /// LineAO: hemispheres, and r0 as a multiple of the line width.
+    /// LineAO: hemispheres, r0 as a multiple of the line width, and the scale of δ(j).
     s_r: u32,
     r0_per_width: f32,
+    delta_scale: f32,
     /// The reference variant's base radius, px.
     reference_radius_px: f32,
     /// VO's and SSAO's sphere, zoom units.
@@ -541,7 +548,14 @@ impl ChainSettings {
     /// s_r and r0 (lines; tubes keep Eq. 16's r0), VO's and SSAO's radius in zoom units.
     /// [`Preset::Paper`] restores the defaults of those.
     pub fn with_preset(mut self, preset: Preset) -> ChainSettings {
-        let paper = Calibrated { strength: 1.0, s_r: 3, r0_per_width: 1.5, reference_radius_px: 2.0, radius: 2.0 };
+        let paper = Calibrated {
+            strength: 1.0,
+            s_r: 3,
+            r0_per_width: 1.5,
+            delta_scale: 1.0,
+            reference_radius_px: 2.0,
+            radius: 2.0,
+        };
         let c = match (preset, self.method, self.line_ao.variant) {
             (Preset::Paper, ..) => paper,
             // One hemisphere: the outer ones (on coarser levels, up to 2 mm out) darken dense
@@ -559,6 +573,7 @@ impl ChainSettings {
         };
         self.strength = c.strength;
         self.line_ao.s_r = c.s_r;
+        self.line_ao.delta_scale = c.delta_scale;
         self.line_ao.r0_px = if self.tubes.is_none() { Some(c.r0_per_width * self.line_width_px) } else { None };
         self.line_ao.reference_radius_px = c.reference_radius_px;
         self.vo.radius_world = c.radius * self.zoom_unit;
@@ -613,8 +628,12 @@ impl ChainSettings {
         if !(self.r0_px().is_finite() && self.r0_px() >= 0.0) {
             return bad(format!("r0 must be a finite number of pixels >= 0, got {}", self.r0_px()));
         }
-        if !(ao.delta0.is_finite() && ao.delta0 >= 0.0 && ao.delta0 < (1.0 / ao.s_r as f32).powi(2)) {
-            return bad(format!("delta0 must be in [0, (1/s_r)^2), got {}", ao.delta0));
+        if !(ao.delta_scale.is_finite() && ao.delta_scale > 0.0 && ao.delta_scale <= 1.0) {
+            return bad(format!("the δ scale must be in (0, 1], got {}", ao.delta_scale));
+        }
+        let last_delta = ao.delta_scale * (1.0 / ao.s_r as f32).powi(2);
+        if !(ao.delta0.is_finite() && ao.delta0 >= 0.0 && ao.delta0 < last_delta) {
+            return bad(format!("delta0 must be in [0, δ scale · (1/s_r)^2) = [0, {last_delta}), got {}", ao.delta0));
         }
         if ao.variant == LineAoVariant::Reference && ao.outer == LineAoOuter::Level {
             return bad("outer = level applies to variant paper (reference reads level 0 only)".into());

@@ -25,7 +25,9 @@ fn settings(s_r: u32, r0_px: f32, light_attenuation: bool) -> ChainSettings {
 fn delta_curve_and_depth_weight() {
     // δ(l) = (1 − l/s_r)² (Eq. 11): 1, 4/9, 1/9 for s_r = 3.
     for (j, expected) in [(0, 1.0), (1, 4.0 / 9.0), (2, 1.0 / 9.0)] {
-        assert!((reference::delta(j, 3) - expected).abs() < 1e-6);
+        assert!((reference::delta(j, 3, 1.0) - expected).abs() < 1e-6);
+        // The δ scale multiplies the whole curve.
+        assert!((reference::delta(j, 3, 0.1) - 0.1 * expected).abs() < 1e-7);
     }
     let (d0, dj) = (1e-4, 4.0 / 9.0);
     assert_eq!(reference::depth_weight(0.5 * d0, dj, d0), 1.0);
@@ -50,6 +52,7 @@ fn light_weight_closed_form() {
         r0_px: 3.0,
         r0_zoom: 0.0,
         delta0: 1e-4,
+        delta_scale: 1.0,
         epsilon: 1e-6,
         light_attenuation: true,
         lights: vec![Light { dir, intensity: 1.0 }],
@@ -248,6 +251,12 @@ fn gpu_matches_cpu_reference_on_rendered_lines() {
             perspective,
             ChainSettings { lighting: Lighting { lights: vec![], ..Lighting::default() }, ..Default::default() },
         ),
+        (
+            // The δ scale reaches the shader: occluders beyond 0.05 in depth stop counting.
+            "perspective, δ scale 0.05",
+            perspective,
+            ChainSettings { line_ao: LineAoSettings { delta_scale: 0.05, ..Default::default() }, ..Default::default() },
+        ),
     ];
     for (name, cam, s) in cases {
         let frame = render(&gpu, &positions, &offsets, &cam, None, s.clone(), (240, 180));
@@ -270,6 +279,14 @@ fn gpu_matches_cpu_reference_on_rendered_lines() {
         let stats = check_policy(&frame.ao, &cpu, &frame.nd[0], line_ao_flip_bound(3, 32))
             .unwrap_or_else(|e| panic!("{name}: {e}"));
         println!("{name}: {stats}");
+        if s.line_ao.delta_scale != 1.0 {
+            // The case can fail: with the paper's δ the reference differs on many pixels.
+            let paper =
+                ChainSettings { line_ao: LineAoSettings { delta_scale: 1.0, ..s.line_ao.clone() }, ..s.clone() };
+            let unscaled = cpu_line_ao(&frame.nd, &frame.zoom, &paper, &frame.view);
+            let differing = unscaled.data.iter().zip(&cpu.data).filter(|(a, b)| (*a - *b).abs() > 0.02).count();
+            assert!(differing > 500, "{name}: δ scale changes only {differing} pixels");
+        }
         let occluded = frame.ao.data.iter().filter(|&&a| a > 0.05).count();
         assert!(occluded > 500, "{name}: only {occluded} occluded pixels");
         // The composite over the visible window.

@@ -77,6 +77,9 @@ pub struct LineAoUniform {
     pub epsilon: f32,
     /// r0's part per unit of zoom (tubes, Eq. 16): r0(P) = r0_px + r0_zoom · z(P).
     pub r0_zoom: f32,
+    /// δ(j) = delta_scale · (1 − j/s_r)².
+    pub delta_scale: f32,
+    pub _pad: [f32; 3],
 }
 
 /// The `reference` variant's base radius per axis, in pixels per unit of zoom z(P) at d = 0.
@@ -287,6 +290,8 @@ impl LineAo {
             reference_scale: reference_scale(view, settings.reference_radius_px),
             epsilon: settings.epsilon,
             r0_zoom: r0.per_zoom,
+            delta_scale: settings.delta_scale,
+            _pad: [0.0; 3],
         };
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
         queue.write_buffer(&self.lighting, 0, bytemuck::bytes_of(&lighting.uniform()));

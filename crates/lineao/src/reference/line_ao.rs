@@ -21,6 +21,8 @@ pub struct LineAoParams {
     /// Tubes (Eq. 16): r0(P) = r0_px + r0_zoom · z(P).
     pub r0_zoom: f32,
     pub delta0: f32,
+    /// δ(j) = delta_scale · (1 − j/s_r)².
+    pub delta_scale: f32,
     pub epsilon: f32,
     pub light_attenuation: bool,
     /// Unit view-space directions toward the lights, with intensities.
@@ -48,6 +50,7 @@ impl LineAoParams {
             r0_px: settings.r0().px,
             r0_zoom: settings.r0().per_zoom,
             delta0: ao.delta0,
+            delta_scale: ao.delta_scale,
             epsilon: ao.epsilon,
             light_attenuation: ao.light_attenuation,
             lights: settings.lighting.normalized(),
@@ -64,10 +67,10 @@ pub fn hermite(x: f32) -> f32 {
     x * x * (3.0 - 2.0 * x)
 }
 
-/// δ(j) = (1 − j/s_r)² (Eq. 11).
-pub fn delta(j: u32, s_r: u32) -> f32 {
+/// δ(j) = scale · (1 − j/s_r)² (Eq. 11; the paper's scale is 1).
+pub fn delta(j: u32, s_r: u32, scale: f32) -> f32 {
     let falloff = 1.0 - j as f32 / s_r as f32;
-    falloff * falloff
+    scale * falloff * falloff
 }
 
 /// g_depth (Eq. 12): 0 above δ(j), 1 below δ0, 1 − h((Δd − δ0)/(δ(j) − δ0)) between.
@@ -195,7 +198,7 @@ fn hemisphere(&Inputs { levels, zoom, noise, samples }: &Inputs, p: &LineAoParam
     let centre = level.clamped(cx, cy);
     let n = Vec3::new(centre[0], centre[1], centre[2]);
     let radius = p.r0_px + (p.r0_zoom + j as f32) * zoom.get(x, y);
-    let delta_j = delta(j, p.s_r);
+    let delta_j = delta(j, p.s_r, p.delta_scale);
     let count = crate::noise::samples_on_hemisphere(p.s_h, j);
     let mut occlusion = 0.0f32;
     for i in 0..count {

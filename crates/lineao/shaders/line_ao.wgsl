@@ -4,6 +4,7 @@
 //   LineAO(P) = clamp( sum_j AO_j(P), 0, 1 )                                       (Eq. 7)
 //   AO_j(P)   = 1/n_j sum_i [Δd > ε] · g_depth(Δd, j) · g_light(n_j(P), ω_i)      (Eq. 6, 9)
 //   Δd        = d_j(P) - d_j(P + r_j (ω.x, -ω.y))                                  (Eq. 10)
+//   δ(j)      = delta_scale · (1 - j/s_r)²  (Eq. 11; the paper's delta_scale is 1)
 //   n_j = ceil(s_h / (j + 1)),  r_j = r0 + j · z(P) pixels  (tubes: r0 = 1.5 · z(P) · t_s, Eq. 16)
 //   ω_i = reflect(R1(P), R2[j][i]), flipped into n_j(P)'s hemisphere
 //
@@ -55,6 +56,8 @@ struct LineAoUniform {
     epsilon: f32,
     // Tubes (Eq. 16): r0(P) = r0_px + r0_zoom · z(P).
     r0_zoom: f32,
+    // δ(j) = delta_scale · (1 - j/s_r)².
+    delta_scale: f32,
 }
 
 @group(0) @binding(0) var<uniform> params: LineAoUniform;
@@ -112,7 +115,7 @@ fn hemisphere(nd: texture_2d<f32>, j: u32, pixel: vec2<u32>, r1: vec3<f32>, zoom
     let n = centre.xyz;
     let radius = params.r0_px + (params.r0_zoom + f32(j)) * zoom;
     let falloff = 1.0 - f32(j) / f32(S_R);
-    let delta_j = falloff * falloff;
+    let delta_j = params.delta_scale * falloff * falloff;
     let inv_range = 1.0 / (delta_j - params.delta0);
     let count = (S_H + j) / (j + 1u);
     var occlusion = 0.0;
