@@ -262,7 +262,7 @@ fn render(width: u32, height: u32) -> Result<Rendered, Box<dyn std::error::Error
         &device,
         &queue,
         FrameView::from_matrices(view, proj, width, height, &bounds, settings.zoom_unit),
-    );
+    )?;
 
     let mut encoder = device.create_command_encoder(&Default::default());
     let clear = |r, g, b| wgpu::Operations {
@@ -310,7 +310,7 @@ fn render(width: u32, height: u32) -> Result<Rendered, Box<dyn std::error::Error
         pass.draw_indexed(0..indices.len() as u32, 0, 0..1);
     }
     let inputs = HostInputs { depth: &depth_view, normals: Some(&normal_view), color: Some(&color_view) };
-    chain.encode_host(&device, &queue, &mut encoder, &inputs, Some(&output_view));
+    chain.encode_host(&device, &mut encoder, &inputs, Some(&output_view))?;
     queue.submit([encoder.finish()]);
 
     let rgba = lineao::readback::read_texture(&device, &queue, &output)?.bytes;

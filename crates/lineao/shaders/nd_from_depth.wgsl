@@ -18,9 +18,8 @@ struct HostUniform {
     orthographic: u32,
     // The depth the host clears to: 1 (standard) or 0 (reversed-Z).
     far_depth: f32,
-    // Whether a host color texture is bound (else the color is white: the composite shows AO).
-    has_color: u32,
     _pad0: u32,
+    _pad3: u32,
     _pad1: u32,
     _pad2: u32,
 }
@@ -40,6 +39,9 @@ override NORMALS: u32 = 0u;
 @group(0) @binding(5) var zoom_out: texture_storage_2d<r32float, write>;
 @group(0) @binding(6) var color_out: texture_storage_2d<rgba16float, write>;
 @group(0) @binding(7) var specular_out: texture_storage_2d<r32float, write>;
+// x: whether a host color texture is bound (else the color is white: the composite shows AO).
+// One of two constant buffers, chosen per frame, so recording writes nothing to the queue.
+@group(0) @binding(8) var<uniform> has_color: vec4<u32>;
 
 // The pixel's depth. Under MSAA: background unless at least half the samples hold geometry,
 // else the mean of those (the standard sample patterns are symmetric about the pixel's centre,
@@ -150,7 +152,7 @@ fn nd_from_depth(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     textureStore(nd_out, p, nd);
     textureStore(zoom_out, p, vec4<f32>(zoom, 0.0, 0.0, 0.0));
-    let color = select(vec4<f32>(1.0), textureLoad(host_color, p, 0), host.has_color != 0u);
+    let color = select(vec4<f32>(1.0), textureLoad(host_color, p, 0), has_color.x != 0u);
     textureStore(color_out, p, vec4<f32>(color.rgb, 1.0));
     textureStore(specular_out, p, vec4<f32>(0.0));
 }

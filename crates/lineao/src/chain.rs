@@ -83,6 +83,8 @@ pub struct AoChain {
     /// Made when the settings ask for object-space AO.
     volume_ao: Option<VolumeAo>,
     composite: Composite,
+    /// The composite's target format.
+    format: wgpu::TextureFormat,
     size: (u32, u32),
     max_texture: u32,
     /// Bytes a storage buffer binding may hold (VO area's moments pyramid).
@@ -98,6 +100,11 @@ impl AoChain {
     /// [`Error::Unsupported`], not wgpu's panic.
     pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat, settings: ChainSettings) -> Result<AoChain, Error> {
         settings.validate()?;
+        if format.is_depth_stencil_format() {
+            return Err(Error::Usage(format!(
+                "AoChain::new takes the color format the composite writes, not the depth's ({format:?})"
+            )));
+        }
         crate::gpu::validated(device, "creating the pass chain's pipelines", || AoChain {
             lines: LineRenderer::with_outputs(device, LineStyle::Quads, settings.volume.is_some()),
             tubes: settings.tubes.as_ref().map(|_| TubeRenderer::new(device, settings.volume.is_some())),
@@ -112,6 +119,7 @@ impl AoChain {
             bilateral: Bilateral::new(device),
             volume_ao: settings.volume.as_ref().map(|_| VolumeAo::new(device)),
             composite: Composite::new(device, format),
+            format,
             settings,
             size: (0, 0),
             max_texture: device.limits().max_texture_dimension_2d,
@@ -309,15 +317,34 @@ impl AoChain {
         }
         let guard = self.guard_for(camera, bounds);
         let view = FrameView::new(camera, bounds, width, height, guard, self.settings.zoom_unit);
-        self.prepare_view(device, queue, view)
+        self.prepare_frame(device, queue, view)
     }
 
     /// [`AoChain::prepare`] for a view made elsewhere: a host's own matrices
-    /// ([`FrameView::from_matrices`], no guard band) for [`AoChain::encode_host`]. Its size must
-    /// be the chain's.
-    pub fn prepare_view(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, view: FrameView) -> Option<FrameView> {
+    /// ([`FrameView::from_matrices`], no guard band) for [`AoChain::encode_host`]. `Ok(None)`
+    /// while the chain is 0 × 0 (nothing is recorded then); a view of another size than the
+    /// chain's is an [`Error::Usage`].
+    pub fn prepare_view(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        view: FrameView,
+    ) -> Result<Option<FrameView>, Error> {
         let (width, height) = self.size;
-        if width == 0 || height == 0 || (view.width, view.height) != (width, height) {
+        if (view.width, view.height) != (width, height) {
+            self.view = None;
+            return Err(Error::Usage(format!(
+                "prepare_view with a {}×{} view but the chain is {width}×{height}: call AoChain::resize first",
+                view.width, view.height
+            )));
+        }
+        Ok(self.prepare_frame(device, queue, view))
+    }
+
+    /// The uniforms for `view` (of the chain's size), reallocating targets when needed.
+    fn prepare_frame(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, view: FrameView) -> Option<FrameView> {
+        let (width, height) = self.size;
+        if width == 0 || height == 0 {
             self.view = None;
             return None;
         }
@@ -403,18 +430,64 @@ impl AoChain {
     /// [`AoChain::prepare_view`]): the G-buffer derived from its depth, normals and color
     /// ([`crate::passes::nd_from_depth`]), the method, and the composite into `target`; or only
     /// the AO (`target` `None`), which the host then reads from [`AoChain::ao_view`].
+    ///
+    /// Writes nothing to the queue. Every texture is checked first
+    /// ([`crate::passes::nd_from_depth::check_inputs`] has the table): a missing call or a
+    /// texture of the wrong size, format, usage or sample count is an [`Error::Usage`] saying
+    /// what to change, with nothing recorded. At 0 × 0 it records nothing and returns `Ok`.
+    ///
+    /// ```no_run
+    /// use lineao::glam::{Mat4, Vec3};
+    /// use lineao::{AoChain, Bounds, ChainSettings, FrameView, HostConfig, HostInputs, wgpu};
+    ///
+    /// /// One frame of a host that has drawn its scene into `depth` (Depth32Float, usage
+    /// /// RENDER_ATTACHMENT | TEXTURE_BINDING, stored) and `color`, seen through `view`, `proj`.
+    /// fn frame(
+    ///     device: &wgpu::Device,
+    ///     queue: &wgpu::Queue,
+    ///     (depth, color, output): (&wgpu::TextureView, &wgpu::TextureView, &wgpu::TextureView),
+    ///     (view, proj): (Mat4, Mat4),
+    /// ) -> Result<(), lineao::Error> {
+    ///     let (width, height) = (1280, 1024);
+    ///     // Once: the composite's format, the size, what the host's depth is like.
+    ///     let mut chain = AoChain::new(device, wgpu::TextureFormat::Rgba8UnormSrgb, ChainSettings::default())?;
+    ///     chain.resize(width, height)?;
+    ///     chain.enable_host(device, HostConfig { depth_samples: 1, reversed_z: false, normals: None })?;
+    ///     // Per frame: the host's matrices, and the sphere that holds the scene (its depth range).
+    ///     let bounds = Bounds { center: Vec3::ZERO, radius: 100.0 };
+    ///     chain.prepare_view(device, queue, FrameView::from_matrices(view, proj, width, height, &bounds, 1.0))?;
+    ///     let mut encoder = device.create_command_encoder(&Default::default());
+    ///     let inputs = HostInputs { depth, normals: None, color: Some(color) };
+    ///     chain.encode_host(device, &mut encoder, &inputs, Some(output))?;
+    ///     queue.submit([encoder.finish()]);
+    ///     Ok(())
+    /// }
+    /// ```
     pub fn encode_host(
         &self,
         device: &wgpu::Device,
-        queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
         inputs: &HostInputs,
         target: Option<&wgpu::TextureView>,
-    ) {
-        let (Some(targets), Some(host), Some(_)) = (&self.targets, &self.host, &self.view) else { return };
+    ) -> Result<(), Error> {
+        let Some(host) = &self.host else {
+            return Err(Error::Usage("encode_host before enable_host: call AoChain::enable_host once first".into()));
+        };
+        if self.size.0 == 0 || self.size.1 == 0 {
+            return Ok(());
+        }
+        let (Some(targets), Some(_)) = (&self.targets, &self.view) else {
+            return Err(Error::Usage(
+                "encode_host before prepare_view: call AoChain::prepare_view with the frame's matrices first".into(),
+            ));
+        };
+        crate::passes::nd_from_depth::check_inputs(&host.config(), inputs, self.size)?;
+        if let Some(target) = target {
+            self.check_target(target)?;
+        }
         let span = |name| self.timer.as_ref().and_then(|t| t.span(name));
         encoder.push_debug_group("lineao");
-        host.encode(device, queue, encoder, targets, inputs, span("lines"));
+        host.encode(device, encoder, targets, inputs, span("lines"));
         self.encode_method(encoder, targets, &span);
         if let Some(target) = target {
             self.composite.encode(encoder, target, span("composite"));
@@ -423,6 +496,33 @@ impl AoChain {
             timer.resolve(encoder);
         }
         encoder.pop_debug_group();
+        Ok(())
+    }
+
+    /// The composite's target: a render attachment of the chain's format and visible size.
+    fn check_target(&self, target: &wgpu::TextureView) -> Result<(), Error> {
+        let texture = target.texture();
+        let (width, height) = self.size;
+        if !texture.usage().contains(wgpu::TextureUsages::RENDER_ATTACHMENT) {
+            return Err(Error::Usage("the composite's target lacks TextureUsages::RENDER_ATTACHMENT".into()));
+        }
+        // A view may be the sRGB twin of its texture's format (`view_formats`).
+        if texture.format().remove_srgb_suffix() != self.format.remove_srgb_suffix() || texture.sample_count() != 1 {
+            return Err(Error::Usage(format!(
+                "the composite's target is {:?} with {} samples; the chain was made for {:?}, 1 sample",
+                texture.format(),
+                texture.sample_count(),
+                self.format
+            )));
+        }
+        if (texture.width(), texture.height()) != (width, height) {
+            return Err(Error::Usage(format!(
+                "the composite's target is {}×{} but the chain is {width}×{height}",
+                texture.width(),
+                texture.height()
+            )));
+        }
+        Ok(())
     }
 
     /// The occlusion the composite shows (after the blur when there is one): what a host that

@@ -61,8 +61,19 @@ pub mod truth;
 pub mod verify;
 pub mod volume;
 
+// The exact versions lineao's API speaks: a host names `lineao::wgpu` and `lineao::glam` and
+// never fights a second copy.
+pub use glam;
+pub use wgpu;
+
+// What an embedding needs first, at the root.
+pub use camera::{Bounds, Camera, FrameView, Projection};
 pub use chain::AoChain;
 pub use gpu::Gpu;
+pub use passes::lines::{LineGeometry, LineRenderer, LineStyle};
+pub use passes::meshes::{MeshGeometry, MeshRenderer};
+pub use passes::nd_from_depth::{HostConfig, HostInputs};
+pub use passes::tubes::TubeRenderer;
 pub use settings::{
     AoMethod, BilateralSettings, ChainSettings, Colormap, DebugView, LineAoOuter, LineAoSettings, LineAoVariant,
     LineColor, Preset, R0, SsaoKernel, SsaoSettings, SurfaceSettings, TubeSettings, VoCombine, VoSettings,
@@ -91,4 +102,7 @@ pub enum Error {
     Unsupported(String),
     #[error("stopped before it finished")]
     Cancelled,
+    /// A call out of order, or a host texture that does not fit: the text says what to change.
+    #[error("wrong use of lineao: {0}")]
+    Usage(String),
 }

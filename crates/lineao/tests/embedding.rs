@@ -37,7 +37,7 @@ fn run_host(
     chain.enable_host(d, config).unwrap();
     chain.prepare_view(d, q, view).unwrap();
     let mut encoder = d.create_command_encoder(&Default::default());
-    chain.encode_host(d, q, &mut encoder, &HostInputs { depth, normals, color: None }, None);
+    chain.encode_host(d, &mut encoder, &HostInputs { depth, normals, color: None }, None).unwrap();
     q.submit([encoder.finish()]);
     let t = chain.targets().unwrap();
     HostFrame {
@@ -294,4 +294,112 @@ fn the_composite_writes_any_host_color_format() {
         println!("{format:?}: worst |Δ| {worst:.2e} against Rgba32Float");
         assert!(worst <= tolerance * 1.01, "{format:?}: {worst}");
     }
+}
+
+/// A plain texture of `size`, `format`, `usage` and `samples`, for the misuse tests.
+fn texture(
+    gpu: &lineao::Gpu,
+    size: (u32, u32),
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+    samples: u32,
+) -> wgpu::TextureView {
+    gpu.device
+        .create_texture(&wgpu::TextureDescriptor {
+            label: Some("test::misuse"),
+            size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: samples,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage,
+            view_formats: &[],
+        })
+        .create_view(&Default::default())
+}
+
+/// Every misuse of the host API is an `Error::Usage` naming what to change, with nothing
+/// recorded — never a silent no-op, never a wgpu panic inside lineao.
+#[test]
+fn host_api_misuse_is_an_error_that_says_what_to_change() {
+    use wgpu::TextureFormat as F;
+    use wgpu::TextureUsages as U;
+    let gpu = gpu();
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let size = (64u32, 48u32);
+    let bounds = Bounds { center: Vec3::ZERO, radius: 1.0 };
+    let camera = Camera {
+        eye: Vec3::new(0.0, 0.0, 5.0),
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        projection: Projection::Perspective { fov_y_deg: 45.0 },
+    };
+    let view = |(w, h): (u32, u32)| FrameView::new(&camera, &bounds, w, h, 0, 1.0);
+    let depth_usage = U::RENDER_ATTACHMENT | U::TEXTURE_BINDING;
+    let depth = texture(&gpu, size, F::Depth32Float, depth_usage, 1);
+    let color = texture(&gpu, size, F::Rgba8Unorm, U::TEXTURE_BINDING, 1);
+    let output = texture(&gpu, size, common::OUTPUT_FORMAT, U::RENDER_ATTACHMENT, 1);
+    let inputs = HostInputs { depth: &depth, normals: None, color: Some(&color) };
+    let expect = |result: Result<(), lineao::Error>, says: &str| match result {
+        Err(lineao::Error::Usage(text)) => assert!(text.contains(says), "{text:?} should say {says:?}"),
+        other => panic!("expected a usage error saying {says:?}, got {other:?}"),
+    };
+
+    // A depth format where the composite's color format belongs.
+    let made = AoChain::new(d, F::Depth32Float, ChainSettings::default());
+    expect(made.map(|_| ()), "not the depth's");
+
+    let mut chain = AoChain::new(d, common::OUTPUT_FORMAT, ChainSettings::default()).unwrap();
+    chain.resize(size.0, size.1).unwrap();
+    let mut encoder = d.create_command_encoder(&Default::default());
+    expect(chain.encode_host(d, &mut encoder, &inputs, None), "enable_host");
+    chain.enable_host(d, HostConfig::default()).unwrap();
+    expect(chain.encode_host(d, &mut encoder, &inputs, None), "prepare_view");
+    expect(chain.prepare_view(d, q, view((32, 32))).map(|_| ()), "resize");
+    chain.prepare_view(d, q, view(size)).unwrap().expect("a view at the chain's size");
+
+    let unsampled = texture(&gpu, size, F::Depth32Float, U::RENDER_ATTACHMENT, 1);
+    let multisampled = texture(&gpu, size, F::Depth32Float, depth_usage, 4);
+    let small = texture(&gpu, (32, 32), F::Depth32Float, depth_usage, 1);
+    let not_depth = texture(&gpu, size, F::R32Float, U::TEXTURE_BINDING, 1);
+    let uint_color = texture(&gpu, size, F::R32Uint, U::TEXTURE_BINDING, 1);
+    let small_color = texture(&gpu, (32, 32), F::Rgba8Unorm, U::TEXTURE_BINDING, 1);
+    let with = |depth, normals, color| HostInputs { depth, normals, color };
+    for (inputs, says) in [
+        (with(&unsampled, None, None), "TEXTURE_BINDING"),
+        (with(&multisampled, None, None), "depth_samples"),
+        (with(&small, None, None), "AoChain::resize"),
+        (with(&not_depth, None, None), "not a depth format"),
+        (with(&depth, Some(&color), None), "HostConfig::normals is None"),
+        (with(&depth, None, Some(&uint_color)), "float or unorm"),
+        (with(&depth, None, Some(&small_color)), "32×32"),
+    ] {
+        expect(chain.encode_host(d, &mut encoder, &inputs, None), says);
+    }
+    // Normals promised but not passed.
+    let normals =
+        HostConfig { normals: Some(HostNormals { world_space: false, unorm: true }), ..HostConfig::default() };
+    chain.enable_host(d, normals).unwrap();
+    expect(chain.encode_host(d, &mut encoder, &with(&depth, None, None), None), "HostInputs::normals is None");
+    chain.enable_host(d, HostConfig::default()).unwrap();
+
+    // The composite's target: its format, its size, its usage.
+    let wrong_format = texture(&gpu, size, F::Rgba16Float, U::RENDER_ATTACHMENT, 1);
+    let wrong_size = texture(&gpu, (32, 32), common::OUTPUT_FORMAT, U::RENDER_ATTACHMENT, 1);
+    let not_attachment = texture(&gpu, size, common::OUTPUT_FORMAT, U::TEXTURE_BINDING, 1);
+    expect(chain.encode_host(d, &mut encoder, &inputs, Some(&wrong_format)), "the chain was made for");
+    expect(chain.encode_host(d, &mut encoder, &inputs, Some(&wrong_size)), "32×32");
+    expect(chain.encode_host(d, &mut encoder, &inputs, Some(&not_attachment)), "RENDER_ATTACHMENT");
+
+    // What is right records, and the frame runs without a validation error.
+    let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
+    chain.encode_host(d, &mut encoder, &inputs, Some(&output)).unwrap();
+    q.submit([encoder.finish()]);
+    assert!(pollster::block_on(scope.pop()).is_none(), "a checked frame must be valid");
+
+    // 0 × 0: nothing to record, no error.
+    chain.resize(0, 0).unwrap();
+    assert!(chain.prepare_view(d, q, view((0, 0))).unwrap().is_none());
+    let mut encoder = d.create_command_encoder(&Default::default());
+    chain.encode_host(d, &mut encoder, &inputs, None).unwrap();
 }

@@ -24,6 +24,7 @@
 
 use glam::Mat4;
 
+use crate::Error;
 use crate::binding::{self, Slot};
 use crate::camera::FrameView;
 use crate::passes::dispatch_full_screen;
@@ -74,6 +75,85 @@ pub struct HostInputs<'a> {
     pub color: Option<&'a wgpu::TextureView>,
 }
 
+/// What each host texture must be (checked by [`check_inputs`] before anything is recorded, so
+/// a mismatch is an [`Error::Usage`] that says what to change, never a wgpu panic):
+///
+/// | texture | usage | format | samples | size |
+/// |---|---|---|---|---|
+/// | `depth` | `TEXTURE_BINDING` (and stored: `StoreOp::Store`) | a depth format | [`HostConfig::depth_samples`] | the chain's |
+/// | `normals` | `TEXTURE_BINDING` | float or unorm color; present iff [`HostConfig::normals`] | 1 | the chain's |
+/// | `color` | `TEXTURE_BINDING` | float or unorm color (sRGB decodes) | 1 | the chain's |
+/// | composite target | `RENDER_ATTACHMENT` | the format given to `AoChain::new` | 1 | the chain's |
+pub fn check_inputs(config: &HostConfig, inputs: &HostInputs, size: (u32, u32)) -> Result<(), Error> {
+    let depth = inputs.depth.texture();
+    if !depth.format().has_depth_aspect() {
+        return Err(Error::Usage(format!("the host depth is {:?}, not a depth format", depth.format())));
+    }
+    if depth.sample_count() != config.depth_samples {
+        return Err(Error::Usage(format!(
+            "the host depth has {} samples per pixel but HostConfig::depth_samples is {}: \
+             call enable_host with the depth's sample count",
+            depth.sample_count(),
+            config.depth_samples
+        )));
+    }
+    match (inputs.normals, config.normals) {
+        (Some(_), None) => {
+            return Err(Error::Usage(
+                "normals were passed but HostConfig::normals is None: say how they are stored in \
+                 enable_host, or pass none (normals then come from the depth)"
+                    .into(),
+            ));
+        }
+        (None, Some(_)) => {
+            return Err(Error::Usage(
+                "HostConfig::normals says the host has normals but HostInputs::normals is None".into(),
+            ));
+        }
+        _ => {}
+    }
+    check_texture("depth", depth, size)?;
+    for (name, view) in [("normals", inputs.normals), ("color", inputs.color)] {
+        let Some(view) = view else { continue };
+        let texture = view.texture();
+        check_texture(name, texture, size)?;
+        if texture.sample_count() != 1 {
+            return Err(Error::Usage(format!(
+                "the host {name} texture has {} samples per pixel; resolve it to one first",
+                texture.sample_count()
+            )));
+        }
+        if !matches!(texture.format().sample_type(None, None), Some(wgpu::TextureSampleType::Float { .. })) {
+            return Err(Error::Usage(format!(
+                "the host {name} texture is {:?}; it must be a float or unorm color format",
+                texture.format()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// A host texture the chain reads: sampled, 2D, at the chain's size.
+fn check_texture(name: &str, texture: &wgpu::Texture, (width, height): (u32, u32)) -> Result<(), Error> {
+    if !texture.usage().contains(wgpu::TextureUsages::TEXTURE_BINDING) {
+        return Err(Error::Usage(format!(
+            "the host {name} texture lacks TextureUsages::TEXTURE_BINDING (has {:?}); add it where the \
+             host creates the texture",
+            texture.usage()
+        )));
+    }
+    if texture.dimension() != wgpu::TextureDimension::D2 || (texture.width(), texture.height()) != (width, height) {
+        return Err(Error::Usage(format!(
+            "the host {name} texture is {}×{} ({:?}) but the chain is {width}×{height}: call \
+             AoChain::resize with the host's size",
+            texture.width(),
+            texture.height(),
+            texture.dimension()
+        )));
+    }
+    Ok(())
+}
+
 /// Keep in sync with `HostUniform` in `shaders/nd_from_depth.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
@@ -87,8 +167,7 @@ pub struct HostUniform {
     pub zoom_unit: f32,
     pub orthographic: u32,
     pub far_depth: f32,
-    pub has_color: u32,
-    pub _pad: [u32; 3],
+    pub _pad: [u32; 4],
 }
 
 pub struct NdFromDepth {
@@ -98,6 +177,8 @@ pub struct NdFromDepth {
     uniform: wgpu::Buffer,
     /// Stands in for the normal and color textures a host does not have.
     placeholder: Target,
+    /// `has_color` = 0 and 1, bound per frame.
+    has_color: [wgpu::Buffer; 2],
 }
 
 impl NdFromDepth {
@@ -116,6 +197,7 @@ impl NdFromDepth {
                 Slot::StorageTexture(AO_FORMAT),
                 Slot::StorageTexture(COLOR_FORMAT),
                 Slot::StorageTexture(AO_FORMAT),
+                Slot::Uniform,
             ],
         );
         let replacements: &[(&str, &str)] =
@@ -144,6 +226,14 @@ impl NdFromDepth {
             layout,
             uniform: binding::uniform_buffer::<HostUniform>(device, "lineao::NdFromDepth::uniform"),
             placeholder,
+            has_color: [0u32, 1].map(|flag| {
+                use wgpu::util::DeviceExt;
+                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some("lineao::NdFromDepth::has_color"),
+                    contents: bytemuck::cast_slice(&[flag, 0, 0, 0]),
+                    usage: wgpu::BufferUsages::UNIFORM,
+                })
+            }),
         }
     }
 
@@ -165,8 +255,7 @@ impl NdFromDepth {
             zoom_unit: view.zoom_unit,
             orthographic: view.orthographic as u32,
             far_depth: if self.config.reversed_z { 0.0 } else { 1.0 },
-            has_color: 0,
-            _pad: [0; 3],
+            _pad: [0; 4],
         };
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
     }
@@ -176,19 +265,11 @@ impl NdFromDepth {
     pub fn encode(
         &self,
         device: &wgpu::Device,
-        queue: &wgpu::Queue,
         encoder: &mut wgpu::CommandEncoder,
         targets: &FrameTargets,
         inputs: &HostInputs,
         span: Option<Span>,
     ) {
-        // Whether a color comes with this frame: the uniform's one per-frame word.
-        let has_color = inputs.color.is_some() as u32;
-        queue.write_buffer(
-            &self.uniform,
-            std::mem::offset_of!(HostUniform, has_color) as u64,
-            bytemuck::bytes_of(&has_color),
-        );
         let placeholder = &self.placeholder.view;
         let group = binding::group(
             device,
@@ -203,6 +284,7 @@ impl NdFromDepth {
                 wgpu::BindingResource::TextureView(&targets.zoom.view),
                 wgpu::BindingResource::TextureView(&targets.color.view),
                 wgpu::BindingResource::TextureView(&targets.specular.view),
+                self.has_color[inputs.color.is_some() as usize].as_entire_binding(),
             ],
         );
         dispatch_full_screen(encoder, "lineao::NdFromDepth", &self.pipeline, &group, targets.size, span);
