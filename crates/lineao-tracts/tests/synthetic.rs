@@ -189,7 +189,35 @@ fn vtk_51_ascii_lines_with_point_and_cell_data() {
     let old = "# vtk DataFile Version 3.0\nold\nASCII\nDATASET POLYDATA\nPOINTS 4 double\n0 0 0 1 0 0 2 0 0 3 0 0\n\
         LINES 2 7\n2 3 2\n3 0 1 3\n";
     let t2 = load(write(dir.path(), "old.vtk", old.as_bytes())).unwrap().tractogram;
-    assert_eq!((t2.offsets, t2.positions), (t.offsets, t.positions));
+    assert_eq!((t2.offsets.clone(), t2.positions.clone()), (t.offsets.clone(), t.positions.clone()));
+
+    // Without a title line (the version line straight followed by ASCII, as MRtrix's
+    // tckconvert may write it), and with a title that reads "ASCII".
+    let untitled = old.replacen("old\n", "", 1);
+    let t3 = load(write(dir.path(), "untitled.vtk", untitled.as_bytes())).unwrap().tractogram;
+    assert_eq!((&t3.offsets, &t3.positions), (&t.offsets, &t.positions));
+    let ascii_title = old.replacen("old\n", "ASCII\n", 1);
+    let t4 = load(write(dir.path(), "ascii_title.vtk", ascii_title.as_bytes())).unwrap().tractogram;
+    assert_eq!((&t4.offsets, &t4.positions), (&t.offsets, &t.positions));
+}
+
+/// Zero streamlines, as a converter writes them (no title, no points, no lines; or empty LINES):
+/// an empty tractogram, not an error — while a surface without lines stays an error.
+#[test]
+fn vtk_with_zero_lines_is_an_empty_tractogram() {
+    let dir = tempfile::tempdir().unwrap();
+    for (name, text) in [
+        ("bare.vtk", "# vtk DataFile Version 3.0\nASCII\nDATASET POLYDATA\nPOINTS 0 float\n"),
+        ("empty_lines.vtk", "# vtk DataFile Version 3.0\nempty\nASCII\nDATASET POLYDATA\nPOINTS 0 float\nLINES 0 0\n"),
+        ("binary.vtk", "# vtk DataFile Version 4.2\nBINARY\nDATASET POLYDATA\nPOINTS 0 float\n\nLINES 0 0\n"),
+    ] {
+        let t = load(write(dir.path(), name, text.as_bytes())).unwrap_or_else(|e| panic!("{name}: {e}")).tractogram;
+        assert_eq!((t.streamlines(), t.positions.len()), (0, 0), "{name}");
+    }
+    let surface = "# vtk DataFile Version 3.0\ns\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\n\
+        POLYGONS 1 4\n3 0 1 2\n";
+    let e = load(write(dir.path(), "surface.vtk", surface.as_bytes())).unwrap_err();
+    assert!(matches!(e.kind, ErrorKind::NoLines(_)), "{e}");
 }
 
 /// A VTP whose arrays are appended: raw zlib blocks behind UInt64 headers, or base64.

@@ -186,7 +186,15 @@ pub(crate) fn read(b: &[u8]) -> Parse<Tractogram> {
     let mut c = Cursor { b, at: 0, binary: false };
     let first = c.rest_of_line();
     let version: f32 = first.rsplit(' ').next().and_then(|v| v.trim().parse().ok()).unwrap_or(3.0);
-    c.rest_of_line(); // title
+    // The title line; writers such as MRtrix's tckconvert may leave it out, the version line
+    // then being followed directly by ASCII or BINARY (a title that reads "ASCII" is told apart
+    // by the format line after it).
+    let is_format = |line: &str| ["ASCII", "BINARY"].iter().any(|f| line.trim().eq_ignore_ascii_case(f));
+    let title_at = c.at;
+    let title = c.rest_of_line();
+    let after_title = c.at;
+    let next = c.rest_of_line();
+    c.at = if is_format(title) && !is_format(next) { title_at } else { after_title };
     let fmt_at = c.at as u64;
     c.binary = match c.need("ASCII or BINARY")?.to_ascii_uppercase().as_str() {
         "ASCII" => false,
@@ -299,6 +307,11 @@ pub(crate) fn read(b: &[u8]) -> Parse<Tractogram> {
                 );
             }
         }
+    }
+    // No lines at all (a tractogram of zero streamlines, as a converter writes it): empty. A
+    // file of polygons or strips without lines is a surface, not a tractogram.
+    if other_cells == 0 && lines.as_ref().is_none_or(|l| l.offsets.len() <= 1) {
+        return Ok(Tractogram::new());
     }
     let Some(lines) = lines.filter(|l| l.offsets.len() > 1) else {
         return Err(ErrorKind::NoLines(format!(
