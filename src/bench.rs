@@ -119,7 +119,6 @@ struct Passes {
     /// is made per frame, on the device).
     nd_from_depth: NdFromDepth,
     device: wgpu::Device,
-    queue: wgpu::Queue,
     output: Target,
 }
 
@@ -147,7 +146,6 @@ impl Passes {
             tubes: TubeRenderer::new(device, false),
             nd_from_depth: NdFromDepth::new(device, HostConfig::default()),
             device: device.clone(),
-            queue: queue.clone(),
             output: Target::output(device, "lineao::bench::output", (view.width, view.height), format),
         };
         for renderer in [&passes.lines, &passes.lines_native, &passes.lines_full] {
@@ -233,7 +231,7 @@ impl Passes {
             "tubes" => self.tubes.encode(encoder, targets, geometry, Load::Clear(background), span),
             "nd-from-depth" => {
                 let inputs = HostInputs { depth: &targets.depth.view, normals: None, color: None };
-                self.nd_from_depth.encode(&self.device, &self.queue, encoder, targets, &inputs, span);
+                self.nd_from_depth.encode(&self.device, encoder, targets, &inputs, span);
             }
             _ => unreachable!("unknown bench pass {name}"),
         }
