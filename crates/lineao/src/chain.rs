@@ -23,6 +23,11 @@
 //! pixel's normal (`volume_ao`), and the composite shows it alone (method `None`) or combined
 //! with the method's occlusion.
 //!
+//! Each method is a [`crate::stage::Stage`]: the chain builds only the active method's stage
+//! (keeping a few built ones for settings it may switch back to), asks it how far it reads for
+//! the guard band and which timing spans it records, and binds, prepares and records it without
+//! branching on the method.
+//!
 //! Every pass is labelled and the frame sits in a `lineao` debug group, so GPU debuggers show
 //! the chain by name. With [`AoChain::set_timing`] each pass also records timestamp queries under
 //! the names `lineao bench` uses (CONTRACT.md): `lines`, `nd-pyramid`, `lineao`, `ssao`,
@@ -33,19 +38,14 @@ use crate::camera::{self, Bounds, Camera, FrameView};
 use crate::gbuffer::Load;
 use crate::passes::bilateral::Bilateral;
 use crate::passes::composite::{Composite, Shown};
-use crate::passes::line_ao::LineAo;
 use crate::passes::lines::LineStyle;
 use crate::passes::lines::{LineGeometry, LineRenderer};
 use crate::passes::meshes::{MeshGeometry, MeshRenderer};
 use crate::passes::nd_from_depth::{HostConfig, HostInputs, NdFromDepth};
-use crate::passes::nd_pyramid::NdPyramid;
-use crate::passes::ssao::Ssao;
-use crate::passes::ssao_blur::SsaoBlur;
 use crate::passes::tubes::TubeRenderer;
-use crate::passes::vo_area::VoArea;
-use crate::passes::vo_line::VoLine;
 use crate::passes::volume_ao::VolumeAo;
-use crate::settings::{AoMethod, ChainSettings, LineAoVariant};
+use crate::settings::{AoMethod, ChainSettings};
+use crate::stage::{self, Reach, Stages};
 use crate::targets::{FrameTargets, Moments};
 use crate::timing::{PassTime, PassTimer, Span};
 
@@ -73,12 +73,8 @@ pub struct AoChain {
     meshes: Option<MeshRenderer>,
     /// Made by [`AoChain::enable_host`].
     host: Option<NdFromDepth>,
-    pyramid: NdPyramid,
-    line_ao: LineAo,
-    ssao: Ssao,
-    ssao_blur: SsaoBlur,
-    vo_line: VoLine,
-    vo_area: VoArea,
+    /// The method's stage (built for the active method only; [`crate::stage`]).
+    stages: Stages,
     bilateral: Bilateral,
     /// Made when the settings ask for object-space AO.
     volume_ao: Option<VolumeAo>,
@@ -106,16 +102,15 @@ impl AoChain {
             )));
         }
         crate::gpu::validated(device, "creating the pass chain's pipelines", || AoChain {
+            stages: {
+                let mut stages = Stages::default();
+                stages.select(&settings, None, device, || stage::build(device, &settings));
+                stages
+            },
             lines: LineRenderer::with_outputs(device, LineStyle::Quads, settings.volume.is_some()),
             tubes: settings.tubes.as_ref().map(|_| TubeRenderer::new(device, settings.volume.is_some())),
             meshes: settings.surfaces.as_ref().map(|_| MeshRenderer::new(device, settings.volume.is_some())),
             host: None,
-            pyramid: NdPyramid::new(device),
-            line_ao: LineAo::new(device, &settings.line_ao, &settings.lighting),
-            ssao: Ssao::new(device, &settings.ssao),
-            ssao_blur: SsaoBlur::new(device),
-            vo_line: VoLine::new(device, &settings.vo),
-            vo_area: VoArea::new(device, &settings.vo),
             bilateral: Bilateral::new(device),
             volume_ao: settings.volume.as_ref().map(|_| VolumeAo::new(device)),
             composite: Composite::new(device, format),
@@ -138,31 +133,12 @@ impl AoChain {
     pub fn set_settings(&mut self, device: &wgpu::Device, settings: ChainSettings) -> Result<(), Error> {
         settings.validate()?;
         self.check_size(&settings, self.size.0, self.size.1)?;
-        if !self.line_ao.matches(&settings.line_ao, &settings.lighting) {
-            // A new pipeline (sample counts, variant, lights): the targets stay.
-            self.line_ao = LineAo::new(device, &settings.line_ao, &settings.lighting);
-            if let Some(targets) = &self.targets {
-                self.line_ao.resize(device, targets);
-            }
-        }
-        if !self.ssao.matches(&settings.ssao) {
-            self.ssao = Ssao::new(device, &settings.ssao);
-            if let Some(targets) = &self.targets {
-                self.ssao.resize(device, targets);
-            }
-        }
-        if !self.vo_line.matches(&settings.vo) {
-            self.vo_line = VoLine::new(device, &settings.vo);
-            if let Some(targets) = &self.targets {
-                self.vo_line.resize(device, targets);
-            }
-        }
-        if !self.vo_area.matches(&settings.vo) {
-            self.vo_area = VoArea::new(device, &settings.vo);
-            if let Some(targets) = &self.targets {
-                self.vo_area.resize(device, targets);
-            }
-        }
+        // The method's pipelines: kept when they still compute the settings, else a kept or a
+        // new stage (the targets stay; a new stage binds them).
+        let (stages, targets) = (&mut self.stages, self.targets.as_ref());
+        crate::gpu::validated(device, "creating the method's pipelines", || {
+            stages.select(&settings, targets, device, || stage::build(device, &settings))
+        })?;
         let octants = settings.volume.is_some();
         if octants != self.lines.writes_octants() {
             // Writing octants or not is a matter of the geometry pipelines.
@@ -212,14 +188,7 @@ impl AoChain {
     /// is off. Passes the method skips are left out.
     pub fn pass_times(&self, device: &wgpu::Device) -> Result<Option<Vec<PassTime>>, Error> {
         let Some(timer) = &self.timer else { return Ok(None) };
-        let method: &[&str] = match (self.settings.method, self.settings.levels()) {
-            (AoMethod::LineAo, 2..) => &["nd-pyramid", "lineao"],
-            (AoMethod::LineAo, _) => &["lineao"],
-            (AoMethod::Ssao, _) => &["ssao", "ssao-blur"],
-            (AoMethod::VoLine, _) => &["vo-line"],
-            (AoMethod::VoArea, _) => &["moments", "vo-area"],
-            (AoMethod::None | AoMethod::RayTraced, _) => &[],
-        };
+        let method = self.stages.active().map_or(&[][..], |stage| stage.spans(&self.settings));
         let blur: &[&str] =
             if self.settings.blur.is_some() && self.settings.method != AoMethod::None { &["blur"] } else { &[] };
         let volume: &[&str] = if self.settings.volume.is_some() { &["volume-ao"] } else { &[] };
@@ -263,39 +232,15 @@ impl AoChain {
     /// The guard band for this view: the largest sampling radius over the image (CONTRACT.md).
     pub fn guard_for(&self, camera: &Camera, bounds: &Bounds) -> u32 {
         let s = &self.settings;
-        match (s.method, s.line_ao.variant) {
-            // The ray-traced truth reads no neighbours on screen.
-            (AoMethod::None | AoMethod::RayTraced, _) => 0,
-            // The sphere's radius in pixels where it is largest (at the near plane), plus the
-            // blur's 2 px.
+        // The ray-traced truth and plain lines read no neighbours on screen.
+        let Some(stage) = self.stages.active() else { return 0 };
+        let unguarded = FrameView::new(camera, bounds, self.size.0, self.size.1, 0, s.zoom_unit);
+        match stage.reach(s, &unguarded) {
+            Reach::Unbounded => s.line_ao.guard_max_px,
             // The bilateral blur reaches its radius further.
-            (AoMethod::Ssao | AoMethod::VoLine | AoMethod::VoArea, _) => {
-                let unguarded = FrameView::new(camera, bounds, self.size.0, self.size.1, 0, s.zoom_unit);
-                // Area samples read moments over a footprint around each sample point: half its
-                // side is at most ½ √π r < r, and the Gaussian levels' tails reach about as far
-                // again, so 2 r covers what they read.
-                let (radius_world, blur) = match s.method {
-                    AoMethod::Ssao => (s.ssao.radius_world, 2.0),
-                    AoMethod::VoArea => (2.0 * s.vo.max_radius_world(), 0.0),
-                    _ => (s.vo.max_radius_world(), 0.0),
-                };
-                let blur = blur + s.blur.as_ref().map_or(0.0, |b| b.radius_px as f32);
-                let radius = radius_world * unguarded.zoom_max() / s.zoom_unit + blur;
-                camera::guard_band(radius, 1, s.line_ao.guard_max_px)
-            }
-            // Its radius grows as 1/(1 − d), without bound toward the far plane.
-            (AoMethod::LineAo, LineAoVariant::Reference) => s.line_ao.guard_max_px,
-            (AoMethod::LineAo, LineAoVariant::Paper) => {
-                let unguarded = FrameView::new(camera, bounds, self.size.0, self.size.1, 0, s.zoom_unit);
-                // The widest hemisphere reads the deepest level, whose texels near the band's
-                // edge are filtered with clamp-to-edge: the band covers that reach too.
-                let deepest = s.line_ao.s_r - 1;
-                let r0 = s.r0();
-                let radius = r0.px
-                    + (r0.per_zoom + deepest as f32) * unguarded.zoom_max()
-                    + camera::pyramid_reach(deepest)
-                    + s.blur.as_ref().map_or(0.0, |b| b.radius_px as f32);
-                camera::guard_band(radius, s.line_ao.s_r, s.line_ao.guard_max_px)
+            Reach::Pixels { radius_px, levels } => {
+                let blur = s.blur.as_ref().map_or(0.0, |b| b.radius_px as f32);
+                camera::guard_band(radius_px + blur, levels, s.line_ao.guard_max_px)
             }
         }
     }
@@ -360,12 +305,7 @@ impl AoChain {
             if s.volume.is_some() {
                 targets = targets.with_volume(device);
             }
-            self.pyramid.resize(device, &targets);
-            self.line_ao.resize(device, &targets);
-            self.ssao.resize(device, &targets);
-            self.ssao_blur.resize(device, &targets);
-            self.vo_line.resize(device, &targets);
-            self.vo_area.resize(device, &targets);
+            self.stages.resize(device, &targets);
             self.bilateral.resize(device, &targets);
             if let Some(pass) = &mut self.volume_ao {
                 pass.resize(device, &targets);
@@ -385,12 +325,8 @@ impl AoChain {
         if let (Some(meshes), Some(surfaces)) = (&self.meshes, &s.surfaces) {
             meshes.prepare(queue, &view, surfaces.color, &s.lighting);
         }
-        match s.method {
-            AoMethod::LineAo => self.line_ao.prepare(queue, targets, &view, &s.line_ao, s.r0(), &s.lighting),
-            AoMethod::Ssao => self.ssao.prepare(queue, targets, &view, &s.ssao),
-            AoMethod::VoLine => self.vo_line.prepare(queue, targets, &view, &s.vo),
-            AoMethod::VoArea => self.vo_area.prepare(queue, targets, &view, &s.vo),
-            AoMethod::None | AoMethod::RayTraced => {}
+        if let Some(stage) = self.stages.active() {
+            stage.prepare(queue, targets, &view, s);
         }
         if let Some(blur) = &s.blur {
             self.bilateral.prepare(queue, &view, blur);
@@ -592,21 +528,10 @@ impl AoChain {
         targets: &FrameTargets,
         span: &dyn Fn(&'static str) -> Option<Span<'s>>,
     ) {
-        match self.settings.method {
-            AoMethod::LineAo => {
-                if self.settings.levels() > 1 {
-                    self.pyramid.encode(encoder, targets, span("nd-pyramid"));
-                }
-                self.line_ao.encode(encoder, targets, span("lineao"));
-            }
-            AoMethod::Ssao => {
-                self.ssao.encode(encoder, targets, span("ssao"));
-                self.ssao_blur.encode(encoder, targets, span("ssao-blur"));
-            }
-            AoMethod::VoLine => self.vo_line.encode(encoder, targets, span("vo-line")),
-            AoMethod::VoArea => self.vo_area.encode(encoder, targets, span("moments"), span("vo-area")),
-            // The caller writes `ao` (see `encode_composite`).
-            AoMethod::None | AoMethod::RayTraced => {}
+        // None and the ray-traced truth have no stage: the caller writes `ao` (see
+        // `encode_composite`).
+        if let Some(stage) = self.stages.active() {
+            stage.encode(encoder, targets, span);
         }
         if self.settings.blur.is_some() && self.settings.method != AoMethod::None {
             self.bilateral.encode(encoder, targets, span("blur"));

@@ -55,6 +55,7 @@ pub mod reference;
 pub mod sample_sets;
 pub mod settings;
 pub mod shader;
+pub mod stage;
 pub mod targets;
 pub mod timing;
 pub mod truth;

@@ -7,7 +7,7 @@ use common::{gpu, render_geometry};
 use glam::Vec3;
 use lineao::camera::{Bounds, Camera, Projection};
 use lineao::passes::lines::LineGeometry;
-use lineao::{AoChain, ChainSettings, Error, Gpu};
+use lineao::{AoChain, AoMethod, ChainSettings, Error, Gpu};
 
 fn spiral_bundle(lines: usize, points: usize) -> (Vec<[f32; 3]>, Vec<u64>) {
     let mut positions = Vec::with_capacity(lines * points);
@@ -121,4 +121,52 @@ fn a_chain_can_move_between_threads_and_be_shared() {
     fn send_and_sync<T: Send + Sync>() {}
     send_and_sync::<AoChain>();
     send_and_sync::<LineGeometry>();
+}
+
+/// One chain switched between methods and sizes (stages built lazily, kept ones rebound to the
+/// targets of the moment) renders exactly what a fresh chain renders for each settings.
+#[test]
+fn a_chain_switching_methods_renders_what_fresh_chains_do() {
+    let gpu = common::gpu();
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let (positions, offsets) = common::polylines(60, 0.4);
+    let geometry = lineao::LineGeometry::new(d, q, &positions, &offsets).unwrap();
+    let bounds = geometry.bounds.unwrap();
+    let (camera, _) = common::cameras_for_polylines();
+    // No guard band for any method, so that a switch keeps the targets and only selecting a
+    // stage can bind them to it.
+    let capped = |s_r| lineao::LineAoSettings { s_r, guard_max_px: 0, ..Default::default() };
+    let with = |method| ChainSettings { method, line_ao: capped(3), ..ChainSettings::default() };
+    let one_level = ChainSettings { line_ao: capped(1), ..with(AoMethod::LineAo) };
+    let steps = [
+        (with(AoMethod::LineAo), (96, 72)),
+        (with(AoMethod::Ssao), (96, 72)),
+        // The same targets' layout as SSAO's: the new stage must bind them itself.
+        (with(AoMethod::VoLine), (96, 72)),
+        (with(AoMethod::Ssao), (96, 72)),
+        (with(AoMethod::VoArea), (80, 60)),
+        (with(AoMethod::None), (80, 60)),
+        (one_level, (64, 48)),
+        // A kept stage, bound to 96 × 72 targets long gone; the layout is unchanged, so only
+        // selecting it can rebind it.
+        (with(AoMethod::VoLine), (64, 48)),
+        (with(AoMethod::LineAo), (64, 48)),
+    ];
+    let mut chain = AoChain::new(d, common::OUTPUT_FORMAT, steps[0].0.clone()).unwrap();
+    for (i, (settings, (w, h))) in steps.into_iter().enumerate() {
+        chain.set_settings(d, settings.clone()).unwrap();
+        chain.resize(w, h).unwrap();
+        chain.prepare(d, q, &camera, &bounds).unwrap();
+        let output = lineao::targets::Target::output(d, "test::output", (w, h), common::OUTPUT_FORMAT);
+        let mut encoder = d.create_command_encoder(&Default::default());
+        chain.encode(&mut encoder, &geometry, &output.view);
+        q.submit([encoder.finish()]);
+        let switched = lineao::verify::read_rgba(d, q, &output).unwrap();
+        let fresh = common::render_geometry(&gpu, &geometry, &camera, bounds, settings.clone(), (w, h)).output;
+        assert_eq!(switched.data, fresh.data, "step {i}: {:?} at {w}×{h}", settings.method);
+        let ao = lineao::verify::read_f32(d, q, &chain.targets().unwrap().ao).unwrap();
+        if settings.method != AoMethod::None {
+            assert!(ao.data.iter().any(|&a| a > 0.05), "step {i}: no occlusion at all");
+        }
+    }
 }

@@ -310,3 +310,68 @@ impl LineAo {
         dispatch_full_screen(encoder, "lineao::LineAo", &self.pipeline, group, targets.size, last);
     }
 }
+
+/// LineAO's [`crate::stage::Stage`]: the Gaussian ND pyramid (when s_r > 1), then the
+/// hemispheres (or the authors' variant on level 0).
+pub struct LineAoStage {
+    pyramid: crate::passes::nd_pyramid::NdPyramid,
+    line_ao: LineAo,
+}
+
+impl LineAoStage {
+    pub fn new(device: &wgpu::Device, settings: &crate::ChainSettings) -> LineAoStage {
+        LineAoStage {
+            pyramid: crate::passes::nd_pyramid::NdPyramid::new(device),
+            line_ao: LineAo::new(device, &settings.line_ao, &settings.lighting),
+        }
+    }
+}
+
+impl crate::stage::Stage for LineAoStage {
+    fn matches(&self, settings: &crate::ChainSettings) -> bool {
+        settings.method == crate::AoMethod::LineAo && self.line_ao.matches(&settings.line_ao, &settings.lighting)
+    }
+
+    fn reach(&self, settings: &crate::ChainSettings, unguarded: &FrameView) -> crate::stage::Reach {
+        let ao = &settings.line_ao;
+        match ao.variant {
+            // Its radius grows as 1/(1 − d), without bound toward the far plane.
+            LineAoVariant::Reference => crate::stage::Reach::Unbounded,
+            // The widest hemisphere reads the deepest level, whose texels near the band's edge
+            // are filtered with clamp-to-edge: the band covers that reach too.
+            LineAoVariant::Paper => {
+                let deepest = ao.s_r - 1;
+                let r0 = settings.r0();
+                let radius_px = r0.px
+                    + (r0.per_zoom + deepest as f32) * unguarded.zoom_max()
+                    + crate::camera::pyramid_reach(deepest);
+                crate::stage::Reach::Pixels { radius_px, levels: ao.s_r }
+            }
+        }
+    }
+
+    fn spans(&self, settings: &crate::ChainSettings) -> &'static [&'static str] {
+        if settings.levels() > 1 { &["nd-pyramid", "lineao"] } else { &["lineao"] }
+    }
+
+    fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets) {
+        self.pyramid.resize(device, targets);
+        self.line_ao.resize(device, targets);
+    }
+
+    fn prepare(&self, queue: &wgpu::Queue, targets: &FrameTargets, view: &FrameView, settings: &crate::ChainSettings) {
+        self.line_ao.prepare(queue, targets, view, &settings.line_ao, settings.r0(), &settings.lighting);
+    }
+
+    fn encode<'t>(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &FrameTargets,
+        span: &dyn Fn(&'static str) -> Option<Span<'t>>,
+    ) {
+        if targets.nd.len() > 1 {
+            self.pyramid.encode(encoder, targets, span("nd-pyramid"));
+        }
+        self.line_ao.encode(encoder, targets, span("lineao"));
+    }
+}

@@ -145,3 +145,52 @@ impl Ssao {
         dispatch_full_screen(encoder, "lineao::Ssao", &self.pipeline, group, targets.size, span);
     }
 }
+
+/// Crytek SSAO's [`crate::stage::Stage`]: the samples (`nd[0]` → `ao_raw`), then the 4 × 4 blur
+/// matched to the rotation tile (`ao_raw` → `ao`).
+pub struct SsaoStage {
+    ssao: Ssao,
+    blur: crate::passes::ssao_blur::SsaoBlur,
+}
+
+impl SsaoStage {
+    pub fn new(device: &wgpu::Device, settings: &crate::ChainSettings) -> SsaoStage {
+        SsaoStage { ssao: Ssao::new(device, &settings.ssao), blur: crate::passes::ssao_blur::SsaoBlur::new(device) }
+    }
+}
+
+impl crate::stage::Stage for SsaoStage {
+    fn matches(&self, settings: &crate::ChainSettings) -> bool {
+        settings.method == crate::AoMethod::Ssao && self.ssao.matches(&settings.ssao)
+    }
+
+    /// The sphere's radius in pixels where it is largest (at the near plane), plus the blur's
+    /// 2 px.
+    fn reach(&self, settings: &crate::ChainSettings, unguarded: &FrameView) -> crate::stage::Reach {
+        let radius_px = settings.ssao.radius_world * unguarded.zoom_max() / settings.zoom_unit + 2.0;
+        crate::stage::Reach::Pixels { radius_px, levels: 1 }
+    }
+
+    fn spans(&self, _: &crate::ChainSettings) -> &'static [&'static str] {
+        &["ssao", "ssao-blur"]
+    }
+
+    fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets) {
+        self.ssao.resize(device, targets);
+        self.blur.resize(device, targets);
+    }
+
+    fn prepare(&self, queue: &wgpu::Queue, targets: &FrameTargets, view: &FrameView, settings: &crate::ChainSettings) {
+        self.ssao.prepare(queue, targets, view, &settings.ssao);
+    }
+
+    fn encode<'t>(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &FrameTargets,
+        span: &dyn Fn(&'static str) -> Option<Span<'t>>,
+    ) {
+        self.ssao.encode(encoder, targets, span("ssao"));
+        self.blur.encode(encoder, targets, span("ssao-blur"));
+    }
+}

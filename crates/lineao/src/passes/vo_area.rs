@@ -83,3 +83,38 @@ impl VoArea {
         self.core.encode(encoder, targets, span);
     }
 }
+
+impl crate::stage::Stage for VoArea {
+    fn matches(&self, settings: &crate::ChainSettings) -> bool {
+        settings.method == crate::AoMethod::VoArea && VoArea::matches(self, &settings.vo)
+    }
+
+    /// Area samples read moments over a footprint around each sample point: half its side is at
+    /// most ½ √π r < r, and the Gaussian levels' tails reach about as far again, so 2 r covers
+    /// what they read.
+    fn reach(&self, settings: &crate::ChainSettings, unguarded: &FrameView) -> crate::stage::Reach {
+        let radius_px = 2.0 * settings.vo.max_radius_world() * unguarded.zoom_max() / settings.zoom_unit;
+        crate::stage::Reach::Pixels { radius_px, levels: 1 }
+    }
+
+    fn spans(&self, _: &crate::ChainSettings) -> &'static [&'static str] {
+        &["moments", "vo-area"]
+    }
+
+    fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets) {
+        VoArea::resize(self, device, targets);
+    }
+
+    fn prepare(&self, queue: &wgpu::Queue, targets: &FrameTargets, view: &FrameView, settings: &crate::ChainSettings) {
+        VoArea::prepare(self, queue, targets, view, &settings.vo);
+    }
+
+    fn encode<'t>(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &FrameTargets,
+        span: &dyn Fn(&'static str) -> Option<Span<'t>>,
+    ) {
+        VoArea::encode(self, encoder, targets, span("moments"), span("vo-area"));
+    }
+}

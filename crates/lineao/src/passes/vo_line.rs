@@ -190,3 +190,36 @@ impl VoLine {
         self.core.encode(encoder, targets, span);
     }
 }
+
+impl crate::stage::Stage for VoLine {
+    fn matches(&self, settings: &crate::ChainSettings) -> bool {
+        settings.method == crate::AoMethod::VoLine && VoLine::matches(self, &settings.vo)
+    }
+
+    /// The sphere's radius in pixels where it is largest (at the near plane).
+    fn reach(&self, settings: &crate::ChainSettings, unguarded: &FrameView) -> crate::stage::Reach {
+        let radius_px = settings.vo.max_radius_world() * unguarded.zoom_max() / settings.zoom_unit;
+        crate::stage::Reach::Pixels { radius_px, levels: 1 }
+    }
+
+    fn spans(&self, _: &crate::ChainSettings) -> &'static [&'static str] {
+        &["vo-line"]
+    }
+
+    fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets) {
+        VoLine::resize(self, device, targets);
+    }
+
+    fn prepare(&self, queue: &wgpu::Queue, targets: &FrameTargets, view: &FrameView, settings: &crate::ChainSettings) {
+        VoLine::prepare(self, queue, targets, view, &settings.vo);
+    }
+
+    fn encode<'t>(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &FrameTargets,
+        span: &dyn Fn(&'static str) -> Option<Span<'t>>,
+    ) {
+        VoLine::encode(self, encoder, targets, span("vo-line"));
+    }
+}
