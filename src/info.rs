@@ -1,6 +1,5 @@
 //! `lineao info` and `lineao convert`, and the progress bar every file-loading command shares.
 
-use std::io::IsTerminal;
 use std::path::Path;
 
 use anyhow::Result;
@@ -11,16 +10,7 @@ use crate::cli::{ConvertArgs, InfoArgs};
 
 /// Loads a file, with a progress bar on a terminal for files over 32 MiB.
 pub fn load(path: &Path) -> Result<Loaded> {
-    let size = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
-    if !std::io::stderr().is_terminal() || size < 32 << 20 {
-        return Ok(lineao_tracts::load(path)?);
-    }
-    let bar = indicatif::ProgressBar::new(size).with_style(
-        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {bytes}/{total_bytes} {bytes_per_sec}")
-            .expect("a valid template")
-            .progress_chars("=> "),
-    );
-    bar.set_message(format!("loading {}", path.display()));
+    let Some(bar) = crate::source::progress_bar(path) else { return Ok(lineao_tracts::load(path)?) };
     let mut report = |p: lineao_tracts::Progress| bar.set_position(p.bytes);
     let loaded = lineao_tracts::load_with(path, &LoadOptions::default(), Some(&mut report));
     bar.finish_and_clear();

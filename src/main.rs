@@ -13,6 +13,7 @@ mod label;
 mod output;
 mod render;
 mod score;
+mod source;
 mod truth;
 mod view;
 

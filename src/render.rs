@@ -23,6 +23,7 @@ use crate::cli::{
     VolumeNormal,
 };
 use crate::label::Rgba8;
+use crate::source::{Loaded, Source, submit_frame, upload};
 
 fn combine(c: Combine) -> VoCombine {
     match c {
@@ -118,7 +119,6 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky) -> 
             epsilon: args.epsilon,
             light_attenuation: !args.no_light_attenuation,
             noise_seed: args.noise_seed,
-            guard_max_px: args.guard_max,
             variant: match args.variant {
                 Variant::Paper => LineAoVariant::Paper,
                 Variant::Reference => LineAoVariant::Reference,
@@ -154,6 +154,7 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky) -> 
         strength: 1.0,
         debug_view: args.debug_view,
         zoom_unit: args.zoom_unit.unwrap_or(zoom_unit),
+        guard_max_px: args.guard_max,
     }
     .with_preset(args.preset);
     // What the command line names explicitly wins over the preset.
@@ -252,25 +253,15 @@ impl Session {
     /// Loads the file (or builds the scene) and the surfaces, checks the camera, and uploads
     /// the geometry.
     pub fn open(args: &RenderArgs) -> Result<Session> {
-        let (name, tracts, hint) = match &args.file {
-            Some(path) => {
-                let loaded = crate::info::load(path)?;
-                if !loaded.tractogram.has_points() {
-                    anyhow::bail!(
-                        "{}: a .{} holds values without points; render its .tck",
-                        path.display(),
-                        loaded.format.name()
-                    );
-                }
-                let hint = ViewHint::for_tractogram(&loaded.tractogram);
-                (path.display().to_string(), loaded.tractogram, hint)
-            }
-            None => {
-                let vertices = args.vertices.unwrap_or(args.scene.default_vertices());
-                let scene = args.scene.build(args.seed, vertices);
-                (scene.kind.name().to_string(), scene.tractogram, scene.view)
-            }
+        let source = match &args.file {
+            Some(path) => Source::File(path.clone()),
+            None => Source::Scene {
+                kind: args.scene,
+                vertices: args.vertices.unwrap_or(args.scene.default_vertices()),
+                seed: args.seed,
+            },
         };
+        let Loaded { name, tracts, hint } = source.load_on_terminal()?;
         let camera = Camera {
             eye: Vec3::from_array(args.eye.unwrap_or(hint.eye)),
             target: Vec3::from_array(args.target.unwrap_or(hint.target)),
@@ -296,15 +287,12 @@ impl Session {
             _ => None,
         };
         let gpu = Gpu::headless()?;
-        let mut geometry = LineGeometry::new(&gpu.device, &gpu.queue, &tracts.positions, &tracts.offsets)?;
+        let mut geometry = upload(&name, &tracts, &gpu.device, &gpu.queue)?;
         let meshes = surfaces
             .iter()
             .map(|m| MeshGeometry::new(&gpu.device, &gpu.queue, &m.positions, &m.normals, &m.indices))
             .collect::<Result<Vec<_>, _>>()?;
-        let bounds = meshes
-            .iter()
-            .filter_map(|m| m.bounds)
-            .fold(geometry.bounds.with_context(|| format!("{name} has no finite points"))?, |b, m| b.union(&m));
+        let bounds = meshes.iter().filter_map(|m| m.bounds).fold(geometry.bounds.expect("checked"), |b, m| b.union(&m));
         if radii.is_some() || scalars.is_some() {
             let attributes = VertexAttributes { radius: radii.as_deref(), scalar: scalars.as_deref(), octants: None };
             geometry.set_attributes(&gpu.device, &gpu.queue, &tracts.positions, &tracts.offsets, &attributes)?;
@@ -455,15 +443,12 @@ impl Session {
             chain.set_timing(&gpu.device, &gpu.queue, true);
         }
         chain.resize(args.width, args.height)?;
-        chain.prepare(&gpu.device, &gpu.queue, &self.camera, &self.bounds);
         let size = (args.width, args.height);
         let target = lineao::targets::Target::output(&gpu.device, "lineao::render::output", size, format);
-        let mut encoder =
-            gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::render") });
         let meshes: Vec<&MeshGeometry> = self.meshes.iter().collect();
-        chain.encode_with_meshes(&mut encoder, &self.geometry, &meshes, &target.view);
         let start = std::time::Instant::now();
-        gpu.queue.submit([encoder.finish()]);
+        let scene = (&self.geometry, &meshes[..]);
+        submit_frame(gpu, &mut chain, scene, (&self.camera, &self.bounds), &target.view);
         if args.timings {
             gpu.wait()?;
             let wall_ms = start.elapsed().as_secs_f64() * 1e3;

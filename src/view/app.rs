@@ -250,7 +250,7 @@ impl App {
                     ui.menu_button("Built-in scene", |ui| {
                         for kind in SceneKind::ALL {
                             if ui.button(kind.name()).clicked() {
-                                self.load(Source::Scene { kind, vertices: kind.default_vertices() });
+                                self.load(Source::Scene { kind, vertices: kind.default_vertices(), seed: 1 });
                                 ui.close();
                             }
                         }

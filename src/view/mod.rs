@@ -26,7 +26,7 @@ fn options(args: &ViewArgs) -> app::Options {
         Some(path) => Source::File(path.clone()),
         None => {
             let kind = args.scene.unwrap_or(lineao_tracts::SceneKind::Bundles);
-            Source::Scene { kind, vertices: args.vertices.unwrap_or(kind.default_vertices()) }
+            Source::Scene { kind, vertices: args.vertices.unwrap_or(kind.default_vertices()), seed: 1 }
         }
     };
     let preset = match args.preset {

@@ -23,7 +23,7 @@ fn options(source: Source, methods: [crate::cli::Method; 2], compare: bool) -> O
 }
 
 fn scene(kind: SceneKind, vertices: usize) -> Source {
-    Source::Scene { kind, vertices }
+    Source::Scene { kind, vertices, seed: 1 }
 }
 
 /// The app in egui's harness, rendered by egui's wgpu renderer. The harness steps the UI itself

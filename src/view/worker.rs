@@ -8,7 +8,6 @@
 //! [`PREVIEW_VERTICES`] vertices) at half resolution — visibly coarser, and replaced by the full
 //! frame as soon as the camera rests.
 
-use std::path::PathBuf;
 use std::sync::mpsc::{Receiver, Sender, TryRecvError};
 
 use lineao::camera::Camera;
@@ -16,17 +15,13 @@ use lineao::passes::lines::{LineGeometry, VertexAttributes};
 use lineao::timing::PassTime;
 use lineao::volume::{VertexVisibility, VolumeAoOptions};
 use lineao::{AoChain, ChainSettings, Gpu, LineColor};
-use lineao_tracts::{SceneKind, Tractogram, ViewHint};
+use lineao_tracts::{Tractogram, ViewHint};
+
+pub use crate::source::Source;
+use crate::source::{Loaded, submit_frame, upload};
 
 /// Vertices of a preview frame at most.
 pub const PREVIEW_VERTICES: usize = 250_000;
-
-/// What to show.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Source {
-    Scene { kind: SceneKind, vertices: usize },
-    File(PathBuf),
-}
 
 /// One image of a frame: the chain's settings, and the object-space AO it needs.
 #[derive(Clone, Debug, PartialEq)]
@@ -160,27 +155,9 @@ pub fn run(rx: Receiver<ToWorker>, tx: Sender<FromWorker>, repaint: impl Fn() + 
 }
 
 fn load(gpu: &Gpu, source: &Source, send: &dyn Fn(FromWorker)) -> Result<(Scene, Dataset), String> {
-    let (name, tracts, hint) = match source {
-        Source::Scene { kind, vertices } => {
-            let scene = kind.build(1, *vertices);
-            (kind.name().to_string(), scene.tractogram, scene.view)
-        }
-        Source::File(path) => {
-            let mut report = |p: lineao_tracts::Progress| send(FromWorker::Progress { bytes: p.bytes, total: p.total });
-            let loaded =
-                lineao_tracts::load_with(path, &Default::default(), Some(&mut report)).map_err(|e| e.to_string())?;
-            if !loaded.tractogram.has_points() {
-                return Err(format!("{}: holds values without points", path.display()));
-            }
-            let hint = ViewHint::for_tractogram(&loaded.tractogram);
-            (path.display().to_string(), loaded.tractogram, hint)
-        }
-    };
-    let full = LineGeometry::new(&gpu.device, &gpu.queue, &tracts.positions, &tracts.offsets)
-        .map_err(|e| format!("{name}: {e}"))?;
-    if full.bounds.is_none() {
-        return Err(format!("{name}: no finite points"));
-    }
+    let mut report = |p: lineao_tracts::Progress| send(FromWorker::Progress { bytes: p.bytes, total: p.total });
+    let Loaded { name, tracts, hint } = source.load(Some(&mut report)).map_err(|e| format!("{e:#}"))?;
+    let full = upload(&name, &tracts, &gpu.device, &gpu.queue).map_err(|e| format!("{e:#}"))?;
     let fields = tracts
         .vertex_fields
         .iter()
@@ -291,10 +268,7 @@ fn render_frame(
             chain.set_timing(d, q, view.timings);
         }
         chain.resize(size.0, size.1).map_err(|e| e.to_string())?;
-        chain.prepare(d, q, &view.camera, &bounds);
-        let mut encoder = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::view") });
-        chain.encode(&mut encoder, geometry, &target.view);
-        q.submit([encoder.finish()]);
+        submit_frame(gpu, chain, (geometry, &[]), (&view.camera, &bounds), &target.view);
         times.push(if view.timings { chain.pass_times(d).map_err(|e| e.to_string())? } else { None });
         images.push(lineao::readback::read_texture(d, q, &target.texture).map_err(|e| e.to_string())?.bytes);
     }

@@ -1,0 +1,111 @@
+//! What every command renders from, shared by `render`, `score`, `bench` and the viewer's
+//! worker: a source (a built-in scene or a file) loaded with progress into streamlines and a
+//! view hint, with one set of error texts; and one frame of a chain recorded, submitted and read
+//! back.
+
+use std::path::PathBuf;
+
+use anyhow::{Result, bail};
+use lineao::passes::meshes::MeshGeometry;
+use lineao::{AoChain, Camera, LineGeometry};
+use lineao_tracts::{Progress, SceneKind, Tractogram, ViewHint};
+
+/// What to show.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Source {
+    /// A built-in scene of `vertices` vertices from `seed`.
+    Scene {
+        kind: SceneKind,
+        vertices: usize,
+        seed: u64,
+    },
+    File(PathBuf),
+}
+
+/// A loaded source: its name (the scene's, or the file's path), its streamlines and the
+/// camera it suggests.
+pub struct Loaded {
+    pub name: String,
+    pub tracts: Tractogram,
+    pub hint: ViewHint,
+}
+
+impl Source {
+    /// [`Source::load`] with a progress bar on a terminal ([`progress_bar`]): the CLI's.
+    pub fn load_on_terminal(&self) -> Result<Loaded> {
+        let bar = match self {
+            Source::File(path) => progress_bar(path),
+            Source::Scene { .. } => None,
+        };
+        let Some(bar) = bar else { return self.load(None) };
+        let loaded = self.load(Some(&mut |p: Progress| bar.set_position(p.bytes)));
+        bar.finish_and_clear();
+        loaded
+    }
+
+    /// Builds the scene or loads the file, reporting the bytes read to `progress` (files only).
+    /// A file of values without points (a .tsf) is an error that says what to render instead.
+    pub fn load(&self, progress: Option<&mut dyn FnMut(Progress)>) -> Result<Loaded> {
+        match self {
+            Source::Scene { kind, vertices, seed } => {
+                let scene = kind.build(*seed, *vertices);
+                Ok(Loaded { name: kind.name().to_string(), tracts: scene.tractogram, hint: scene.view })
+            }
+            Source::File(path) => {
+                let loaded = lineao_tracts::load_with(path, &Default::default(), progress)?;
+                if !loaded.tractogram.has_points() {
+                    bail!(
+                        "{}: a .{} holds values without points; render its .tck",
+                        path.display(),
+                        loaded.format.name()
+                    );
+                }
+                let hint = ViewHint::for_tractogram(&loaded.tractogram);
+                Ok(Loaded { name: path.display().to_string(), tracts: loaded.tractogram, hint })
+            }
+        }
+    }
+}
+
+/// `tracts` (of the source `name`) on the GPU; an error naming it when no point is finite.
+pub fn upload(name: &str, tracts: &Tractogram, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<LineGeometry> {
+    let geometry = LineGeometry::new(device, queue, &tracts.positions, &tracts.offsets)
+        .map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
+    if geometry.bounds.is_none() {
+        bail!("{name} has no finite points");
+    }
+    Ok(geometry)
+}
+
+/// Records one frame of `chain` (already sized) over `geometry` and `meshes`, seen by
+/// `camera`, into `target` (the chain's size and format), and submits it.
+pub fn submit_frame(
+    gpu: &lineao::Gpu,
+    chain: &mut AoChain,
+    (geometry, meshes): (&LineGeometry, &[&MeshGeometry]),
+    (camera, bounds): (&Camera, &lineao::Bounds),
+    target: &wgpu::TextureView,
+) {
+    let (d, q) = (&gpu.device, &gpu.queue);
+    chain.prepare(d, q, camera, bounds);
+    let mut encoder = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::frame") });
+    chain.encode_with_meshes(&mut encoder, geometry, meshes, target);
+    q.submit([encoder.finish()]);
+}
+
+/// A progress bar on stderr for loading `path` when stderr is a terminal and the file is
+/// 32 MiB or more (smaller ones load before a bar would show).
+pub fn progress_bar(path: &std::path::Path) -> Option<indicatif::ProgressBar> {
+    use std::io::IsTerminal;
+    let size = std::fs::metadata(path).map(|m| m.len()).unwrap_or(0);
+    if !std::io::stderr().is_terminal() || size < 32 << 20 {
+        return None;
+    }
+    let bar = indicatif::ProgressBar::new(size).with_style(
+        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {bytes}/{total_bytes} {bytes_per_sec}")
+            .expect("a valid template")
+            .progress_chars("=> "),
+    );
+    bar.set_message(format!("loading {}", path.display()));
+    Some(bar)
+}
