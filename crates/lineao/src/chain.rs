@@ -209,7 +209,7 @@ impl AoChain {
 
     /// Whether `settings` fit the adapter at `width` × `height` with the largest guard band.
     fn check_size(&self, settings: &ChainSettings, width: u32, height: u32) -> Result<(), Error> {
-        let guard = settings.line_ao.guard_max_px;
+        let guard = settings.guard_max_px;
         let limit = self.max_texture.saturating_sub(2 * guard);
         if width > limit || height > limit {
             return Err(Error::TooLarge(format!(
@@ -236,11 +236,11 @@ impl AoChain {
         let Some(stage) = self.stages.active() else { return 0 };
         let unguarded = FrameView::new(camera, bounds, self.size.0, self.size.1, 0, s.zoom_unit);
         match stage.reach(s, &unguarded) {
-            Reach::Unbounded => s.line_ao.guard_max_px,
+            Reach::Unbounded => s.guard_max_px,
             // The bilateral blur reaches its radius further.
             Reach::Pixels { radius_px, levels } => {
                 let blur = s.blur.as_ref().map_or(0.0, |b| b.radius_px as f32);
-                camera::guard_band(radius_px + blur, levels, s.line_ao.guard_max_px)
+                camera::guard_band(radius_px + blur, levels, s.guard_max_px)
             }
         }
     }

@@ -92,8 +92,6 @@ pub struct LineAoSettings {
     pub light_attenuation: bool,
     /// Seed of the R1/R2 noise (CONTRACT.md "Noise"). Default 1.
     pub noise_seed: u32,
-    /// Upper bound of the guard band in pixels. Default 128.
-    pub guard_max_px: u32,
     /// Variant `reference`: the base radius in pixels at the home zoom (the authors'
     /// `u_lineAORadius`). Default 2.
     pub reference_radius_px: f32,
@@ -134,7 +132,6 @@ impl Default for LineAoSettings {
             epsilon: 1e-6,
             light_attenuation: true,
             noise_seed: 1,
-            guard_max_px: 128,
             variant: LineAoVariant::Paper,
             reference_radius_px: 2.0,
             outer: LineAoOuter::Full,
@@ -476,6 +473,8 @@ pub struct ChainSettings {
     pub debug_view: DebugView,
     /// World units per zoom unit (1 mm for tractography). Default 1.
     pub zoom_unit: f32,
+    /// Upper bound of the guard band in pixels, whatever the method. Default 128.
+    pub guard_max_px: u32,
 }
 
 impl Default for ChainSettings {
@@ -496,6 +495,7 @@ impl Default for ChainSettings {
             strength: 1.0,
             debug_view: DebugView::Final,
             zoom_unit: 1.0,
+            guard_max_px: 128,
         }
     }
 }

@@ -100,7 +100,7 @@ fn edge_pixels_see_what_a_larger_render_sees() {
         let size = (w as usize, h as usize);
         let small = render(&gpu, &geometry, camera(fov), &settings, (w, h));
         let large = render(&gpu, &geometry, camera(wide_fov), &settings, (w + 2 * MARGIN, h + 2 * MARGIN));
-        let cap = settings.line_ao.guard_max_px as usize;
+        let cap = settings.guard_max_px as usize;
         assert!(small.guard > 0 && small.guard < cap, "{name}: the guard band {} must not be capped", small.guard);
         let occluded = (0..w as usize).filter(|&x| small.ao.get(x + small.guard, small.guard) > 0.05).count();
         assert!(occluded > 10, "{name}: the top edge must be occluded somewhere ({occluded} px)");
@@ -139,10 +139,7 @@ fn edge_pixels_see_what_a_larger_render_sees() {
         );
 
         // Without the guard band the edge differs: the comparison can tell.
-        let unguarded = ChainSettings {
-            line_ao: LineAoSettings { guard_max_px: 0, ..settings.line_ao.clone() },
-            ..settings.clone()
-        };
+        let unguarded = ChainSettings { guard_max_px: 0, ..settings.clone() };
         let bare = render(&gpu, &geometry, camera(fov), &unguarded, (w, h));
         assert_eq!(bare.guard, 0);
         let bare = edge_band(&bare, &bare.ao, &large, size, 8);

@@ -135,9 +135,9 @@ fn a_chain_switching_methods_renders_what_fresh_chains_do() {
     let (camera, _) = common::cameras_for_polylines();
     // No guard band for any method, so that a switch keeps the targets and only selecting a
     // stage can bind them to it.
-    let capped = |s_r| lineao::LineAoSettings { s_r, guard_max_px: 0, ..Default::default() };
-    let with = |method| ChainSettings { method, line_ao: capped(3), ..ChainSettings::default() };
-    let one_level = ChainSettings { line_ao: capped(1), ..with(AoMethod::LineAo) };
+    let with = |method| ChainSettings { method, guard_max_px: 0, ..ChainSettings::default() };
+    let one_level =
+        ChainSettings { line_ao: lineao::LineAoSettings { s_r: 1, ..Default::default() }, ..with(AoMethod::LineAo) };
     let steps = [
         (with(AoMethod::LineAo), (96, 72)),
         (with(AoMethod::Ssao), (96, 72)),

@@ -427,7 +427,6 @@ fn reference_variant_matches_its_cpu_reference_on_rendered_lines() {
     let reference = |light_attenuation| LineAoSettings {
         variant: LineAoVariant::Reference,
         light_attenuation,
-        guard_max_px: 32,
         ..LineAoSettings::default()
     };
     let cases = [
@@ -436,9 +435,13 @@ fn reference_variant_matches_its_cpu_reference_on_rendered_lines() {
         (
             "perspective, light",
             perspective,
-            ChainSettings { line_ao: reference(true), strength: 2.5, ..Default::default() },
+            ChainSettings { line_ao: reference(true), strength: 2.5, guard_max_px: 32, ..Default::default() },
         ),
-        ("orthographic, no light", ortho, ChainSettings { line_ao: reference(false), ..Default::default() }),
+        (
+            "orthographic, no light",
+            ortho,
+            ChainSettings { line_ao: reference(false), guard_max_px: 32, ..Default::default() },
+        ),
     ];
     for (name, cam, s) in cases {
         let frame = render(&gpu, &positions, &offsets, &cam, None, s.clone(), (240, 180));
