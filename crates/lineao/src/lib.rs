@@ -60,6 +60,7 @@ pub mod targets;
 pub mod timing;
 pub mod truth;
 pub mod verify;
+pub mod view_params;
 pub mod volume;
 
 // The exact versions lineao's API speaks: a host names `lineao::wgpu` and `lineao::glam` and

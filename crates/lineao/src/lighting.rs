@@ -177,3 +177,22 @@ impl Lighting {
         }
     }
 }
+
+/// `alpha` when it is a whole number in 1..512, which the shader raises by squaring (a pipeline
+/// constant, `SHININESS_WHOLE`), else 0 (it calls `pow`).
+pub fn whole_exponent(alpha: f32) -> u32 {
+    if alpha.fract() == 0.0 && (1.0..512.0).contains(&alpha) { alpha as u32 } else { 0 }
+}
+
+/// max(x, 0)^n for a whole 1 ≤ n < 512 by squaring, multiplied in the shader's order
+/// (`whole_pow` in `shaders/shared/lighting.wgsl`).
+pub fn whole_pow(x: f32, n: u32) -> f32 {
+    let (mut result, mut power) = (1.0f32, x.max(0.0));
+    for bit in 0..9 {
+        if (n >> bit) & 1 != 0 {
+            result *= power;
+        }
+        power *= power;
+    }
+    result
+}

@@ -17,11 +17,11 @@
 use crate::binding::{self, Slot};
 use crate::camera::FrameView;
 use crate::passes::dispatch_size;
-use crate::passes::ssao::ViewUniform;
-use crate::reference::ViewParams;
 use crate::settings::BilateralSettings;
 use crate::targets::{AO_FORMAT, FrameTargets};
 use crate::timing::{self, Span};
+use crate::view_params::ViewParams;
+use crate::view_params::ViewUniform;
 
 /// Keep in sync with `BilateralUniform` in `shaders/bilateral.wgsl`.
 #[repr(C)]

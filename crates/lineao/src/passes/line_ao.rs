@@ -125,7 +125,7 @@ impl Shape {
             noise_seed: settings.noise_seed,
             light_attenuation: settings.light_attenuation,
             lights: lighting.lights.len().min(crate::lighting::MAX_LIGHTS) as u32,
-            shininess_whole: crate::reference::whole_exponent(lighting.shininess),
+            shininess_whole: crate::lighting::whole_exponent(lighting.shininess),
         }
     }
 }

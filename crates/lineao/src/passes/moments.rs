@@ -14,10 +14,10 @@
 use crate::binding::{self, Slot};
 use crate::camera::FrameView;
 use crate::passes::dispatch_size;
-use crate::passes::ssao::ViewUniform;
-use crate::reference::ViewParams;
 use crate::targets::{FrameTargets, Moments};
 use crate::timing::{self, Span};
+use crate::view_params::ViewParams;
+use crate::view_params::ViewUniform;
 
 pub struct MomentsPyramid {
     level0: wgpu::ComputePipeline,

@@ -22,35 +22,10 @@ use crate::binding::{self, Slot};
 use crate::camera::FrameView;
 use crate::noise;
 use crate::passes::dispatch_full_screen;
-use crate::reference::ViewParams;
 use crate::settings::{SsaoKernel, SsaoSettings};
 use crate::targets::{AO_FORMAT, FrameTargets};
 use crate::timing::Span;
-
-/// `ViewParams` in `shaders/shared/view.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-pub struct ViewUniform {
-    pub near: f32,
-    pub far: f32,
-    pub f_px: f32,
-    pub orthographic: u32,
-    pub center: [f32; 2],
-    pub _pad: [f32; 2],
-}
-
-impl From<ViewParams> for ViewUniform {
-    fn from(v: ViewParams) -> Self {
-        ViewUniform {
-            near: v.near,
-            far: v.far,
-            f_px: v.f_px,
-            orthographic: v.orthographic as u32,
-            center: v.center,
-            _pad: [0.0; 2],
-        }
-    }
-}
+use crate::view_params::{ViewParams, ViewUniform};
 
 /// Keep in sync with `SsaoUniform` in `shaders/ssao.wgsl`.
 #[repr(C)]

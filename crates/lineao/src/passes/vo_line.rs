@@ -32,12 +32,12 @@ use crate::binding::{self, Slot};
 use crate::camera::FrameView;
 use crate::noise;
 use crate::passes::dispatch_full_screen;
-use crate::passes::ssao::ViewUniform;
-use crate::reference::ViewParams;
 use crate::sample_sets;
 use crate::settings::{VoCombine, VoSettings};
 use crate::targets::{AO_FORMAT, FrameTargets, Moments};
 use crate::timing::Span;
+use crate::view_params::ViewParams;
+use crate::view_params::ViewUniform;
 
 /// Keep in sync with `VoUniform` in `shaders/shared/vo.wgsl`.
 #[repr(C)]
@@ -71,7 +71,7 @@ impl VoUniform {
             normal_clamp: settings.normal_clamp as u32,
             combine: (settings.combine == VoCombine::Min) as u32,
             max_level: max_level as f32,
-            sigma_floor: crate::reference::vo_sigma_floor(view.near, view.far),
+            sigma_floor: crate::sample_sets::vo_sigma_floor(view.near, view.far),
             samples: 0,
             _pad: 0,
         }
@@ -166,7 +166,7 @@ impl VoLine {
         let samples: Vec<[f32; 4]> = sample_sets::vo_disk_samples(settings.samples)
             .unwrap_or_default()
             .iter()
-            .map(|s| [s[0], s[1], s[2], crate::reference::vo_chord_half(s[0], s[1])])
+            .map(|s| [s[0], s[1], s[2], crate::sample_sets::vo_chord_half(s[0], s[1])])
             .collect();
         VoLine { core: VoCore::new(device, "lineao::VoLine", "vo_line.wgsl", &samples, settings, false) }
     }

@@ -2,56 +2,7 @@
 //! in the shaders' f32 operation order.
 
 use super::{Image, NdImage};
-use crate::camera::FrameView;
-
-/// What a screen-space pass needs to go from a pixel and its normalized depth to view space
-/// and back: the linear depth range of the ND map and the projection in pixels.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct ViewParams {
-    /// −z_view at normalized depth 0 and 1 (world units).
-    pub near: f32,
-    pub far: f32,
-    /// Focal length in pixels (perspective) or pixels per world unit (orthographic).
-    pub f_px: f32,
-    pub orthographic: bool,
-    /// The optical axis in pixel coordinates of the guard-banded image: (W, H) / 2.
-    pub center: [f32; 2],
-}
-
-impl ViewParams {
-    pub fn of(view: &FrameView) -> ViewParams {
-        let (w, h) = view.banded_size();
-        ViewParams {
-            near: view.near,
-            far: view.far,
-            f_px: view.f_px,
-            orthographic: view.orthographic,
-            center: [w as f32 * 0.5, h as f32 * 0.5],
-        }
-    }
-
-    /// −z_view of a normalized depth.
-    pub fn linear_depth(&self, d: f32) -> f32 {
-        self.near + d * (self.far - self.near)
-    }
-
-    /// The view-space point seen at pixel (x, y) at linear depth `depth`.
-    pub fn view_position(&self, x: u32, y: u32, depth: f32) -> [f32; 3] {
-        let sx = (x as f32 + 0.5 - self.center[0]) / self.f_px;
-        let sy = (self.center[1] - (y as f32 + 0.5)) / self.f_px;
-        if self.orthographic { [sx, sy, -depth] } else { [sx * depth, sy * depth, -depth] }
-    }
-
-    /// The pixel coordinates (not yet floored) a view-space point projects to.
-    pub fn project(&self, q: [f32; 3]) -> [f32; 2] {
-        let depth = -q[2];
-        if self.orthographic {
-            [self.center[0] + self.f_px * q[0], self.center[1] - self.f_px * q[1]]
-        } else {
-            [self.center[0] + self.f_px * q[0] / depth, self.center[1] - self.f_px * q[1] / depth]
-        }
-    }
-}
+pub use crate::view_params::ViewParams;
 
 /// A sample counts as occluded only when the surface is in front of it by more than this
 /// fraction of the depth range (f32 noise on a flat surface stays unoccluded).

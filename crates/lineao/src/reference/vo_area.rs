@@ -8,10 +8,7 @@ use super::{Image, NdImage, binomial_5x5};
 /// A level of the moments pyramid: (E\[z\], E\[z²\]) of linear depth, world units.
 pub type MomentsImage = Image<[f32; 2]>;
 
-/// σ below which VO area sampling treats depth as a step (CONTRACT.md): 1e-3 (far − near).
-pub fn vo_sigma_floor(near: f32, far: f32) -> f32 {
-    1e-3 * (far - near)
-}
+pub use crate::sample_sets::vo_sigma_floor;
 
 /// The moments pyramid over the ND map `nd0`: level 0 = (z, z²), z = −z_view at each pixel;
 /// level l the binomial 5 × 5 of level l − 1 around (2x, 2y), ⌊W/2⌋ × ⌊H/2⌋ (at least 1),

@@ -39,10 +39,7 @@ impl VoParams {
     }
 }
 
-/// z_s = √(1 − x² − y²): half the chord at disk point (x, y) (the line pass keeps it in its table).
-pub fn vo_chord_half(x: f32, y: f32) -> f32 {
-    (1.0 - (x * x + y * y)).max(0.0).sqrt()
-}
+pub use crate::sample_sets::vo_chord_half;
 
 /// g = n.xy / n_z of the tangent plane, whose depth at s is s · g; 0 when n_z is 0.
 pub fn vo_plane(n: [f32; 3]) -> [f32; 2] {

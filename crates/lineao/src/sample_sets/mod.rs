@@ -249,3 +249,13 @@ pub fn sphere_volume_spread(points: &[[f32; 3]], res: usize) -> f64 {
     let points: Vec<Point<3>> = points.iter().map(|p| p.map(f64::from)).collect();
     volume_spread(&voronoi(&points, &ball_cells(res)).0)
 }
+
+/// σ below which VO area sampling treats depth as a step (CONTRACT.md): 1e-3 (far − near).
+pub fn vo_sigma_floor(near: f32, far: f32) -> f32 {
+    1e-3 * (far - near)
+}
+
+/// z_s = √(1 − x² − y²): half the chord at disk point (x, y) (the line pass keeps it in its table).
+pub fn vo_chord_half(x: f32, y: f32) -> f32 {
+    (1.0 - (x * x + y * y)).max(0.0).sqrt()
+}
