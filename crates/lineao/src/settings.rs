@@ -529,8 +529,9 @@ impl Preset {
 
 /// The calibrated values of one method: `lineao score --fit --width 640 --height 512 --rays 64
 /// --views 4` over the 3 built-in scenes and the 12 tractograms of `shared/data` with at least 10
-/// streamlines, binary AO to R = 2 mm, the least mean RMSE on the even views
-/// (docs/ground-truth.md has the table, fit and held-out).
+/// streamlines, binary AO to R = 2 mm, the least mean RMSE on the even views among the settings
+/// that keep every real tractogram's mean AO within 0.1 of the truth's (docs/ground-truth.md
+/// has the table, fit and held-out).
 struct Calibrated {
     strength: f32,
     /// LineAO: hemispheres, r0 as a multiple of the line width, and the scale of δ(j).
@@ -545,7 +546,7 @@ struct Calibrated {
 
 impl ChainSettings {
     /// `self` with `preset`'s values for its method (and LineAO variant): the strength, LineAO's
-    /// s_r and r0 (lines; tubes keep Eq. 16's r0), VO's and SSAO's radius in zoom units.
+    /// s_r, δ scale and r0 (lines; tubes keep Eq. 16's r0), VO's and SSAO's radius in zoom units.
     /// [`Preset::Paper`] restores the defaults of those.
     pub fn with_preset(mut self, preset: Preset) -> ChainSettings {
         let paper = Calibrated {
@@ -558,17 +559,19 @@ impl ChainSettings {
         };
         let c = match (preset, self.method, self.line_ao.variant) {
             (Preset::Paper, ..) => paper,
-            // One hemisphere: the outer ones (on coarser levels, up to 2 mm out) darken dense
-            // and sparse data alike, and the truth tells them apart.
+            // Two hemispheres with δ a tenth of the paper's: the third hemisphere and occluders
+            // far in front (in depth) darken dense and sparse data alike, where the truth tells
+            // them apart; with them LineAO's mean stays within 0.1 of the truth's on every
+            // real tractogram (within 0.09), and its held-out RMSE is 0.204 (paper: 0.450).
             (Preset::Calibrated, AoMethod::LineAo, LineAoVariant::Paper) => {
-                Calibrated { strength: 0.66, s_r: 1, ..paper }
+                Calibrated { strength: 0.58, s_r: 2, delta_scale: 0.1, ..paper }
             }
             (Preset::Calibrated, AoMethod::LineAo, LineAoVariant::Reference) => {
                 Calibrated { strength: 0.46, reference_radius_px: 1.0, ..paper }
             }
             (Preset::Calibrated, AoMethod::VoLine, _) => Calibrated { strength: 0.22, radius: 1.5, ..paper },
             (Preset::Calibrated, AoMethod::VoArea, _) => Calibrated { strength: 0.22, radius: 1.0, ..paper },
-            (Preset::Calibrated, AoMethod::Ssao, _) => Calibrated { strength: 0.66, radius: 3.0, ..paper },
+            (Preset::Calibrated, AoMethod::Ssao, _) => Calibrated { strength: 0.68, radius: 3.0, ..paper },
             (Preset::Calibrated, AoMethod::None | AoMethod::RayTraced, _) => paper,
         };
         self.strength = c.strength;
