@@ -188,12 +188,25 @@ impl AoChain {
     /// is off. Passes the method skips are left out.
     pub fn pass_times(&self, device: &wgpu::Device) -> Result<Option<Vec<PassTime>>, Error> {
         let Some(timer) = &self.timer else { return Ok(None) };
+        timer.read(device, &self.timed_spans()).map(Some)
+    }
+
+    /// [`AoChain::pass_times`] without waiting, for a host's render loop: call it after
+    /// submitting a frame; it returns the times of a finished earlier frame, or `None` while the
+    /// GPU is still at it (or timing is off). Frames submitted while a readback is pending are
+    /// not timed.
+    pub fn try_pass_times(&self, device: &wgpu::Device) -> Result<Option<Vec<PassTime>>, Error> {
+        let Some(timer) = &self.timer else { return Ok(None) };
+        timer.try_read(device, &self.timed_spans())
+    }
+
+    /// The spans a frame with the current settings records.
+    fn timed_spans(&self) -> Vec<&'static str> {
         let method = self.stages.active().map_or(&[][..], |stage| stage.spans(&self.settings));
         let blur: &[&str] =
             if self.settings.blur.is_some() && self.settings.method != AoMethod::None { &["blur"] } else { &[] };
         let volume: &[&str] = if self.settings.volume.is_some() { &["volume-ao"] } else { &[] };
-        let used = [&["lines"], method, blur, volume, &["composite"]].concat();
-        timer.read(device, &used).map(Some)
+        [&["lines"], method, blur, volume, &["composite"]].concat()
     }
 
     /// Sets the visible size. 0 × 0 (a minimized window) is allowed: nothing is rendered until a

@@ -5,12 +5,24 @@
 //! `timestamp_writes` (the portable form: no timestamps between passes, which WebGPU lacks);
 //! a span may start in one pass and end in a later one ([`Span::begin_only`], [`Span::end_only`]),
 //! which is how a chain of passes is timed as a whole. After the commands are submitted,
-//! [`PassTimer::read`] returns each span's duration.
+//! [`PassTimer::read`] waits for them and returns each span's duration; a host that must not
+//! block asks with [`PassTimer::try_read`] instead, once per frame, and gets the durations of an
+//! earlier frame when the GPU has finished it (frames in between are not timed).
 //!
 //! Adapters without `TIMESTAMP_QUERY` get no timer ([`PassTimer::new`] returns `None`); callers
 //! then fall back to CPU wall time around submit + wait, and say so.
 
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU8, Ordering};
+
 use crate::Error;
+
+/// Where the readback buffer stands: free (the next `resolve` copies into it), holding a
+/// frame's timestamps, being mapped, or mapped and readable.
+const FREE: u8 = 0;
+const COPIED: u8 = 1;
+const MAPPING: u8 = 2;
+const MAPPED: u8 = 3;
 
 /// The timestamps of one span inside a [`PassTimer`]'s query set.
 #[derive(Clone, Copy)]
@@ -80,6 +92,8 @@ pub struct PassTimer {
     resolve: wgpu::Buffer,
     readback: wgpu::Buffer,
     period_ns: f64,
+    /// [`FREE`], [`COPIED`], [`MAPPING`] or [`MAPPED`]; the map callback writes it.
+    state: Arc<AtomicU8>,
 }
 
 impl PassTimer {
@@ -114,6 +128,7 @@ impl PassTimer {
                 wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
             ),
             period_ns: queue.get_timestamp_period() as f64,
+            state: Arc::new(AtomicU8::new(FREE)),
         })
     }
 
@@ -124,34 +139,63 @@ impl PassTimer {
     }
 
     /// Records the copy of every timestamp to the CPU-readable buffer; call once per frame after
-    /// the timed passes.
+    /// the timed passes. While an earlier frame's timestamps wait to be read ([`PassTimer::try_read`]),
+    /// this frame's are resolved but not copied: that frame is not timed.
     pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
         let count = 2 * self.names.len() as u32;
         encoder.resolve_query_set(&self.query_set, 0..count, &self.resolve, 0);
-        encoder.copy_buffer_to_buffer(&self.resolve, 0, &self.readback, 0, self.resolve.size());
+        let copied = self.state.compare_exchange(FREE, COPIED, Ordering::AcqRel, Ordering::Acquire);
+        // A frame recorded but never submitted leaves COPIED: the next copy overwrites it.
+        if copied.is_ok() || copied == Err(COPIED) {
+            encoder.copy_buffer_to_buffer(&self.resolve, 0, &self.readback, 0, self.resolve.size());
+        }
     }
 
     /// Waits for the submitted frame and returns the duration of every span it wrote, in the
     /// order of `names`. A span that was not recorded this frame reads as garbage: only ask for
     /// the spans the frame used (`only`), or all when `only` is empty.
     pub fn read(&self, device: &wgpu::Device, only: &[&str]) -> Result<Vec<PassTime>, Error> {
-        let slice = self.readback.slice(..);
-        slice.map_async(wgpu::MapMode::Read, |_| {});
+        self.request();
         device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| Error::Gpu(e.to_string()))?;
+        self.try_read(device, only)?.ok_or_else(|| Error::Gpu("no timed frame was submitted".into()))
+    }
+
+    /// Never waits: the durations of the last timed frame once the GPU has finished it, else
+    /// `None` (ask again next frame). The first call after a timed frame starts the readback.
+    pub fn try_read(&self, device: &wgpu::Device, only: &[&str]) -> Result<Option<Vec<PassTime>>, Error> {
+        self.request();
+        device.poll(wgpu::PollType::Poll).map_err(|e| Error::Gpu(e.to_string()))?;
+        if self.state.load(Ordering::Acquire) != MAPPED {
+            return Ok(None);
+        }
+        let slice = self.readback.slice(..);
         let ticks: Vec<u64> = {
             let mapped = slice.get_mapped_range().map_err(|e| Error::Gpu(e.to_string()))?;
             bytemuck::pod_collect_to_vec(&mapped)
         };
         self.readback.unmap();
-        Ok(self
-            .names
-            .iter()
-            .enumerate()
-            .filter(|(_, name)| only.is_empty() || only.contains(name))
-            .map(|(i, &name)| PassTime {
-                name,
-                ms: ticks[2 * i + 1].wrapping_sub(ticks[2 * i]) as f64 * self.period_ns * 1e-6,
-            })
-            .collect())
+        self.state.store(FREE, Ordering::Release);
+        Ok(Some(
+            self.names
+                .iter()
+                .enumerate()
+                .filter(|(_, name)| only.is_empty() || only.contains(name))
+                .map(|(i, &name)| PassTime {
+                    name,
+                    ms: ticks[2 * i + 1].wrapping_sub(ticks[2 * i]) as f64 * self.period_ns * 1e-6,
+                })
+                .collect(),
+        ))
+    }
+
+    /// Starts mapping the readback buffer if it holds a frame's timestamps.
+    fn request(&self) {
+        if self.state.compare_exchange(COPIED, MAPPING, Ordering::AcqRel, Ordering::Acquire).is_err() {
+            return;
+        }
+        let state = Arc::clone(&self.state);
+        self.readback.slice(..).map_async(wgpu::MapMode::Read, move |result| {
+            state.store(if result.is_ok() { MAPPED } else { FREE }, Ordering::Release);
+        });
     }
 }

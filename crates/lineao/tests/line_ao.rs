@@ -485,3 +485,43 @@ fn chain_reports_gpu_time_per_pass() {
         assert!(times.iter().all(|t| t.ms > 0.0 && t.ms < 10_000.0), "{variant:?}: {times:?}");
     }
 }
+
+/// The polled timings never wait: right after a submission they may say "not yet" (`None`),
+/// and asking on, frame after frame, they return the times of a finished frame — with the
+/// same spans as the blocking read.
+#[test]
+fn pass_times_can_be_polled_without_waiting() {
+    let gpu = gpu();
+    if !gpu.device.features().contains(wgpu::Features::TIMESTAMP_QUERY) {
+        return; // lavapipe has timestamp queries; an adapter without them has no timer at all
+    }
+    let (positions, offsets) = polylines(40, 0.7);
+    let geometry = lineao::passes::lines::LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap();
+    let (camera, _) = cameras_for_polylines();
+    let mut chain = lineao::AoChain::new(&gpu.device, common::OUTPUT_FORMAT, ChainSettings::default()).unwrap();
+    assert!(chain.set_timing(&gpu.device, &gpu.queue, true));
+    assert_eq!(chain.try_pass_times(&gpu.device).unwrap(), None, "nothing was submitted yet");
+    chain.resize(64, 48).unwrap();
+    let output = lineao::targets::Target::output(&gpu.device, "test::output", (64, 48), common::OUTPUT_FORMAT);
+    let mut polled = None;
+    for _ in 0..1000 {
+        chain.prepare(&gpu.device, &gpu.queue, &camera, &geometry.bounds.unwrap()).unwrap();
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        chain.encode(&mut encoder, &geometry, &output.view);
+        gpu.queue.submit([encoder.finish()]);
+        if let Some(times) = chain.try_pass_times(&gpu.device).unwrap() {
+            polled = Some(times);
+            break;
+        }
+    }
+    let polled = polled.expect("a finished frame's times within 1000 frames");
+    // The next frame is timed again, and the blocking read waits for it.
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    chain.encode(&mut encoder, &geometry, &output.view);
+    gpu.queue.submit([encoder.finish()]);
+    let blocking = chain.pass_times(&gpu.device).unwrap().unwrap();
+    let names = |t: &[lineao::timing::PassTime]| t.iter().map(|t| t.name).collect::<Vec<_>>();
+    assert_eq!(names(&polled), names(&blocking));
+    assert_eq!(names(&polled), ["lines", "nd-pyramid", "lineao", "composite"]);
+    assert!(polled.iter().all(|t| t.ms > 0.0 && t.ms < 10_000.0), "{polled:?}");
+}
