@@ -3,6 +3,9 @@
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use lineao::lighting::LineShading;
+use lineao::truth::Falloff;
+use lineao::{Colormap, LineAoOuter, LineAoVariant, Named, SsaoKernel, VoCombine};
 use lineao_tracts::SceneKind;
 
 #[derive(Parser, Debug)]
@@ -94,14 +97,6 @@ fn parse_score_method(s: &str) -> Result<ScoreMethod, String> {
     })
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum FalloffArg {
-    /// Binary AO: the fraction of rays that hit within the distance.
-    None,
-    /// Obscurance: the mean of 1 − t/R over hits.
-    Linear,
-}
-
 fn parse_distance(s: &str) -> Result<f32, String> {
     match s.parse::<f32>() {
         Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
@@ -134,14 +129,14 @@ pub struct ViewArgs {
     #[arg(long, value_enum, default_value_t = PresetArg::Calibrated)]
     pub preset: PresetArg,
     /// How lines are lit (as `render --line-shading`).
-    #[arg(long, value_enum, default_value_t = LineShadingArg::Specular)]
-    pub line_shading: LineShadingArg,
+    #[arg(long, value_parser = named::<LineShading>(), default_value = "specular")]
+    pub line_shading: LineShading,
     /// Line color: `tangent`, R,G,B in [0, 1], or `field:NAME` (see `render --color`).
     #[arg(long, default_value = "tangent", value_parser = parse_color)]
     pub color: ColorArg,
     /// The colormap of `--color field:NAME`.
-    #[arg(long, value_enum, default_value_t = ColormapArg::Viridis)]
-    pub colormap: ColormapArg,
+    #[arg(long, value_parser = named::<Colormap>(), default_value = "viridis")]
+    pub colormap: Colormap,
     /// What to show: final, ao, normals, depth, zoom, or level:K.
     #[arg(long, default_value = "final", value_parser = parse_debug_view)]
     pub debug_view: lineao::DebugView,
@@ -293,23 +288,6 @@ pub enum GeometryArg {
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum LineShadingArg {
-    /// Zöckler's maximum-principle specular added to the AO-darkened color (the paper's §3.3).
-    Specular,
-    /// Mallo et al.'s cylinder-averaged diffuse and specular.
-    Cylinder,
-}
-
-impl LineShadingArg {
-    pub fn shading(self) -> lineao::lighting::LineShading {
-        match self {
-            LineShadingArg::Specular => lineao::lighting::LineShading::Specular,
-            LineShadingArg::Cylinder => lineao::lighting::LineShading::CylinderAveraged,
-        }
-    }
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum SkyArg {
     /// Light from every direction.
     Uniform,
@@ -326,38 +304,6 @@ pub enum VolumeNormal {
     Tangent,
     /// No geometry term: every octant counts the same (view-independent).
     None,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum Combine {
-    /// Brightness multiplies: 1 − (1 − ao_small)(1 − ao_large).
-    Product,
-    /// The darker of the two.
-    Min,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum SsaoKernelArg {
-    /// Mittring's random kernel, denser near the centre.
-    Crytek,
-    /// The VO paper's generated point set (8, 12, 16, 24 or 32 samples).
-    Sphere,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum Outer {
-    /// At every pixel, as the paper does.
-    Full,
-    /// At level j's resolution, upsampled depth-aware.
-    Level,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum Variant {
-    /// The paper's equations with CONTRACT.md's conventions.
-    Paper,
-    /// What the authors' OpenWalnut shader does (no pyramid, growing radii, `1.5 − …` weights).
-    Reference,
 }
 
 #[derive(Args, Debug)]
@@ -429,12 +375,12 @@ pub struct RenderArgs {
     #[arg(long)]
     pub grid: bool,
     /// LineAO variant.
-    #[arg(long, value_enum, default_value_t = Variant::Paper)]
-    pub variant: Variant,
+    #[arg(long, value_parser = named::<LineAoVariant>(), default_value = "paper")]
+    pub variant: LineAoVariant,
     /// LineAO (variant paper): hemispheres j ≥ 1 at every pixel (`full`) or at their pyramid
     /// level's resolution, upsampled depth-aware (`level`: faster).
-    #[arg(long, value_enum, default_value_t = Outer::Full)]
-    pub outer: Outer,
+    #[arg(long, value_parser = named::<LineAoOuter>(), default_value = "full")]
+    pub outer: LineAoOuter,
     /// Output PNG [default: lineao.png; `score`: no grid].
     #[arg(short, long)]
     pub output: Option<PathBuf>,
@@ -454,8 +400,8 @@ pub struct RenderArgs {
     /// Lines: the illuminated-lines specular on top of the AO (`specular`, the paper's), or
     /// diffuse and specular averaged over the visible half of the line's cylinder (`cylinder`:
     /// Mallo et al. 2005).
-    #[arg(long, value_enum, default_value_t = LineShadingArg::Specular)]
-    pub line_shading: LineShadingArg,
+    #[arg(long, value_parser = named::<LineShading>(), default_value = "specular")]
+    pub line_shading: LineShading,
     /// Context surface shown with the tracts (OBJ or glTF triangles, optionally gzipped); may be
     /// given several times. It occludes the lines and is occluded, and the AO sees it.
     #[arg(long = "surface", value_name = "MESH")]
@@ -506,8 +452,8 @@ pub struct RenderArgs {
     #[arg(long)]
     pub radius2: Option<f32>,
     /// VO with two radii: how they combine.
-    #[arg(long, value_enum, default_value_t = Combine::Product, requires = "radius2")]
-    pub combine: Combine,
+    #[arg(long, value_parser = named::<VoCombine>(), default_value = "product", requires = "radius2")]
+    pub combine: VoCombine,
     /// Bilateral (depth-aware, separable) blur after the method.
     #[arg(long)]
     pub bilateral: bool,
@@ -531,8 +477,8 @@ pub struct RenderArgs {
     #[arg(long)]
     pub ssao_range: Option<f32>,
     /// SSAO: the kernel's points.
-    #[arg(long, value_enum, default_value_t = SsaoKernelArg::Crytek)]
-    pub ssao_kernel: SsaoKernelArg,
+    #[arg(long, value_parser = named::<SsaoKernel>(), default_value = "crytek")]
+    pub ssao_kernel: SsaoKernel,
     /// LineAO δ0.
     #[arg(long, default_value_t = 1e-4)]
     pub delta0: f32,
@@ -564,8 +510,8 @@ pub struct RenderArgs {
     #[arg(long, default_value = "tangent", value_parser = parse_color)]
     pub color: ColorArg,
     /// The colormap of `--color field:NAME`.
-    #[arg(long, value_enum, default_value_t = ColormapArg::Viridis)]
-    pub colormap: ColormapArg,
+    #[arg(long, value_parser = named::<Colormap>(), default_value = "viridis")]
+    pub colormap: Colormap,
     /// Background color R,G,B in [0, 1].
     #[arg(long, default_value = "1,1,1", value_parser = parse_vec3)]
     pub background: [f32; 3],
@@ -590,8 +536,8 @@ pub struct RenderArgs {
     pub sweep_alpha: f32,
     /// A screen-space method with object-space AO: brightness multiplied (`product`) or the
     /// darker of the two (`min`).
-    #[arg(long, value_enum, default_value_t = Combine::Product)]
-    pub volume_combine: Combine,
+    #[arg(long, value_parser = named::<VoCombine>(), default_value = "product")]
+    pub volume_combine: VoCombine,
     /// Ray-traced AO (`--method raytraced`, `score`): rays per geometry pixel. 256 is LineVis's
     /// reference count: a standard error of at most 0.03 per pixel.
     #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
@@ -601,8 +547,8 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 2.0, value_parser = parse_distance)]
     pub ao_distance: f32,
     /// Ray-traced AO: binary (`none`) or obscurance with a linear falloff (`linear`).
-    #[arg(long, value_enum, default_value_t = FalloffArg::None)]
-    pub ao_falloff: FalloffArg,
+    #[arg(long, value_parser = named::<Falloff>(), default_value = "none")]
+    pub ao_falloff: Falloff,
     /// Ray-traced AO: seed of the per-pixel scrambled ray sequence.
     #[arg(long, default_value_t = 1)]
     pub ray_seed: u32,
@@ -645,13 +591,6 @@ fn parse_color(s: &str) -> Result<ColorArg, String> {
     }
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum ColormapArg {
-    Viridis,
-    Gray,
-    Coolwarm,
-}
-
 fn parse_debug_view(s: &str) -> Result<lineao::DebugView, String> {
     use lineao::DebugView as D;
     Ok(match s {
@@ -665,4 +604,12 @@ fn parse_debug_view(s: &str) -> Result<lineao::DebugView, String> {
             _ => return Err(format!("unknown debug view '{s}' (final, ao, normals, depth, zoom, level:K)")),
         },
     })
+}
+
+/// A parser of a library setting's own names ([`lineao::Named`]), listing each with its help:
+/// the CLI mirrors no enum of the library's.
+fn named<T: Named>() -> impl clap::builder::TypedValueParser<Value = T> {
+    use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+    PossibleValuesParser::new(T::VALUES.iter().map(|v| PossibleValue::new(v.name()).help(v.help())))
+        .map(|name| T::from_name(&name).expect("clap accepts the listed names only"))
 }

@@ -13,24 +13,14 @@ use lineao::volume::density::DensityOptions;
 use lineao::volume::sweep::SweepSettings;
 use lineao::volume::{ScalarForm, Sky, VertexVisibility, VolumeAoOptions, VolumeMethod};
 use lineao::{
-    AoChain, AoMethod, BilateralSettings, ChainSettings, Colormap, Gpu, LineAoOuter, LineAoSettings, LineAoVariant,
-    LineColor, SsaoKernel, SsaoSettings, SurfaceSettings, TubeSettings, VoCombine, VoSettings, VolumeAoSettings,
+    AoChain, AoMethod, BilateralSettings, ChainSettings, Gpu, LineAoSettings, LineAoVariant, LineColor, SsaoSettings,
+    SurfaceSettings, TubeSettings, VoSettings, VolumeAoSettings,
 };
 use lineao_tracts::scenes::ViewHint;
 
-use crate::cli::{
-    ColorArg, ColormapArg, Combine, GeometryArg, Method, Outer, RenderArgs, SkyArg, SsaoKernelArg, Variant,
-    VolumeNormal,
-};
+use crate::cli::{ColorArg, GeometryArg, Method, RenderArgs, SkyArg, VolumeNormal};
 use crate::label::Rgba8;
 use crate::source::{Loaded, Source, submit_frame, upload};
-
-fn combine(c: Combine) -> VoCombine {
-    match c {
-        Combine::Product => VoCombine::Product,
-        Combine::Min => VoCombine::Min,
-    }
-}
 
 /// The sky of object-space AO: open, or lit from the world axis nearest to the camera's `up`.
 pub fn sky(args: &RenderArgs, up: Vec3) -> Sky {
@@ -78,7 +68,7 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky) -> 
     let volume = method.volume.map(|_| VolumeAoSettings {
         // The view-independent forms hold the sky already.
         sky: if args.volume_normal == VolumeNormal::Pixel { sky.weights() } else { [1.0; 8] },
-        combine: combine(args.volume_combine),
+        combine: args.volume_combine,
     });
     let method = method.screen;
     // --samples counts the chosen method's samples; the others keep their defaults.
@@ -92,7 +82,7 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky) -> 
             area_samples: samples(AoMethod::VoArea, vo_default.area_samples),
             radius_world: vo_default.radius_world,
             radius2_world: args.radius2,
-            combine: combine(args.combine),
+            combine: args.combine,
             normal_clamp: !args.no_normal_clamp,
             thickness_world: args.thickness,
             noise_seed: args.noise_seed,
@@ -102,10 +92,7 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky) -> 
             radius_world: SsaoSettings::default().radius_world,
             range_world: SsaoSettings::default().range_world,
             noise_seed: args.noise_seed,
-            kernel: match args.ssao_kernel {
-                SsaoKernelArg::Crytek => SsaoKernel::Crytek,
-                SsaoKernelArg::Sphere => SsaoKernel::Sphere,
-            },
+            kernel: args.ssao_kernel,
         },
         blur: args
             .bilateral
@@ -119,19 +106,13 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky) -> 
             epsilon: args.epsilon,
             light_attenuation: !args.no_light_attenuation,
             noise_seed: args.noise_seed,
-            variant: match args.variant {
-                Variant::Paper => LineAoVariant::Paper,
-                Variant::Reference => LineAoVariant::Reference,
-            },
+            variant: args.variant,
             reference_radius_px: LineAoSettings::default().reference_radius_px,
-            outer: match args.outer {
-                Outer::Full => LineAoOuter::Full,
-                Outer::Level => LineAoOuter::Level,
-            },
+            outer: args.outer,
         },
         line_width_px: args.line_width,
         lighting: lineao::lighting::Lighting {
-            line_shading: args.line_shading.shading(),
+            line_shading: args.line_shading,
             ..lineao::lighting::Lighting::default()
         },
         tubes: (args.geometry == GeometryArg::Tubes)
@@ -141,14 +122,7 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky) -> 
             ColorArg::Tangent => LineColor::Tangent,
             ColorArg::Constant(rgb) => LineColor::Constant(*rgb),
             // The range comes from the data (`run` sets it).
-            ColorArg::Field(_) => LineColor::Scalar {
-                colormap: match args.colormap {
-                    ColormapArg::Viridis => Colormap::Viridis,
-                    ColormapArg::Gray => Colormap::Gray,
-                    ColormapArg::Coolwarm => Colormap::CoolWarm,
-                },
-                range: [0.0, 1.0],
-            },
+            ColorArg::Field(_) => LineColor::Scalar { colormap: args.colormap, range: [0.0, 1.0] },
         },
         background: args.background,
         strength: 1.0,
@@ -227,7 +201,7 @@ fn panels(args: &RenderArgs, zoom_unit: f32, sky: Sky) -> Vec<Panel> {
     let lineao = Method { screen: AoMethod::LineAo, volume: None };
     let mut reference = settings(args, lineao, zoom_unit, sky);
     reference.line_ao.variant =
-        if args.variant == Variant::Reference { LineAoVariant::Paper } else { LineAoVariant::Reference };
+        if args.variant == LineAoVariant::Reference { LineAoVariant::Paper } else { LineAoVariant::Reference };
     all.insert(2, Panel::new(lineao, reference));
     all
 }

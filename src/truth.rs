@@ -7,11 +7,11 @@ use std::sync::OnceLock;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::{Context, Result};
-use lineao::truth::{Bvh, Falloff, LineShape, Truth, TruthSettings};
+use lineao::truth::{Bvh, LineShape, Truth, TruthSettings};
 use lineao::{AoChain, Gpu};
 use lineao_tracts::{Tractogram, TriangleMesh};
 
-use crate::cli::{FalloffArg, RenderArgs};
+use crate::cli::RenderArgs;
 
 /// What the frame drew, on the CPU.
 pub struct Scene<'a> {
@@ -26,10 +26,7 @@ pub fn settings(args: &RenderArgs) -> TruthSettings {
     TruthSettings {
         rays: args.rays,
         distance_world: args.ao_distance,
-        falloff: match args.ao_falloff {
-            FalloffArg::None => Falloff::None,
-            FalloffArg::Linear => Falloff::Linear,
-        },
+        falloff: args.ao_falloff,
         seed: args.ray_seed,
         vo: None,
         threads: 0,

@@ -611,6 +611,11 @@ fn truth_options_are_checked() {
         (&["score", "--ao-distance", "0"], "positive"),
         (&["score", "--methods", "magic"], "unknown method"),
         (&["render", "--preset", "fancy"], "unknown preset"),
+        (&["render", "--delta-scale", "x"], "invalid value"),
+        // The library's own names, listed from it (lineao::Named).
+        (&["render", "--variant", "authors"], "[possible values: paper, reference]"),
+        (&["render", "--colormap", "jet"], "[possible values: viridis, gray, coolwarm]"),
+        (&["render", "--ao-falloff", "cubic"], "[possible values: none, linear]"),
     ] {
         let out = lineao(bad);
         assert_eq!(out.status.code(), Some(2), "{bad:?}: {}", stderr(&out));

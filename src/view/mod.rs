@@ -16,7 +16,7 @@ mod worker;
 
 use anyhow::{Context, Result};
 
-use crate::cli::{ColorArg, ColormapArg, GeometryArg, PresetArg, ViewArgs};
+use crate::cli::{ColorArg, GeometryArg, PresetArg, ViewArgs};
 use controls::{ColorMode, Controls, Geometry, Preset};
 use worker::Source;
 
@@ -43,17 +43,13 @@ fn options(args: &ViewArgs) -> app::Options {
         GeometryArg::Lines => Geometry::Lines,
         GeometryArg::Tubes => Geometry::Tubes,
     };
-    controls.line_shading = args.line_shading.shading();
+    controls.line_shading = args.line_shading;
     controls.color = match &args.color {
         ColorArg::Tangent => ColorMode::Tangent,
         ColorArg::Constant(rgb) => ColorMode::Constant(rgb.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8)),
         ColorArg::Field(name) => ColorMode::Field(name.clone()),
     };
-    controls.colormap = match args.colormap {
-        ColormapArg::Viridis => lineao::Colormap::Viridis,
-        ColormapArg::Gray => lineao::Colormap::Gray,
-        ColormapArg::Coolwarm => lineao::Colormap::CoolWarm,
-    };
+    controls.colormap = args.colormap;
     controls.debug_view = args.debug_view;
     controls.timings = args.timings;
     app::Options {

@@ -78,7 +78,7 @@ pub use passes::nd_from_depth::{HostConfig, HostInputs};
 pub use passes::tubes::TubeRenderer;
 pub use settings::{
     AoMethod, BilateralSettings, ChainSettings, Colormap, DebugView, LineAoOuter, LineAoSettings, LineAoVariant,
-    LineColor, Preset, R0, SsaoKernel, SsaoSettings, SurfaceSettings, TubeSettings, VoCombine, VoSettings,
+    LineColor, Named, Preset, R0, SsaoKernel, SsaoSettings, SurfaceSettings, TubeSettings, VoCombine, VoSettings,
     VolumeAoSettings,
 };
 

@@ -58,6 +58,60 @@ pub enum LineAoVariant {
     Reference,
 }
 
+/// A setting with a fixed set of values, each with the name the command line, `params.json` and
+/// CONTRACT.md use and a line of help: what a CLI or a binding (Python, a host's UI) parses and
+/// lists, so that it mirrors no enum of its own.
+pub trait Named: Copy + Send + Sync + 'static {
+    /// Every value, the default first.
+    const VALUES: &'static [Self];
+    fn name(self) -> &'static str;
+    /// What the value does, in one line.
+    fn help(self) -> &'static str;
+    fn from_name(name: &str) -> Option<Self> {
+        Self::VALUES.iter().copied().find(|v| v.name() == name)
+    }
+}
+
+/// `impl Named` from the inherent `name` and a help line per value.
+macro_rules! named {
+    ($ty:ty { $($value:ident => $help:literal),+ $(,)? }) => {
+        impl Named for $ty {
+            const VALUES: &'static [Self] = &[$(<$ty>::$value),+];
+            fn name(self) -> &'static str {
+                <$ty>::name(self)
+            }
+            fn help(self) -> &'static str {
+                match self {
+                    $(<$ty>::$value => $help),+
+                }
+            }
+        }
+    };
+}
+pub(crate) use named;
+
+named!(LineAoVariant {
+    Paper => "The paper's equations with CONTRACT.md's conventions",
+    Reference => "What the authors' OpenWalnut shader does (no pyramid, growing radii, `1.5 − …` weights)",
+});
+named!(LineAoOuter {
+    Full => "Hemispheres j ≥ 1 at every pixel, as the paper does",
+    Level => "Hemispheres j ≥ 1 at level j's resolution, upsampled depth-aware",
+});
+named!(SsaoKernel {
+    Crytek => "Mittring's random kernel, denser near the centre",
+    Sphere => "The VO paper's generated point set (8, 12, 16, 24 or 32 samples)",
+});
+named!(VoCombine {
+    Product => "Brightness multiplies: 1 − (1 − ao_a)(1 − ao_b)",
+    Min => "The darker of the two",
+});
+named!(Colormap {
+    Viridis => "Perceptually uniform, dark blue to yellow",
+    Gray => "Black to white",
+    CoolWarm => "Moreland's diverging blue–white–red",
+});
+
 impl LineAoVariant {
     /// The name used on the command line and in `params.json`.
     pub fn name(self) -> &'static str {

@@ -50,6 +50,7 @@ pub mod metrics;
 pub mod primitive;
 pub mod sequence;
 
+use crate::settings::Named;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
@@ -89,6 +90,11 @@ impl Falloff {
         Falloff::ALL.into_iter().find(|f| f.name() == name)
     }
 }
+
+crate::settings::named!(Falloff {
+    None => "Binary AO: the fraction of rays that hit within the distance",
+    Linear => "Obscurance: the mean of 1 − t/R over hits",
+});
 
 /// Which ball the VO truth measures.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
