@@ -9,12 +9,13 @@
 //!
 //! - [`AoChain`] wires the passes for a method and owns every size-dependent texture:
 //!   `resize`, `prepare`, `encode` into your `CommandEncoder` and target view.
-//! - [`passes`]: [`LineRenderer`](passes::lines::LineRenderer) (fixed-width lines writing the
+//! - [`passes`]: [`LineRenderer`] (fixed-width lines writing the
 //!   G-buffer), [`NdPyramid`](passes::nd_pyramid::NdPyramid), [`LineAo`](passes::line_ao::LineAo),
 //!   the alternatives LineAO is measured against — [`Ssao`](passes::ssao::Ssao) (Crytek),
 //!   [`VoLine`](passes::vo_line::VoLine) and [`VoArea`](passes::vo_area::VoArea) (Volumetric
 //!   Obscurance) — the [`Bilateral`](passes::bilateral::Bilateral) blur and the
-//!   [`Composite`](passes::composite::Composite), each usable alone.
+//!   [`Composite`](passes::composite::Composite), each usable alone; each method is a
+//!   [`stage::Stage`] of the chain.
 //! - [`mod@reference`]: the CPU reference of each pass.
 //! - [`truth`]: the ground truth — ambient occlusion ray traced on the geometry the frame shows
 //!   (a BVH over rounded cones and triangles), and the [`truth::metrics`] that score a method
