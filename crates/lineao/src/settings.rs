@@ -193,6 +193,36 @@ impl Default for LineAoSettings {
     }
 }
 
+impl LineAoSettings {
+    /// Checks every range documented above.
+    pub fn validate(&self) -> Result<(), crate::Error> {
+        let bad = |what: String| Err(crate::Error::InvalidSettings(what));
+        if !(1..=crate::MAX_LEVELS).contains(&self.s_r) {
+            return bad(format!("s_r must be in 1..={}, got {}", crate::MAX_LEVELS, self.s_r));
+        }
+        if !(1..=256).contains(&self.s_h) {
+            return bad(format!("s_h must be in 1..=256, got {}", self.s_h));
+        }
+        if !(self.delta_scale.is_finite() && self.delta_scale > 0.0 && self.delta_scale <= 1.0) {
+            return bad(format!("the δ scale must be in (0, 1], got {}", self.delta_scale));
+        }
+        let last_delta = self.delta_scale * (1.0 / self.s_r as f32).powi(2);
+        if !(self.delta0.is_finite() && self.delta0 >= 0.0 && self.delta0 < last_delta) {
+            return bad(format!("delta0 must be in [0, δ scale · (1/s_r)^2) = [0, {last_delta}), got {}", self.delta0));
+        }
+        if self.variant == LineAoVariant::Reference && self.outer == LineAoOuter::Level {
+            return bad("outer = level applies to variant paper (reference reads level 0 only)".into());
+        }
+        if !(self.reference_radius_px.is_finite() && self.reference_radius_px >= 0.0) {
+            return bad(format!("the reference radius must be >= 0 px, got {}", self.reference_radius_px));
+        }
+        if !(self.epsilon.is_finite() && self.epsilon >= 0.0) {
+            return bad(format!("epsilon must be >= 0, got {}", self.epsilon));
+        }
+        Ok(())
+    }
+}
+
 /// Crytek SSAO (`lineao::passes::ssao`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct SsaoSettings {
@@ -212,6 +242,30 @@ pub struct SsaoSettings {
 impl Default for SsaoSettings {
     fn default() -> Self {
         SsaoSettings { samples: 16, radius_world: 2.0, range_world: 2.0, noise_seed: 1, kernel: SsaoKernel::Crytek }
+    }
+}
+
+impl SsaoSettings {
+    /// Checks every range documented above.
+    pub fn validate(&self) -> Result<(), crate::Error> {
+        let bad = |what: String| Err(crate::Error::InvalidSettings(what));
+        if !(8..=32).contains(&self.samples) {
+            return bad(format!("SSAO samples must be in 8..=32, got {}", self.samples));
+        }
+        if self.kernel == SsaoKernel::Sphere && !crate::sample_sets::VO_SPHERE_SAMPLE_COUNTS.contains(&self.samples) {
+            return bad(format!(
+                "the sphere kernel has {:?} samples, got {}",
+                crate::sample_sets::VO_SPHERE_SAMPLE_COUNTS,
+                self.samples
+            ));
+        }
+        if !(self.radius_world.is_finite() && self.radius_world > 0.0) {
+            return bad(format!("the SSAO radius must be > 0 world units, got {}", self.radius_world));
+        }
+        if !(self.range_world.is_finite() && self.range_world > 0.0) {
+            return bad(format!("the SSAO range must be > 0 world units, got {}", self.range_world));
+        }
+        Ok(())
     }
 }
 
@@ -312,6 +366,36 @@ impl Default for VoSettings {
     }
 }
 
+impl VoSettings {
+    /// Checks every range documented above.
+    pub fn validate(&self) -> Result<(), crate::Error> {
+        let bad = |what: String| Err(crate::Error::InvalidSettings(what));
+        if !crate::sample_sets::VO_SAMPLE_COUNTS.contains(&self.samples) {
+            return bad(format!(
+                "VO samples must be one of {:?}, got {}",
+                crate::sample_sets::VO_SAMPLE_COUNTS,
+                self.samples
+            ));
+        }
+        if !crate::sample_sets::VO_AREA_SAMPLE_COUNTS.contains(&self.area_samples) {
+            return bad(format!(
+                "VO area samples must be one of {:?}, got {}",
+                crate::sample_sets::VO_AREA_SAMPLE_COUNTS,
+                self.area_samples
+            ));
+        }
+        for radius in std::iter::once(self.radius_world).chain(self.radius2_world) {
+            if !(radius.is_finite() && radius > 0.0) {
+                return bad(format!("a VO radius must be > 0 world units, got {radius}"));
+            }
+        }
+        if !(self.thickness_world.is_finite() && self.thickness_world >= 0.0) {
+            return bad(format!("the VO thickness must be >= 0 world units, got {}", self.thickness_world));
+        }
+        Ok(())
+    }
+}
+
 /// Object-space AO in the chain ([`crate::volume`], [`crate::passes::volume_ao`]): the
 /// geometry's per-vertex octant visibilities ([`crate::passes::lines::VertexAttributes`])
 /// turned into occlusion with each pixel's normal, alone (with [`AoMethod::None`]) or combined
@@ -348,6 +432,20 @@ pub struct BilateralSettings {
 impl Default for BilateralSettings {
     fn default() -> Self {
         BilateralSettings { radius_px: 4, depth_sigma_world: 1.0 }
+    }
+}
+
+impl BilateralSettings {
+    /// Checks every range documented above.
+    pub fn validate(&self) -> Result<(), crate::Error> {
+        let bad = |what: String| Err(crate::Error::InvalidSettings(what));
+        if !(1..=16).contains(&self.radius_px) {
+            return bad(format!("the blur radius must be in 1..=16 px, got {}", self.radius_px));
+        }
+        if !(self.depth_sigma_world.is_finite() && self.depth_sigma_world > 0.0) {
+            return bad(format!("the blur's depth sigma must be > 0, got {}", self.depth_sigma_world));
+        }
+        Ok(())
     }
 }
 
@@ -664,15 +762,15 @@ impl ChainSettings {
     /// Checks every range documented above.
     pub fn validate(&self) -> Result<(), crate::Error> {
         let bad = |what: String| Err(crate::Error::InvalidSettings(what));
-        let ao = &self.line_ao;
         if self.method == AoMethod::RayTraced && self.blur.is_some() {
             return bad("the ray-traced truth takes no blur: it is shown as traced".into());
         }
-        if !(1..=crate::MAX_LEVELS).contains(&ao.s_r) {
-            return bad(format!("s_r must be in 1..={}, got {}", crate::MAX_LEVELS, ao.s_r));
-        }
-        if !(1..=256).contains(&ao.s_h) {
-            return bad(format!("s_h must be in 1..=256, got {}", ao.s_h));
+        // Each method's own settings, then what the chain adds.
+        self.line_ao.validate()?;
+        self.ssao.validate()?;
+        self.vo.validate()?;
+        if let Some(blur) = &self.blur {
+            blur.validate()?;
         }
         if !(self.line_width_px.is_finite() && self.line_width_px > 0.0 && self.line_width_px <= 256.0) {
             return bad(format!("line width must be in (0, 256] px, got {}", self.line_width_px));
@@ -684,70 +782,6 @@ impl ChainSettings {
         }
         if !(self.r0_px().is_finite() && self.r0_px() >= 0.0) {
             return bad(format!("r0 must be a finite number of pixels >= 0, got {}", self.r0_px()));
-        }
-        if !(ao.delta_scale.is_finite() && ao.delta_scale > 0.0 && ao.delta_scale <= 1.0) {
-            return bad(format!("the δ scale must be in (0, 1], got {}", ao.delta_scale));
-        }
-        let last_delta = ao.delta_scale * (1.0 / ao.s_r as f32).powi(2);
-        if !(ao.delta0.is_finite() && ao.delta0 >= 0.0 && ao.delta0 < last_delta) {
-            return bad(format!("delta0 must be in [0, δ scale · (1/s_r)^2) = [0, {last_delta}), got {}", ao.delta0));
-        }
-        if ao.variant == LineAoVariant::Reference && ao.outer == LineAoOuter::Level {
-            return bad("outer = level applies to variant paper (reference reads level 0 only)".into());
-        }
-        if !(ao.reference_radius_px.is_finite() && ao.reference_radius_px >= 0.0) {
-            return bad(format!("the reference radius must be >= 0 px, got {}", ao.reference_radius_px));
-        }
-        if !(ao.epsilon.is_finite() && ao.epsilon >= 0.0) {
-            return bad(format!("epsilon must be >= 0, got {}", ao.epsilon));
-        }
-        let ssao = &self.ssao;
-        if !(8..=32).contains(&ssao.samples) {
-            return bad(format!("SSAO samples must be in 8..=32, got {}", ssao.samples));
-        }
-        if ssao.kernel == SsaoKernel::Sphere && !crate::sample_sets::VO_SPHERE_SAMPLE_COUNTS.contains(&ssao.samples) {
-            return bad(format!(
-                "the sphere kernel has {:?} samples, got {}",
-                crate::sample_sets::VO_SPHERE_SAMPLE_COUNTS,
-                ssao.samples
-            ));
-        }
-        if !(ssao.radius_world.is_finite() && ssao.radius_world > 0.0) {
-            return bad(format!("the SSAO radius must be > 0 world units, got {}", ssao.radius_world));
-        }
-        if !(ssao.range_world.is_finite() && ssao.range_world > 0.0) {
-            return bad(format!("the SSAO range must be > 0 world units, got {}", ssao.range_world));
-        }
-        let vo = &self.vo;
-        if !crate::sample_sets::VO_SAMPLE_COUNTS.contains(&vo.samples) {
-            return bad(format!(
-                "VO samples must be one of {:?}, got {}",
-                crate::sample_sets::VO_SAMPLE_COUNTS,
-                vo.samples
-            ));
-        }
-        if !crate::sample_sets::VO_AREA_SAMPLE_COUNTS.contains(&vo.area_samples) {
-            return bad(format!(
-                "VO area samples must be one of {:?}, got {}",
-                crate::sample_sets::VO_AREA_SAMPLE_COUNTS,
-                vo.area_samples
-            ));
-        }
-        for radius in std::iter::once(vo.radius_world).chain(vo.radius2_world) {
-            if !(radius.is_finite() && radius > 0.0) {
-                return bad(format!("a VO radius must be > 0 world units, got {radius}"));
-            }
-        }
-        if !(vo.thickness_world.is_finite() && vo.thickness_world >= 0.0) {
-            return bad(format!("the VO thickness must be >= 0 world units, got {}", vo.thickness_world));
-        }
-        if let Some(blur) = &self.blur {
-            if !(1..=16).contains(&blur.radius_px) {
-                return bad(format!("the blur radius must be in 1..=16 px, got {}", blur.radius_px));
-            }
-            if !(blur.depth_sigma_world.is_finite() && blur.depth_sigma_world > 0.0) {
-                return bad(format!("the blur's depth sigma must be > 0, got {}", blur.depth_sigma_world));
-            }
         }
         if let Some(volume) = &self.volume
             && !volume.sky.iter().all(|w| (0.0..=1.0).contains(w))
