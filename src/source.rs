@@ -67,9 +67,12 @@ impl Source {
     }
 }
 
-/// `tracts` (of the source `name`) on the GPU; an error naming it when no point is finite.
+/// `tracts` (of the source `name`) on the GPU; an error naming it when no point is finite. The
+/// CLI and the viewer's worker own their devices, so they bound the staging memory (peak: the
+/// strip plus one buffer) by waiting after each buffer.
 pub fn upload(name: &str, tracts: &Tractogram, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<LineGeometry> {
-    let geometry = LineGeometry::new(device, queue, &tracts.positions, &tracts.offsets)
+    let options = lineao::passes::lines::GeometryOptions { bounded_staging: true, ..Default::default() };
+    let geometry = LineGeometry::with_options(device, queue, &tracts.positions, &tracts.offsets, options)
         .map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
     if geometry.bounds.is_none() {
         bail!("{name} has no finite points");

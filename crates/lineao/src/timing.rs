@@ -17,12 +17,11 @@ use std::sync::atomic::{AtomicU8, Ordering};
 
 use crate::Error;
 
-/// Where the readback buffer stands: free (the next `resolve` copies into it), holding a
-/// frame's timestamps, being mapped, or mapped and readable.
+/// Where the readback buffer stands: free (the next `resolve` copies into it and asks for it
+/// to be mapped once that frame has run), waiting for a frame to run, or mapped and readable.
 const FREE: u8 = 0;
-const COPIED: u8 = 1;
-const MAPPING: u8 = 2;
-const MAPPED: u8 = 3;
+const PENDING: u8 = 1;
+const MAPPED: u8 = 2;
 
 /// The timestamps of one span inside a [`PassTimer`]'s query set.
 #[derive(Clone, Copy)]
@@ -138,32 +137,35 @@ impl PassTimer {
         Some(Span { query_set: &self.query_set, begin: Some(2 * index), end: Some(2 * index + 1) })
     }
 
-    /// Records the copy of every timestamp to the CPU-readable buffer; call once per frame after
-    /// the timed passes. While an earlier frame's timestamps wait to be read ([`PassTimer::try_read`]),
-    /// this frame's are resolved but not copied: that frame is not timed.
+    /// Records the copy of every timestamp to the CPU-readable buffer, mapped for reading once
+    /// the frame has run (`map_buffer_on_submit`); call once per frame after the timed passes.
+    /// While an earlier frame's timestamps wait to be read, this frame's are resolved but not
+    /// copied: that frame is not timed. A timed frame recorded but never submitted stops the
+    /// timings until the timer is made again.
     pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
         let count = 2 * self.names.len() as u32;
         encoder.resolve_query_set(&self.query_set, 0..count, &self.resolve, 0);
-        let copied = self.state.compare_exchange(FREE, COPIED, Ordering::AcqRel, Ordering::Acquire);
-        // A frame recorded but never submitted leaves COPIED: the next copy overwrites it.
-        if copied.is_ok() || copied == Err(COPIED) {
-            encoder.copy_buffer_to_buffer(&self.resolve, 0, &self.readback, 0, self.resolve.size());
+        if self.state.compare_exchange(FREE, PENDING, Ordering::AcqRel, Ordering::Acquire).is_err() {
+            return;
         }
+        encoder.copy_buffer_to_buffer(&self.resolve, 0, &self.readback, 0, self.resolve.size());
+        let state = Arc::clone(&self.state);
+        encoder.map_buffer_on_submit(&self.readback, wgpu::MapMode::Read, .., move |result| {
+            state.store(if result.is_ok() { MAPPED } else { FREE }, Ordering::Release);
+        });
     }
 
     /// Waits for the submitted frame and returns the duration of every span it wrote, in the
     /// order of `names`. A span that was not recorded this frame reads as garbage: only ask for
     /// the spans the frame used (`only`), or all when `only` is empty.
     pub fn read(&self, device: &wgpu::Device, only: &[&str]) -> Result<Vec<PassTime>, Error> {
-        self.request();
         device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| Error::Gpu(e.to_string()))?;
         self.try_read(device, only)?.ok_or_else(|| Error::Gpu("no timed frame was submitted".into()))
     }
 
     /// Never waits: the durations of the last timed frame once the GPU has finished it, else
-    /// `None` (ask again next frame). The first call after a timed frame starts the readback.
+    /// `None` (ask again next frame).
     pub fn try_read(&self, device: &wgpu::Device, only: &[&str]) -> Result<Option<Vec<PassTime>>, Error> {
-        self.request();
         device.poll(wgpu::PollType::Poll).map_err(|e| Error::Gpu(e.to_string()))?;
         if self.state.load(Ordering::Acquire) != MAPPED {
             return Ok(None);
@@ -186,16 +188,5 @@ impl PassTimer {
                 })
                 .collect(),
         ))
-    }
-
-    /// Starts mapping the readback buffer if it holds a frame's timestamps.
-    fn request(&self) {
-        if self.state.compare_exchange(COPIED, MAPPING, Ordering::AcqRel, Ordering::Acquire).is_err() {
-            return;
-        }
-        let state = Arc::clone(&self.state);
-        self.readback.slice(..).map_async(wgpu::MapMode::Read, move |result| {
-            state.store(if result.is_ok() { MAPPED } else { FREE }, Ordering::Release);
-        });
     }
 }

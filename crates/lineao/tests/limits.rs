@@ -170,3 +170,51 @@ fn a_chain_switching_methods_renders_what_fresh_chains_do() {
         }
     }
 }
+
+/// What a host does while a long frame runs on the GPU — upload geometry, make, size, prepare
+/// and record a chain, poll its timings — returns before that frame is done: nothing waits for
+/// the device (`GeometryOptions::bounded_staging` is off by default).
+#[test]
+fn prepare_encode_and_upload_do_not_wait_for_the_device() {
+    use std::sync::Arc;
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let gpu = gpu();
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let (positions, offsets) = common::polylines(400, 0.3);
+    let geometry = LineGeometry::new(d, q, &positions, &offsets).unwrap();
+    let bounds = geometry.bounds.unwrap();
+    let (camera, _) = common::cameras_for_polylines();
+    // A long submission (seconds on lavapipe): LineAO with five hemispheres of up to 128
+    // samples on 1536 × 1536.
+    let heavy = ChainSettings {
+        line_ao: lineao::LineAoSettings { s_r: 5, s_h: 128, ..Default::default() },
+        ..ChainSettings::default()
+    };
+    let mut long = AoChain::new(d, common::OUTPUT_FORMAT, heavy).unwrap();
+    long.resize(1536, 1536).unwrap();
+    long.prepare(d, q, &camera, &bounds).unwrap();
+    let output = lineao::targets::Target::output(d, "test::long", (1536, 1536), common::OUTPUT_FORMAT);
+    let mut encoder = d.create_command_encoder(&Default::default());
+    long.encode(&mut encoder, &geometry, &output.view);
+    q.submit([encoder.finish()]);
+    let done = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&done);
+    q.on_submitted_work_done(move || flag.store(true, Ordering::Release));
+
+    let start = std::time::Instant::now();
+    let uploaded = LineGeometry::new(d, q, &positions, &offsets).unwrap();
+    let mut chain = AoChain::new(d, common::OUTPUT_FORMAT, ChainSettings::default()).unwrap();
+    chain.set_timing(d, q, true);
+    chain.resize(256, 192).unwrap();
+    chain.prepare(d, q, &camera, &bounds).unwrap();
+    let small = lineao::targets::Target::output(d, "test::small", (256, 192), common::OUTPUT_FORMAT);
+    let mut encoder = d.create_command_encoder(&Default::default());
+    chain.encode(&mut encoder, &uploaded, &small.view);
+    assert_eq!(chain.try_pass_times(d).unwrap(), None, "no timed frame was submitted");
+    let took = start.elapsed();
+    assert!(!done.load(Ordering::Acquire), "the calls waited for the long frame ({took:?})");
+    // The long frame was real: waiting for it now sees it finish.
+    d.poll(wgpu::PollType::wait_indefinitely()).unwrap();
+    assert!(done.load(Ordering::Acquire));
+    println!("upload, chain, prepare and encode took {took:?} while the long frame ran");
+}
