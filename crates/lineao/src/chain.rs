@@ -94,14 +94,26 @@ impl AoChain {
     /// A chain that composites into targets of `format`. A device that cannot run the passes
     /// (see [`crate::gpu::check_adapter`]) or a `format` that cannot be rendered to is an
     /// [`Error::Unsupported`], not wgpu's panic.
+    ///
+    /// Blocks on wgpu's validation answer, which native wgpu gives at once; a host that must
+    /// never block (the web, an async runtime) awaits [`AoChain::new_async`].
     pub fn new(device: &wgpu::Device, format: wgpu::TextureFormat, settings: ChainSettings) -> Result<AoChain, Error> {
+        pollster::block_on(Self::new_async(device, format, settings))
+    }
+
+    /// [`AoChain::new`] as a future.
+    pub async fn new_async(
+        device: &wgpu::Device,
+        format: wgpu::TextureFormat,
+        settings: ChainSettings,
+    ) -> Result<AoChain, Error> {
         settings.validate()?;
         if format.is_depth_stencil_format() {
             return Err(Error::Usage(format!(
                 "AoChain::new takes the color format the composite writes, not the depth's ({format:?})"
             )));
         }
-        crate::gpu::validated(device, "creating the pass chain's pipelines", || AoChain {
+        crate::gpu::validated_async(device, "creating the pass chain's pipelines", || AoChain {
             stages: {
                 let mut stages = Stages::default();
                 stages.select(&settings, None, device, || stage::build(device, &settings));
@@ -123,6 +135,7 @@ impl AoChain {
             view: None,
             timer: None,
         })
+        .await
     }
 
     pub fn settings(&self) -> &ChainSettings {
