@@ -269,7 +269,7 @@ impl Session {
         let bounds = meshes.iter().filter_map(|m| m.bounds).fold(geometry.bounds.expect("checked"), |b, m| b.union(&m));
         if radii.is_some() || scalars.is_some() {
             let attributes = VertexAttributes { radius: radii.as_deref(), scalar: scalars.as_deref(), octants: None };
-            geometry.set_attributes(&gpu.device, &gpu.queue, &tracts.positions, &tracts.offsets, &attributes)?;
+            geometry.set_attributes(&gpu.device, &gpu.queue, &attributes)?;
         }
         Ok(Session { name, tracts, hint, camera, sky, surfaces, radii, scalars, gpu, geometry, meshes, bounds })
     }
@@ -333,7 +333,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 scalar: session.scalars.as_deref(),
             };
             let gpu = &session.gpu;
-            session.geometry.set_attributes(&gpu.device, &gpu.queue, &tracts.positions, &tracts.offsets, &octants)?;
+            session.geometry.set_attributes(&gpu.device, &gpu.queue, &octants)?;
             attributes = Some(method);
         }
         // One method dumps into DIR itself, several into DIR/<label>/.

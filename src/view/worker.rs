@@ -97,8 +97,6 @@ struct Scene {
 /// Every k-th streamline: its geometry, and which full-detail vertices it keeps.
 struct Preview {
     geometry: LineGeometry,
-    positions: Vec<[f32; 3]>,
-    offsets: Vec<u64>,
     kept: Vec<usize>,
     attributes: (Option<String>, Option<VolumeAoOptions>),
 }
@@ -196,7 +194,7 @@ fn render_frame(
         let k = scene.full.vertices.div_ceil(PREVIEW_VERTICES);
         let (positions, offsets, kept) = subset(&scene.tracts, k);
         let geometry = LineGeometry::new(d, q, &positions, &offsets).map_err(|e| e.to_string())?;
-        scene.preview = Some(Preview { geometry, positions, offsets, kept, attributes: (None, None) });
+        scene.preview = Some(Preview { geometry, kept, attributes: (None, None) });
     }
     let bounds = scene.full.bounds.expect("checked at load");
     let scalars = match &view.scalar_field {
@@ -234,19 +232,18 @@ fn render_frame(
                 let scalar = scalars.as_deref().map(pick);
                 let attributes =
                     VertexAttributes { octants: octants.as_deref(), scalar: scalar.as_deref(), radius: None };
-                p.geometry.set_attributes(d, q, &p.positions, &p.offsets, &attributes).map_err(|e| e.to_string())?;
+                p.geometry.set_attributes(d, q, &attributes).map_err(|e| e.to_string())?;
                 p.attributes = wanted;
             }
             &p.geometry
         } else {
             if scene.attributes != wanted && (wanted.0.is_some() || wanted.1.is_some()) {
-                let t = &scene.tracts;
                 let attributes = VertexAttributes {
                     octants: visibility.map(|v| v.octants.as_slice()),
                     scalar: scalars.as_deref(),
                     radius: None,
                 };
-                scene.full.set_attributes(d, q, &t.positions, &t.offsets, &attributes).map_err(|e| e.to_string())?;
+                scene.full.set_attributes(d, q, &attributes).map_err(|e| e.to_string())?;
                 scene.attributes = wanted;
             }
             &scene.full

@@ -49,6 +49,7 @@ pub mod chain;
 pub mod gbuffer;
 pub mod gpu;
 pub mod lighting;
+pub mod line_geometry;
 pub mod noise;
 pub mod passes;
 pub mod readback;

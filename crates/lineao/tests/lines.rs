@@ -362,7 +362,7 @@ fn scalar_colors_follow_the_colormap_table() {
     let per_vertex: Vec<f32> = scalars.iter().flat_map(|&s| [s, s]).collect();
     let mut geometry = LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap();
     let attributes = lineao::passes::lines::VertexAttributes { scalar: Some(&per_vertex), ..Default::default() };
-    geometry.set_attributes(&gpu.device, &gpu.queue, &positions, &offsets, &attributes).unwrap();
+    geometry.set_attributes(&gpu.device, &gpu.queue, &attributes).unwrap();
     let table = lineao::Colormap::Viridis.table();
     let expected = |s: f32| {
         let x = (s / 20.0).clamp(0.0, 1.0) * 15.0;

@@ -279,7 +279,7 @@ fn curved_tubes_of_varying_radius_are_the_union_of_their_segments() {
         let used: Vec<f32> = if varying { radii.clone() } else { vec![1.5; positions.len()] };
         if varying {
             let attributes = VertexAttributes { radius: Some(&radii), ..Default::default() };
-            geometry.set_attributes(&gpu.device, &gpu.queue, &positions, &offsets, &attributes).unwrap();
+            geometry.set_attributes(&gpu.device, &gpu.queue, &attributes).unwrap();
         }
         let frame = render_tubes(&gpu, &geometry, &camera, tubes(1.5), (240, 180));
         let hits = nearest_hits(&frame.view, &positions, &offsets, &used);

@@ -339,7 +339,7 @@ fn swept_polylines(gpu: &lineao::Gpu, options: GeometryOptions) -> (LineGeometry
     let octants = sweep::octant_visibility(&volume, &positions, &tangents, &SweepSettings::default()).unwrap();
     let mut geometry = LineGeometry::with_options(&gpu.device, &gpu.queue, &positions, &offsets, options).unwrap();
     let attributes = VertexAttributes { octants: Some(&octants), ..Default::default() };
-    geometry.set_attributes(&gpu.device, &gpu.queue, &positions, &offsets, &attributes).unwrap();
+    geometry.set_attributes(&gpu.device, &gpu.queue, &attributes).unwrap();
     (geometry, octants)
 }
 
@@ -457,19 +457,8 @@ fn attributes_split_with_the_strip_and_bad_attributes_are_errors() {
     // Wrong lengths are errors naming what differs.
     let short = vec![[1.0; 8]; positions.len() - 1];
     let error = plain
-        .set_attributes(
-            &gpu.device,
-            &gpu.queue,
-            &positions,
-            &offsets,
-            &VertexAttributes { octants: Some(&short), ..Default::default() },
-        )
+        .set_attributes(&gpu.device, &gpu.queue, &VertexAttributes { octants: Some(&short), ..Default::default() })
         .unwrap_err()
         .to_string();
     assert!(error.contains("octant visibilities"), "{error}");
-    let error = plain
-        .set_attributes(&gpu.device, &gpu.queue, &positions[..60], &offsets[..2], &VertexAttributes::default())
-        .unwrap_err()
-        .to_string();
-    assert!(error.contains("the geometry has"), "{error}");
 }

@@ -25,7 +25,7 @@
 use crate::camera::FrameView;
 use crate::gbuffer::{self, GeometryBindings, GeometryUniform, Load, PipelineSpec};
 use crate::lighting::Lighting;
-use crate::passes::lines::{ATTRIBUTE_SIZE, LineGeometry, POINT_SIZE};
+use crate::line_geometry::{ATTRIBUTE_SIZE, LineGeometry, POINT_SIZE};
 use crate::settings::LineColor;
 use crate::targets::FrameTargets;
 use crate::timing::Span;

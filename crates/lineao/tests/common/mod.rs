@@ -154,7 +154,7 @@ pub fn polylines_with_octants(gpu: &Gpu, count: usize, seed: f32, c: f32) -> Lin
     let octants = vec![[c; 8]; positions.len()];
     let mut geometry = LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap();
     let attributes = lineao::passes::lines::VertexAttributes { octants: Some(&octants), ..Default::default() };
-    geometry.set_attributes(&gpu.device, &gpu.queue, &positions, &offsets, &attributes).unwrap();
+    geometry.set_attributes(&gpu.device, &gpu.queue, &attributes).unwrap();
     geometry
 }
 
