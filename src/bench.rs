@@ -263,8 +263,13 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         LineGeometry::with_options(device, queue, &scene.tractogram.positions, &scene.tractogram.offsets, options)?;
     let bounds = geometry.bounds.context("the scene has no finite points")?;
 
-    // The chain decides the guard band and allocates the G-buffer; the passes below share it.
-    let mut chain = AoChain::new(device, wgpu::TextureFormat::Rgba8UnormSrgb, settings.clone())?;
+    // The chain decides the guard band and allocates the G-buffer (with the `outer = level`
+    // targets `lineao-level` needs); the passes below share it.
+    let level = ChainSettings {
+        line_ao: LineAoSettings { outer: LineAoOuter::Level, ..settings.line_ao.clone() },
+        ..settings.clone()
+    };
+    let mut chain = AoChain::new(device, wgpu::TextureFormat::Rgba8UnormSrgb, level)?;
     chain.resize(args.width, args.height)?;
     let view = chain.prepare(device, queue, &camera, &bounds).context("nothing to render at this size")?;
     let targets = chain.targets().context("the chain allocated no targets")?;

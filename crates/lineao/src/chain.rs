@@ -176,8 +176,9 @@ impl AoChain {
         }
         // The pyramid's depth, whether moments and octants exist and what the composite shows
         // are bound at allocation.
-        let layout =
-            |s: &ChainSettings| (s.levels(), s.method == AoMethod::VoArea, s.blur.is_some(), s.volume.is_some());
+        let layout = |s: &ChainSettings| {
+            (s.levels(), s.method == AoMethod::VoArea, s.blur.is_some(), s.volume.is_some(), outer_level(s))
+        };
         if layout(&settings) != layout(&self.settings) {
             self.targets = None;
         }
@@ -327,6 +328,9 @@ impl AoChain {
             let mut targets = FrameTargets::new(device, width, height, guard, levels);
             if s.method == AoMethod::VoArea {
                 targets = targets.with_moments(device);
+            }
+            if outer_level(s) {
+                targets = targets.with_outer(device);
             }
             if s.volume.is_some() {
                 targets = targets.with_volume(device);
@@ -576,4 +580,13 @@ impl AoChain {
     pub fn frame_view(&self) -> Option<&FrameView> {
         self.view.as_ref()
     }
+}
+
+/// Whether LineAO evaluates its outer hemispheres at their level's size (and so needs the
+/// `outer` targets).
+fn outer_level(s: &ChainSettings) -> bool {
+    s.method == AoMethod::LineAo
+        && s.line_ao.variant == crate::LineAoVariant::Paper
+        && s.line_ao.outer == crate::LineAoOuter::Level
+        && s.levels() > 1
 }

@@ -43,7 +43,7 @@
 //! # Ok(()) }
 //! ```
 
-pub mod binding;
+pub(crate) mod binding;
 pub mod camera;
 pub mod chain;
 pub mod gbuffer;

@@ -203,11 +203,6 @@ impl FrameTargets {
                 Target::new(device, &format!("lineao::FrameTargets::nd[{j}]"), level, ND_FORMAT, usage)
             })
             .collect();
-        let outer = (sizes.iter().enumerate().skip(1))
-            .map(|(j, &level)| {
-                Target::new(device, &format!("lineao::FrameTargets::outer[{j}]"), level, OUTER_FORMAT, level_usage)
-            })
-            .collect();
         FrameTargets {
             size,
             guard,
@@ -220,7 +215,7 @@ impl FrameTargets {
             ao_raw: Target::new(device, "lineao::FrameTargets::ao_raw", size, AO_FORMAT, ao_usage),
             ao_blur_tmp: Target::new(device, "lineao::FrameTargets::ao_blur_tmp", size, AO_FORMAT, ao_usage),
             ao_blurred: Target::new(device, "lineao::FrameTargets::ao_blurred", size, AO_FORMAT, ao_usage),
-            outer,
+            outer: Vec::new(),
             moments: None,
             octants: None,
             volume_ao: None,
@@ -235,6 +230,19 @@ impl FrameTargets {
         self.octants =
             Some(Target::new(device, "lineao::FrameTargets::octants", self.size, OCTANTS_FORMAT, attachment));
         self.volume_ao = Some(Target::new(device, "lineao::FrameTargets::volume_ao", self.size, AO_FORMAT, storage));
+        self
+    }
+
+    /// These targets with LineAO's `outer = level` targets (`outer`: one per pyramid level
+    /// j ≥ 1, at its size).
+    pub fn with_outer(mut self, device: &wgpu::Device) -> FrameTargets {
+        let usage =
+            wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+        self.outer = (self.nd.iter().enumerate().skip(1))
+            .map(|(j, level)| {
+                Target::new(device, &format!("lineao::FrameTargets::outer[{j}]"), level.size(), OUTER_FORMAT, usage)
+            })
+            .collect();
         self
     }
 

@@ -131,7 +131,10 @@ pub fn line_ao_on(
 ) -> (Vec<NdImage>, Image<f32>) {
     let (d, q) = (&gpu.device, &gpu.queue);
     let (w, h) = (nd0.width as u32 - 2 * guard, nd0.height as u32 - 2 * guard);
-    let targets = FrameTargets::new(d, w, h, guard, settings.levels());
+    let mut targets = FrameTargets::new(d, w, h, guard, settings.levels());
+    if settings.line_ao.outer == lineao::LineAoOuter::Level {
+        targets = targets.with_outer(d);
+    }
     write_target(q, &targets.nd[0], nd0);
     write_target(q, &targets.zoom, zoom);
     let mut pyramid = NdPyramid::new(d);
