@@ -126,7 +126,7 @@ fn polyline_points(line: &[[f32; 3]], out: &mut Vec<LinePoint>) {
 pub struct GeometryOptions {
     /// Upper bound of one vertex buffer in bytes (further capped by the device's limit).
     pub chunk_bytes: u64,
-    /// Also upload the index buffers [`LineStyle::Native1px`] draws from (8 bytes per segment).
+    /// Also upload the index buffers [`LineStyle::Native1px`](crate::passes::lines::LineStyle::Native1px) draws from (8 bytes per segment).
     pub native_lines: bool,
     /// Wait for the device after each chunk, so that each chunk's staging copy is freed before
     /// the next is made: 11 M vertices peak at 1.4 GB instead of 2.1 GB. It waits for whatever
