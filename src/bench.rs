@@ -263,16 +263,15 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         LineGeometry::with_options(device, queue, &scene.tractogram.positions, &scene.tractogram.offsets, options)?;
     let bounds = geometry.bounds.context("the scene has no finite points")?;
 
-    // The chain decides the guard band and allocates the G-buffer (with the `outer = level`
-    // targets `lineao-level` needs); the passes below share it.
-    let level = ChainSettings {
-        line_ao: LineAoSettings { outer: LineAoOuter::Level, ..settings.line_ao.clone() },
-        ..settings.clone()
-    };
-    let mut chain = AoChain::new(device, wgpu::TextureFormat::Rgba8UnormSrgb, level)?;
+    // The chain decides the guard band; the passes below share one G-buffer with every target
+    // any of them writes (`outer = level`'s, SSAO's before its blur, the bilateral blur's).
+    let mut chain = AoChain::new(device, wgpu::TextureFormat::Rgba8UnormSrgb, settings.clone())?;
     chain.resize(args.width, args.height)?;
     let view = chain.prepare(device, queue, &camera, &bounds).context("nothing to render at this size")?;
-    let targets = chain.targets().context("the chain allocated no targets")?;
+    let targets = &FrameTargets::new(device, args.width, args.height, view.guard, settings.levels())
+        .with_outer(device)
+        .with_ao_raw(device)
+        .with_blur(device);
     let passes = Passes::new(&gpu, &settings, targets, &view);
     let timer = if args.no_timestamps { None } else { PassTimer::new(device, queue, &GPU_PASSES) };
 

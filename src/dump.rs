@@ -75,9 +75,9 @@ pub fn write(
     }
     let (w, h) = (targets.size.0 as u64, targets.size.1 as u64);
     write_npy(dir, "zoom.npy", &[h, w], &read(&targets.zoom.texture)?.to_f32())?;
-    let raw = match (s.method, &targets.volume_ao) {
-        (AoMethod::None, Some(volume_ao)) => volume_ao,
-        (AoMethod::Ssao, _) => &targets.ao_raw,
+    let raw = match (s.method, &targets.volume_ao, &targets.ao_raw) {
+        (AoMethod::None, Some(volume_ao), _) => volume_ao,
+        (AoMethod::Ssao, _, Some(raw)) => raw,
         _ => &targets.ao,
     };
     write_npy(dir, "ao.npy", &[h, w], &read(&raw.texture)?.to_f32())?;

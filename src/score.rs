@@ -92,7 +92,7 @@ pub fn raw_ao(
     chain.encode_with_meshes(&mut encoder, &session.geometry, &meshes, &target.view);
     gpu.queue.submit([encoder.finish()]);
     let targets = chain.targets().context("nothing was rendered")?;
-    let shown = if chain.settings().blur.is_some() { &targets.ao_blurred } else { &targets.ao };
+    let shown = targets.shown();
     let raw = lineao::verify::read_f32(&gpu.device, &gpu.queue, shown)?;
     let nd = lineao::verify::read_rgba(&gpu.device, &gpu.queue, &targets.nd[0])?;
     let guard = targets.guard as usize;

@@ -177,7 +177,8 @@ impl AoChain {
         // The pyramid's depth, whether moments and octants exist and what the composite shows
         // are bound at allocation.
         let layout = |s: &ChainSettings| {
-            (s.levels(), s.method == AoMethod::VoArea, s.blur.is_some(), s.volume.is_some(), outer_level(s))
+            let method = (s.method == AoMethod::VoArea, s.method == AoMethod::Ssao, outer_level(s));
+            (s.levels(), method, s.blur.is_some(), s.volume.is_some())
         };
         if layout(&settings) != layout(&self.settings) {
             self.targets = None;
@@ -332,6 +333,12 @@ impl AoChain {
             if outer_level(s) {
                 targets = targets.with_outer(device);
             }
+            if s.method == AoMethod::Ssao {
+                targets = targets.with_ao_raw(device);
+            }
+            if s.blur.is_some() {
+                targets = targets.with_blur(device);
+            }
             if s.volume.is_some() {
                 targets = targets.with_volume(device);
             }
@@ -340,7 +347,7 @@ impl AoChain {
             if let Some(pass) = &mut self.volume_ao {
                 pass.resize(device, &targets);
             }
-            let shown = if s.blur.is_some() { &targets.ao_blurred } else { &targets.ao };
+            let shown = targets.shown();
             self.composite.resize(device, &targets, shown);
             self.targets = Some(targets);
         }
@@ -495,7 +502,7 @@ impl AoChain {
     /// lights its own pixels samples. `None` before the first `prepare`.
     pub fn ao_view(&self) -> Option<&wgpu::TextureView> {
         let targets = self.targets.as_ref()?;
-        Some(if self.settings.blur.is_some() { &targets.ao_blurred.view } else { &targets.ao.view })
+        Some(&targets.shown().view)
     }
 
     /// Records the frame into `encoder`, compositing into `target` (the visible size, the format

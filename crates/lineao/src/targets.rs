@@ -10,8 +10,8 @@
 //! | specular  | R32Float      | illuminated-lines specular, added in the composite         |
 //! | depth     | Depth32Float  | hardware depth                                             |
 //! | ao        | R32Float      | occlusion of the chosen method, 0 = none                   |
-//! | ao_raw    | R32Float      | SSAO's occlusion before its 4 × 4 blur                     |
-//! | ao_blurred| R32Float      | `ao` after the bilateral blur (via `ao_blur_tmp`)          |
+//! | ao_raw    | R32Float      | SSAO's occlusion before its 4 × 4 blur (SSAO only)         |
+//! | ao_blurred| R32Float      | `ao` after the bilateral blur (via `ao_blur_tmp`; blur only)|
 //! | octants   | Rg32Uint      | object-space AO: the lines' octant visibilities, unorm8 × 8 |
 //! | volume_ao | R32Float      | object-space AO with the pixel's normal (`volume_ao` pass) |
 //!
@@ -91,6 +91,13 @@ pub struct LevelsUniform {
     pub size: [[u32; 4]; 5],
 }
 
+/// How the AO targets are used: written by compute passes, read by later ones, copied for
+/// readback and written by hosts and tests.
+const AO_USAGE: wgpu::TextureUsages = wgpu::TextureUsages::STORAGE_BINDING
+    .union(wgpu::TextureUsages::TEXTURE_BINDING)
+    .union(wgpu::TextureUsages::COPY_SRC)
+    .union(wgpu::TextureUsages::COPY_DST);
+
 /// Every size-dependent texture of the chain.
 pub struct FrameTargets {
     /// Guard-banded size.
@@ -106,10 +113,10 @@ pub struct FrameTargets {
     /// What the composite shows: the method's occlusion, after its blur if it has one.
     pub ao: Target,
     /// A method's occlusion before its blur (SSAO); the blur writes `ao`.
-    pub ao_raw: Target,
+    pub ao_raw: Option<Target>,
     /// The bilateral blur's horizontal half, and its result.
-    pub ao_blur_tmp: Target,
-    pub ao_blurred: Target,
+    pub ao_blur_tmp: Option<Target>,
+    pub ao_blurred: Option<Target>,
     /// LineAO `outer = level`: hemisphere j's (AO_j, d_j) at level j's size, for j = 1..levels
     /// (`outer[j − 1]`).
     pub outer: Vec<Target>,
@@ -192,7 +199,6 @@ impl FrameTargets {
         // the pass that derives it from a host's depth.
         let attachment = U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC | U::COPY_DST;
         let gbuffer = attachment | U::STORAGE_BINDING;
-        let ao_usage = U::STORAGE_BINDING | U::TEXTURE_BINDING | U::COPY_SRC | U::COPY_DST;
         let level_usage = U::STORAGE_BINDING | U::TEXTURE_BINDING | U::COPY_SRC;
         let sizes = level_sizes(size, levels.max(1));
         let nd = sizes
@@ -211,10 +217,10 @@ impl FrameTargets {
             zoom: Target::new(device, "lineao::FrameTargets::zoom", size, ZOOM_FORMAT, gbuffer),
             specular: Target::new(device, "lineao::FrameTargets::specular", size, SPECULAR_FORMAT, gbuffer),
             depth: Target::new(device, "lineao::FrameTargets::depth", size, DEPTH_FORMAT, attachment),
-            ao: Target::new(device, "lineao::FrameTargets::ao", size, AO_FORMAT, ao_usage),
-            ao_raw: Target::new(device, "lineao::FrameTargets::ao_raw", size, AO_FORMAT, ao_usage),
-            ao_blur_tmp: Target::new(device, "lineao::FrameTargets::ao_blur_tmp", size, AO_FORMAT, ao_usage),
-            ao_blurred: Target::new(device, "lineao::FrameTargets::ao_blurred", size, AO_FORMAT, ao_usage),
+            ao: Target::new(device, "lineao::FrameTargets::ao", size, AO_FORMAT, AO_USAGE),
+            ao_raw: None,
+            ao_blur_tmp: None,
+            ao_blurred: None,
             outer: Vec::new(),
             moments: None,
             octants: None,
@@ -231,6 +237,25 @@ impl FrameTargets {
             Some(Target::new(device, "lineao::FrameTargets::octants", self.size, OCTANTS_FORMAT, attachment));
         self.volume_ao = Some(Target::new(device, "lineao::FrameTargets::volume_ao", self.size, AO_FORMAT, storage));
         self
+    }
+
+    /// These targets with `ao_raw`, where SSAO writes its occlusion before its 4 × 4 blur.
+    pub fn with_ao_raw(mut self, device: &wgpu::Device) -> FrameTargets {
+        self.ao_raw = Some(Target::new(device, "lineao::FrameTargets::ao_raw", self.size, AO_FORMAT, AO_USAGE));
+        self
+    }
+
+    /// These targets with the bilateral blur's two (`ao_blur_tmp`, `ao_blurred`).
+    pub fn with_blur(mut self, device: &wgpu::Device) -> FrameTargets {
+        let target = |label| Target::new(device, label, self.size, AO_FORMAT, AO_USAGE);
+        self.ao_blur_tmp = Some(target("lineao::FrameTargets::ao_blur_tmp"));
+        self.ao_blurred = Some(target("lineao::FrameTargets::ao_blurred"));
+        self
+    }
+
+    /// What the composite shows: `ao_blurred` when the blur's targets exist, else `ao`.
+    pub fn shown(&self) -> &Target {
+        self.ao_blurred.as_ref().unwrap_or(&self.ao)
     }
 
     /// These targets with LineAO's `outer = level` targets (`outer`: one per pyramid level

@@ -219,3 +219,35 @@ fn prepare_encode_and_upload_do_not_wait_for_the_device() {
     assert!(done.load(Ordering::Acquire));
     println!("upload, chain, prepare and encode took {took:?} while the long frame ran");
 }
+
+/// The chain allocates only what its method reads and writes: SSAO's `ao_raw`, the blur's two,
+/// `outer = level`'s and VO area's moments exist only when asked for.
+#[test]
+fn the_chain_allocates_only_the_targets_its_method_uses() {
+    let gpu = common::gpu();
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let bounds = Bounds { center: Vec3::ZERO, radius: 1.0 };
+    let camera = Camera {
+        eye: Vec3::new(0.0, 0.0, 5.0),
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        projection: Projection::Perspective { fov_y_deg: 45.0 },
+    };
+    let with = |method| ChainSettings { method, ..ChainSettings::default() };
+    let level = lineao::LineAoSettings { outer: lineao::LineAoOuter::Level, ..Default::default() };
+    let blur = Some(lineao::BilateralSettings::default());
+    for (settings, raw, blurred, outer, moments) in [
+        (with(AoMethod::LineAo), false, false, false, false),
+        (ChainSettings { line_ao: level, ..with(AoMethod::LineAo) }, false, false, true, false),
+        (with(AoMethod::Ssao), true, false, false, false),
+        (ChainSettings { blur, ..with(AoMethod::VoLine) }, false, true, false, false),
+        (with(AoMethod::VoArea), false, false, false, true),
+    ] {
+        let mut chain = AoChain::new(d, common::OUTPUT_FORMAT, settings.clone()).unwrap();
+        chain.resize(64, 48).unwrap();
+        chain.prepare(d, q, &camera, &bounds).unwrap();
+        let t = chain.targets().unwrap();
+        let has = (t.ao_raw.is_some(), t.ao_blurred.is_some(), !t.outer.is_empty(), t.moments.is_some());
+        assert_eq!(has, (raw, blurred, outer, moments), "{:?}", settings.method);
+    }
+}

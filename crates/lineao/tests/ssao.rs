@@ -15,7 +15,7 @@ use lineao::{AoMethod, ChainSettings, Gpu, SsaoKernel, SsaoSettings, noise};
 fn ssao_on(gpu: &Gpu, nd0: &NdImage, settings: &SsaoSettings, guard: u32) -> (Image<f32>, Image<f32>, SsaoParams) {
     let (d, q) = (&gpu.device, &gpu.queue);
     let (w, h) = (nd0.width as u32 - 2 * guard, nd0.height as u32 - 2 * guard);
-    let targets = FrameTargets::new(d, w, h, guard, 1);
+    let targets = FrameTargets::new(d, w, h, guard, 1).with_ao_raw(d);
     write_target(q, &targets.nd[0], nd0);
     let view = flat_view(w, h, guard);
     let mut ssao = Ssao::new(d, settings);
@@ -33,7 +33,7 @@ fn ssao_on(gpu: &Gpu, nd0: &NdImage, settings: &SsaoSettings, guard: u32) -> (Im
         range: settings.range_world,
         noise_origin: [guard as i32; 2],
     };
-    (read_f32(d, q, &targets.ao_raw).unwrap(), read_f32(d, q, &targets.ao).unwrap(), params)
+    (read_f32(d, q, targets.ao_raw.as_ref().unwrap()).unwrap(), read_f32(d, q, &targets.ao).unwrap(), params)
 }
 
 fn reflect(k: [f32; 3], r: [f32; 3]) -> [f32; 3] {
@@ -97,11 +97,11 @@ fn blur_skips_the_background_and_keeps_a_constant() {
         if (10..14).contains(&x) && (8..12).contains(&y) { [0.0; 4] } else { [0.0, 0.0, 1.0, 0.5] }
     });
     let (d, q) = (&gpu.device, &gpu.queue);
-    let targets = FrameTargets::new(d, w as u32, h as u32, 0, 1);
+    let targets = FrameTargets::new(d, w as u32, h as u32, 0, 1).with_ao_raw(d);
     write_target(q, &targets.nd[0], &nd0);
     write_target(
         q,
-        &targets.ao_raw,
+        targets.ao_raw.as_ref().unwrap(),
         &Image::from_fn(w, h, |x, y| if is_geometry(nd0.get(x, y)) { 0.25f32 } else { 0.9 }),
     );
     let mut blur = SsaoBlur::new(d);

@@ -76,9 +76,14 @@ impl Bilateral {
         }
     }
 
-    /// `ao` → `ao_blur_tmp` (x) → `ao_blurred` (y), depth from `nd[0]`.
+    /// `ao` → `ao_blur_tmp` (x) → `ao_blurred` (y), depth from `nd[0]` (without the blur's
+    /// targets the pass records nothing).
     pub fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets) {
-        let halves = [(&targets.ao, &targets.ao_blur_tmp), (&targets.ao_blur_tmp, &targets.ao_blurred)];
+        let (Some(tmp), Some(blurred)) = (&targets.ao_blur_tmp, &targets.ao_blurred) else {
+            self.groups.clear();
+            return;
+        };
+        let halves = [(&targets.ao, tmp), (tmp, blurred)];
         self.groups = halves
             .iter()
             .map(|(src, dst)| {
@@ -103,6 +108,9 @@ impl Bilateral {
 
     /// Records both halves, timed into `span` when given.
     pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, targets: &FrameTargets, span: Option<Span>) {
+        if self.groups.is_empty() {
+            return;
+        }
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("lineao::Bilateral"),
             timestamp_writes: timing::compute_writes(span),

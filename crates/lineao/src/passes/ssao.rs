@@ -89,7 +89,12 @@ impl Ssao {
     }
 
     /// Reads `nd[0]`, writes `ao_raw`.
+    /// Binds `nd[0]` and `ao_raw` (without `ao_raw` the pass records nothing).
     pub fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets) {
+        let Some(raw) = &targets.ao_raw else {
+            self.group = None;
+            return;
+        };
         self.group = Some(binding::group(
             device,
             "lineao::Ssao::group",
@@ -98,7 +103,7 @@ impl Ssao {
                 self.uniform.as_entire_binding(),
                 self.tables.as_entire_binding(),
                 wgpu::BindingResource::TextureView(&targets.nd[0].view),
-                wgpu::BindingResource::TextureView(&targets.ao_raw.view),
+                wgpu::BindingResource::TextureView(&raw.view),
             ],
         ));
     }

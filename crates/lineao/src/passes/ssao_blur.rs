@@ -28,14 +28,19 @@ impl SsaoBlur {
         SsaoBlur { pipeline, layout, group: None }
     }
 
+    /// Binds `ao_raw` → `ao` (without `ao_raw` the pass records nothing).
     pub fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets) {
+        let Some(raw) = &targets.ao_raw else {
+            self.group = None;
+            return;
+        };
         self.group = Some(binding::group(
             device,
             "lineao::SsaoBlur::group",
             &self.layout,
             &[
                 wgpu::BindingResource::TextureView(&targets.nd[0].view),
-                wgpu::BindingResource::TextureView(&targets.ao_raw.view),
+                wgpu::BindingResource::TextureView(&raw.view),
                 wgpu::BindingResource::TextureView(&targets.ao.view),
             ],
         ));

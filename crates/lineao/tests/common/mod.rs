@@ -99,8 +99,16 @@ pub fn render_scene(
         specular: read_f32(d, q, &t.specular).unwrap(),
         depth: read_f32(d, q, &t.depth).unwrap(),
         ao: read_f32(d, q, &t.ao).unwrap(),
-        ao_raw: read_f32(d, q, &t.ao_raw).unwrap(),
-        ao_blurred: read_f32(d, q, &t.ao_blurred).unwrap(),
+        ao_raw: t
+            .ao_raw
+            .as_ref()
+            .map(|raw| read_f32(d, q, raw).unwrap())
+            .unwrap_or_else(|| Image::from_fn(0, 0, |_, _| 0.0)),
+        ao_blurred: t
+            .ao_blurred
+            .as_ref()
+            .map(|b| read_f32(d, q, b).unwrap())
+            .unwrap_or_else(|| Image::from_fn(0, 0, |_, _| 0.0)),
         moments: t.moments.as_ref().map(|m| lineao::verify::read_moments(d, q, m).unwrap()).unwrap_or_default(),
         output: read_rgba(d, q, &output).unwrap(),
         octants: t.octants.as_ref().map(|o| lineao::verify::read_image(d, q, o).unwrap()),
