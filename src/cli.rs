@@ -234,6 +234,26 @@ pub struct Method {
 }
 
 impl Method {
+    /// Every method the viewer lists and `--grid` shows (the grid all but the last, with
+    /// LineAO's other variant inserted third), in that order: the screen-space ones, the
+    /// object-space ones, and LineAO with each object-space one.
+    pub const ALL: [Method; 9] = {
+        const fn m(screen: lineao::AoMethod, volume: Option<lineao::volume::VolumeMethod>) -> Method {
+            Method { screen, volume }
+        }
+        [
+            m(lineao::AoMethod::None, None),
+            m(lineao::AoMethod::LineAo, None),
+            m(lineao::AoMethod::VoLine, None),
+            m(lineao::AoMethod::VoArea, None),
+            m(lineao::AoMethod::Ssao, None),
+            m(lineao::AoMethod::None, Some(lineao::volume::VolumeMethod::Sweep)),
+            m(lineao::AoMethod::None, Some(lineao::volume::VolumeMethod::VarianceVolume)),
+            m(lineao::AoMethod::LineAo, Some(lineao::volume::VolumeMethod::Sweep)),
+            m(lineao::AoMethod::LineAo, Some(lineao::volume::VolumeMethod::VarianceVolume)),
+        ]
+    };
+
     pub fn name(&self) -> String {
         match (self.screen, self.volume) {
             (screen, None) => screen.name().to_string(),

@@ -26,12 +26,7 @@ use crate::source::{Loaded, Source, submit_frame, upload};
 pub fn sky(args: &RenderArgs, up: Vec3) -> Sky {
     match args.sky {
         SkyArg::Uniform => Sky::Uniform,
-        SkyArg::Cloudy => {
-            let axis = up.abs().max_position();
-            let mut direction = [0.0; 3];
-            direction[axis] = up[axis].signum();
-            Sky::Above(direction)
-        }
+        SkyArg::Cloudy => Sky::above_nearest_axis(up.to_array()),
     }
 }
 
@@ -181,10 +176,7 @@ impl Panel {
 
 /// The methods of `--grid`, in order (LineAO's other variant is inserted third).
 fn grid_methods() -> Vec<Method> {
-    let screen = AoMethod::ALL.map(|screen| Method { screen, volume: None });
-    let volume = VolumeMethod::ALL.map(|volume| Method { screen: AoMethod::None, volume: Some(volume) });
-    let both = Method { screen: AoMethod::LineAo, volume: Some(VolumeMethod::Sweep) };
-    screen.into_iter().chain(volume).chain([both]).collect()
+    Method::ALL[..8].to_vec()
 }
 
 /// The panels the command line asks for: one method, two (--compare) or all (--grid).

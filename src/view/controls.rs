@@ -18,22 +18,8 @@ use super::worker::Panel;
 use crate::cli::Method;
 
 /// The methods the selector offers, in the order `render --grid` shows them.
-pub const METHODS: [Method; 9] = {
-    const fn m(screen: AoMethod, volume: Option<VolumeMethod>) -> Method {
-        Method { screen, volume }
-    }
-    [
-        m(AoMethod::None, None),
-        m(AoMethod::LineAo, None),
-        m(AoMethod::VoLine, None),
-        m(AoMethod::VoArea, None),
-        m(AoMethod::Ssao, None),
-        m(AoMethod::None, Some(VolumeMethod::Sweep)),
-        m(AoMethod::None, Some(VolumeMethod::VarianceVolume)),
-        m(AoMethod::LineAo, Some(VolumeMethod::Sweep)),
-        m(AoMethod::LineAo, Some(VolumeMethod::VarianceVolume)),
-    ]
-};
+/// The viewer's method list: [`Method::ALL`].
+pub const METHODS: [Method; 9] = Method::ALL;
 
 /// What the method selector calls a method.
 pub fn method_label(method: Method) -> String {
@@ -182,14 +168,7 @@ impl Controls {
 
     fn panel(&self, method: Method, up: Vec3, range: Option<[f32; 2]>) -> Panel {
         let p = &self.params;
-        let sky = if p.cloudy {
-            let axis = up.abs().max_position();
-            let mut direction = [0.0; 3];
-            direction[axis] = up[axis].signum();
-            Sky::Above(direction)
-        } else {
-            Sky::Uniform
-        };
+        let sky = if p.cloudy { Sky::above_nearest_axis(up.to_array()) } else { Sky::Uniform };
         let mut settings = p.chain.clone();
         settings.method = method.screen;
         if self.preset == Preset::Calibrated {

@@ -185,6 +185,16 @@ pub enum Sky {
 }
 
 impl Sky {
+    /// A cloudy day lit from the world axis nearest to a camera's `up` (its sign kept): the
+    /// sky that stays put while the camera orbits.
+    pub fn above_nearest_axis(up: [f32; 3]) -> Sky {
+        // The first of equal components, as glam's `max_position`.
+        let axis = (1..3).fold(0, |best, a| if up[a].abs() > up[best].abs() { a } else { best });
+        let mut direction = [0.0; 3];
+        direction[axis] = if up[axis] < 0.0 { -1.0 } else { 1.0 };
+        Sky::Above(direction)
+    }
+
     pub fn weights(&self) -> [f32; 8] {
         match self {
             Sky::Uniform => [1.0; 8],
