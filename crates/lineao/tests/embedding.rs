@@ -327,13 +327,7 @@ fn host_api_misuse_is_an_error_that_says_what_to_change() {
     let gpu = gpu();
     let (d, q) = (&gpu.device, &gpu.queue);
     let size = (64u32, 48u32);
-    let bounds = Bounds { center: Vec3::ZERO, radius: 1.0 };
-    let camera = Camera {
-        eye: Vec3::new(0.0, 0.0, 5.0),
-        target: Vec3::ZERO,
-        up: Vec3::Y,
-        projection: Projection::Perspective { fov_y_deg: 45.0 },
-    };
+    let (camera, bounds) = common::unit_sphere_view();
     let view = |(w, h): (u32, u32)| FrameView::new(&camera, &bounds, w, h, 0, 1.0);
     let depth_usage = U::RENDER_ATTACHMENT | U::TEXTURE_BINDING;
     let depth = texture(&gpu, size, F::Depth32Float, depth_usage, 1);

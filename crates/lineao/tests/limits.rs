@@ -226,13 +226,7 @@ fn prepare_encode_and_upload_do_not_wait_for_the_device() {
 fn the_chain_allocates_only_the_targets_its_method_uses() {
     let gpu = common::gpu();
     let (d, q) = (&gpu.device, &gpu.queue);
-    let bounds = Bounds { center: Vec3::ZERO, radius: 1.0 };
-    let camera = Camera {
-        eye: Vec3::new(0.0, 0.0, 5.0),
-        target: Vec3::ZERO,
-        up: Vec3::Y,
-        projection: Projection::Perspective { fov_y_deg: 45.0 },
-    };
+    let (camera, bounds) = common::unit_sphere_view();
     let with = |method| ChainSettings { method, ..ChainSettings::default() };
     let level = lineao::LineAoSettings { outer: lineao::LineAoOuter::Level, ..Default::default() };
     let blur = Some(lineao::BilateralSettings::default());

@@ -316,3 +316,14 @@ pub fn sphere_triangles(centre: glam::Vec3, radius: f32, rings: usize) -> Vec<[f
     }
     out
 }
+
+/// A camera 5 units in front of a unit sphere of bounds at the origin (45° field of view).
+pub fn unit_sphere_view() -> (Camera, Bounds) {
+    let camera = Camera {
+        eye: glam::Vec3::new(0.0, 0.0, 5.0),
+        target: glam::Vec3::ZERO,
+        up: glam::Vec3::Y,
+        projection: lineao::camera::Projection::Perspective { fov_y_deg: 45.0 },
+    };
+    (camera, Bounds { center: glam::Vec3::ZERO, radius: 1.0 })
+}
