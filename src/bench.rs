@@ -245,13 +245,14 @@ fn summary(name: &str, on: &str, mut ms: Vec<f64>) -> serde_json::Value {
 }
 
 pub fn run(args: &BenchArgs) -> Result<()> {
-    let scene = args.scene.build(args.seed, args.vertices);
+    let source = crate::source::Source::Scene { kind: args.scene, vertices: args.vertices, seed: args.seed };
+    let scene = source.load(None)?;
     let settings = ChainSettings {
         line_ao: LineAoSettings { light_attenuation: !args.no_light_attenuation, ..LineAoSettings::default() },
-        zoom_unit: scene.view.zoom_unit,
+        zoom_unit: scene.hint.zoom_unit,
         ..ChainSettings::default()
     };
-    let mut camera = crate::render::camera_from_hint(&scene.view);
+    let mut camera = crate::render::camera_from_hint(&scene.hint);
     if let Some(fov_y_deg) = args.fov {
         camera.projection = Projection::Perspective { fov_y_deg };
     }
@@ -259,8 +260,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let gpu = Gpu::headless()?;
     let (device, queue) = (&gpu.device, &gpu.queue);
     let options = GeometryOptions { native_lines: true, bounded_staging: true, ..Default::default() };
-    let geometry =
-        LineGeometry::with_options(device, queue, &scene.tractogram.positions, &scene.tractogram.offsets, options)?;
+    let geometry = LineGeometry::with_options(device, queue, &scene.tracts.positions, &scene.tracts.offsets, options)?;
     let bounds = geometry.bounds.context("the scene has no finite points")?;
 
     // The chain decides the guard band; the passes below share one G-buffer with every target
@@ -327,7 +327,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         .map(|(name, ms)| summary(name, on, ms))
         .collect();
     let runs = args.frames.min(3);
-    let tractogram = &scene.tractogram;
+    let tractogram = &scene.tracts;
     for (name, ms) in object_space_times(&tractogram.positions, &tractogram.offsets, runs, &selected)? {
         passes.push(summary(name, "cpu", ms));
     }
@@ -340,7 +340,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         "backend": info.backend.to_str(),
         "width": args.width,
         "height": args.height,
-        "scene": scene.kind.name(),
+        "scene": scene.name,
         "vertices": geometry.vertices,
         "frames": args.frames,
         "timestamps": timer.is_some(),

@@ -11,7 +11,7 @@ use lineao::passes::lines::{LineGeometry, VertexAttributes};
 use lineao::passes::meshes::MeshGeometry;
 use lineao::volume::density::DensityOptions;
 use lineao::volume::sweep::SweepSettings;
-use lineao::volume::{ScalarForm, Sky, VertexVisibility, VolumeAoOptions, VolumeMethod};
+use lineao::volume::{ScalarForm, Sky, VolumeAoOptions, VolumeMethod};
 use lineao::{
     AoChain, AoMethod, BilateralSettings, ChainSettings, Gpu, LineAoSettings, LineAoVariant, LineColor, SsaoSettings,
     SurfaceSettings, TubeSettings, VoSettings, VolumeAoSettings,
@@ -20,7 +20,7 @@ use lineao_tracts::scenes::ViewHint;
 
 use crate::cli::{ColorArg, GeometryArg, Method, RenderArgs, SkyArg, VolumeNormal};
 use crate::label::Rgba8;
-use crate::source::{Loaded, Source, submit_frame, upload};
+use crate::source::{Loaded, Source, VolumeCache, submit_frame, upload};
 
 /// The sky of object-space AO: open, or lit from the world axis nearest to the camera's `up`.
 pub fn sky(args: &RenderArgs, up: Vec3) -> Sky {
@@ -299,26 +299,23 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     // Object-space AO once per method, uploaded as the geometry's attributes when a panel needs
     // another method's than the last.
-    let mut volumes: Vec<(VolumeMethod, VertexVisibility)> = Vec::new();
+    let mut volumes = VolumeCache::default();
     let mut attributes: Option<VolumeMethod> = None;
     let mut images = Vec::new();
     for panel in &panels {
         if let Some(method) = panel.volume.filter(|&m| attributes != Some(m)) {
-            let tracts = &session.tracts;
-            if !volumes.iter().any(|(m, _)| *m == method) {
-                let start = std::time::Instant::now();
-                let computed =
-                    lineao::volume::vertex_visibility(&tracts.positions, &tracts.offsets, &volume_options(method))
-                        .with_context(|| format!("{}: {}", session.name, method.name()))?;
+            let (start, mut computed) = (std::time::Instant::now(), false);
+            let visibility = volumes
+                .get(&session.tracts, &volume_options(method), || computed = true)
+                .with_context(|| session.name.clone())?;
+            if computed {
                 eprintln!(
                     "lineao: {} at {} voxels along the longest axis: {:.2} s on the CPU",
                     method.name(),
                     args.volume_resolution,
                     start.elapsed().as_secs_f64()
                 );
-                volumes.push((method, computed));
             }
-            let (_, visibility) = volumes.iter().find(|(m, _)| *m == method).expect("computed above");
             let octants = VertexAttributes {
                 octants: Some(&visibility.octants),
                 radius: session.radii.as_deref(),

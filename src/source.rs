@@ -5,10 +5,29 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Result, bail};
 use lineao::passes::meshes::MeshGeometry;
+use lineao::volume::{VertexVisibility, VolumeAoOptions};
 use lineao::{AoChain, Camera, LineGeometry};
 use lineao_tracts::{Progress, SceneKind, Tractogram, ViewHint};
+
+/// Why a source could not be shown, with the source named.
+#[derive(Debug, thiserror::Error)]
+pub enum SourceError {
+    #[error(transparent)]
+    Load(#[from] lineao_tracts::Error),
+    #[error("{path}: a .{format} holds values without points; render its .tck")]
+    ValuesWithoutPoints { path: String, format: &'static str },
+    #[error("{0} has no finite points")]
+    NoFinitePoints(String),
+    /// The GPU refused the geometry (too large for its buffers, a lost device).
+    #[error("{name}: {source}")]
+    Gpu { name: String, source: lineao::Error },
+    /// Object-space AO could not be computed with these options.
+    #[error("{method}: {source}")]
+    Volume { method: &'static str, source: lineao::Error },
+}
+
+type Result<T> = std::result::Result<T, SourceError>;
 
 /// What to show.
 #[derive(Clone, Debug, PartialEq)]
@@ -54,11 +73,8 @@ impl Source {
             Source::File(path) => {
                 let loaded = lineao_tracts::load_with(path, &Default::default(), progress)?;
                 if !loaded.tractogram.has_points() {
-                    bail!(
-                        "{}: a .{} holds values without points; render its .tck",
-                        path.display(),
-                        loaded.format.name()
-                    );
+                    let path = path.display().to_string();
+                    return Err(SourceError::ValuesWithoutPoints { path, format: loaded.format.name() });
                 }
                 let hint = ViewHint::for_tractogram(&loaded.tractogram);
                 Ok(Loaded { name: path.display().to_string(), tracts: loaded.tractogram, hint })
@@ -73,9 +89,9 @@ impl Source {
 pub fn upload(name: &str, tracts: &Tractogram, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<LineGeometry> {
     let options = lineao::passes::lines::GeometryOptions { bounded_staging: true, ..Default::default() };
     let geometry = LineGeometry::with_options(device, queue, &tracts.positions, &tracts.offsets, options)
-        .map_err(|e| anyhow::anyhow!("{name}: {e}"))?;
+        .map_err(|source| SourceError::Gpu { name: name.to_string(), source })?;
     if geometry.bounds.is_none() {
-        bail!("{name} has no finite points");
+        return Err(SourceError::NoFinitePoints(name.to_string()));
     }
     Ok(geometry)
 }
@@ -111,4 +127,41 @@ pub fn progress_bar(path: &std::path::Path) -> Option<indicatif::ProgressBar> {
     );
     bar.set_message(format!("loading {}", path.display()));
     Some(bar)
+}
+
+/// Object-space AO of one tractogram, computed once per options and kept for a few (each holds
+/// 32 bytes per vertex): what the CLI's panels and the viewer's frames share.
+#[derive(Default)]
+pub struct VolumeCache {
+    /// The most recently computed last.
+    entries: Vec<(VolumeAoOptions, VertexVisibility)>,
+}
+
+/// Options kept at most.
+const VOLUMES_KEPT: usize = 4;
+
+impl VolumeCache {
+    /// The visibility of `tracts` under `options`, computed on first use (after `computing` is
+    /// told, e.g. to show a busy state or time it).
+    pub fn get(
+        &mut self,
+        tracts: &Tractogram,
+        options: &VolumeAoOptions,
+        computing: impl FnOnce(),
+    ) -> Result<&VertexVisibility> {
+        let index = match self.entries.iter().position(|(o, _)| o == options) {
+            Some(index) => index,
+            None => {
+                computing();
+                let computed = lineao::volume::vertex_visibility(&tracts.positions, &tracts.offsets, options)
+                    .map_err(|source| SourceError::Volume { method: options.method.name(), source })?;
+                if self.entries.len() == VOLUMES_KEPT {
+                    self.entries.remove(0);
+                }
+                self.entries.push((options.clone(), computed));
+                self.entries.len() - 1
+            }
+        };
+        Ok(&self.entries[index].1)
+    }
 }

@@ -13,12 +13,12 @@ use std::sync::mpsc::{Receiver, Sender, TryRecvError};
 use lineao::camera::Camera;
 use lineao::passes::lines::{LineGeometry, VertexAttributes};
 use lineao::timing::PassTime;
-use lineao::volume::{VertexVisibility, VolumeAoOptions};
+use lineao::volume::VolumeAoOptions;
 use lineao::{AoChain, ChainSettings, Gpu, LineColor};
 use lineao_tracts::{Tractogram, ViewHint};
 
 pub use crate::source::Source;
-use crate::source::{Loaded, submit_frame, upload};
+use crate::source::{Loaded, VolumeCache, submit_frame, upload};
 
 /// Vertices of a preview frame at most.
 pub const PREVIEW_VERTICES: usize = 250_000;
@@ -91,7 +91,7 @@ struct Scene {
     /// What the full geometry's attributes hold now (scalar field, object-space AO options).
     attributes: (Option<String>, Option<VolumeAoOptions>),
     /// Object-space AO computed so far, by options.
-    volumes: Vec<(VolumeAoOptions, VertexVisibility)>,
+    volumes: VolumeCache,
 }
 
 /// Every k-th streamline: its geometry, and which full-detail vertices it keeps.
@@ -163,7 +163,7 @@ fn load(gpu: &Gpu, source: &Source, send: &dyn Fn(FromWorker)) -> Result<(Scene,
         .map(|f| (f.name.clone(), crate::render::percentile_range(&f.values)))
         .collect();
     let dataset = Dataset { name, streamlines: full.streamlines, vertices: full.vertices, hint, fields };
-    let scene = Scene { tracts, full, preview: None, attributes: (None, None), volumes: Vec::new() };
+    let scene = Scene { tracts, full, preview: None, attributes: (None, None), volumes: VolumeCache::default() };
     Ok((scene, dataset))
 }
 
@@ -208,20 +208,14 @@ fn render_frame(
         // The geometry's attributes this panel needs: the scalar's field and object-space AO.
         let wanted = (view.scalar_field.clone(), panel.volume.clone());
         let visibility = match &panel.volume {
-            Some(options) => {
-                if !scene.volumes.iter().any(|(o, _)| o == options) {
-                    send(FromWorker::Busy(format!("computing {} …", options.method.name())));
-                    let t = &scene.tracts;
-                    let computed = lineao::volume::vertex_visibility(&t.positions, &t.offsets, options)
-                        .map_err(|e| e.to_string())?;
-                    // A few settings' worth: each holds 32 bytes per vertex.
-                    if scene.volumes.len() == 4 {
-                        scene.volumes.remove(0);
-                    }
-                    scene.volumes.push((options.clone(), computed));
-                }
-                scene.volumes.iter().find(|(o, _)| o == options).map(|(_, v)| v)
-            }
+            Some(options) => Some(
+                scene
+                    .volumes
+                    .get(&scene.tracts, options, || {
+                        send(FromWorker::Busy(format!("computing {} …", options.method.name())))
+                    })
+                    .map_err(|e| format!("{e:#}"))?,
+            ),
             None => None,
         };
         let geometry = if preview {
