@@ -61,40 +61,10 @@ use lineao::volume::vertex_tangents;
 use lineao::{AoChain, BilateralSettings, ChainSettings, Gpu, LineAoOuter, LineAoSettings, SsaoSettings, VoSettings};
 use serde_json::json;
 
-use crate::cli::BenchArgs;
-
-/// The GPU passes of one run, in CONTRACT.md's order.
-pub const GPU_PASSES: [&str; 17] = [
-    "lines",
-    "lines-native-1px",
-    "lines-full-strip",
-    "nd-pyramid",
-    "lineao",
-    "lineao-tap-floor",
-    "composite",
-    "lineao-chain",
-    "lineao-level",
-    "lineao-chain-level",
-    "ssao-12",
-    "ssao-16-chain",
-    "vo-line-5",
-    "vo-area-1",
-    "bilateral",
-    "tubes",
-    "nd-from-depth",
-];
+use crate::cli::{BenchArgs, GPU_PASSES};
 
 /// The radius of pass `tubes` in zoom units (0.5 mm for tractograms).
 const TUBE_RADIUS: f32 = 0.5;
-
-/// The CPU passes, after the GPU's.
-pub const CPU_PASSES: [&str; 5] =
-    ["density-256", "sweep-256", "variance-volume-256", "bvh-build-1m", "raytraced-cpu-64"];
-
-/// Whether `name` is a pass of the benchmark.
-pub fn is_pass(name: &str) -> bool {
-    GPU_PASSES.contains(&name) || CPU_PASSES.contains(&name)
-}
 
 /// Every pass of the benchmark, prepared for one view over one G-buffer.
 struct Passes {

@@ -217,10 +217,10 @@ pub struct BenchArgs {
 }
 
 fn parse_bench_pass(s: &str) -> Result<String, String> {
-    if crate::bench::is_pass(s) {
+    if is_pass(s) {
         Ok(s.to_string())
     } else {
-        let all = [&crate::bench::GPU_PASSES[..], &crate::bench::CPU_PASSES[..]].concat();
+        let all = [&GPU_PASSES[..], &CPU_PASSES[..]].concat();
         Err(format!("unknown pass '{s}' (one of {})", all.join(", ")))
     }
 }
@@ -632,4 +632,36 @@ fn named<T: Named>() -> impl clap::builder::TypedValueParser<Value = T> {
     use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
     PossibleValuesParser::new(T::VALUES.iter().map(|v| PossibleValue::new(v.name()).help(v.help())))
         .map(|name| T::from_name(&name).expect("clap accepts the listed names only"))
+}
+
+// The passes `lineao bench --passes` names (its vocabulary, so the CLI needs nothing of the
+// bench itself).
+/// The GPU passes of one run, in CONTRACT.md's order.
+pub const GPU_PASSES: [&str; 17] = [
+    "lines",
+    "lines-native-1px",
+    "lines-full-strip",
+    "nd-pyramid",
+    "lineao",
+    "lineao-tap-floor",
+    "composite",
+    "lineao-chain",
+    "lineao-level",
+    "lineao-chain-level",
+    "ssao-12",
+    "ssao-16-chain",
+    "vo-line-5",
+    "vo-area-1",
+    "bilateral",
+    "tubes",
+    "nd-from-depth",
+];
+
+/// The CPU passes, after the GPU's.
+pub const CPU_PASSES: [&str; 5] =
+    ["density-256", "sweep-256", "variance-volume-256", "bvh-build-1m", "raytraced-cpu-64"];
+
+/// Whether `name` is a pass of the benchmark.
+pub fn is_pass(name: &str) -> bool {
+    GPU_PASSES.contains(&name) || CPU_PASSES.contains(&name)
 }

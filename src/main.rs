@@ -34,6 +34,7 @@ fn main() -> ExitCode {
         cli::Command::Convert(args) => info::convert(&args),
         cli::Command::BenchLoad(args) => bench_load::run(&args),
         cli::Command::View(args) => view::run(&args),
+        cli::Command::Score(args) if args.fit => fit::run(&args),
         cli::Command::Score(args) => score::run(&args),
     });
     match result {

@@ -192,9 +192,6 @@ fn srgb(v: f32) -> f32 {
 
 pub fn run(args: &ScoreArgs) -> Result<()> {
     let render = &args.render;
-    if args.fit {
-        return crate::fit::run(args);
-    }
     let methods = if args.methods.is_empty() { ScoreMethod::ALL.to_vec() } else { args.methods.clone() };
     let session = Session::open(render)?;
     let report = score(&session, render, &methods)?;

@@ -174,12 +174,9 @@ impl AoChain {
         if !meshes_match {
             self.meshes = settings.surfaces.as_ref().map(|_| MeshRenderer::new(device, octants));
         }
-        // The pyramid's depth, whether moments and octants exist and what the composite shows
-        // are bound at allocation.
-        let layout = |s: &ChainSettings| {
-            let method = (s.method == AoMethod::VoArea, s.method == AoMethod::Ssao, outer_level(s));
-            (s.levels(), method, s.blur.is_some(), s.volume.is_some())
-        };
+        // The pyramid's depth, the method's own targets, the blur's and object-space AO's, and
+        // what the composite shows are bound at allocation.
+        let layout = |s: &ChainSettings| (s.levels(), stage::needs(s), s.blur.is_some(), s.volume.is_some());
         if layout(&settings) != layout(&self.settings) {
             self.targets = None;
         }
@@ -246,7 +243,7 @@ impl AoChain {
             )));
         }
         let banded = (width + 2 * guard, height + 2 * guard);
-        if settings.method == AoMethod::VoArea && Moments::bytes(banded) > self.max_storage {
+        if stage::needs(settings).moments && Moments::bytes(banded) > self.max_storage {
             return Err(Error::TooLarge(format!(
                 "VO area's moments pyramid for {width} x {height} px needs {} bytes, more than the adapter's {} \
                  byte storage buffers",
@@ -327,13 +324,14 @@ impl AoChain {
         let stale = self.targets.as_ref().is_none_or(|t| t.guard != guard || t.nd.len() != levels as usize);
         if stale {
             let mut targets = FrameTargets::new(device, width, height, guard, levels);
-            if s.method == AoMethod::VoArea {
+            let needs = stage::needs(s);
+            if needs.moments {
                 targets = targets.with_moments(device);
             }
-            if outer_level(s) {
+            if needs.outer {
                 targets = targets.with_outer(device);
             }
-            if s.method == AoMethod::Ssao {
+            if needs.ao_raw {
                 targets = targets.with_ao_raw(device);
             }
             if s.blur.is_some() {
@@ -587,13 +585,4 @@ impl AoChain {
     pub fn frame_view(&self) -> Option<&FrameView> {
         self.view.as_ref()
     }
-}
-
-/// Whether LineAO evaluates its outer hemispheres at their level's size (and so needs the
-/// `outer` targets).
-fn outer_level(s: &ChainSettings) -> bool {
-    s.method == AoMethod::LineAo
-        && s.line_ao.variant == crate::LineAoVariant::Paper
-        && s.line_ao.outer == crate::LineAoOuter::Level
-        && s.levels() > 1
 }

@@ -48,6 +48,33 @@ pub trait Stage: Send + Sync {
     );
 }
 
+/// The targets a method's stage writes besides the G-buffer, its pyramid and `ao`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Needs {
+    /// `ao_raw`: an occlusion before the stage's own blur (SSAO).
+    pub ao_raw: bool,
+    /// The moments pyramid of VO area sampling.
+    pub moments: bool,
+    /// LineAO's `outer = level` targets.
+    pub outer: bool,
+}
+
+/// What `settings`' method needs allocated ([`Needs`]): the second entry of the list a new
+/// method adds to.
+pub fn needs(settings: &ChainSettings) -> Needs {
+    use crate::settings::{LineAoOuter, LineAoVariant};
+    let ao = &settings.line_ao;
+    match settings.method {
+        AoMethod::LineAo => Needs {
+            outer: ao.variant == LineAoVariant::Paper && ao.outer == LineAoOuter::Level && ao.s_r > 1,
+            ..Needs::default()
+        },
+        AoMethod::Ssao => Needs { ao_raw: true, ..Needs::default() },
+        AoMethod::VoArea => Needs { moments: true, ..Needs::default() },
+        AoMethod::VoLine | AoMethod::None | AoMethod::RayTraced => Needs::default(),
+    }
+}
+
 /// The stage of `settings`' method; `None` for the methods whose `ao` is written elsewhere
 /// (none, or the ray-traced truth). The list of methods: adding one is one arm here.
 pub fn build(device: &wgpu::Device, settings: &ChainSettings) -> Option<Box<dyn Stage>> {
