@@ -173,8 +173,13 @@ pub fn run(args: &ScoreArgs) -> Result<()> {
                 let pick = |data: &[f32]| data.iter().zip(&mask).filter(|(_, m)| **m).map(|(v, _)| *v).collect();
                 per_family.push((pick(&target.data), maps.iter().map(|m| pick(m)).collect()));
             }
-            eprintln!("lineao: fit view {} of {} ({} geometry pixels)", k + 1, session.name, truth.geometry_pixels);
-            views.push(View { source: session.name.clone(), real, fit: k % 2 == 0, families: per_family });
+            eprintln!(
+                "lineao: fit view {} of {} ({} geometry pixels)",
+                k + 1,
+                session.lines.name,
+                truth.geometry_pixels
+            );
+            views.push(View { source: session.lines.name.clone(), real, fit: k % 2 == 0, families: per_family });
         }
     }
     report(&families, &views);

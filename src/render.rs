@@ -7,7 +7,6 @@ use std::path::Path;
 use anyhow::{Context, Result};
 use glam::Vec3;
 use lineao::camera::{Bounds, Camera, Projection};
-use lineao::passes::lines::{LineGeometry, VertexAttributes};
 use lineao::passes::meshes::MeshGeometry;
 use lineao::volume::density::DensityOptions;
 use lineao::volume::sweep::SweepSettings;
@@ -20,7 +19,7 @@ use lineao_tracts::scenes::ViewHint;
 
 use crate::cli::{ColorArg, GeometryArg, Method, RenderArgs, SkyArg, VolumeNormal};
 use crate::label::Rgba8;
-use crate::source::{Loaded, Source, VolumeCache, submit_frame, upload};
+use crate::source::{AttributeKey, Lines, Source, submit_frame, vertex_field};
 
 /// The sky of object-space AO: open, or lit from the world axis nearest to the camera's `up`.
 pub fn sky(args: &RenderArgs, up: Vec3) -> Sky {
@@ -201,16 +200,15 @@ fn panels(args: &RenderArgs, zoom_unit: f32, sky: Sky) -> Vec<Panel> {
 /// What every panel of a `render` (or `score`) shares: the data on the CPU and on the GPU, and
 /// the camera.
 pub struct Session {
-    pub name: String,
-    pub tracts: lineao_tracts::Tractogram,
-    pub hint: ViewHint,
+    /// The streamlines on the GPU with their attributes.
+    pub lines: Lines,
+    /// The attributes every panel has: the scalar of `--color field:NAME`, the radii of
+    /// `--tube-radius-field`.
+    pub base: AttributeKey,
     pub camera: Camera,
     pub sky: Sky,
     pub surfaces: Vec<lineao_tracts::TriangleMesh>,
-    pub radii: Option<Vec<f32>>,
-    pub scalars: Option<Vec<f32>>,
     pub gpu: Gpu,
-    pub geometry: LineGeometry,
     pub meshes: Vec<MeshGeometry>,
     pub bounds: Bounds,
 }
@@ -227,7 +225,8 @@ impl Session {
                 seed: args.seed,
             },
         };
-        let Loaded { name, tracts, hint } = source.load_on_terminal()?;
+        let loaded = source.load_on_terminal()?;
+        let hint = loaded.hint;
         let camera = Camera {
             eye: Vec3::from_array(args.eye.unwrap_or(hint.eye)),
             target: Vec3::from_array(args.target.unwrap_or(hint.target)),
@@ -244,70 +243,72 @@ impl Session {
             .iter()
             .map(|path| lineao_tracts::load_mesh(path).map_err(anyhow::Error::from))
             .collect::<Result<Vec<_>>>()?;
-        let radii = match &args.tube_radius_field {
-            Some(field) => Some(vertex_field(&tracts, field).with_context(|| name.clone())?),
-            None => None,
+        let base = AttributeKey {
+            scalar: match &args.color {
+                ColorArg::Field(field) => Some(field.clone()),
+                _ => None,
+            },
+            radius: args.tube_radius_field.clone(),
+            volume: None,
         };
-        let scalars = match &args.color {
-            ColorArg::Field(field) => Some(vertex_field(&tracts, field).with_context(|| name.clone())?),
-            _ => None,
-        };
+        // The fields exist, before any GPU work.
+        for field in base.scalar.iter().chain(&base.radius) {
+            vertex_field(&loaded.name, &loaded.tracts, field)?;
+        }
         let gpu = Gpu::headless()?;
-        let mut geometry = upload(&name, &tracts, &gpu.device, &gpu.queue)?;
+        let mut lines = Lines::new(loaded, &gpu.device, &gpu.queue)?;
+        lines.hold((&gpu.device, &gpu.queue), &base, || {})?;
         let meshes = surfaces
             .iter()
             .map(|m| MeshGeometry::new(&gpu.device, &gpu.queue, &m.positions, &m.normals, &m.indices))
             .collect::<Result<Vec<_>, _>>()?;
-        let bounds = meshes.iter().filter_map(|m| m.bounds).fold(geometry.bounds.expect("checked"), |b, m| b.union(&m));
-        if radii.is_some() || scalars.is_some() {
-            let attributes = VertexAttributes { radius: radii.as_deref(), scalar: scalars.as_deref(), octants: None };
-            geometry.set_attributes(&gpu.device, &gpu.queue, &attributes)?;
-        }
-        Ok(Session { name, tracts, hint, camera, sky, surfaces, radii, scalars, gpu, geometry, meshes, bounds })
+        let lines_bounds = lines.geometry.bounds.expect("checked at upload");
+        let bounds = meshes.iter().filter_map(|m| m.bounds).fold(lines_bounds, |b, m| b.union(&m));
+        Ok(Session { lines, base, camera, sky, surfaces, gpu, meshes, bounds })
     }
 
     /// The chain's settings for `method` from the command line, the colour range from the data.
     pub fn settings(&self, args: &RenderArgs, method: Method) -> ChainSettings {
-        let mut settings = settings(args, method, self.hint.zoom_unit, self.sky);
+        let mut settings = settings(args, method, self.lines.hint.zoom_unit, self.sky);
         self.fit_color_range(&mut settings);
         settings
     }
 
     fn fit_color_range(&self, settings: &mut ChainSettings) {
-        if let (Some(values), LineColor::Scalar { range, .. }) = (&self.scalars, &mut settings.line_color) {
+        let scalars = self.base.scalar.as_deref().and_then(|field| self.lines.field(field).ok());
+        if let (Some(values), LineColor::Scalar { range, .. }) = (scalars, &mut settings.line_color) {
             *range = percentile_range(values);
         }
     }
 
     /// What the truth is traced against.
     pub fn truth_scene(&self) -> crate::truth::Scene<'_> {
-        crate::truth::Scene { tracts: &self.tracts, surfaces: &self.surfaces, radii: self.radii.as_deref() }
+        let radii = self.base.radius.as_deref().and_then(|field| self.lines.field(field).ok());
+        crate::truth::Scene { tracts: &self.lines.tracts, surfaces: &self.surfaces, radii }
     }
 }
 
 pub fn run(args: &RenderArgs) -> Result<()> {
     let mut session = Session::open(args)?;
-    let mut panels = panels(args, session.hint.zoom_unit, session.sky);
+    let mut panels = panels(args, session.lines.hint.zoom_unit, session.sky);
     for panel in &mut panels {
         panel.settings.validate().with_context(|| panel.label.clone())?;
         session.fit_color_range(&mut panel.settings);
     }
-    let (sky, zoom_unit) = (session.sky, session.hint.zoom_unit);
+    let (sky, zoom_unit) = (session.sky, session.lines.hint.zoom_unit);
     let volume_options = |method| volume_options(args, method, sky, zoom_unit);
     if panels.iter().any(|p| p.volume.is_some()) {
         volume_options(VolumeMethod::Sweep).sweep.validate()?;
     }
-    // Object-space AO once per method, uploaded as the geometry's attributes when a panel needs
-    // another method's than the last.
-    let mut volumes = VolumeCache::default();
-    let mut attributes: Option<VolumeMethod> = None;
+    // Object-space AO once per method (the session keeps it), uploaded as the geometry's
+    // attributes when a panel needs another method's than the last.
     let mut images = Vec::new();
     for panel in &panels {
-        if let Some(method) = panel.volume.filter(|&m| attributes != Some(m)) {
+        if let Some(method) = panel.volume {
+            let wanted = AttributeKey { volume: Some(volume_options(method)), ..session.base.clone() };
             let (start, mut computed) = (std::time::Instant::now(), false);
-            let visibility = volumes
-                .get(&session.tracts, &volume_options(method), || computed = true)
-                .with_context(|| session.name.clone())?;
+            let gpu = &session.gpu;
+            session.lines.hold((&gpu.device, &gpu.queue), &wanted, || computed = true)?;
             if computed {
                 eprintln!(
                     "lineao: {} at {} voxels along the longest axis: {:.2} s on the CPU",
@@ -316,14 +317,6 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                     start.elapsed().as_secs_f64()
                 );
             }
-            let octants = VertexAttributes {
-                octants: Some(&visibility.octants),
-                radius: session.radii.as_deref(),
-                scalar: session.scalars.as_deref(),
-            };
-            let gpu = &session.gpu;
-            session.geometry.set_attributes(&gpu.device, &gpu.queue, &octants)?;
-            attributes = Some(method);
         }
         // One method dumps into DIR itself, several into DIR/<label>/.
         let dump = args.dump.as_ref().map(|dir| match panels.len() {
@@ -349,25 +342,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let methods: Vec<&str> = panels.iter().map(|p| p.label.as_str()).collect();
     eprintln!(
         "lineao: {} ({} streamlines, {} vertices) with {} at {width} x {height} on {} -> {}",
-        session.name,
-        session.geometry.streamlines,
-        session.geometry.vertices,
+        session.lines.name,
+        session.lines.geometry.streamlines,
+        session.lines.geometry.vertices,
         methods.join(", "),
         session.gpu.describe(),
         output.display()
     );
     Ok(())
-}
-
-/// The values of the per-vertex field `field` (one column).
-pub fn vertex_field(tracts: &lineao_tracts::Tractogram, field: &str) -> Result<Vec<f32>> {
-    let names: Vec<&str> = tracts.vertex_fields.iter().map(|f| f.name.as_str()).collect();
-    let found = tracts.vertex_field(field).with_context(|| {
-        let names = if names.is_empty() { "none".to_string() } else { names.join(", ") };
-        format!("no per-vertex field '{field}' (the file has: {names})")
-    })?;
-    anyhow::ensure!(found.columns == 1, "per-vertex field '{field}' has {} columns, not 1", found.columns);
-    Ok(found.values.clone())
 }
 
 /// The 2nd and 98th percentiles of the finite `values` (robust to outliers), or [0, 1].
@@ -410,7 +392,7 @@ impl Session {
         let target = lineao::targets::Target::output(&gpu.device, "lineao::render::output", size, format);
         let meshes: Vec<&MeshGeometry> = self.meshes.iter().collect();
         let start = std::time::Instant::now();
-        let scene = (&self.geometry, &meshes[..]);
+        let scene = (&self.lines.geometry, &meshes[..]);
         submit_frame(gpu, &mut chain, scene, (&self.camera, &self.bounds), &target.view);
         if args.timings {
             gpu.wait()?;

@@ -89,7 +89,7 @@ pub fn raw_ao(
     );
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     let meshes: Vec<&lineao::passes::meshes::MeshGeometry> = session.meshes.iter().collect();
-    chain.encode_with_meshes(&mut encoder, &session.geometry, &meshes, &target.view);
+    chain.encode_with_meshes(&mut encoder, &session.lines.geometry, &meshes, &target.view);
     gpu.queue.submit([encoder.finish()]);
     let targets = chain.targets().context("nothing was rendered")?;
     let shown = targets.shown();
@@ -131,7 +131,7 @@ pub fn score(session: &Session, args: &crate::cli::RenderArgs, methods: &[ScoreM
         let t = image.get(x, y);
         t[0] != 0.0 || t[1] != 0.0 || t[2] != 0.0
     };
-    anyhow::ensure!(truth.geometry_pixels > 0, "{}: no geometry in view", session.name);
+    anyhow::ensure!(truth.geometry_pixels > 0, "{}: no geometry in view", session.lines.name);
     let ao_truth = truth.ao.clone();
     let vo_truth = truth.vo.clone();
     let strength_of = |m: ScoreMethod| method_settings(session, args, m).strength;
@@ -201,7 +201,7 @@ pub fn run(args: &ScoreArgs) -> Result<()> {
     } else {
         println!(
             "{}: {} x {}, {} geometry pixels, {} rays to {} ({} falloff), truth mean {:.3}, {:.1} % buried",
-            session.name,
+            session.lines.name,
             render.width,
             render.height,
             truth.geometry_pixels,
@@ -264,7 +264,7 @@ pub fn to_json(session: &Session, args: &crate::cli::RenderArgs, report: &Report
     let errors = |e: &metrics::Errors| json!({"bias": e.bias, "mean_abs": e.mean_abs, "rmse": e.rmse, "ssim": e.ssim});
     let settings = crate::truth::settings(args);
     json!({
-        "scene": session.name,
+        "scene": session.lines.name,
         "width": args.width,
         "height": args.height,
         "rays": settings.rays,

@@ -5,6 +5,7 @@
 
 use std::path::PathBuf;
 
+use lineao::passes::lines::VertexAttributes;
 use lineao::passes::meshes::MeshGeometry;
 use lineao::volume::{VertexVisibility, VolumeAoOptions};
 use lineao::{AoChain, Camera, LineGeometry};
@@ -25,6 +26,10 @@ pub enum SourceError {
     /// Object-space AO could not be computed with these options.
     #[error("{method}: {source}")]
     Volume { method: &'static str, source: lineao::Error },
+    #[error("{name}: no per-vertex field '{field}' (the file has: {available})")]
+    NoField { name: String, field: String, available: String },
+    #[error("{name}: per-vertex field '{field}' has {columns} columns, not 1")]
+    FieldColumns { name: String, field: String, columns: usize },
 }
 
 type Result<T> = std::result::Result<T, SourceError>;
@@ -164,4 +169,95 @@ impl VolumeCache {
         };
         Ok(&self.entries[index].1)
     }
+}
+
+/// Which per-vertex attributes a geometry holds, by what they come from: compared before
+/// uploading others.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct AttributeKey {
+    /// The per-vertex field [`lineao::LineColor::Scalar`] colors by.
+    pub scalar: Option<String>,
+    /// The per-vertex field that gives tubes their radii.
+    pub radius: Option<String>,
+    /// The object-space AO whose octant visibilities it holds.
+    pub volume: Option<VolumeAoOptions>,
+}
+
+impl AttributeKey {
+    fn is_empty(&self) -> bool {
+        self.scalar.is_none() && self.radius.is_none() && self.volume.is_none()
+    }
+}
+
+/// A loaded source on the GPU, with the attributes its geometry holds and the object-space AO
+/// computed for it: what a render session keeps per dataset (the CLI's `Session`, the viewer's
+/// worker).
+pub struct Lines {
+    pub name: String,
+    pub tracts: Tractogram,
+    pub hint: ViewHint,
+    pub geometry: LineGeometry,
+    pub volumes: VolumeCache,
+    held: AttributeKey,
+}
+
+impl Lines {
+    /// `loaded` uploaded ([`upload`]).
+    pub fn new(Loaded { name, tracts, hint }: Loaded, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Lines> {
+        let geometry = upload(&name, &tracts, device, queue)?;
+        Ok(Lines { name, tracts, hint, geometry, volumes: VolumeCache::default(), held: AttributeKey::default() })
+    }
+
+    /// The values of the per-vertex field `field` (one column).
+    pub fn field(&self, field: &str) -> Result<&[f32]> {
+        vertex_field(&self.name, &self.tracts, field)
+    }
+
+    /// The object-space AO `wanted` asks for, computed on first use (after `computing` is told).
+    pub fn visibility(&mut self, wanted: &AttributeKey, computing: impl FnOnce()) -> Result<Option<&VertexVisibility>> {
+        match &wanted.volume {
+            Some(options) => Ok(Some(self.volumes.get(&self.tracts, options, computing)?)),
+            None => Ok(None),
+        }
+    }
+
+    /// Makes the geometry hold the attributes `wanted` names, uploading them unless it holds
+    /// them already (or nothing is wanted: what it holds then is not read).
+    pub fn hold(
+        &mut self,
+        (device, queue): (&wgpu::Device, &wgpu::Queue),
+        wanted: &AttributeKey,
+        computing: impl FnOnce(),
+    ) -> Result<()> {
+        if wanted.is_empty() || self.held == *wanted {
+            return Ok(());
+        }
+        let Lines { name, tracts, geometry, volumes, .. } = self;
+        let octants = match &wanted.volume {
+            Some(options) => Some(volumes.get(tracts, options, computing)?.octants.as_slice()),
+            None => None,
+        };
+        let scalar = wanted.scalar.as_deref().map(|f| vertex_field(name, tracts, f)).transpose()?;
+        let radius = wanted.radius.as_deref().map(|f| vertex_field(name, tracts, f)).transpose()?;
+        let attributes = VertexAttributes { octants, scalar, radius };
+        geometry
+            .set_attributes(device, queue, &attributes)
+            .map_err(|source| SourceError::Gpu { name: name.clone(), source })?;
+        self.held = wanted.clone();
+        Ok(())
+    }
+}
+
+/// The values of the per-vertex field `field` of `tracts` (source `name`), one column.
+pub fn vertex_field<'t>(name: &str, tracts: &'t Tractogram, field: &str) -> Result<&'t [f32]> {
+    let found = tracts.vertex_field(field).ok_or_else(|| {
+        let names: Vec<&str> = tracts.vertex_fields.iter().map(|f| f.name.as_str()).collect();
+        let available = if names.is_empty() { "none".to_string() } else { names.join(", ") };
+        SourceError::NoField { name: name.to_string(), field: field.to_string(), available }
+    })?;
+    if found.columns != 1 {
+        let (name, field) = (name.to_string(), field.to_string());
+        return Err(SourceError::FieldColumns { name, field, columns: found.columns });
+    }
+    Ok(&found.values)
 }

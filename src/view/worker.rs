@@ -18,7 +18,7 @@ use lineao::{AoChain, ChainSettings, Gpu, LineColor};
 use lineao_tracts::{Tractogram, ViewHint};
 
 pub use crate::source::Source;
-use crate::source::{Loaded, VolumeCache, submit_frame, upload};
+use crate::source::{AttributeKey, Lines, submit_frame};
 
 /// Vertices of a preview frame at most.
 pub const PREVIEW_VERTICES: usize = 250_000;
@@ -85,20 +85,16 @@ pub enum FromWorker {
 
 /// The loaded data on the GPU: full detail and the preview's subset.
 struct Scene {
-    tracts: Tractogram,
-    full: LineGeometry,
+    /// Full detail, with its attributes and object-space AO.
+    lines: Lines,
     preview: Option<Preview>,
-    /// What the full geometry's attributes hold now (scalar field, object-space AO options).
-    attributes: (Option<String>, Option<VolumeAoOptions>),
-    /// Object-space AO computed so far, by options.
-    volumes: VolumeCache,
 }
 
 /// Every k-th streamline: its geometry, and which full-detail vertices it keeps.
 struct Preview {
     geometry: LineGeometry,
     kept: Vec<usize>,
-    attributes: (Option<String>, Option<VolumeAoOptions>),
+    attributes: AttributeKey,
 }
 
 /// Runs the worker until the app's sender is dropped. `repaint` asks the window for a frame
@@ -154,16 +150,18 @@ pub fn run(rx: Receiver<ToWorker>, tx: Sender<FromWorker>, repaint: impl Fn() + 
 
 fn load(gpu: &Gpu, source: &Source, send: &dyn Fn(FromWorker)) -> Result<(Scene, Dataset), String> {
     let mut report = |p: lineao_tracts::Progress| send(FromWorker::Progress { bytes: p.bytes, total: p.total });
-    let Loaded { name, tracts, hint } = source.load(Some(&mut report)).map_err(|e| format!("{e:#}"))?;
-    let full = upload(&name, &tracts, &gpu.device, &gpu.queue).map_err(|e| format!("{e:#}"))?;
-    let fields = tracts
+    let loaded = source.load(Some(&mut report)).map_err(|e| format!("{e:#}"))?;
+    let lines = Lines::new(loaded, &gpu.device, &gpu.queue).map_err(|e| format!("{e:#}"))?;
+    let fields = lines
+        .tracts
         .vertex_fields
         .iter()
         .filter(|f| f.columns == 1)
         .map(|f| (f.name.clone(), crate::render::percentile_range(&f.values)))
         .collect();
-    let dataset = Dataset { name, streamlines: full.streamlines, vertices: full.vertices, hint, fields };
-    let scene = Scene { tracts, full, preview: None, attributes: (None, None), volumes: VolumeCache::default() };
+    let (streamlines, vertices) = (lines.geometry.streamlines, lines.geometry.vertices);
+    let dataset = Dataset { name: lines.name.clone(), streamlines, vertices, hint: lines.hint, fields };
+    let scene = Scene { lines, preview: None };
     Ok((scene, dataset))
 }
 
@@ -188,63 +186,55 @@ fn render_frame(
 ) -> Result<Frame, String> {
     let start = std::time::Instant::now();
     let (d, q) = (&gpu.device, &gpu.queue);
-    let preview = view.preview && scene.full.vertices > PREVIEW_VERTICES;
+    let preview = view.preview && scene.lines.geometry.vertices > PREVIEW_VERTICES;
     let size = if preview { ((view.size.0 / 2).max(1), (view.size.1 / 2).max(1)) } else { view.size };
     if preview && scene.preview.is_none() {
-        let k = scene.full.vertices.div_ceil(PREVIEW_VERTICES);
-        let (positions, offsets, kept) = subset(&scene.tracts, k);
+        let k = scene.lines.geometry.vertices.div_ceil(PREVIEW_VERTICES);
+        let (positions, offsets, kept) = subset(&scene.lines.tracts, k);
         let geometry = LineGeometry::new(d, q, &positions, &offsets).map_err(|e| e.to_string())?;
-        scene.preview = Some(Preview { geometry, kept, attributes: (None, None) });
+        scene.preview = Some(Preview { geometry, kept, attributes: AttributeKey::default() });
     }
-    let bounds = scene.full.bounds.expect("checked at load");
-    let scalars = match &view.scalar_field {
-        Some(name) => Some(scene.tracts.vertex_field(name).ok_or(format!("no field {name}"))?.values.clone()),
-        None => None,
-    };
+    let bounds = scene.lines.geometry.bounds.expect("checked at load");
     let format = wgpu::TextureFormat::Rgba8UnormSrgb;
     let target = lineao::targets::Target::output(d, "lineao::view::frame", size, format);
     let (mut images, mut times) = (Vec::new(), Vec::new());
     for (i, panel) in view.panels.iter().enumerate() {
         // The geometry's attributes this panel needs: the scalar's field and object-space AO.
-        let wanted = (view.scalar_field.clone(), panel.volume.clone());
-        let visibility = match &panel.volume {
-            Some(options) => Some(
-                scene
-                    .volumes
-                    .get(&scene.tracts, options, || {
-                        send(FromWorker::Busy(format!("computing {} …", options.method.name())))
-                    })
-                    .map_err(|e| format!("{e:#}"))?,
-            ),
-            None => None,
+        let wanted = AttributeKey { scalar: view.scalar_field.clone(), radius: None, volume: panel.volume.clone() };
+        let busy = || {
+            if let Some(options) = &wanted.volume {
+                send(FromWorker::Busy(format!("computing {} …", options.method.name())));
+            }
         };
+        let error = |e: crate::source::SourceError| format!("{e:#}");
+        // Object-space AO first (computed once per options, busy meanwhile): its sky goes
+        // into the settings, its octants into the attributes below.
+        let sky = scene.lines.visibility(&wanted, busy).map_err(error)?.map(|v| v.sky);
         let geometry = if preview {
             let p = scene.preview.as_mut().expect("made above");
-            if p.attributes != wanted && (wanted.0.is_some() || wanted.1.is_some()) {
+            if p.attributes != wanted && (wanted.scalar.is_some() || wanted.volume.is_some()) {
+                let lines = &mut scene.lines;
+                let scalars = match &wanted.scalar {
+                    Some(field) => Some(lines.field(field).map_err(error)?.to_vec()),
+                    None => None,
+                };
                 let pick = |values: &[f32]| p.kept.iter().map(|&k| values[k]).collect::<Vec<f32>>();
+                let visibility = lines.visibility(&wanted, || {}).map_err(error)?;
                 let octants: Option<Vec<[f32; 8]>> = visibility.map(|v| p.kept.iter().map(|&k| v.octants[k]).collect());
                 let scalar = scalars.as_deref().map(pick);
                 let attributes =
                     VertexAttributes { octants: octants.as_deref(), scalar: scalar.as_deref(), radius: None };
                 p.geometry.set_attributes(d, q, &attributes).map_err(|e| e.to_string())?;
-                p.attributes = wanted;
+                p.attributes = wanted.clone();
             }
             &p.geometry
         } else {
-            if scene.attributes != wanted && (wanted.0.is_some() || wanted.1.is_some()) {
-                let attributes = VertexAttributes {
-                    octants: visibility.map(|v| v.octants.as_slice()),
-                    scalar: scalars.as_deref(),
-                    radius: None,
-                };
-                scene.full.set_attributes(d, q, &attributes).map_err(|e| e.to_string())?;
-                scene.attributes = wanted;
-            }
-            &scene.full
+            scene.lines.hold((d, q), &wanted, || {}).map_err(error)?;
+            &scene.lines.geometry
         };
         let mut settings = panel.settings.clone();
-        if let (Some(visibility), Some(volume)) = (visibility, &mut settings.volume) {
-            volume.sky = visibility.sky;
+        if let (Some(sky), Some(volume)) = (sky, &mut settings.volume) {
+            volume.sky = sky;
         }
         if view.scalar_field.is_none() && matches!(settings.line_color, LineColor::Scalar { .. }) {
             settings.line_color = LineColor::Tangent;
