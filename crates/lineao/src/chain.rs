@@ -142,16 +142,23 @@ impl AoChain {
         &self.settings
     }
 
-    /// Changes settings; pipelines and targets are rebuilt only where needed.
+    /// Changes settings; pipelines and targets are rebuilt only where needed. Blocks on wgpu's
+    /// validation answer as [`AoChain::new`] does; [`AoChain::set_settings_async`] awaits it.
     pub fn set_settings(&mut self, device: &wgpu::Device, settings: ChainSettings) -> Result<(), Error> {
+        pollster::block_on(self.set_settings_async(device, settings))
+    }
+
+    /// [`AoChain::set_settings`] as a future.
+    pub async fn set_settings_async(&mut self, device: &wgpu::Device, settings: ChainSettings) -> Result<(), Error> {
         settings.validate()?;
         self.check_size(&settings, self.size.0, self.size.1)?;
         // The method's pipelines: kept when they still compute the settings, else a kept or a
         // new stage (the targets stay; a new stage binds them).
         let (stages, targets) = (&mut self.stages, self.targets.as_ref());
-        crate::gpu::validated(device, "creating the method's pipelines", || {
+        crate::gpu::validated_async(device, "creating the method's pipelines", || {
             stages.select(&settings, targets, device, || stage::build(device, &settings))
-        })?;
+        })
+        .await?;
         let octants = settings.volume.is_some();
         if octants != self.lines.writes_octants() {
             // Writing octants or not is a matter of the geometry pipelines.
@@ -384,6 +391,11 @@ impl AoChain {
     /// depth's samples and convention and whether it has normals. Host frames use
     /// [`AoChain::prepare_view`] with the host's matrices.
     pub fn enable_host(&mut self, device: &wgpu::Device, config: HostConfig) -> Result<(), Error> {
+        pollster::block_on(self.enable_host_async(device, config))
+    }
+
+    /// [`AoChain::enable_host`] as a future.
+    pub async fn enable_host_async(&mut self, device: &wgpu::Device, config: HostConfig) -> Result<(), Error> {
         if config.depth_samples == 0 || config.depth_samples > 32 {
             return Err(Error::InvalidSettings(format!(
                 "depth samples must be in 1..=32, got {}",
@@ -391,8 +403,9 @@ impl AoChain {
             )));
         }
         if self.host.as_ref().is_none_or(|h| h.config() != config) {
-            self.host =
-                Some(crate::gpu::validated(device, "creating the host pass", || NdFromDepth::new(device, config))?);
+            let host =
+                crate::gpu::validated_async(device, "creating the host pass", || NdFromDepth::new(device, config));
+            self.host = Some(host.await?);
         }
         Ok(())
     }

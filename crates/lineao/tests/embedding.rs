@@ -347,7 +347,7 @@ fn host_api_misuse_is_an_error_that_says_what_to_change() {
     chain.resize(size.0, size.1).unwrap();
     let mut encoder = d.create_command_encoder(&Default::default());
     expect(chain.encode_host(d, &mut encoder, &inputs, None), "enable_host");
-    chain.enable_host(d, HostConfig::default()).unwrap();
+    pollster::block_on(chain.enable_host_async(d, HostConfig::default())).unwrap();
     expect(chain.encode_host(d, &mut encoder, &inputs, None), "prepare_view");
     expect(chain.prepare_view(d, q, view((32, 32))).map(|_| ()), "resize");
     chain.prepare_view(d, q, view(size)).unwrap().expect("a view at the chain's size");
