@@ -292,7 +292,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut session = Session::open(args)?;
     let mut panels = panels(args, session.lines.hint.zoom_unit, session.sky);
     for panel in &mut panels {
-        panel.settings.validate().with_context(|| panel.label.clone())?;
+        panel.settings.validate().with_context(|| format!("method {}", panel.label))?;
         session.fit_color_range(&mut panel.settings);
     }
     let (sky, zoom_unit) = (session.sky, session.lines.hint.zoom_unit);
