@@ -98,6 +98,11 @@ impl Triangle {
 /// entry of a ray from outside is the smallest candidate, and one from inside meets the surface
 /// first at the smallest candidate beyond its origin. When one sphere holds the other
 /// (d2 ≤ 0) the body is empty and the spheres alone are the solid.
+///
+/// The same algebra as [`crate::reference::tubes::intersect_rounded_cone`], kept apart on
+/// purpose: that one replays the tube shader's f32 arithmetic and early exits (so the shader
+/// can be compared with it bit for bit) and returns the normal; this one is the ground truth,
+/// in f64 relative to the ray's origin, with an interval (t_min, t_max) and origins inside.
 #[allow(clippy::too_many_arguments)]
 pub fn intersect_rounded_cone(
     ro: DVec3,
