@@ -30,8 +30,10 @@
 //!
 //! Every pass is labelled and the frame sits in a `lineao` debug group, so GPU debuggers show
 //! the chain by name. With [`AoChain::set_timing`] each pass also records timestamp queries under
-//! the names `lineao bench` uses (CONTRACT.md): `lines`, `nd-pyramid`, `lineao`, `ssao`,
+//! the names `lineao bench` uses (CONTRACT.md): `lines`, `nd-pyramid`, `lineao`, `raytraced`, `ssao`,
 //! `ssao-blur`, `vo-line`, `moments`, `vo-area`, `blur`, `volume-ao`, `composite`.
+
+use std::sync::Arc;
 
 use crate::Error;
 use crate::camera::{self, Bounds, Camera, FrameView};
@@ -42,18 +44,21 @@ use crate::passes::lines::LineStyle;
 use crate::passes::lines::{LineGeometry, LineRenderer};
 use crate::passes::meshes::{MeshGeometry, MeshRenderer};
 use crate::passes::nd_from_depth::{HostConfig, HostInputs, NdFromDepth};
+use crate::passes::raytraced_ao::RayProgress;
 use crate::passes::tubes::TubeRenderer;
 use crate::passes::volume_ao::VolumeAo;
+use crate::ray_scene::RayScene;
 use crate::settings::{AoMethod, ChainSettings};
 use crate::stage::{self, Reach, Stages};
 use crate::targets::{FrameTargets, Moments};
 use crate::timing::{PassTime, PassTimer, Span};
 
 /// The spans of a timed frame, in chain order.
-pub const PASS_NAMES: [&str; 11] = [
+pub const PASS_NAMES: [&str; 12] = [
     "lines",
     "nd-pyramid",
     "lineao",
+    "raytraced",
     "ssao",
     "ssao-blur",
     "vo-line",
@@ -191,6 +196,19 @@ impl AoChain {
         Ok(())
     }
 
+    /// The geometry the ray-traced method ([`AoMethod::RayTraced`]) traces: what the frame draws,
+    /// uploaded once per geometry ([`RayScene::new`]). Without a scene that method shows no
+    /// occlusion. A new scene starts the progressive picture again.
+    pub fn set_ray_scene(&mut self, device: &wgpu::Device, scene: Option<Arc<RayScene>>) {
+        self.stages.set_scene(device, scene, self.targets.as_ref());
+    }
+
+    /// How far the ray-traced method's picture has come (rays per pixel so far, the cap), or
+    /// `None` for the other methods.
+    pub fn ray_progress(&self) -> Option<RayProgress> {
+        self.stages.active().and_then(|stage| stage.progress())
+    }
+
     /// Turns per-pass GPU timing on or off. Returns whether timing is on: it stays off on
     /// adapters without timestamp queries.
     pub fn set_timing(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, enabled: bool) -> bool {
@@ -250,6 +268,14 @@ impl AoChain {
             )));
         }
         let banded = (width + 2 * guard, height + 2 * guard);
+        let accumulation = banded.0 as u64 * banded.1 as u64 * 8;
+        if settings.method == AoMethod::RayTraced && accumulation > self.max_storage {
+            return Err(Error::TooLarge(format!(
+                "the ray tracer's accumulation for {width} x {height} px needs {accumulation} bytes, more than the \
+                 adapter's {} byte storage buffers",
+                self.max_storage
+            )));
+        }
         if stage::needs(settings).moments && Moments::bytes(banded) > self.max_storage {
             return Err(Error::TooLarge(format!(
                 "VO area's moments pyramid for {width} x {height} px needs {} bytes, more than the adapter's {} \
@@ -264,7 +290,7 @@ impl AoChain {
     /// The guard band for this view: the largest sampling radius over the image (CONTRACT.md).
     pub fn guard_for(&self, camera: &Camera, bounds: &Bounds) -> u32 {
         let s = &self.settings;
-        // The ray-traced truth and plain lines read no neighbours on screen.
+        // Plain lines read no neighbours on screen.
         let Some(stage) = self.stages.active() else { return 0 };
         let unguarded = FrameView::new(camera, bounds, self.size.0, self.size.1, 0, s.zoom_unit);
         match stage.reach(s, &unguarded) {
@@ -561,7 +587,7 @@ impl AoChain {
 
     /// Records only the composite of the last prepared frame over the targets as they are: for a
     /// caller that wrote its own occlusion into `targets().ao` after the frame's G-buffer was
-    /// rendered ([`AoMethod::RayTraced`]: the ray-traced truth). Does nothing before the first
+    /// rendered (the CPU truth, `lineao render --method raytraced --cpu`). Does nothing before the first
     /// `prepare` with a non-zero size.
     pub fn encode_composite(&self, encoder: &mut wgpu::CommandEncoder, target: &wgpu::TextureView) {
         if self.targets.is_some() && self.view.is_some() {
@@ -576,8 +602,7 @@ impl AoChain {
         targets: &FrameTargets,
         span: &dyn Fn(&'static str) -> Option<Span<'s>>,
     ) {
-        // None and the ray-traced truth have no stage: the caller writes `ao` (see
-        // `encode_composite`).
+        // None has no stage.
         if let Some(stage) = self.stages.active() {
             stage.encode(encoder, targets, span);
         }

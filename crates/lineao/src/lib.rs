@@ -52,6 +52,7 @@ pub mod lighting;
 pub mod line_geometry;
 pub mod noise;
 pub mod passes;
+pub mod ray_scene;
 pub mod readback;
 pub mod reference;
 pub mod sample_sets;
@@ -78,10 +79,11 @@ pub use passes::lines::{LineGeometry, LineRenderer, LineStyle};
 pub use passes::meshes::{MeshGeometry, MeshRenderer};
 pub use passes::nd_from_depth::{HostConfig, HostInputs};
 pub use passes::tubes::TubeRenderer;
+pub use ray_scene::{RayGeometry, RayScene};
 pub use settings::{
     AoMethod, BilateralSettings, ChainSettings, Colormap, DebugView, LineAoOuter, LineAoSettings, LineAoVariant,
-    LineColor, Named, Preset, R0, SsaoKernel, SsaoSettings, SurfaceSettings, TubeSettings, VoCombine, VoSettings,
-    VolumeAoSettings,
+    LineColor, Named, Preset, R0, RayTracedSettings, SsaoKernel, SsaoSettings, SurfaceSettings, TubeSettings,
+    VoCombine, VoSettings, VolumeAoSettings,
 };
 
 /// Pyramid levels (and so LineAO hemispheres) the shaders can bind.

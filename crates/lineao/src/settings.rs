@@ -571,6 +571,59 @@ pub struct TubeSettings {
     pub radius_world: f32,
 }
 
+/// The ray-traced method on the GPU ([`crate::passes::raytraced_ao`]): rays per frame while the
+/// view rests, accumulated up to a cap, as the CPU truth traces them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RayTracedSettings {
+    /// Rays per geometry pixel each frame, ≥ 1. Default 4 (LineVis's).
+    pub rays_per_frame: u32,
+    /// Rays per pixel after which the frame is converged and nothing more is traced, ≥ 1.
+    /// Default 1024.
+    pub max_rays: u32,
+    /// The rays' reach R in world units, > 0. Default 2 (the truth's).
+    pub distance_world: f32,
+    pub falloff: crate::truth::Falloff,
+    /// Seed of the per-pixel scramble (the CPU truth's `seed`).
+    pub seed: u32,
+}
+
+impl Default for RayTracedSettings {
+    fn default() -> Self {
+        let truth = crate::truth::TruthSettings::default();
+        RayTracedSettings {
+            rays_per_frame: 4,
+            max_rays: 1024,
+            distance_world: truth.distance_world,
+            falloff: truth.falloff,
+            seed: truth.seed,
+        }
+    }
+}
+
+impl RayTracedSettings {
+    /// The CPU truth's settings tracing the same rays as `rays` rays per pixel of these.
+    pub fn truth(&self, rays: u32) -> crate::truth::TruthSettings {
+        crate::truth::TruthSettings {
+            rays,
+            distance_world: self.distance_world,
+            falloff: self.falloff,
+            seed: self.seed,
+            vo: None,
+            threads: 0,
+        }
+    }
+
+    pub fn validate(&self) -> Result<(), crate::Error> {
+        if self.rays_per_frame == 0 || self.max_rays == 0 {
+            return Err(crate::Error::InvalidSettings(format!(
+                "rays per frame and the ray cap must be at least 1, got {} and {}",
+                self.rays_per_frame, self.max_rays
+            )));
+        }
+        self.truth(1).validate()
+    }
+}
+
 /// Context surfaces (`lineao::passes::meshes`) drawn with the lines.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SurfaceSettings {
@@ -605,6 +658,7 @@ pub struct ChainSettings {
     pub line_ao: LineAoSettings,
     pub ssao: SsaoSettings,
     pub vo: VoSettings,
+    pub raytraced: RayTracedSettings,
     /// The bilateral blur after the method, or none. Default none.
     pub blur: Option<BilateralSettings>,
     /// Object-space AO from the geometry's attributes, or none. Default none.
@@ -636,6 +690,7 @@ impl Default for ChainSettings {
             line_ao: LineAoSettings::default(),
             ssao: SsaoSettings::default(),
             vo: VoSettings::default(),
+            raytraced: RayTracedSettings::default(),
             blur: None,
             volume: None,
             lighting: Lighting::default(),
@@ -769,6 +824,7 @@ impl ChainSettings {
         self.line_ao.validate()?;
         self.ssao.validate()?;
         self.vo.validate()?;
+        self.raytraced.validate()?;
         if let Some(blur) = &self.blur {
             blur.validate()?;
         }

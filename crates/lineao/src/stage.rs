@@ -12,7 +12,11 @@
 //! touches its own module, its WGSL file and the one `match` in [`build`] — the chain, the
 //! guard band and the timings follow from the trait.
 
+use std::sync::Arc;
+
 use crate::camera::FrameView;
+use crate::passes::raytraced_ao::RayProgress;
+use crate::ray_scene::RayScene;
 use crate::settings::{AoMethod, ChainSettings};
 use crate::targets::FrameTargets;
 use crate::timing::Span;
@@ -37,6 +41,13 @@ pub trait Stage: Send + Sync {
     fn spans(&self, settings: &ChainSettings) -> &'static [&'static str];
     /// Binds newly allocated targets.
     fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets);
+    /// Takes the geometry itself, for a stage that traces it (the ray-traced method); `targets`
+    /// are bound again when given. Others ignore it.
+    fn set_scene(&mut self, _device: &wgpu::Device, _scene: Option<&Arc<RayScene>>, _targets: Option<&FrameTargets>) {}
+    /// How far a progressive stage's picture has come; `None` for the others.
+    fn progress(&self) -> Option<RayProgress> {
+        None
+    }
     /// Writes the frame's uniforms.
     fn prepare(&self, queue: &wgpu::Queue, targets: &FrameTargets, view: &FrameView, settings: &ChainSettings);
     /// Records the stage; `span(name)` times one of [`Stage::spans`].
@@ -75,16 +86,17 @@ pub fn needs(settings: &ChainSettings) -> Needs {
     }
 }
 
-/// The stage of `settings`' method; `None` for the methods whose `ao` is written elsewhere
-/// (none, or the ray-traced truth). The list of methods: adding one is one arm here.
+/// The stage of `settings`' method; `None` for `None`. The list of methods: adding one is one
+/// arm here.
 pub fn build(device: &wgpu::Device, settings: &ChainSettings) -> Option<Box<dyn Stage>> {
-    use crate::passes::{line_ao, ssao, vo_area, vo_line};
+    use crate::passes::{line_ao, raytraced_ao, ssao, vo_area, vo_line};
     Some(match settings.method {
         AoMethod::LineAo => Box::new(line_ao::LineAoStage::new(device, settings)),
         AoMethod::Ssao => Box::new(ssao::SsaoStage::new(device, settings)),
         AoMethod::VoLine => Box::new(vo_line::VoLine::new(device, &settings.vo)),
         AoMethod::VoArea => Box::new(vo_area::VoArea::new(device, &settings.vo)),
-        AoMethod::None | AoMethod::RayTraced => return None,
+        AoMethod::RayTraced => Box::new(raytraced_ao::RayTracedAo::new(device)),
+        AoMethod::None => return None,
     })
 }
 
@@ -95,6 +107,8 @@ pub struct Stages {
     active: Option<Box<dyn Stage>>,
     /// Least recently used first.
     kept: Vec<Box<dyn Stage>>,
+    /// The geometry for stages that trace it, given to each that becomes active.
+    scene: Option<Arc<RayScene>>,
 }
 
 /// Built stages kept besides the active one.
@@ -118,7 +132,7 @@ impl Stages {
         let wanted = |stage: &dyn Stage| stage.matches(settings);
         let unchanged = match &self.active {
             Some(stage) => wanted(stage.as_ref()),
-            None => matches!(settings.method, AoMethod::None | AoMethod::RayTraced),
+            None => settings.method == AoMethod::None,
         };
         if unchanged {
             return;
@@ -133,8 +147,19 @@ impl Stages {
                 self.kept.remove(0);
             }
         }
-        if let (Some(stage), Some(targets)) = (&mut self.active, targets) {
-            stage.resize(device, targets);
+        if let Some(stage) = &mut self.active {
+            stage.set_scene(device, self.scene.as_ref(), None);
+            if let Some(targets) = targets {
+                stage.resize(device, targets);
+            }
+        }
+    }
+
+    /// Gives `scene` to the active stage (binding `targets` again) and to each one activated later.
+    pub fn set_scene(&mut self, device: &wgpu::Device, scene: Option<Arc<RayScene>>, targets: Option<&FrameTargets>) {
+        self.scene = scene;
+        if let Some(stage) = &mut self.active {
+            stage.set_scene(device, self.scene.as_ref(), targets);
         }
     }
 

@@ -105,6 +105,13 @@ const PARALLEL_DEPTH: u32 = 3;
 impl Bvh {
     /// Builds the tree over `cones` and `triangles`. Non-finite primitives are left out.
     pub fn build(cones: Vec<RoundedCone>, triangles: Vec<Triangle>) -> Bvh {
+        Bvh::build_with_leaves(cones, triangles, 2)
+    }
+
+    /// [`Bvh::build`] where every node of at most `leaf` primitives is a leaf (the SAH decides
+    /// above that): bigger leaves, fewer nodes, for the GPU tree whose memory is what counts
+    /// ([`crate::ray_scene`]). `build` is `leaf` 2: the SAH decides down to pairs.
+    pub fn build_with_leaves(cones: Vec<RoundedCone>, triangles: Vec<Triangle>, leaf: usize) -> Bvh {
         let finite = |lo: Vec3, hi: Vec3| lo.is_finite() && hi.is_finite();
         let mut items: Vec<Item> = Vec::with_capacity(cones.len() + triangles.len());
         for (i, cone) in cones.iter().enumerate() {
@@ -120,7 +127,7 @@ impl Bvh {
                 items.push(Item { r: i as u32 | TRIANGLE_BIT, lo, hi, c: 0.5 * (lo + hi) });
             }
         }
-        let nodes = if items.is_empty() { Vec::new() } else { build_subtree(&mut items, 0, 0) };
+        let nodes = if items.is_empty() { Vec::new() } else { build_subtree(&mut items, 0, 0, leaf.max(1)) };
         let refs = items.iter().map(|item| item.r).collect();
         Bvh { nodes, refs, cones, triangles }
     }
@@ -308,13 +315,13 @@ fn inside_box(n: &Node, p: DVec3, margin: f64) -> bool {
 
 /// Builds the subtree over `items` (depth-first, child indices relative to its root; leaves
 /// point into `items` as positions from `base`), reordering `items` in place.
-fn build_subtree(items: &mut [Item], base: u32, depth: u32) -> Vec<Node> {
+fn build_subtree(items: &mut [Item], base: u32, depth: u32, leaf: usize) -> Vec<Node> {
     let mut nodes = Vec::with_capacity(items.len() / 2 + 1);
-    build_node(items, base, depth, &mut nodes);
+    build_node(items, base, depth, leaf, &mut nodes);
     nodes
 }
 
-fn build_node(items: &mut [Item], base: u32, depth: u32, nodes: &mut Vec<Node>) {
+fn build_node(items: &mut [Item], base: u32, depth: u32, leaf: usize, nodes: &mut Vec<Node>) {
     let mut bounds = Aabb::EMPTY;
     let mut centroids = Aabb::EMPTY;
     for item in items.iter() {
@@ -323,14 +330,14 @@ fn build_node(items: &mut [Item], base: u32, depth: u32, nodes: &mut Vec<Node>) 
     }
     let me = nodes.len();
     nodes.push(Node { min: bounds.lo.into(), first: base, max: bounds.hi.into(), count: items.len() as u32 });
-    let Some(mid) = split(items, &bounds, &centroids) else { return };
+    let Some(mid) = split(items, &bounds, &centroids, leaf) else { return };
     let parallel = items.len() >= PARALLEL_MIN && depth < PARALLEL_DEPTH;
     let (left, right) = items.split_at_mut(mid);
     if parallel {
         let right_base = base + mid as u32;
         let right_nodes = std::thread::scope(|scope| {
-            let handle = scope.spawn(|| build_subtree(right, right_base, depth + 1));
-            build_node(left, base, depth + 1, nodes);
+            let handle = scope.spawn(|| build_subtree(right, right_base, depth + 1, leaf));
+            build_node(left, base, depth + 1, leaf, nodes);
             handle.join().expect("a BVH build thread panicked")
         });
         let offset = nodes.len() as u32;
@@ -342,17 +349,18 @@ fn build_node(items: &mut [Item], base: u32, depth: u32, nodes: &mut Vec<Node>) 
             n
         }));
     } else {
-        build_node(left, base, depth + 1, nodes);
+        build_node(left, base, depth + 1, leaf, nodes);
         nodes[me].first = nodes.len() as u32;
-        build_node(right, base + mid as u32, depth + 1, nodes);
+        build_node(right, base + mid as u32, depth + 1, leaf, nodes);
     }
     nodes[me].count = 0;
 }
 
-/// The SAH split of `items` (partitioned in place): the left half's length, or `None` for a leaf.
-fn split(items: &mut [Item], bounds: &Aabb, centroids: &Aabb) -> Option<usize> {
+/// The SAH split of `items` (partitioned in place): the left half's length, or `None` for a leaf
+/// (always at most `leaf` items).
+fn split(items: &mut [Item], bounds: &Aabb, centroids: &Aabb, leaf: usize) -> Option<usize> {
     let n = items.len();
-    if n <= 1 {
+    if n <= leaf.max(1) {
         return None;
     }
     let extent = centroids.hi - centroids.lo;
@@ -404,10 +412,10 @@ fn split(items: &mut [Item], bounds: &Aabb, centroids: &Aabb) -> Option<usize> {
     let (cost, axis, bin) = match best {
         Some(b) => b,
         // Every centroid in one place: split in the middle if the leaf would be too big.
-        None if n > MAX_LEAF => return Some(n / 2),
+        None if n > MAX_LEAF.max(leaf) => return Some(n / 2),
         None => return None,
     };
-    if n <= MAX_LEAF && cost + bounds.area() >= leaf_cost {
+    if n <= MAX_LEAF.max(leaf) && cost + bounds.area() >= leaf_cost {
         return None;
     }
     let scale = BINS as f32 / extent[axis];

@@ -1,0 +1,288 @@
+//! Ray-traced ambient occlusion on the GPU, progressive: the ground truth ([`crate::truth`])
+//! converging while one looks, on every wgpu adapter (a compute shader walks the BVH; no
+//! ray-tracing hardware needed).
+//!
+//! Each frame, every geometry pixel traces k = `rays_per_frame` cosine-weighted rays and adds
+//! them to its running sum; `ao` is the sum over the rays so far. The rays are the CPU truth's:
+//! ray i of a pixel is point i of its scrambled Sobol' sequence ([`crate::truth::sequence`]), and
+//! frame f traces rays f·k .. f·k + k, so after F frames the image *is* the CPU truth with F·k
+//! rays (up to f32 against f64 at grazing hits; the tests measure it). The origin, the pixel's
+//! own segment, buried origins and both falloffs follow [`crate::truth`] step by step.
+//!
+//! **Progressive.** The stage remembers what the last frame traced — view, size, the settings
+//! the picture depends on, the scene — and starts again from ray 0 when any of it changes.
+//! After `max_rays` rays a pixel is converged: the pass then only copies the sums into `ao`.
+//! [`RayTracedAo::progress`] says how far it is.
+//!
+//! **Scene.** The rays need the geometry itself, not only the G-buffer: a [`RayScene`] uploaded
+//! once per geometry ([`crate::AoChain::set_ray_scene`]). Without one there is nothing to hit
+//! and `ao` is 0.
+
+use std::sync::{Arc, Mutex};
+
+use crate::binding::{self, Slot};
+use crate::camera::FrameView;
+use crate::passes::dispatch_full_screen;
+use crate::ray_scene::{MAX_CHUNKS, RayScene};
+use crate::settings::{AoMethod, ChainSettings};
+use crate::targets::{AO_FORMAT, FrameTargets};
+use crate::timing::Span;
+use crate::truth::{EPSILON_PER_DISTANCE, Falloff};
+use crate::view_params::{ViewParams, ViewUniform};
+
+/// Keep in sync with `Trace` in `shaders/raytraced_ao.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct TraceUniform {
+    view: ViewUniform,
+    inv_view: [[f32; 4]; 4],
+    view_z: [f32; 4],
+    frame_rays: u32,
+    first_ray: u32,
+    seed: u32,
+    falloff: u32,
+    distance: f32,
+    epsilon: f32,
+    lines: u32,
+    line_half: f32,
+    tube_radius: f32,
+    max_radius: f32,
+    guard: u32,
+    chunk_shift: u32,
+    nodes_at: u32,
+    node_count: u32,
+    refs_at: u32,
+    positions_at: u32,
+    radii_at: u32,
+    starts_at: u32,
+    streamlines: u32,
+    triangles_at: u32,
+    width: u32,
+    height: u32,
+    _pad: [u32; 2],
+}
+
+/// How far the accumulation has come.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RayProgress {
+    /// Rays per geometry pixel traced into the current picture.
+    pub rays_per_pixel: u32,
+    /// The cap (`RayTracedSettings::max_rays`).
+    pub max_rays: u32,
+    /// Rays the last recorded frame traced per pixel (0 once converged).
+    pub frame_rays: u32,
+}
+
+impl RayProgress {
+    pub fn converged(&self) -> bool {
+        self.rays_per_pixel >= self.max_rays
+    }
+}
+
+/// What the last frame traced: a change of any of it starts the picture again.
+#[derive(Clone, Debug, Default, PartialEq)]
+struct Key {
+    bits: Vec<u32>,
+}
+
+impl Key {
+    fn of(view: &FrameView, settings: &ChainSettings, scene: Option<&RayScene>, targets: &FrameTargets) -> Key {
+        let r = &settings.raytraced;
+        let mut bits: Vec<u32> = Vec::with_capacity(48);
+        bits.extend(view.view.to_cols_array().map(f32::to_bits));
+        bits.extend(view.proj.to_cols_array().map(f32::to_bits));
+        bits.extend([view.width, view.height, view.guard, view.near.to_bits(), view.far.to_bits()]);
+        bits.extend([targets.size.0, targets.size.1]);
+        bits.extend([r.rays_per_frame, r.distance_world.to_bits(), (r.falloff == Falloff::Linear) as u32, r.seed]);
+        bits.push(settings.line_width_px.to_bits());
+        bits.push(settings.tubes.as_ref().map_or(0, |t| t.radius_world.to_bits()));
+        let generation = scene.map_or(0, |s| s.generation);
+        bits.extend([generation as u32, (generation >> 32) as u32]);
+        Key { bits }
+    }
+}
+
+#[derive(Default)]
+struct Progress {
+    key: Key,
+    /// Rays per pixel traced so far (before the frame being prepared).
+    traced: u32,
+    /// Rays the prepared frame traces.
+    frame_rays: u32,
+    max_rays: u32,
+}
+
+pub struct RayTracedAo {
+    layout: wgpu::BindGroupLayout,
+    /// (chunks, pipeline): rebuilt when a scene comes with another chunk count.
+    pipeline: (usize, wgpu::ComputePipeline),
+    uniform: wgpu::Buffer,
+    scene: Option<Arc<RayScene>>,
+    accumulation: Option<wgpu::Buffer>,
+    group: Option<wgpu::BindGroup>,
+    progress: Mutex<Progress>,
+}
+
+const LABEL: &str = "lineao::RayTracedAo";
+
+impl RayTracedAo {
+    pub fn new(device: &wgpu::Device) -> RayTracedAo {
+        let mut slots = vec![Slot::Uniform, Slot::Texture, Slot::StorageTexture(AO_FORMAT), Slot::StorageReadWrite];
+        slots.extend([Slot::Storage; MAX_CHUNKS]);
+        let layout = binding::layout(device, LABEL, wgpu::ShaderStages::COMPUTE, &slots);
+        RayTracedAo {
+            pipeline: (1, Self::pipeline(device, &layout, 1)),
+            layout,
+            uniform: binding::uniform_buffer::<TraceUniform>(device, LABEL),
+            scene: None,
+            accumulation: None,
+            group: None,
+            progress: Mutex::new(Progress::default()),
+        }
+    }
+
+    fn pipeline(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, chunks: usize) -> wgpu::ComputePipeline {
+        let constants = [("CHUNKS", chunks as f64)];
+        binding::compute_pipeline(device, LABEL, layout, "raytraced_ao.wgsl", "raytraced_ao", &constants)
+    }
+
+    /// Traces against `scene` from now on (and starts again).
+    pub fn set_scene(&mut self, device: &wgpu::Device, scene: Option<Arc<RayScene>>) {
+        let chunks = scene.as_ref().map_or(1, |s| s.chunk_count());
+        if chunks != self.pipeline.0 {
+            self.pipeline = (chunks, Self::pipeline(device, &self.layout, chunks));
+        }
+        self.scene = scene;
+        self.group = None;
+    }
+
+    /// Binds `nd[0]`, `ao`, a new accumulation buffer and the scene.
+    pub fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets) {
+        let (w, h) = targets.size;
+        let accumulation = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("lineao::RayTracedAo::accumulation"),
+            size: (w as u64 * h as u64 * 8).max(8),
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        self.group = self.scene.as_ref().map(|scene| {
+            let mut resources = vec![
+                self.uniform.as_entire_binding(),
+                wgpu::BindingResource::TextureView(&targets.nd[0].view),
+                wgpu::BindingResource::TextureView(&targets.ao.view),
+                accumulation.as_entire_binding(),
+            ];
+            // Bindings past the scene's chunks repeat its first (the shader never reads them).
+            resources
+                .extend((0..MAX_CHUNKS).map(|i| scene.chunks.get(i).unwrap_or(&scene.chunks[0]).as_entire_binding()));
+            binding::group(device, LABEL, &self.layout, &resources)
+        });
+        self.accumulation = Some(accumulation);
+        // A new buffer holds nothing yet.
+        self.progress.lock().expect("the progress lock").key = Key::default();
+    }
+
+    /// Writes the frame's uniform: the next rays of the same picture, or ray 0 of a new one.
+    pub fn prepare(&self, queue: &wgpu::Queue, targets: &FrameTargets, view: &FrameView, settings: &ChainSettings) {
+        let r = &settings.raytraced;
+        let key = Key::of(view, settings, self.scene.as_deref(), targets);
+        let mut progress = self.progress.lock().expect("the progress lock");
+        if progress.key != key {
+            *progress = Progress { key, ..Progress::default() };
+        }
+        progress.max_rays = r.max_rays;
+        progress.frame_rays = r.rays_per_frame.min(r.max_rays.saturating_sub(progress.traced));
+        let Some(scene) = &self.scene else { return };
+        let regions = scene.regions;
+        let inv_view = view.view.inverse();
+        let row = view.view.row(2);
+        let tube_radius = settings.tubes.as_ref().map_or(0.0, |t| t.radius_world);
+        let uniform = TraceUniform {
+            view: ViewParams::of(view).into(),
+            inv_view: inv_view.to_cols_array_2d(),
+            view_z: row.to_array(),
+            frame_rays: progress.frame_rays,
+            first_ray: progress.traced,
+            seed: r.seed,
+            falloff: (r.falloff == Falloff::Linear) as u32,
+            distance: r.distance_world,
+            epsilon: (EPSILON_PER_DISTANCE * r.distance_world as f64) as f32,
+            lines: settings.tubes.is_none() as u32,
+            line_half: 0.5 * settings.line_width_px / view.f_px,
+            tube_radius,
+            max_radius: tube_radius.max(scene.max_vertex_radius),
+            guard: view.guard,
+            chunk_shift: scene.chunk_shift,
+            nodes_at: regions.nodes,
+            node_count: regions.node_count,
+            refs_at: regions.refs,
+            positions_at: regions.positions,
+            radii_at: regions.radii,
+            starts_at: regions.starts,
+            streamlines: regions.streamlines,
+            triangles_at: regions.triangles,
+            width: targets.size.0,
+            height: targets.size.1,
+            _pad: [0; 2],
+        };
+        queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
+    }
+
+    /// Records the frame's rays (or, once converged, only the copy into `ao`), timed into `span`.
+    /// One `encode` per `prepare`: the next `prepare` continues after these rays.
+    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, targets: &FrameTargets, span: Option<Span>) {
+        let Some(group) = &self.group else { return };
+        dispatch_full_screen(encoder, LABEL, &self.pipeline.1, group, targets.size, span);
+        let mut progress = self.progress.lock().expect("the progress lock");
+        progress.traced += progress.frame_rays;
+    }
+
+    /// How far the picture has come: rays per pixel so far, after the last recorded frame.
+    pub fn progress(&self) -> RayProgress {
+        let progress = self.progress.lock().expect("the progress lock");
+        RayProgress { rays_per_pixel: progress.traced, max_rays: progress.max_rays, frame_rays: progress.frame_rays }
+    }
+}
+
+impl crate::stage::Stage for RayTracedAo {
+    fn matches(&self, settings: &ChainSettings) -> bool {
+        settings.method == AoMethod::RayTraced
+    }
+
+    /// Rays go through the scene, not the screen: no guard band.
+    fn reach(&self, _: &ChainSettings, _: &FrameView) -> crate::stage::Reach {
+        crate::stage::Reach::Pixels { radius_px: 0.0, levels: 1 }
+    }
+
+    fn spans(&self, _: &ChainSettings) -> &'static [&'static str] {
+        &["raytraced"]
+    }
+
+    fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets) {
+        RayTracedAo::resize(self, device, targets);
+    }
+
+    fn set_scene(&mut self, device: &wgpu::Device, scene: Option<&Arc<RayScene>>, targets: Option<&FrameTargets>) {
+        RayTracedAo::set_scene(self, device, scene.cloned());
+        if let Some(targets) = targets {
+            RayTracedAo::resize(self, device, targets);
+        }
+    }
+
+    fn progress(&self) -> Option<RayProgress> {
+        Some(RayTracedAo::progress(self))
+    }
+
+    fn prepare(&self, queue: &wgpu::Queue, targets: &FrameTargets, view: &FrameView, settings: &ChainSettings) {
+        RayTracedAo::prepare(self, queue, targets, view, settings);
+    }
+
+    fn encode<'t>(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &FrameTargets,
+        span: &dyn Fn(&'static str) -> Option<Span<'t>>,
+    ) {
+        RayTracedAo::encode(self, encoder, targets, span("raytraced"));
+    }
+}

@@ -1,0 +1,241 @@
+//! The GPU ray tracer against the CPU truth with the same rays (sequence, seed, frame indices):
+//! lines, tubes and a mesh, a scene split over several bindings, progressive accumulation and
+//! its restart, the cap, and linear falloff.
+
+mod common;
+
+use std::sync::Arc;
+
+use common::{OUTPUT_FORMAT, gpu};
+use glam::Vec3;
+use lineao::camera::{Bounds, Camera, Projection};
+use lineao::passes::meshes::MeshGeometry;
+use lineao::reference::{Image, NdImage};
+use lineao::targets::Target;
+use lineao::truth::{self, Bvh, Falloff};
+use lineao::verify::{read_f32, read_rgba};
+use lineao::{AoChain, AoMethod, ChainSettings, Gpu, LineGeometry, RayGeometry, RayScene, SurfaceSettings};
+
+const SIZE: (u32, u32) = (128, 96);
+
+/// The scene: helical polylines, and optionally a square under them.
+struct Scene {
+    positions: Vec<[f32; 3]>,
+    offsets: Vec<u64>,
+    radii: Option<Vec<f32>>,
+    mesh: Option<([[f32; 3]; 4], [u32; 6])>,
+}
+
+impl Scene {
+    fn lines(count: usize) -> Scene {
+        let (positions, offsets) = common::polylines(count, 0.3);
+        Scene { positions, offsets, radii: None, mesh: None }
+    }
+
+    fn with_mesh(mut self) -> Scene {
+        let (s, y) = (45.0, -42.0);
+        self.mesh = Some(([[-s, y, -s], [s, y, -s], [s, y, s], [-s, y, s]], [0, 2, 1, 0, 3, 2]));
+        self
+    }
+
+    fn meshes(&self) -> Vec<(&[[f32; 3]], &[u32])> {
+        self.mesh.iter().map(|(p, i)| (&p[..], &i[..])).collect()
+    }
+
+    fn geometry(&self) -> (Vec<(&[[f32; 3]], &[u32])>, Option<&[f32]>) {
+        (self.meshes(), self.radii.as_deref())
+    }
+}
+
+/// A chain tracing `scene` on the GPU, frame after frame.
+struct Tracer {
+    gpu: Gpu,
+    chain: AoChain,
+    lines: LineGeometry,
+    mesh: Option<MeshGeometry>,
+    output: Target,
+    bounds: Bounds,
+}
+
+impl Tracer {
+    fn new(scene: &Scene, settings: ChainSettings, chunk_words: Option<u64>) -> Tracer {
+        let gpu = gpu();
+        let (d, q) = (&gpu.device, &gpu.queue);
+        let lines = LineGeometry::new(d, q, &scene.positions, &scene.offsets).unwrap();
+        let mesh = scene.mesh.map(|(p, i)| MeshGeometry::new(d, q, &p, &[[0.0, 1.0, 0.0]; 4], &i).unwrap());
+        let mut bounds = lines.bounds.unwrap();
+        if let Some(m) = &mesh {
+            bounds = bounds.union(&m.bounds.unwrap());
+        }
+        let (meshes, radii) = scene.geometry();
+        let geometry = RayGeometry { positions: &scene.positions, offsets: &scene.offsets, radii, meshes: &meshes };
+        let ray_scene = match chunk_words {
+            Some(words) => RayScene::with_chunk_words(d, &geometry, words).unwrap(),
+            None => RayScene::new(d, &geometry).unwrap(),
+        };
+        if chunk_words.is_some() {
+            assert!(ray_scene.chunk_count() >= 3, "{} chunks", ray_scene.chunk_count());
+        }
+        let mut chain = AoChain::new(d, OUTPUT_FORMAT, settings).unwrap();
+        chain.resize(SIZE.0, SIZE.1).unwrap();
+        chain.set_ray_scene(d, Some(Arc::new(ray_scene)));
+        let output = Target::output(d, "test::output", SIZE, OUTPUT_FORMAT);
+        Tracer { gpu, chain, lines, mesh, output, bounds }
+    }
+
+    /// One frame from `camera`: the G-buffer's ND map and the accumulated AO.
+    fn frame(&mut self, camera: &Camera) -> (NdImage, Image<f32>) {
+        let (d, q) = (&self.gpu.device, &self.gpu.queue);
+        self.chain.prepare(d, q, camera, &self.bounds).unwrap();
+        let mut encoder = d.create_command_encoder(&Default::default());
+        let meshes: Vec<&MeshGeometry> = self.mesh.iter().collect();
+        self.chain.encode_with_meshes(&mut encoder, &self.lines, &meshes, &self.output.view);
+        q.submit([encoder.finish()]);
+        let t = self.chain.targets().unwrap();
+        (read_rgba(d, q, &t.nd[0]).unwrap(), read_f32(d, q, &t.ao).unwrap())
+    }
+}
+
+/// The CPU truth with `rays` rays on the chain's last frame.
+fn cpu_truth(tracer: &Tracer, scene: &Scene, nd: &NdImage, rays: u32) -> Image<f32> {
+    let s = tracer.chain.settings();
+    let view = tracer.chain.frame_view().unwrap();
+    let cones = match &s.tubes {
+        Some(t) => truth::tube_cones(&scene.positions, &scene.offsets, t.radius_world, scene.radii.as_deref()),
+        None => truth::line_cones(&scene.positions, &scene.offsets, view, s.line_width_px),
+    };
+    let triangles = scene.meshes().iter().flat_map(|(p, i)| truth::mesh_triangles(p, i)).collect();
+    let bvh = Bvh::build(cones, triangles);
+    let frame = truth::Frame { nd, view, lines: s.tubes.is_none() };
+    let settings = s.raytraced.truth(rays);
+    let cancel = std::sync::atomic::AtomicBool::new(false);
+    truth::compute(&bvh, &frame, &settings, &|_, _| {}, &cancel).unwrap().ao
+}
+
+/// Binary AO: the share of geometry pixels whose hit counts agree, the largest difference in
+/// rays, and the number of geometry pixels.
+fn compare_counts(nd: &NdImage, gpu: &Image<f32>, cpu: &Image<f32>, rays: u32) -> (f64, u32, usize) {
+    let (mut same, mut worst, mut geometry) = (0usize, 0u32, 0usize);
+    for ((g, c), texel) in gpu.data.iter().zip(&cpu.data).zip(&nd.data) {
+        if !common::is_geometry(*texel) {
+            assert_eq!((*g, *c), (0.0, 0.0), "background has no occlusion");
+            continue;
+        }
+        let (g, c) = ((g * rays as f32).round() as i64, (c * rays as f32).round() as i64);
+        geometry += 1;
+        same += (g == c) as usize;
+        worst = worst.max(g.abs_diff(c) as u32);
+    }
+    (same as f64 / geometry.max(1) as f64, worst, geometry)
+}
+
+fn settings(rays_per_frame: u32) -> ChainSettings {
+    let mut s = ChainSettings { method: AoMethod::RayTraced, ..ChainSettings::default() };
+    s.raytraced.rays_per_frame = rays_per_frame;
+    s.raytraced.distance_world = 12.0;
+    s
+}
+
+fn camera() -> Camera {
+    common::cameras_for_polylines().0
+}
+
+/// ≥ 99.9 % of geometry pixels trace the same number of hits on both sides, the rest within one
+/// ray (float ties), and there is occlusion to compare.
+fn assert_same_hits(nd: &NdImage, gpu: &Image<f32>, cpu: &Image<f32>, rays: u32, what: &str) {
+    let (share, worst, geometry) = compare_counts(nd, gpu, cpu, rays);
+    let mean: f32 = cpu.data.iter().sum::<f32>() / geometry.max(1) as f32;
+    eprintln!("{what}: {geometry} pixels, {:.4} % same hits, worst {worst} rays, mean AO {mean:.3}", 100.0 * share);
+    assert!(geometry > 1000, "{what}: only {geometry} geometry pixels");
+    assert!(mean > 0.05 && mean < 0.95, "{what}: mean AO {mean}: nothing to compare");
+    assert!(share >= 0.999 && worst <= 1, "{what}: {share} same, worst {worst}");
+}
+
+#[test]
+fn lines_accumulate_to_the_cpu_truth_with_the_same_rays_and_restart_when_the_camera_moves() {
+    let scene = Scene::lines(60);
+    let mut tracer = Tracer::new(&scene, settings(4), None);
+    let (nd, first) = tracer.frame(&camera());
+    assert_eq!(tracer.chain.ray_progress().unwrap().rays_per_pixel, 4);
+    assert_same_hits(&nd, &first, &cpu_truth(&tracer, &scene, &nd, 4), 4, "lines, 1 frame × 4");
+    // Two more frames: rays 4..12 continue the same sequence.
+    tracer.frame(&camera());
+    let (nd, third) = tracer.frame(&camera());
+    assert_eq!(tracer.chain.ray_progress().unwrap().rays_per_pixel, 12);
+    assert_same_hits(&nd, &third, &cpu_truth(&tracer, &scene, &nd, 12), 12, "lines, 3 frames × 4");
+    // The camera moves: the count starts again, and the picture is the new view's 4 rays.
+    let moved = Camera { eye: Vec3::new(-60.0, 20.0, 120.0), ..camera() };
+    let (nd, restarted) = tracer.frame(&moved);
+    assert_eq!(tracer.chain.ray_progress().unwrap().rays_per_pixel, 4);
+    assert_same_hits(&nd, &restarted, &cpu_truth(&tracer, &scene, &nd, 4), 4, "lines, moved");
+}
+
+#[test]
+fn tubes_with_per_vertex_radii_and_a_mesh_split_over_several_bindings_match_the_cpu_truth() {
+    let mut scene = Scene::lines(40).with_mesh();
+    // Every third vertex carries its own radius; the others take the settings'.
+    scene.radii = Some((0..scene.positions.len()).map(|v| if v % 3 == 0 { 1.6 } else { 0.0 }).collect());
+    let mut s = settings(8);
+    s.tubes = Some(lineao::TubeSettings { radius_world: 1.0 });
+    s.surfaces = Some(SurfaceSettings::default());
+    let mut tracer = Tracer::new(&scene, s, Some(4096));
+    let (nd, ao) = tracer.frame(&camera());
+    assert_same_hits(&nd, &ao, &cpu_truth(&tracer, &scene, &nd, 8), 8, "tubes + mesh, split");
+}
+
+#[test]
+fn an_orthographic_view_with_a_mesh_matches_and_the_cap_stops_tracing() {
+    let scene = Scene::lines(40).with_mesh();
+    let mut s = settings(4);
+    s.surfaces = Some(SurfaceSettings::default());
+    s.raytraced.max_rays = 6;
+    let mut tracer = Tracer::new(&scene, s, None);
+    let orthographic = Camera { projection: Projection::Orthographic { height: 110.0 }, ..camera() };
+    tracer.frame(&orthographic);
+    // The cap: the second frame traces the 2 rays left, the third none and keeps the picture.
+    let (nd, capped) = tracer.frame(&orthographic);
+    let progress = tracer.chain.ray_progress().unwrap();
+    assert_eq!((progress.rays_per_pixel, progress.frame_rays, progress.converged()), (6, 2, true));
+    assert_same_hits(&nd, &capped, &cpu_truth(&tracer, &scene, &nd, 6), 6, "orthographic + mesh, capped at 6");
+    let (_, after) = tracer.frame(&orthographic);
+    assert_eq!(tracer.chain.ray_progress().unwrap().frame_rays, 0);
+    assert_eq!(after.data, capped.data);
+}
+
+#[test]
+fn linear_falloff_matches_the_cpu_truth() {
+    let scene = Scene::lines(60);
+    let mut s = settings(8);
+    s.raytraced.falloff = Falloff::Linear;
+    let mut tracer = Tracer::new(&scene, s, None);
+    let (nd, gpu) = tracer.frame(&camera());
+    let cpu = cpu_truth(&tracer, &scene, &nd, 8);
+    // Each of the 8 rays adds 1 − t/R: f32 against f64 moves t by far less than 1e-3 R, unless a
+    // ray hits on one side only (a float tie), which moves the mean by up to 1/8.
+    let (mut close, mut geometry) = (0usize, 0usize);
+    for ((g, c), texel) in gpu.data.iter().zip(&cpu.data).zip(&nd.data) {
+        if !common::is_geometry(*texel) {
+            continue;
+        }
+        geometry += 1;
+        close += ((g - c).abs() < 1e-3) as usize;
+        assert!((g - c).abs() <= 0.126, "{g} vs {c}");
+    }
+    let share = close as f64 / geometry as f64;
+    eprintln!("linear falloff: {geometry} pixels, {:.4} % within 1e-3", 100.0 * share);
+    assert!(share >= 0.999, "{share}");
+}
+
+#[test]
+fn a_scene_beyond_six_bindings_is_too_large_and_no_scene_is_no_occlusion() {
+    let gpu = gpu();
+    let scene = Scene::lines(200);
+    let geometry = RayGeometry { positions: &scene.positions, offsets: &scene.offsets, ..Default::default() };
+    match RayScene::with_chunk_words(&gpu.device, &geometry, 64) {
+        Err(lineao::Error::TooLarge(message)) => assert!(message.contains("bytes"), "{message}"),
+        other => panic!("expected TooLarge, got {:?}", other.map(|s| s.bytes())),
+    }
+    // An empty scene uploads (one empty chunk) and hits nothing.
+    let empty = RayScene::new(&gpu.device, &RayGeometry::default()).unwrap();
+    assert!(empty.is_empty());
+}
