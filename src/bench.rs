@@ -21,7 +21,12 @@
 //! - `bilateral`: the separable bilateral blur (radius 4), which can follow any method;
 //! - `tubes`: the same streamlines as ray-cast tubes of radius 0.5 mm (against `lines`);
 //! - `nd-from-depth`: the ND and zoom maps derived from the G-buffer's depth, as from a host
-//!   renderer's (what embedding costs besides the method).
+//!   renderer's (what embedding costs besides the method);
+//! - `raytraced-1spp`: a frame of the GPU ray tracer that continues a picture with one more ray
+//!   per geometry pixel (binary AO to 2 mm): what each progressive frame costs per ray, against
+//!   `lineao-chain`; the table adds rays per second;
+//! - `raytraced-start-1spp`: a picture's first frame, which also finds each pixel's own segment
+//!   and tests its origin for being buried (kept for the frames after it).
 //!
 //! The object-space passes run on the CPU (`"on": "cpu"`), `--frames` times up to 3 (each takes
 //! seconds) without warm-up, on the scene's streamlines:
@@ -32,6 +37,8 @@
 //!   density volume of the run (what `--method variance-volume` adds to voxelizing);
 //! - `bvh-build-1m`: the ground truth's BVH over the scene's lines as sphere-swept segments
 //!   (1 M vertices at the default size), on all cores;
+//! - `bvh-upload`: the GPU ray tracer's scene (its BVH with leaves of 8, built on all cores, and
+//!   the upload): what a new geometry costs; the table adds its bytes per vertex;
 //! - `raytraced-cpu-64`: the CPU truth with 64 rays per geometry pixel of the bench's frame
 //!   (binary AO to 2 mm), on all cores; the table adds rays per second per core and the BVH's
 //!   bytes per segment.
@@ -47,6 +54,7 @@ use lineao::passes::line_ao::{Evaluation, LineAo};
 use lineao::passes::lines::{GeometryOptions, LineGeometry, LineRenderer, LineStyle};
 use lineao::passes::nd_from_depth::{HostConfig, HostInputs, NdFromDepth};
 use lineao::passes::nd_pyramid::NdPyramid;
+use lineao::passes::raytraced_ao::RayTracedAo;
 use lineao::passes::ssao::Ssao;
 use lineao::passes::ssao_blur::SsaoBlur;
 use lineao::passes::tubes::TubeRenderer;
@@ -88,12 +96,21 @@ struct Passes {
     /// The ND and zoom maps from the G-buffer's own depth, as from a host's (whose bind group
     /// is made per frame, on the device).
     nd_from_depth: NdFromDepth,
+    /// One ray per pixel: every frame ray 1 of a picture, or ray 0 (prepared once).
+    raytraced: RayTracedAo,
+    raytraced_start: RayTracedAo,
     device: wgpu::Device,
     output: Target,
 }
 
 impl Passes {
-    fn new(gpu: &Gpu, settings: &ChainSettings, targets: &FrameTargets, view: &FrameView) -> Passes {
+    fn new(
+        gpu: &Gpu,
+        settings: &ChainSettings,
+        targets: &FrameTargets,
+        view: &FrameView,
+        scene: std::sync::Arc<lineao::RayScene>,
+    ) -> Passes {
         let (device, queue) = (&gpu.device, &gpu.queue);
         let format = wgpu::TextureFormat::Rgba8UnormSrgb;
         let level = LineAoSettings { outer: LineAoOuter::Level, ..settings.line_ao.clone() };
@@ -115,6 +132,8 @@ impl Passes {
             bilateral: Bilateral::new(device),
             tubes: TubeRenderer::new(device, false),
             nd_from_depth: NdFromDepth::new(device, HostConfig::default()),
+            raytraced: RayTracedAo::new(device),
+            raytraced_start: RayTracedAo::new(device),
             device: device.clone(),
             output: Target::output(device, "lineao::bench::output", (view.width, view.height), format),
         };
@@ -146,6 +165,21 @@ impl Passes {
             view,
             &VoSettings { area_samples: 1, ..settings.vo.clone() },
         );
+        let one_ray = ChainSettings {
+            raytraced: lineao::RayTracedSettings { rays_per_frame: 1, ..Default::default() },
+            ..settings.clone()
+        };
+        for pass in [&mut passes.raytraced, &mut passes.raytraced_start] {
+            pass.set_scene(device, Some(scene.clone()));
+            pass.resize(device, targets);
+            pass.prepare(queue, targets, view, &one_ray);
+        }
+        // `raytraced` continues the picture its first frame started.
+        let mut encoder =
+            device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::bench") });
+        passes.raytraced.encode(&mut encoder, targets, None);
+        queue.submit([encoder.finish()]);
+        passes.raytraced.prepare(queue, targets, view, &one_ray);
         passes.bilateral.resize(device, targets);
         passes.bilateral.prepare(queue, view, &BilateralSettings::default());
         passes.composite.resize(device, targets, &targets.ao);
@@ -199,6 +233,8 @@ impl Passes {
             }
             "bilateral" => self.bilateral.encode(encoder, targets, span),
             "tubes" => self.tubes.encode(encoder, targets, geometry, Load::Clear(background), span),
+            "raytraced-1spp" => self.raytraced.encode(encoder, targets, span),
+            "raytraced-start-1spp" => self.raytraced_start.encode(encoder, targets, span),
             "nd-from-depth" => {
                 let inputs = HostInputs { depth: &targets.depth.view, normals: None, color: None };
                 self.nd_from_depth.encode(&self.device, encoder, targets, &inputs, span);
@@ -242,7 +278,11 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         .with_outer(device)
         .with_ao_raw(device)
         .with_blur(device);
-    let passes = Passes::new(&gpu, &settings, targets, &view);
+    let tractogram = &scene.tracts;
+    let ray_geometry =
+        lineao::RayGeometry { positions: &tractogram.positions, offsets: &tractogram.offsets, ..Default::default() };
+    let ray_scene = std::sync::Arc::new(lineao::RayScene::new(device, &ray_geometry)?);
+    let passes = Passes::new(&gpu, &settings, targets, &view, ray_scene.clone());
     let timer = if args.no_timestamps { None } else { PassTimer::new(device, queue, &GPU_PASSES) };
 
     let mut times: Vec<Vec<f64>> = vec![Vec::new(); GPU_PASSES.len()];
@@ -297,12 +337,38 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         .map(|(name, ms)| summary(name, on, ms))
         .collect();
     let runs = args.frames.min(3);
-    let tractogram = &scene.tracts;
     for (name, ms) in object_space_times(&tractogram.positions, &tractogram.offsets, runs, &selected)? {
         passes.push(summary(name, "cpu", ms));
     }
-    for (name, ms) in ray_tracing_times(&gpu, &chain, &view, tractogram, runs, &selected)? {
+    for (name, ms) in ray_tracing_times(&gpu, &chain, targets, &view, tractogram, runs, &selected)? {
         passes.push(summary(name, "cpu", ms));
+    }
+    if selected("bvh-upload") {
+        let mut ms = Vec::new();
+        for _ in 0..runs {
+            let start = Instant::now();
+            let scene = lineao::RayScene::new(device, &ray_geometry)?;
+            gpu.wait()?;
+            ms.push(start.elapsed().as_secs_f64() * 1e3);
+            drop(scene);
+        }
+        passes.push(summary("bvh-upload", "cpu", ms));
+    }
+    if selected("raytraced-1spp") {
+        let geometry_pixels = lineao::verify::read_rgba(device, queue, &targets.nd[0])?
+            .data
+            .iter()
+            .filter(|texel| texel[..3] != [0.0; 3])
+            .count();
+        let ms = passes.iter().find(|p| p["name"] == "raytraced-1spp").and_then(|p| p["ms_median"].as_f64());
+        eprintln!(
+            "lineao: raytraced-1spp: {geometry_pixels} rays, {:.1} M rays/s; the scene {} bytes, {:.1} bytes per vertex \
+             in {} buffers",
+            geometry_pixels as f64 / ms.unwrap_or(f64::NAN) / 1e3,
+            ray_scene.bytes(),
+            ray_scene.bytes_per_vertex(),
+            ray_scene.chunk_count()
+        );
     }
     let info = gpu.adapter.get_info();
     let report = json!({
@@ -371,6 +437,7 @@ fn object_space_times(
 fn ray_tracing_times(
     gpu: &Gpu,
     chain: &AoChain,
+    targets: &FrameTargets,
     view: &FrameView,
     tractogram: &lineao_tracts::Tractogram,
     runs: u32,
@@ -402,7 +469,7 @@ fn ray_tracing_times(
         out.push(("bvh-build-1m", ms));
     }
     if selected("raytraced-cpu-64") {
-        let targets = chain.targets().context("the chain allocated no targets")?;
+        // The bench's G-buffer (the chain itself only sized the guard band and drew nothing).
         let nd = lineao::verify::read_rgba(&gpu.device, &gpu.queue, &targets.nd[0])?;
         let frame = lineao::truth::Frame { nd: &nd, view, lines: true };
         let settings = TruthSettings { rays: 64, ..TruthSettings::default() };
@@ -459,6 +526,8 @@ fn print_table(report: &serde_json::Value, passes: &[serde_json::Value]) {
         ("lineao-chain-level", "ssao-16-chain"),
         ("vo-line-5", "ssao-12"),
         ("vo-area-1", "ssao-12"),
+        ("raytraced-1spp", "lineao-chain"),
+        ("raytraced-start-1spp", "lineao-chain"),
     ] {
         if let (Some(x), Some(y)) = (median(a), median(b)) {
             println!("{a} / {b}: {:.2}x", x / y);

@@ -41,7 +41,7 @@ pub struct ScoreArgs {
     #[command(flatten)]
     pub render: RenderArgs,
     /// Methods to score, comma-separated (`lineao`, `lineao-reference`, `vo-line`, `vo-area`,
-    /// `ssao`, `raytraced` = the truth again with another --ray-seed) [default: all of them].
+    /// `ssao`, `raytraced` = the truth again with the next --ray-seed, traced on the GPU, or on the CPU with --cpu) [default: all of them].
     #[arg(long, value_delimiter = ',', value_parser = parse_score_method)]
     pub methods: Vec<ScoreMethod>,
     /// Print JSON (CONTRACT.md `lineao score --json`) instead of a table.
@@ -572,6 +572,9 @@ pub struct RenderArgs {
     /// Ray-traced AO: seed of the per-pixel scrambled ray sequence.
     #[arg(long, default_value_t = 1)]
     pub ray_seed: u32,
+    /// Ray-traced AO: trace on the CPU (the reference, f64, all cores) instead of the GPU.
+    #[arg(long)]
+    pub cpu: bool,
     /// Write the method's inputs and output as .npy files and params.json into this folder.
     #[arg(long)]
     pub dump: Option<PathBuf>,
@@ -637,7 +640,7 @@ fn named<T: Named>() -> impl clap::builder::TypedValueParser<Value = T> {
 // The passes `lineao bench --passes` names (its vocabulary, so the CLI needs nothing of the
 // bench itself).
 /// The GPU passes of one run, in CONTRACT.md's order.
-pub const GPU_PASSES: [&str; 17] = [
+pub const GPU_PASSES: [&str; 19] = [
     "lines",
     "lines-native-1px",
     "lines-full-strip",
@@ -655,11 +658,13 @@ pub const GPU_PASSES: [&str; 17] = [
     "bilateral",
     "tubes",
     "nd-from-depth",
+    "raytraced-1spp",
+    "raytraced-start-1spp",
 ];
 
 /// The CPU passes, after the GPU's.
-pub const CPU_PASSES: [&str; 5] =
-    ["density-256", "sweep-256", "variance-volume-256", "bvh-build-1m", "raytraced-cpu-64"];
+pub const CPU_PASSES: [&str; 6] =
+    ["density-256", "sweep-256", "variance-volume-256", "bvh-build-1m", "bvh-upload", "raytraced-cpu-64"];
 
 /// Whether `name` is a pass of the benchmark.
 pub fn is_pass(name: &str) -> bool {

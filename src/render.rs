@@ -104,6 +104,7 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky) -> 
             reference_radius_px: LineAoSettings::default().reference_radius_px,
             outer: args.outer,
         },
+        raytraced: crate::truth::gpu_settings(args),
         line_width_px: args.line_width,
         lighting: lineao::lighting::Lighting {
             line_shading: args.line_shading,
@@ -211,6 +212,8 @@ pub struct Session {
     pub gpu: Gpu,
     pub meshes: Vec<MeshGeometry>,
     pub bounds: Bounds,
+    /// The ray tracer's scene on the GPU, built when a panel first needs it.
+    ray_scene: std::sync::OnceLock<std::sync::Arc<lineao::RayScene>>,
 }
 
 impl Session {
@@ -264,7 +267,7 @@ impl Session {
             .collect::<Result<Vec<_>, _>>()?;
         let lines_bounds = lines.geometry.bounds.expect("checked at upload");
         let bounds = meshes.iter().filter_map(|m| m.bounds).fold(lines_bounds, |b, m| b.union(&m));
-        Ok(Session { lines, base, camera, sky, surfaces, gpu, meshes, bounds })
+        Ok(Session { lines, base, camera, sky, surfaces, gpu, meshes, bounds, ray_scene: Default::default() })
     }
 
     /// The chain's settings for `method` from the command line, the colour range from the data.
@@ -372,7 +375,8 @@ pub struct Rendered {
 impl Session {
     /// Renders `panel` to sRGB bytes (with `--timings`, prints its passes; with `dump`, writes
     /// its inputs and output there, with `volume`'s settings when it has object-space AO). The
-    /// ray-traced method renders the G-buffer, traces the truth on the CPU, writes it into the
+    /// ray-traced method traces on the GPU, frame after frame until `--rays` rays per pixel;
+    /// with `--cpu` it renders the G-buffer, traces the truth on the CPU, writes it into the
     /// chain's `ao` and composites.
     pub fn render(
         &self,
@@ -393,7 +397,16 @@ impl Session {
         let meshes: Vec<&MeshGeometry> = self.meshes.iter().collect();
         let start = std::time::Instant::now();
         let scene = (&self.lines.geometry, &meshes[..]);
+        let gpu_rays = panel.settings.method == AoMethod::RayTraced && !args.cpu;
+        if gpu_rays {
+            chain.set_ray_scene(&gpu.device, Some(self.ray_scene()?));
+        }
         submit_frame(gpu, &mut chain, scene, (&self.camera, &self.bounds), &target.view);
+        if gpu_rays {
+            crate::truth::accumulate(gpu, &mut chain, |chain| {
+                submit_frame(gpu, chain, scene, (&self.camera, &self.bounds), &target.view)
+            })?;
+        }
         if args.timings {
             gpu.wait()?;
             let wall_ms = start.elapsed().as_secs_f64() * 1e3;
@@ -409,7 +422,7 @@ impl Session {
                 None => eprintln!("lineao: {label}: frame {wall_ms:.2} ms (CPU wall time: no timestamp queries)"),
             }
         }
-        let truth = if panel.settings.method == AoMethod::RayTraced {
+        let truth = if panel.settings.method == AoMethod::RayTraced && args.cpu {
             let truth = self.trace(&chain, &crate::truth::settings(args))?;
             let targets = chain.targets().context("nothing was rendered")?;
             lineao::verify::write_target(&gpu.queue, &targets.ao, &truth.ao);
@@ -431,6 +444,16 @@ impl Session {
         }
         let image = Rgba8 { width: args.width, height: args.height, data: image.bytes };
         Ok(Rendered { image, chain })
+    }
+
+    /// The ray tracer's scene on the GPU (built and uploaded once per session), with a line on
+    /// stderr saying what it cost.
+    pub fn ray_scene(&self) -> Result<std::sync::Arc<lineao::RayScene>> {
+        if let Some(scene) = self.ray_scene.get() {
+            return Ok(scene.clone());
+        }
+        let scene = std::sync::Arc::new(crate::truth::ray_scene(&self.gpu, &self.truth_scene())?);
+        Ok(self.ray_scene.get_or_init(|| scene).clone())
     }
 
     /// The truth on `chain`'s last frame, with a line on stderr saying what it cost.

@@ -80,17 +80,25 @@ pub fn raw_ao(
             chain.insert(made)
         }
     };
-    chain.prepare(&gpu.device, &gpu.queue, &session.camera, &session.bounds);
     let target = lineao::targets::Target::output(
         &gpu.device,
         "lineao::score::output",
         (width, height),
         wgpu::TextureFormat::Rgba8UnormSrgb,
     );
-    let mut encoder = gpu.device.create_command_encoder(&Default::default());
     let meshes: Vec<&lineao::passes::meshes::MeshGeometry> = session.meshes.iter().collect();
-    chain.encode_with_meshes(&mut encoder, &session.lines.geometry, &meshes, &target.view);
-    gpu.queue.submit([encoder.finish()]);
+    let scene = (&session.lines.geometry, &meshes[..]);
+    let view = (&session.camera, &session.bounds);
+    let traced = chain.settings().method == AoMethod::RayTraced;
+    if traced {
+        chain.set_ray_scene(&gpu.device, Some(session.ray_scene()?));
+    }
+    crate::source::submit_frame(gpu, chain, scene, view, &target.view);
+    if traced {
+        crate::truth::accumulate(gpu, chain, |chain| {
+            crate::source::submit_frame(gpu, chain, scene, view, &target.view)
+        })?;
+    }
     let targets = chain.targets().context("nothing was rendered")?;
     let shown = targets.shown();
     let raw = lineao::verify::read_f32(&gpu.device, &gpu.queue, shown)?;
@@ -159,12 +167,15 @@ pub fn score(session: &Session, args: &crate::cli::RenderArgs, methods: &[ScoreM
             ),
             _ => (&ao_truth, "ao"),
         };
-        let ao = if m.method == AoMethod::RayTraced {
+        let ao = if m.method == AoMethod::RayTraced && args.cpu {
             let again = TruthSettings { seed: truth_settings.seed.wrapping_add(1), vo: None, ..truth_settings.clone() };
             session.trace(&rendered.chain, &again)?.ao
         } else {
             let mut chain = None;
-            let view = raw_ao(session, &mut chain, method_settings(session, args, m), args.width, args.height)?;
+            let mut settings = method_settings(session, args, m);
+            // The ray tracer on the GPU traces the truth again with the next seed.
+            settings.raytraced.seed = settings.raytraced.seed.wrapping_add(1);
+            let view = raw_ao(session, &mut chain, settings, args.width, args.height)?;
             mask.iter_mut().zip(&view.geometry).for_each(|(m, g)| *m &= g);
             let strength = strength_of(m);
             Image { data: view.ao.data.iter().map(|a| (strength * a).clamp(0.0, 1.0)).collect(), ..view.ao }

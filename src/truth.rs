@@ -33,6 +33,90 @@ pub fn settings(args: &RenderArgs) -> TruthSettings {
     }
 }
 
+/// The GPU ray tracer's settings from the command line: `--rays` rays per pixel in all, at most
+/// [`RAYS_PER_FRAME`] per submitted frame.
+pub fn gpu_settings(args: &RenderArgs) -> lineao::RayTracedSettings {
+    lineao::RayTracedSettings {
+        rays_per_frame: args.rays.min(RAYS_PER_FRAME),
+        max_rays: args.rays,
+        distance_world: args.ao_distance,
+        falloff: args.ao_falloff,
+        seed: args.ray_seed,
+    }
+}
+
+/// Rays per pixel in one submitted frame of `render --method raytraced`: few enough that a frame
+/// stays well under a desktop GPU's watchdog at 1280 × 1024 and 1 M vertices, many enough that
+/// the G-buffer drawn again each frame costs little against them.
+pub const RAYS_PER_FRAME: u32 = 64;
+
+/// The ray tracer's scene of what the frame draws, built on all cores and uploaded, with a line
+/// on stderr saying what it cost.
+pub fn ray_scene(gpu: &Gpu, scene: &Scene) -> Result<lineao::RayScene> {
+    let start = std::time::Instant::now();
+    let meshes: Vec<(&[[f32; 3]], &[u32])> =
+        scene.surfaces.iter().map(|m| (&m.positions[..], &m.indices[..])).collect();
+    let geometry = lineao::RayGeometry {
+        positions: &scene.tracts.positions,
+        offsets: &scene.tracts.offsets,
+        radii: scene.radii,
+        meshes: &meshes,
+    };
+    let ray_scene = lineao::RayScene::new(&gpu.device, &geometry)?;
+    eprintln!(
+        "lineao: ray tracer's scene: {} MB on the GPU ({:.1} bytes per vertex, {} buffers), built in {:.2} s",
+        ray_scene.bytes() >> 20,
+        ray_scene.bytes_per_vertex(),
+        ray_scene.chunk_count(),
+        start.elapsed().as_secs_f64()
+    );
+    Ok(ray_scene)
+}
+
+/// Submits frames with `frame` until `chain`'s ray-traced picture has all its rays (the first
+/// frame submitted already), with a progress bar on a terminal; Ctrl-C stops it with an error.
+pub fn accumulate(gpu: &Gpu, chain: &mut AoChain, mut frame: impl FnMut(&mut AoChain)) -> Result<()> {
+    let start = std::time::Instant::now();
+    let progress = |chain: &AoChain| chain.ray_progress().context("the ray-traced method is not active");
+    let first = progress(chain)?;
+    let bar = std::io::stderr().is_terminal().then(|| {
+        indicatif::ProgressBar::new(first.max_rays as u64).with_style(
+            indicatif::ProgressStyle::with_template(
+                "ray tracing (GPU) [{bar:40}] {pos}/{len} rays per pixel, {eta} left",
+            )
+            .expect("a valid template")
+            .progress_chars("=> "),
+        )
+    });
+    let cancel = cancel_on_ctrl_c();
+    loop {
+        let now = progress(chain)?;
+        if let Some(bar) = &bar {
+            bar.set_position(now.rays_per_pixel as u64);
+        }
+        if now.converged() {
+            break;
+        }
+        if cancel.load(Ordering::Relaxed) {
+            anyhow::bail!("ray tracing stopped (Ctrl-C)");
+        }
+        frame(chain);
+        // One frame in flight: the bar and Ctrl-C follow the GPU, not the queue.
+        gpu.wait()?;
+    }
+    gpu.wait()?;
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    let p = progress(chain)?;
+    eprintln!(
+        "lineao: ray traced {} rays per pixel on the GPU in {:.2} s",
+        p.rays_per_pixel,
+        start.elapsed().as_secs_f64()
+    );
+    Ok(())
+}
+
 /// Set by Ctrl-C while a truth runs.
 static CANCEL: AtomicBool = AtomicBool::new(false);
 

@@ -280,16 +280,20 @@ fn bench_json_is_the_contract() {
             "bilateral",
             "tubes",
             "nd-from-depth",
+            "raytraced-1spp",
+            "raytraced-start-1spp",
             "density-256",
             "sweep-256",
             "variance-volume-256",
             "bvh-build-1m",
-            "raytraced-cpu-64"
+            "raytraced-cpu-64",
+            "bvh-upload"
         ]
     );
     for p in passes {
-        let cpu_pass = ["density-256", "sweep-256", "variance-volume-256", "bvh-build-1m", "raytraced-cpu-64"]
-            .contains(&p["name"].as_str().unwrap());
+        let cpu_pass =
+            ["density-256", "sweep-256", "variance-volume-256", "bvh-build-1m", "raytraced-cpu-64", "bvh-upload"]
+                .contains(&p["name"].as_str().unwrap());
         assert_eq!(p["on"], if cpu_pass { "cpu" } else { on });
         let ms = |k: &str| p[k].as_f64().unwrap();
         assert!(0.0 <= ms("ms_min") && ms("ms_min") <= ms("ms_median") && ms("ms_median") <= ms("ms_max"), "{p}");
@@ -625,21 +629,29 @@ fn truth_options_are_checked() {
 
 /// A lone, gently curved polyline facing the camera occludes nothing: its own segment and its
 /// neighbours never occlude its surface, and no origin is buried. (A sharp zigzag does occlude
-/// itself: segment k + 2 is another part of the line, a few millimetres away.)
+/// itself: segment k + 2 is another part of the line, a few millimetres away.) On the CPU with
+/// the truth's dump, and on the GPU.
 #[test]
 fn a_lone_line_has_no_truth_ao() {
+    for cpu in [true, false] {
+        lone_line(cpu);
+    }
+}
+
+fn lone_line(cpu: bool) {
     let dir = scratch("lone_line");
     let mut tracts = lineao_tracts::Tractogram::new();
     tracts.positions = (0..40).map(|i| [i as f32 * 1.5, (i as f32 * 0.35).sin() * 0.8, 0.0]).collect();
     tracts.offsets = vec![0, 40];
     let file = dir.join("curve.tck");
     lineao_tracts::save(&tracts, &file).unwrap();
-    let dump = dir.join("dump");
+    let dump = dir.join(if cpu { "dump-cpu" } else { "dump-gpu" });
     let out = lineao(&[
         "render",
         file.to_str().unwrap(),
         "--method",
         "raytraced",
+        if cpu { "--cpu" } else { "--ray-seed=1" },
         "--rays",
         "64",
         "--line-width",
@@ -667,6 +679,9 @@ fn a_lone_line_has_no_truth_ao() {
     assert!(geometry > 200, "{geometry} line pixels");
     let worst = ao.iter().cloned().fold(0.0f32, f32::max);
     assert_eq!(worst, 0.0, "a lone line occludes itself");
+    if !cpu {
+        return;
+    }
     let params: Value = serde_json::from_str(&std::fs::read_to_string(dump.join("params.json")).unwrap()).unwrap();
     assert_eq!(params["method"], "raytraced");
     assert_eq!(params["rays"], 64);

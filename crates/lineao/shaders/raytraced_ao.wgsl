@@ -3,7 +3,8 @@
 // traced through the scene's BVH (`lineao::ray_scene`) against rounded cones and triangles, and
 // added to the pixel's running (sum, rays); `ao` = sum / rays. The origin, its own segment, the
 // buried test and both falloffs are `lineao::truth`'s, step by step, in f32 relative to the ray's
-// origin (the CPU truth is f64).
+// origin (the CPU truth is f64). The own segment and the buried test are found on a picture's
+// first frame and kept for the frames that continue it.
 #import shared/nd.wgsl
 #import shared/view.wgsl
 
@@ -45,8 +46,9 @@ struct Trace {
 @group(0) @binding(0) var<uniform> trace: Trace;
 @group(0) @binding(1) var nd0: texture_2d<f32>;
 @group(0) @binding(2) var ao_out: texture_storage_2d<r32float, write>;
-// (sum of ray values, rays) per pixel of the guard-banded frame.
-@group(0) @binding(3) var<storage, read_write> accumulation: array<vec2<f32>>;
+// Per pixel of the guard-banded frame: the sum of ray values and the rays (f32 bits), the own
+// segment's first vertex (NONE for none) and whether the origin is buried.
+@group(0) @binding(3) var<storage, read_write> accumulation: array<vec4<u32>>;
 @group(0) @binding(4) var<storage, read> scene0: array<u32>;
 @group(0) @binding(5) var<storage, read> scene1: array<u32>;
 @group(0) @binding(6) var<storage, read> scene2: array<u32>;
@@ -500,6 +502,29 @@ fn traverse(q: Query, own: Own) -> Found {
     return found;
 }
 
+// The pixel's origin, from its own segment v (NONE: a surface pixel): where its rays start and
+// what they ignore.
+struct Origin {
+    start: vec3<f32>,
+    own: Own,
+}
+
+const NONE: u32 = 0xffffffffu;
+
+fn origin(p: vec3<f32>, n: vec3<f32>, v: u32) -> Origin {
+    if v == NONE {
+        return Origin(p + trace.epsilon * n, Own(NONE, 0u, 0u, vec3<f32>(0.0)));
+    }
+    let c = cone(v);
+    let ba = c.b - c.a;
+    let l2 = dot(ba, ba);
+    let s = select(clamp(dot(p - c.a, ba) / l2, 0.0, 1.0), 0.0, l2 == 0.0);
+    let axis = c.a + ba * s;
+    let r = c.ra + (c.rb - c.ra) * s;
+    let range = streamline_of(v);
+    return Origin(axis + (r + trace.epsilon) * n, Own(v, range.x, range.y, axis));
+}
+
 @compute @workgroup_size(8, 8)
 fn raytraced_ao(@builtin(global_invocation_id) id: vec3<u32>) {
     if id.x >= trace.width || id.y >= trace.height {
@@ -512,50 +537,46 @@ fn raytraced_ao(@builtin(global_invocation_id) id: vec3<u32>) {
         textureStore(ao_out, vec2<i32>(pixel), vec4<f32>(0.0));
         return;
     }
-    var acc = select(accumulation[index], vec2<f32>(0.0), trace.first_ray == 0u);
+    // (sum, rays, own segment, buried) as bits.
+    var state = accumulation[index];
     if trace.frame_rays > 0u {
         // The pixel's world position and normal.
         let depth = linear_depth(trace.view, texel.w);
         let p = (trace.inv_view * vec4<f32>(view_position(trace.view, pixel, depth), 1.0)).xyz;
         let n = normalize((trace.inv_view * vec4<f32>(texel.xyz, 0.0)).xyz);
-        var surface = p;
-        var own = Own(0xffffffffu, 0u, 0u, vec3<f32>(0.0));
-        if trace.lines != 0u {
-            // The segment holding p most deeply, within a pixel's footprint of its surface.
-            let footprint = select(depth, 1.0, trace.view.orthographic != 0u) / trace.view.f_px;
-            let found = traverse(Query(OWN, p, vec3<f32>(1.0), footprint), own);
-            if found.v != 0xffffffffu {
-                let c = cone(found.v);
-                let ba = c.b - c.a;
-                let l2 = dot(ba, ba);
-                let s = select(clamp(dot(p - c.a, ba) / l2, 0.0, 1.0), 0.0, l2 == 0.0);
-                let axis = c.a + ba * s;
-                let r = c.ra + (c.rb - c.ra) * s;
-                let range = streamline_of(found.v);
-                own = Own(found.v, range.x, range.y, axis);
-                surface = axis + r * n;
+        if trace.first_ray == 0u {
+            // A new picture: the pixel's own segment and whether its origin is buried, found once
+            // and kept for the frames that continue it.
+            var own = NONE;
+            if trace.lines != 0u {
+                // The segment holding p most deeply, within a pixel's footprint of its surface.
+                let footprint = select(depth, 1.0, trace.view.orthographic != 0u) / trace.view.f_px;
+                own = traverse(Query(OWN, p, vec3<f32>(1.0), footprint), Own(NONE, 0u, 0u, vec3<f32>(0.0))).v;
             }
+            let o = origin(p, n, own);
+            let buried = traverse(Query(INSIDE, o.start, vec3<f32>(1.0), 0.0), o.own).t == 0.0;
+            state = vec4<u32>(0u, 0u, own, u32(buried));
         }
-        let start = surface + trace.epsilon * n;
+        let o = origin(p, n, state.z);
         let rays = f32(trace.frame_rays);
-        if traverse(Query(INSIDE, start, vec3<f32>(1.0), 0.0), own).t == 0.0 {
-            // Buried in another primitive: every ray is blocked.
-            acc += vec2<f32>(rays, rays);
-        } else {
+        var sum = rays;
+        if state.w == 0u {
             let guard = i32(trace.guard);
             let seed = pixel_seed(i32(pixel.x) - guard, i32(pixel.y) - guard, trace.seed);
             let mode = select(RAY_ANY, RAY_NEAREST, trace.falloff != 0u);
-            var sum = 0.0;
+            sum = 0.0;
             for (var i = 0u; i < trace.frame_rays; i++) {
                 let d = cosine_direction(sample_2d(trace.first_ray + i, seed), n);
-                let t = traverse(Query(mode, start, d, trace.distance), own).t;
+                let t = traverse(Query(mode, o.start, d, trace.distance), o.own).t;
                 if t != NO_HIT {
                     sum += select(1.0, 1.0 - t / trace.distance, mode == RAY_NEAREST);
                 }
             }
-            acc += vec2<f32>(sum, rays);
         }
-        accumulation[index] = acc;
+        state.x = bitcast<u32>(bitcast<f32>(state.x) + sum);
+        state.y = bitcast<u32>(bitcast<f32>(state.y) + rays);
+        accumulation[index] = state;
     }
+    let acc = vec2<f32>(bitcast<f32>(state.x), bitcast<f32>(state.y));
     textureStore(ao_out, vec2<i32>(pixel), vec4<f32>(select(0.0, acc.x / acc.y, acc.y > 0.0)));
 }

@@ -268,7 +268,7 @@ impl AoChain {
             )));
         }
         let banded = (width + 2 * guard, height + 2 * guard);
-        let accumulation = banded.0 as u64 * banded.1 as u64 * 8;
+        let accumulation = banded.0 as u64 * banded.1 as u64 * crate::passes::raytraced_ao::ACCUMULATION_BYTES;
         if settings.method == AoMethod::RayTraced && accumulation > self.max_storage {
             return Err(Error::TooLarge(format!(
                 "the ray tracer's accumulation for {width} x {height} px needs {accumulation} bytes, more than the \

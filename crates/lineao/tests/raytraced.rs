@@ -41,10 +41,6 @@ impl Scene {
     fn meshes(&self) -> Vec<(&[[f32; 3]], &[u32])> {
         self.mesh.iter().map(|(p, i)| (&p[..], &i[..])).collect()
     }
-
-    fn geometry(&self) -> (Vec<(&[[f32; 3]], &[u32])>, Option<&[f32]>) {
-        (self.meshes(), self.radii.as_deref())
-    }
 }
 
 /// A chain tracing `scene` on the GPU, frame after frame.
@@ -67,7 +63,8 @@ impl Tracer {
         if let Some(m) = &mesh {
             bounds = bounds.union(&m.bounds.unwrap());
         }
-        let (meshes, radii) = scene.geometry();
+        let meshes = scene.meshes();
+        let radii = scene.radii.as_deref();
         let geometry = RayGeometry { positions: &scene.positions, offsets: &scene.offsets, radii, meshes: &meshes };
         let ray_scene = match chunk_words {
             Some(words) => RayScene::with_chunk_words(d, &geometry, words).unwrap(),

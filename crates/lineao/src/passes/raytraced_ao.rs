@@ -125,6 +125,9 @@ pub struct RayTracedAo {
 
 const LABEL: &str = "lineao::RayTracedAo";
 
+/// Bytes of the accumulation per pixel: the sum, the rays, the own segment, the buried flag.
+pub const ACCUMULATION_BYTES: u64 = 16;
+
 impl RayTracedAo {
     pub fn new(device: &wgpu::Device) -> RayTracedAo {
         let mut slots = vec![Slot::Uniform, Slot::Texture, Slot::StorageTexture(AO_FORMAT), Slot::StorageReadWrite];
@@ -161,7 +164,7 @@ impl RayTracedAo {
         let (w, h) = targets.size;
         let accumulation = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("lineao::RayTracedAo::accumulation"),
-            size: (w as u64 * h as u64 * 8).max(8),
+            size: (w as u64 * h as u64 * ACCUMULATION_BYTES).max(ACCUMULATION_BYTES),
             usage: wgpu::BufferUsages::STORAGE,
             mapped_at_creation: false,
         });
