@@ -101,10 +101,11 @@ pub fn accumulate(gpu: &Gpu, chain: &mut AoChain, mut frame: impl FnMut(&mut AoC
             anyhow::bail!("ray tracing stopped (Ctrl-C)");
         }
         frame(chain);
-        // One frame in flight: the bar and Ctrl-C follow the GPU, not the queue.
-        gpu.wait()?;
+        // One frame in flight: the bar and Ctrl-C follow the GPU, not the queue; a lost device
+        // ends it here.
+        gpu.wait().context("ray tracing stopped")?;
     }
-    gpu.wait()?;
+    gpu.wait().context("ray tracing stopped")?;
     if let Some(bar) = bar {
         bar.finish_and_clear();
     }

@@ -5,6 +5,8 @@
 //! cannot run the passes (wgpu's GL backend renders no `Rgba32Float`) are skipped for one that
 //! can, or refused with what they lack ([`check_adapter`]).
 
+use std::sync::{Arc, Mutex};
+
 use crate::Error;
 use crate::targets;
 
@@ -68,6 +70,9 @@ pub struct Gpu {
     pub adapter: wgpu::Adapter,
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
+    /// Why the device was lost, once it is: set by the device-lost callback [`Gpu::headless`]
+    /// installs (wgpu keeps one callback per device; a host with its own device installs its own).
+    lost: Arc<Mutex<Option<String>>>,
 }
 
 impl Gpu {
@@ -92,7 +97,18 @@ impl Gpu {
         };
         let (device, queue) = pollster::block_on(adapter.request_device(&Self::device_descriptor(&adapter)))
             .map_err(|e| Error::RequestDevice(e.to_string()))?;
-        Ok(Gpu { instance, adapter, device, queue })
+        Ok(Gpu::new(instance, adapter, device, queue))
+    }
+
+    /// A `Gpu` of a device made elsewhere, with lineao's device-lost callback installed on it.
+    pub fn new(instance: wgpu::Instance, adapter: wgpu::Adapter, device: wgpu::Device, queue: wgpu::Queue) -> Gpu {
+        let lost = Arc::new(Mutex::new(None));
+        let reason = lost.clone();
+        device.set_device_lost_callback(move |why, message| {
+            let text = if message.is_empty() { format!("{why:?}") } else { format!("{why:?}: {message}") };
+            *reason.lock().unwrap_or_else(|poisoned| poisoned.into_inner()) = Some(text);
+        });
+        Gpu { instance, adapter, device, queue, lost }
     }
 
     /// What lineao asks of an adapter: its own limits, plus timestamp queries when offered.
@@ -112,8 +128,18 @@ impl Gpu {
         format!("{} ({:?})", info.name, info.backend)
     }
 
-    /// Blocks until the queue is idle.
+    /// Blocks until the queue is idle; [`Error::DeviceLost`] once the device is lost (wgpu then
+    /// drops the work quietly, so a loop of frames checks here to stop).
     pub fn wait(&self) -> Result<(), Error> {
-        self.device.poll(wgpu::PollType::wait_indefinitely()).map(|_| ()).map_err(|e| Error::Gpu(e.to_string()))
+        let polled = self.device.poll(wgpu::PollType::wait_indefinitely());
+        if let Some(why) = self.lost() {
+            return Err(Error::DeviceLost(why));
+        }
+        polled.map(|_| ()).map_err(|e| Error::Gpu(e.to_string()))
+    }
+
+    /// Why the device was lost, if it was (known after the next poll or [`Gpu::wait`]).
+    pub fn lost(&self) -> Option<String> {
+        self.lost.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).clone()
     }
 }

@@ -108,6 +108,10 @@ pub enum Error {
     Unsupported(String),
     #[error("stopped before it finished")]
     Cancelled,
+    /// The device is gone (a driver reset, a removed GPU, `Device::destroy`): what was being
+    /// rendered or accumulated stops; a new device starts again.
+    #[error("the GPU device was lost: {0}")]
+    DeviceLost(String),
     /// A call out of order, or a host texture that does not fit: the text says what to change.
     #[error("wrong use of lineao: {0}")]
     Usage(String),

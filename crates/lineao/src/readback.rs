@@ -87,8 +87,7 @@ pub fn read_texture(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::
             wgpu::Extent3d { width, height: rows, depth_or_array_layers: 1 },
         );
         queue.submit([encoder.finish()]);
-        buffer.slice(..).map_async(wgpu::MapMode::Read, |_| {});
-        device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| Error::Gpu(e.to_string()))?;
+        map_read(device, &buffer)?;
         let mapped = buffer.slice(..).get_mapped_range().map_err(|e| Error::Gpu(e.to_string()))?;
         for r in 0..rows as usize {
             let start = r * padded_row as usize;
@@ -98,6 +97,27 @@ pub fn read_texture(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::
         buffer.unmap();
     }
     Ok(TextureData { width, height, format, bytes })
+}
+
+/// Maps `buffer` for reading and waits for it. A lost device fails the mapping (wgpu reports the
+/// buffer invalid): an error here, not wgpu's panicking default handler.
+fn map_read(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<(), Error> {
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let mapped = std::sync::Arc::new(std::sync::Mutex::new(None));
+    let result = mapped.clone();
+    buffer.slice(..).map_async(wgpu::MapMode::Read, move |r| {
+        *result.lock().unwrap_or_else(|poisoned| poisoned.into_inner()) = Some(r);
+    });
+    let polled = device.poll(wgpu::PollType::wait_indefinitely());
+    if let Some(error) = pollster::block_on(scope.pop()) {
+        return Err(Error::Gpu(format!("reading back: {error}")));
+    }
+    polled.map_err(|e| Error::Gpu(e.to_string()))?;
+    match mapped.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).take() {
+        Some(Ok(())) => Ok(()),
+        Some(Err(e)) => Err(Error::Gpu(format!("reading back: {e}"))),
+        None => Err(Error::Gpu("reading back: the buffer was never mapped".into())),
+    }
 }
 
 /// Copies `buffer` (created with `COPY_SRC`) to the CPU and waits for it.
@@ -112,8 +132,7 @@ pub fn read_buffer(device: &wgpu::Device, queue: &wgpu::Queue, buffer: &wgpu::Bu
         device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::readback") });
     encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
     queue.submit([encoder.finish()]);
-    staging.slice(..).map_async(wgpu::MapMode::Read, |_| {});
-    device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| Error::Gpu(e.to_string()))?;
+    map_read(device, &staging)?;
     let bytes = staging.slice(..).get_mapped_range().map_err(|e| Error::Gpu(e.to_string()))?.to_vec();
     staging.unmap();
     Ok(bytes)

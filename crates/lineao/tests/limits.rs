@@ -39,7 +39,7 @@ fn a_device_with_small_buffers_gets_more_of_them_and_the_same_image() {
     let limits = wgpu::Limits { max_buffer_size: 256 << 10, ..gpu.adapter.limits() };
     let descriptor = wgpu::DeviceDescriptor { required_limits: limits, ..Gpu::device_descriptor(&gpu.adapter) };
     let (device, queue) = pollster::block_on(gpu.adapter.request_device(&descriptor)).unwrap();
-    let small = Gpu { instance: gpu.instance.clone(), adapter: gpu.adapter.clone(), device, queue };
+    let small = Gpu::new(gpu.instance.clone(), gpu.adapter.clone(), device, queue);
 
     let (positions, offsets) = spiral_bundle(100, 200);
     let big = LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap();

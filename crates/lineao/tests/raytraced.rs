@@ -236,3 +236,93 @@ fn a_scene_beyond_six_bindings_is_too_large_and_no_scene_is_no_occlusion() {
     let empty = RayScene::new(&gpu.device, &RayGeometry::default()).unwrap();
     assert!(empty.is_empty());
 }
+
+
+#[test]
+fn a_lost_device_is_an_error_to_stop_on_never_a_panic() {
+    let scene = Scene::lines(20);
+    let mut tracer = Tracer::new(&scene, settings(4), None);
+    tracer.frame(&camera());
+    assert_eq!(tracer.gpu.lost(), None);
+    tracer.gpu.device.destroy();
+    // A frame on the lost device records and submits without a panic (wgpu drops the work) …
+    let (d, q) = (&tracer.gpu.device, &tracer.gpu.queue);
+    tracer.chain.prepare(d, q, &camera(), &tracer.bounds);
+    let mut encoder = d.create_command_encoder(&Default::default());
+    tracer.chain.encode(&mut encoder, &tracer.lines, &tracer.output.view);
+    q.submit([encoder.finish()]);
+    // … and the next wait says the device is gone: what a loop of frames stops on.
+    match tracer.gpu.wait() {
+        Err(lineao::Error::DeviceLost(why)) => assert!(why.contains("Destroyed"), "{why}"),
+        other => panic!("expected DeviceLost, got {other:?}"),
+    }
+    assert!(tracer.gpu.lost().is_some());
+    // Reading back is an error too.
+    assert!(read_f32(d, q, &tracer.chain.targets().unwrap().ao).is_err());
+}
+
+#[test]
+fn the_scene_takes_at_most_32_bytes_per_vertex_on_the_gpu() {
+    // 180 000 vertices of lines (no radii): nodes, references, positions and streamline starts.
+    let gpu = gpu();
+    let (positions, offsets) = common::polylines(3000, 0.3);
+    let geometry = RayGeometry { positions: &positions, offsets: &offsets, ..Default::default() };
+    let scene = RayScene::new(&gpu.device, &geometry).unwrap();
+    // The positions alone are 12 bytes per vertex; the rest is the BVH.
+    let (bytes, per_vertex) = (scene.bytes(), scene.bytes_per_vertex());
+    eprintln!("{} vertices: {bytes} bytes, {per_vertex:.1} bytes per vertex", positions.len());
+    assert_eq!(per_vertex, bytes as f64 / positions.len() as f64);
+    assert!((12.0..=32.0).contains(&per_vertex), "{per_vertex} bytes per vertex");
+}
+
+#[test]
+fn a_host_renderers_depth_traces_like_the_cpu_truth_through_the_embedding_api() {
+    use lineao::passes::nd_from_depth::{HostConfig, HostInputs};
+    // The host's scene: a sphere resting on a ground square, drawn by the host into its depth;
+    // the same triangles are the ray tracer's scene.
+    let gpu = gpu();
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let mut triangles = common::sphere_triangles(Vec3::ZERO, 1.0, 24);
+    let (g, y) = (4.0, -1.0);
+    let ground = [[-g, y, -g], [g, y, -g], [g, y, g], [-g, y, g]];
+    triangles.extend([0, 2, 1, 0, 3, 2].map(|i| ground[i]));
+    let indices: Vec<u32> = (0..triangles.len() as u32).collect();
+    let camera = Camera {
+        eye: Vec3::new(1.0, 2.5, 5.5),
+        target: Vec3::new(0.0, -0.5, 0.0),
+        up: Vec3::Y,
+        projection: Projection::Perspective { fov_y_deg: 45.0 },
+    };
+    let bounds = lineao::Bounds { center: Vec3::ZERO, radius: 6.0 };
+    let view_matrix = camera.view_matrix();
+    let proj = glam::camera::rh::proj::directx::perspective(45f32.to_radians(), 4.0 / 3.0, 0.5, 50.0);
+    let depth = common::host_depth(&gpu, &triangles, proj * view_matrix, SIZE, 1, false);
+    let depth = depth.create_view(&Default::default());
+
+    let mut s = settings(8);
+    s.raytraced.distance_world = 3.0;
+    let mut chain = AoChain::new(d, OUTPUT_FORMAT, s.clone()).unwrap();
+    chain.resize(SIZE.0, SIZE.1).unwrap();
+    chain.enable_host(d, HostConfig::default()).unwrap();
+    let meshes = [(&triangles[..], &indices[..])];
+    let geometry = RayGeometry { meshes: &meshes, ..Default::default() };
+    chain.set_ray_scene(d, Some(Arc::new(RayScene::new(d, &geometry).unwrap())));
+    let view = lineao::FrameView::from_matrices(view_matrix, proj, SIZE.0, SIZE.1, &bounds, 1.0);
+    let inputs = HostInputs { depth: &depth, normals: None, color: None };
+    for _ in 0..2 {
+        chain.prepare_view(d, q, view).unwrap();
+        let mut encoder = d.create_command_encoder(&Default::default());
+        chain.encode_host(d, &mut encoder, &inputs, None).unwrap();
+        q.submit([encoder.finish()]);
+    }
+    assert_eq!(chain.ray_progress().unwrap().rays_per_pixel, 16);
+    let t = chain.targets().unwrap();
+    let (nd, ao) = (read_rgba(d, q, &t.nd[0]).unwrap(), read_f32(d, q, &t.ao).unwrap());
+
+    // The CPU truth over the G-buffer the host path derived, with the same 16 rays.
+    let bvh = Bvh::build(Vec::new(), truth::mesh_triangles(&triangles, &indices));
+    let frame = truth::Frame { nd: &nd, view: chain.frame_view().unwrap(), lines: false };
+    let cancel = std::sync::atomic::AtomicBool::new(false);
+    let cpu = truth::compute(&bvh, &frame, &s.raytraced.truth(16), &|_, _| {}, &cancel).unwrap().ao;
+    assert_same_hits(&nd, &ao, &cpu, 16, "host depth, sphere on a ground");
+}
