@@ -61,8 +61,10 @@ pub struct App {
     busy: Option<String>,
     pub error: Option<String>,
     /// The last view sent to the render thread, and the frame on screen.
-    requested: Option<View>,
+    pub requested: Option<View>,
     pub shown: Option<Box<Frame>>,
+    /// Frames received from the render thread (a progressive picture sends one per frame).
+    pub frames_received: u64,
     textures: Vec<TextureHandle>,
     /// Compare mode: where the divider is, as a fraction of the image's width.
     pub divider: f32,
@@ -101,6 +103,7 @@ impl App {
             error: None,
             requested: None,
             shown: None,
+            frames_received: 0,
             textures: Vec::new(),
             divider: 0.5,
             last_motion: None,
@@ -136,7 +139,14 @@ impl App {
         }
     }
 
-    /// Whether what is on screen is complete: the newest view rendered, or an error shown.
+    /// Whether what is on screen is final: [`App::settled`], and each ray-traced picture has
+    /// all its rays.
+    pub fn complete(&self) -> bool {
+        self.settled() && (self.error.is_some() || self.shown.as_ref().is_some_and(|f| f.converged()))
+    }
+
+    /// Whether the newest view is on screen (a ray-traced picture may still be gaining rays), or
+    /// an error is.
     pub fn settled(&self) -> bool {
         if self.error.is_some() {
             return true;
@@ -179,6 +189,7 @@ impl App {
                 }
                 FromWorker::Frame(frame) if self.loading.is_none() => {
                     self.busy = None;
+                    self.frames_received += 1;
                     let (w, h) = (frame.size.0 as usize, frame.size.1 as usize);
                     self.textures.truncate(frame.images.len());
                     for (i, bytes) in frame.images.iter().enumerate() {
@@ -211,7 +222,7 @@ impl App {
         Some(View {
             size,
             camera: camera.camera(),
-            panels: self.controls.panels(camera.up, field.map(|(_, range)| *range)),
+            panels: self.controls.panels(camera.up, field.map(|(_, range)| *range), self.moving()),
             preview: self.moving() && dataset.vertices > PREVIEW_VERTICES,
             timings: self.controls.timings,
             scalar_field: field.map(|(name, _)| name.clone()),
@@ -317,6 +328,13 @@ impl App {
                 } else if let Some(frame) = &self.shown {
                     let (w, h) = frame.size;
                     ui.label(format!("{w} × {h} px · {:.0} ms (render and read back)", frame.render_ms));
+                    for status in frame.rays.iter().flatten() {
+                        ui.separator();
+                        if !status.progress.converged() {
+                            ui.spinner();
+                        }
+                        ui.label(ray_status(status));
+                    }
                 }
             });
         });
@@ -523,7 +541,7 @@ impl App {
         }
         // --screenshot: once N frames have passed and the image is complete.
         if let Some((path, frames)) = &self.screenshot {
-            if !self.screenshot_requested && self.frames >= u64::from(*frames) && self.settled() {
+            if !self.screenshot_requested && self.frames >= u64::from(*frames) && self.complete() {
                 self.screenshot_requested = true;
                 ctx.send_viewport_cmd(egui::ViewportCommand::Screenshot(egui::UserData::new(path.clone())));
             }
@@ -578,6 +596,19 @@ fn panel_label(panel: &worker::Panel) -> String {
         label += " (authors' code)";
     }
     label
+}
+
+/// What the status bar says of a ray-traced picture: rays per pixel so far and the speed.
+pub fn ray_status(status: &worker::RayStatus) -> String {
+    let p = status.progress;
+    let speed = status.rays_per_second;
+    let speed =
+        if speed >= 1e6 { format!("{:.1} M rays/s", speed / 1e6) } else { format!("{:.0} k rays/s", speed / 1e3) };
+    if p.converged() {
+        format!("ray traced: {} rays per pixel, complete", p.rays_per_pixel)
+    } else {
+        format!("ray traced: {} of {} rays per pixel · {speed}", p.rays_per_pixel, p.max_rays)
+    }
 }
 
 /// Monospace text on a dark rounded box, `align`ed at `anchor`.

@@ -17,9 +17,23 @@ use lineao::{
 use super::worker::Panel;
 use crate::cli::Method;
 
-/// The methods the selector offers, in the order `render --grid` shows them.
-/// The viewer's method list: [`Method::ALL`].
-pub const METHODS: [Method; 9] = Method::ALL;
+/// The methods the selector offers: `render --grid`'s ([`Method::ALL`], in its order), then
+/// the ray-traced truth converging while the view rests.
+pub const METHODS: [Method; 10] = {
+    let mut methods = [RAY_TRACED; 10];
+    let mut i = 0;
+    while i < Method::ALL.len() {
+        methods[i] = Method::ALL[i];
+        i += 1;
+    }
+    methods
+};
+
+/// The GPU ray tracer ([`lineao::passes::raytraced_ao`]), progressive.
+pub const RAY_TRACED: Method = Method { screen: AoMethod::RayTraced, volume: None };
+
+/// What a ray-traced panel shows while the camera moves, by default: LineAO.
+pub const MOVING_DEFAULT: Method = Method::ALL[1];
 
 /// What the method selector calls a method.
 pub fn method_label(method: Method) -> String {
@@ -29,6 +43,7 @@ pub fn method_label(method: Method) -> String {
         (AoMethod::VoLine, None) => "VO line".into(),
         (AoMethod::VoArea, None) => "VO area".into(),
         (AoMethod::Ssao, None) => "Crytek SSAO".into(),
+        (AoMethod::RayTraced, None) => "ray traced (progressive)".into(),
         (AoMethod::None, Some(VolumeMethod::Sweep)) => "occlusion sweep".into(),
         (AoMethod::None, Some(VolumeMethod::VarianceVolume)) => "variance volume".into(),
         (AoMethod::LineAo, Some(VolumeMethod::Sweep)) => "LineAO + sweep".into(),
@@ -92,6 +107,7 @@ impl Params {
         chain.ssao.radius_world *= zoom_unit;
         chain.ssao.range_world *= zoom_unit;
         chain.vo.radius_world *= zoom_unit;
+        chain.raytraced.distance_world *= zoom_unit;
         let mut volume = VolumeAoOptions::default();
         volume.density.occupancy_radius = 0.5 * zoom_unit;
         let mut params =
@@ -133,6 +149,9 @@ pub struct Controls {
     pub timings: bool,
     pub params: Params,
     pub preset: Preset,
+    /// What a ray-traced panel shows while the camera moves (a screen-space method: the rays
+    /// start again once the camera rests).
+    pub moving_method: Method,
 }
 
 impl Controls {
@@ -151,19 +170,26 @@ impl Controls {
             timings: false,
             params: Params::preset(preset, 1.0),
             preset,
+            moving_method: MOVING_DEFAULT,
         }
     }
 
-    /// The data's zoom unit changed (a new file): the parameters take the preset's values in it.
+    /// The data's zoom unit changed (a new file): the parameters take the preset's values in it,
+    /// except the ray counts (`view --rays`), which are no lengths.
     pub fn set_zoom_unit(&mut self, zoom_unit: f32) {
+        let rays = self.params.chain.raytraced.clone();
         self.params = Params::preset(self.preset, zoom_unit);
+        let r = &mut self.params.chain.raytraced;
+        (r.rays_per_frame, r.max_rays) = (rays.rays_per_frame, rays.max_rays);
     }
 
     /// The panels to render: one, or two in compare mode. `up` is the camera's (a cloudy sky
-    /// comes from the world axis nearest to it), `range` the scalar field's colormap range.
-    pub fn panels(&self, up: Vec3, range: Option<[f32; 2]>) -> Vec<Panel> {
+    /// comes from the world axis nearest to it), `range` the scalar field's colormap range;
+    /// while the camera is `moving`, a ray-traced panel shows [`Controls::moving_method`].
+    pub fn panels(&self, up: Vec3, range: Option<[f32; 2]>, moving: bool) -> Vec<Panel> {
         let count = if self.compare { 2 } else { 1 };
-        self.methods[..count].iter().map(|&method| self.panel(method, up, range)).collect()
+        let shown = |method: Method| if moving && method == RAY_TRACED { self.moving_method } else { method };
+        self.methods[..count].iter().map(|&method| self.panel(shown(method), up, range)).collect()
     }
 
     fn panel(&self, method: Method, up: Vec3, range: Option<[f32; 2]>) -> Panel {
@@ -277,6 +303,11 @@ impl Controls {
         }
         if volume {
             egui::CollapsingHeader::new("Object-space AO").default_open(true).show(ui, |ui| volume_ui(ui, p));
+        }
+        if screen(AoMethod::RayTraced) {
+            egui::CollapsingHeader::new("Ray tracing")
+                .default_open(true)
+                .show(ui, |ui| ray_ui(ui, &mut p.chain, &mut self.moving_method));
         }
         let mut blur = p.chain.blur.is_some();
         ui.checkbox(&mut blur, "Bilateral blur");
@@ -436,6 +467,26 @@ fn vo_ui(ui: &mut Ui, chain: &mut ChainSettings) {
     ui.add(egui::Slider::new(&mut vo.thickness_world, 0.0..=10.0 * z).text("thickness (0 = off)"));
 }
 
+fn ray_ui(ui: &mut Ui, chain: &mut ChainSettings, moving: &mut Method) {
+    let (r, z) = (&mut chain.raytraced, chain.zoom_unit);
+    ui.add(egui::Slider::new(&mut r.rays_per_frame, 1..=64).logarithmic(true).text("rays per frame"))
+        .on_hover_text("Rays per pixel each frame adds; fewer keep a slow GPU responsive");
+    ui.add(egui::Slider::new(&mut r.max_rays, 1..=65536).logarithmic(true).text("rays per pixel"))
+        .on_hover_text("The picture is complete after this many rays (the cap)");
+    ui.add(egui::Slider::new(&mut r.distance_world, 0.1 * z..=20.0 * z).logarithmic(true).text("reach"))
+        .on_hover_text("How far a ray looks for an occluder (the ground truth's R)");
+    ui.horizontal(|ui| {
+        ui.label("falloff");
+        ui.selectable_value(&mut r.falloff, lineao::truth::Falloff::None, "binary");
+        ui.selectable_value(&mut r.falloff, lineao::truth::Falloff::Linear, "linear");
+    });
+    egui::ComboBox::from_label("while moving").selected_text(method_label(*moving)).show_ui(ui, |ui| {
+        for m in METHODS.into_iter().filter(|m| m.volume.is_none() && *m != RAY_TRACED) {
+            ui.selectable_value(moving, m, method_label(m));
+        }
+    });
+}
+
 fn volume_ui(ui: &mut Ui, p: &mut Params) {
     let v = &mut p.volume;
     let z = p.chain.zoom_unit;
@@ -481,7 +532,7 @@ mod tests {
                     for geometry in [Geometry::Lines, Geometry::Tubes] {
                         controls.geometry = geometry;
                         controls.debug_view = DebugView::Level(2);
-                        for panel in controls.panels(Vec3::Z, Some([0.0, 1.0])) {
+                        for panel in controls.panels(Vec3::Z, Some([0.0, 1.0]), false) {
                             panel.settings.validate().unwrap_or_else(|e| panic!("{preset:?} {method:?}: {e}"));
                         }
                     }
@@ -491,9 +542,19 @@ mod tests {
     }
 
     #[test]
+    fn a_ray_traced_panel_shows_the_chosen_method_while_the_camera_moves() {
+        let mut controls = Controls::new([RAY_TRACED, METHODS[4]], true, Preset::Calibrated);
+        let method = |panels: Vec<Panel>| panels.iter().map(|p| p.settings.method).collect::<Vec<_>>();
+        assert_eq!(method(controls.panels(Vec3::Z, None, false)), [AoMethod::RayTraced, AoMethod::Ssao]);
+        assert_eq!(method(controls.panels(Vec3::Z, None, true)), [AoMethod::LineAo, AoMethod::Ssao]);
+        controls.moving_method = METHODS[2];
+        assert_eq!(method(controls.panels(Vec3::Z, None, true)), [AoMethod::VoLine, AoMethod::Ssao]);
+    }
+
+    #[test]
     fn the_default_light_is_the_contracts() {
         let controls = Controls::new([METHODS[1]; 2], false, Preset::Dense);
-        let panel = &controls.panels(Vec3::Z, None)[0];
+        let panel = &controls.panels(Vec3::Z, None, false)[0];
         let expected = lineao::lighting::Lighting::default().lights[0].dir.normalize();
         assert!(panel.settings.lighting.lights[0].dir.distance(expected) < 1e-5);
     }

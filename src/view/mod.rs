@@ -52,6 +52,7 @@ fn options(args: &ViewArgs) -> app::Options {
     controls.colormap = args.colormap;
     controls.debug_view = args.debug_view;
     controls.timings = args.timings;
+    controls.params.chain.raytraced.max_rays = args.rays;
     app::Options {
         source,
         controls,

@@ -13,7 +13,7 @@ use lineao::AoMethod;
 use lineao_tracts::SceneKind;
 
 use super::app::{App, Options};
-use super::controls::{Controls, METHODS, Preset};
+use super::controls::{Controls, METHODS, Preset, RAY_TRACED};
 use super::worker::{PREVIEW_VERTICES, Source};
 
 const SIZE: [f32; 2] = [1000.0, 640.0];
@@ -304,4 +304,72 @@ fn keys_orbit_zoom_reset_and_switch_to_orthographic() {
     settle(&mut harness);
     let frame = harness.state().shown.as_ref().unwrap();
     assert!(matches!(frame.view.camera.projection, lineao::camera::Projection::Orthographic { .. }));
+}
+
+#[test]
+fn the_ray_traced_method_accumulates_while_the_camera_rests_and_shows_lineao_while_it_moves() {
+    let mut options = options(scene(SceneKind::Spiral, 30_000), [RAY_TRACED, METHODS[4]], false);
+    options.controls.params.chain.raytraced.max_rays = 12;
+    let mut harness = harness(options);
+    // Frame after frame, 4 more rays per pixel until 12, each on screen as it comes.
+    let (deadline, mut seen) = (Instant::now() + Duration::from_secs(300), Vec::new());
+    harness.step();
+    while !harness.state().complete() {
+        assert!(Instant::now() < deadline, "the picture did not complete in 300 s");
+        std::thread::sleep(Duration::from_millis(5));
+        harness.step();
+        let rays = harness.state().shown.as_ref().and_then(|f| f.rays[0]).map(|r| r.progress.rays_per_pixel);
+        if let Some(rays) = rays.filter(|r| seen.last() != Some(r)) {
+            seen.push(rays);
+        }
+    }
+    harness.step();
+    assert!(harness.state().error.is_none(), "{:?}", harness.state().error);
+    assert_eq!(seen.last(), Some(&12), "{seen:?}");
+    assert!(seen.windows(2).all(|w| w[0] < w[1]) && seen.iter().all(|r| r % 4 == 0), "{seen:?}");
+    harness.get_by_label("ray traced: 12 rays per pixel, complete");
+    // Complete: the render thread stops sending frames.
+    let received = harness.state().frames_received;
+    assert!(received >= 3, "one frame per 4 rays");
+    std::thread::sleep(Duration::from_millis(300));
+    harness.run_steps(3);
+    assert_eq!(harness.state().frames_received, received, "frames after the cap");
+
+    // The picture is the library's: a chain tracing the same scene with the same settings.
+    let frame = harness.state().shown.as_ref().unwrap();
+    let gpu = lineao::Gpu::headless().unwrap();
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let t = SceneKind::Spiral.build(1, 30_000).tractogram;
+    let geometry = lineao::passes::lines::LineGeometry::new(d, q, &t.positions, &t.offsets).unwrap();
+    let rays = lineao::RayGeometry { positions: &t.positions, offsets: &t.offsets, ..Default::default() };
+    let format = wgpu::TextureFormat::Rgba8UnormSrgb;
+    let mut chain = lineao::AoChain::new(d, format, frame.view.panels[0].settings.clone()).unwrap();
+    chain.set_ray_scene(d, Some(std::sync::Arc::new(lineao::RayScene::new(d, &rays).unwrap())));
+    chain.resize(frame.size.0, frame.size.1).unwrap();
+    let target = lineao::targets::Target::output(d, "test", frame.size, format);
+    for _ in 0..3 {
+        chain.prepare(d, q, &frame.view.camera, &geometry.bounds.unwrap());
+        let mut encoder = d.create_command_encoder(&Default::default());
+        chain.encode(&mut encoder, &geometry, &target.view);
+        q.submit([encoder.finish()]);
+    }
+    assert_eq!(chain.ray_progress().unwrap().rays_per_pixel, 12);
+    let direct = lineao::readback::read_texture(d, q, &target.texture).unwrap().bytes;
+    let differing = direct.iter().zip(&frame.images[0]).filter(|(a, b)| a.abs_diff(**b) > 1).count();
+    assert!(differing * 1000 < direct.len(), "{differing} of {} bytes differ", direct.len());
+
+    // While the camera moves: LineAO; at rest the rays start again.
+    let rect = harness.state().image_rect.unwrap();
+    press_at(&mut harness, rect.center());
+    harness.event(Event::PointerMoved(rect.center() + egui::vec2(30.0, 0.0)));
+    harness.step();
+    button(&harness, rect.center() + egui::vec2(30.0, 0.0), false);
+    harness.step();
+    let requested = harness.state().requested.as_ref().unwrap();
+    assert_eq!(requested.panels[0].settings.method, AoMethod::LineAo, "LineAO while moving");
+    std::thread::sleep(Duration::from_millis(400));
+    settle(&mut harness);
+    let frame = harness.state().shown.as_ref().unwrap();
+    assert_eq!(frame.view.panels[0].settings.method, AoMethod::RayTraced, "ray traced at rest");
+    assert!(frame.rays[0].is_some_and(|r| r.progress.rays_per_pixel <= 12));
 }

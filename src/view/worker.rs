@@ -7,14 +7,23 @@
 //! While the camera moves the app asks for *preview* frames: every k-th streamline (at most
 //! [`PREVIEW_VERTICES`] vertices) at half resolution — visibly coarser, and replaced by the full
 //! frame as soon as the camera rests.
+//!
+//! **Progressive frames.** A view with the ray-traced method is a picture that gets better with
+//! each frame: while nothing new is asked, the worker renders the same view again (each frame
+//! adds `rays_per_frame` rays per pixel) and sends every frame, until each ray-traced panel has
+//! its `max_rays`. Any request ends it; the app asks for the view again (restarting the picture)
+//! when the camera or a setting changes. The ray tracer's scene (its BVH) is built once per
+//! dataset, on first use.
 
+use std::sync::Arc;
 use std::sync::mpsc::{Receiver, Sender, TryRecvError};
 
 use lineao::camera::Camera;
 use lineao::passes::lines::{LineGeometry, VertexAttributes};
+use lineao::passes::raytraced_ao::RayProgress;
 use lineao::timing::PassTime;
 use lineao::volume::VolumeAoOptions;
-use lineao::{AoChain, ChainSettings, Gpu, LineColor};
+use lineao::{AoChain, AoMethod, ChainSettings, Gpu, LineColor, RayScene};
 use lineao_tracts::{Tractogram, ViewHint};
 
 pub use crate::source::Source;
@@ -67,7 +76,26 @@ pub struct Frame {
     pub images: Vec<Vec<u8>>,
     pub size: (u32, u32),
     pub times: Vec<Option<Vec<PassTime>>>,
+    /// Per panel: how far its ray-traced picture is (`None`: another method).
+    pub rays: Vec<Option<RayStatus>>,
     pub render_ms: f64,
+}
+
+impl Frame {
+    /// Whether every ray-traced panel has all its rays (other methods are complete at once).
+    pub fn converged(&self) -> bool {
+        self.rays.iter().flatten().all(|r| r.progress.converged())
+    }
+}
+
+/// A ray-traced panel's picture after a frame.
+#[derive(Clone, Copy, Debug)]
+pub struct RayStatus {
+    pub progress: RayProgress,
+    /// Rays traced by the frame (its geometry pixels, guard band included, times the frame's
+    /// rays per pixel) per second of the render thread's wall clock for the panel: recording,
+    /// the GPU's work and reading the image back.
+    pub rays_per_second: f64,
 }
 
 pub enum FromWorker {
@@ -88,6 +116,16 @@ struct Scene {
     /// Full detail, with its attributes and object-space AO.
     lines: Lines,
     preview: Option<Preview>,
+    /// The ray tracer's scene of the full detail, built when a panel first traces rays.
+    rays: Option<Arc<RayScene>>,
+}
+
+/// A panel's chain, the ray scene it was given (its generation) and its geometry pixels.
+struct PanelChain {
+    chain: AoChain,
+    scene: Option<u64>,
+    /// Geometry pixels of the ray-traced picture in progress (counted on its first frame).
+    geometry_pixels: usize,
 }
 
 /// Every k-th streamline: its geometry, and which full-detail vertices it keeps.
@@ -112,11 +150,18 @@ pub fn run(rx: Receiver<ToWorker>, tx: Sender<FromWorker>, repaint: impl Fn() + 
         }
     };
     let mut scene: Option<Scene> = None;
-    let mut chains: Vec<AoChain> = Vec::new();
+    let mut chains: Vec<PanelChain> = Vec::new();
+    // A view whose ray-traced picture is still accumulating: rendered again while nothing new
+    // is asked.
+    let mut continuing: Option<View> = None;
     loop {
-        // The next command, then whatever else is waiting: loads in order, the newest render.
-        let Ok(first) = rx.recv() else { return };
-        let mut pending = vec![first];
+        // The next command (or none, to continue a picture), then whatever else is waiting:
+        // loads in order, the newest render.
+        let mut pending = Vec::new();
+        if continuing.is_none() {
+            let Ok(first) = rx.recv() else { return };
+            pending.push(first);
+        }
         loop {
             match rx.try_recv() {
                 Ok(command) => pending.push(command),
@@ -129,7 +174,12 @@ pub fn run(rx: Receiver<ToWorker>, tx: Sender<FromWorker>, repaint: impl Fn() + 
             pending.iter().rposition(|c| matches!(c, ToWorker::Render(_))).filter(|&r| last_load.is_none_or(|l| r > l));
         if let Some(l) = last_load {
             let ToWorker::Load(source) = &pending[l] else { unreachable!() };
-            scene = None;
+            (scene, continuing) = (None, None);
+            for panel in &mut chains {
+                // The old dataset's BVH is freed now, not when the next one replaces it.
+                panel.chain.set_ray_scene(&gpu.device, None);
+                panel.scene = None;
+            }
             match load(&gpu, source, &send) {
                 Ok((loaded, dataset)) => {
                     scene = Some(loaded);
@@ -138,11 +188,29 @@ pub fn run(rx: Receiver<ToWorker>, tx: Sender<FromWorker>, repaint: impl Fn() + 
                 Err(e) => send(FromWorker::Error(e)),
             }
         }
-        if let (Some(r), Some(scene)) = (render, scene.as_mut()) {
-            let ToWorker::Render(view) = &pending[r] else { unreachable!() };
-            match render_frame(&gpu, scene, &mut chains, view, &send) {
-                Ok(frame) => send(FromWorker::Frame(Box::new(frame))),
+        let view = match render {
+            Some(r) => {
+                let ToWorker::Render(view) = pending.swap_remove(r) else { unreachable!() };
+                Some(view)
+            }
+            None if pending.is_empty() => continuing.take(),
+            None => None,
+        };
+        if let (Some(view), Some(scene)) = (view, scene.as_mut()) {
+            continuing = None;
+            match render_frame(&gpu, scene, &mut chains, &view, &send) {
+                Ok(frame) => {
+                    if !frame.converged() {
+                        continuing = Some(view);
+                    }
+                    send(FromWorker::Frame(Box::new(frame)));
+                }
                 Err(e) => send(FromWorker::Error(e)),
+            }
+            // A lost device ends the picture with its reason, never a panic.
+            if let Some(why) = gpu.lost() {
+                continuing = None;
+                send(FromWorker::Error(format!("the GPU device was lost: {why}")));
             }
         }
     }
@@ -161,7 +229,7 @@ fn load(gpu: &Gpu, source: &Source, send: &dyn Fn(FromWorker)) -> Result<(Scene,
         .collect();
     let (streamlines, vertices) = (lines.geometry.streamlines, lines.geometry.vertices);
     let dataset = Dataset { name: lines.name.clone(), streamlines, vertices, hint: lines.hint, fields };
-    let scene = Scene { lines, preview: None };
+    let scene = Scene { lines, preview: None, rays: None };
     Ok((scene, dataset))
 }
 
@@ -180,7 +248,7 @@ fn subset(tracts: &Tractogram, k: usize) -> (Vec<[f32; 3]>, Vec<u64>, Vec<usize>
 fn render_frame(
     gpu: &Gpu,
     scene: &mut Scene,
-    chains: &mut Vec<AoChain>,
+    chains: &mut Vec<PanelChain>,
     view: &View,
     send: &dyn Fn(FromWorker),
 ) -> Result<Frame, String> {
@@ -197,8 +265,9 @@ fn render_frame(
     let bounds = scene.lines.geometry.bounds.expect("checked at load");
     let format = wgpu::TextureFormat::Rgba8UnormSrgb;
     let target = lineao::targets::Target::output(d, "lineao::view::frame", size, format);
-    let (mut images, mut times) = (Vec::new(), Vec::new());
+    let (mut images, mut times, mut rays) = (Vec::new(), Vec::new(), Vec::new());
     for (i, panel) in view.panels.iter().enumerate() {
+        let panel_start = std::time::Instant::now();
         // The geometry's attributes this panel needs: the scalar's field and object-space AO.
         let wanted = AttributeKey { scalar: view.scalar_field.clone(), radius: None, volume: panel.volume.clone() };
         let busy = || {
@@ -239,12 +308,33 @@ fn render_frame(
         if view.scalar_field.is_none() && matches!(settings.line_color, LineColor::Scalar { .. }) {
             settings.line_color = LineColor::Tangent;
         }
+        let traced = settings.method == AoMethod::RayTraced;
         if chains.len() <= i {
-            chains.push(AoChain::new(d, format, settings.clone()).map_err(|e| e.to_string())?);
-        } else if chains[i].settings() != &settings {
-            chains[i].set_settings(d, settings).map_err(|e| e.to_string())?;
+            let chain = AoChain::new(d, format, settings.clone()).map_err(|e| e.to_string())?;
+            chains.push(PanelChain { chain, scene: None, geometry_pixels: 0 });
+        } else if chains[i].chain.settings() != &settings {
+            chains[i].chain.set_settings(d, settings).map_err(|e| e.to_string())?;
         }
-        let chain = &mut chains[i];
+        if traced {
+            // The ray tracer's scene: the full detail, whatever this frame draws.
+            let rays = match &scene.rays {
+                Some(rays) => rays.clone(),
+                None => {
+                    send(FromWorker::Busy("building the ray tracer's BVH …".into()));
+                    let tracts = &scene.lines.tracts;
+                    let cpu = crate::truth::Scene { tracts, surfaces: &[], radii: None };
+                    let rays = Arc::new(crate::truth::ray_scene(gpu, &cpu).map_err(|e| format!("{e:#}"))?);
+                    scene.rays.insert(rays).clone()
+                }
+            };
+            let panel = &mut chains[i];
+            if panel.scene != Some(rays.generation()) {
+                panel.chain.set_ray_scene(d, Some(rays.clone()));
+                panel.scene = Some(rays.generation());
+            }
+        }
+        let panel = &mut chains[i];
+        let chain = &mut panel.chain;
         if chain.timing() != view.timings {
             chain.set_timing(d, q, view.timings);
         }
@@ -252,6 +342,20 @@ fn render_frame(
         submit_frame(gpu, chain, (geometry, &[]), (&view.camera, &bounds), &target.view);
         times.push(if view.timings { chain.pass_times(d).map_err(|e| e.to_string())? } else { None });
         images.push(lineao::readback::read_texture(d, q, &target.texture).map_err(|e| e.to_string())?.bytes);
+        let progress = if traced { chain.ray_progress() } else { None };
+        rays.push(match progress {
+            Some(progress) => {
+                if progress.rays_per_pixel <= progress.frame_rays || panel.geometry_pixels == 0 {
+                    // A new picture: the pixels its rays start from.
+                    let nd = &chain.targets().expect("rendered").nd[0];
+                    let nd = lineao::verify::read_rgba(d, q, nd).map_err(|e| e.to_string())?;
+                    panel.geometry_pixels = nd.data.iter().filter(|texel| texel[..3] != [0.0; 3]).count();
+                }
+                let rays = panel.geometry_pixels as f64 * progress.frame_rays as f64;
+                Some(RayStatus { progress, rays_per_second: rays / panel_start.elapsed().as_secs_f64() })
+            }
+            None => None,
+        });
     }
-    Ok(Frame { view: view.clone(), images, size, times, render_ms: start.elapsed().as_secs_f64() * 1e3 })
+    Ok(Frame { view: view.clone(), images, size, times, rays, render_ms: start.elapsed().as_secs_f64() * 1e3 })
 }

@@ -161,6 +161,12 @@ impl RayScene {
         self.bytes as f64 / self.vertices.max(1) as f64
     }
 
+    /// A number no other scene of this process has: what tells a renderer holding scenes that
+    /// the geometry changed.
+    pub fn generation(&self) -> u64 {
+        self.generation
+    }
+
     /// The buffers the words are split over.
     pub fn chunk_count(&self) -> usize {
         self.chunks.len()

@@ -237,7 +237,6 @@ fn a_scene_beyond_six_bindings_is_too_large_and_no_scene_is_no_occlusion() {
     assert!(empty.is_empty());
 }
 
-
 #[test]
 fn a_lost_device_is_an_error_to_stop_on_never_a_panic() {
     let scene = Scene::lines(20);
