@@ -177,7 +177,7 @@ impl Passes {
         // `raytraced` continues the picture its first frame started.
         let mut encoder =
             device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::bench") });
-        passes.raytraced.encode(&mut encoder, targets, None);
+        passes.raytraced.encode(&mut encoder, targets, None, None);
         queue.submit([encoder.finish()]);
         passes.raytraced.prepare(queue, targets, view, &one_ray);
         passes.bilateral.resize(device, targets);
@@ -233,8 +233,8 @@ impl Passes {
             }
             "bilateral" => self.bilateral.encode(encoder, targets, span),
             "tubes" => self.tubes.encode(encoder, targets, geometry, Load::Clear(background), span),
-            "raytraced-1spp" => self.raytraced.encode(encoder, targets, span),
-            "raytraced-start-1spp" => self.raytraced_start.encode(encoder, targets, span),
+            "raytraced-1spp" => self.raytraced.encode(encoder, targets, span, None),
+            "raytraced-start-1spp" => self.raytraced_start.encode(encoder, targets, span, None),
             "nd-from-depth" => {
                 let inputs = HostInputs { depth: &targets.depth.view, normals: None, color: None };
                 self.nd_from_depth.encode(&self.device, encoder, targets, &inputs, span);

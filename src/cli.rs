@@ -577,8 +577,13 @@ pub struct RenderArgs {
     #[arg(long, default_value_t = 1)]
     pub ray_seed: u32,
     /// Ray-traced AO: trace on the CPU (the reference, f64, all cores) instead of the GPU.
-    #[arg(long)]
+    /// The reference is shown as traced: `--denoise` and `--bilateral` are the GPU tracer's.
+    #[arg(long, conflicts_with_all = ["bilateral", "denoise"])]
     pub cpu: bool,
+    /// Ray-traced AO on the GPU: the edge-aware denoiser after the rays (same line or surface,
+    /// a window narrowing as 1/√rays; `lineao::passes::ray_denoise`), for low `--rays`.
+    #[arg(long)]
+    pub denoise: bool,
     /// Write the method's inputs and output as .npy files and params.json into this folder.
     #[arg(long)]
     pub dump: Option<PathBuf>,

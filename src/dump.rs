@@ -3,7 +3,8 @@
 //! `noise.npy`, `samples.npy` (LineAO), `ssao_kernel.npy`, `ssao_noise.npy` (SSAO) or
 //! `vo_samples.npy`, `vo_noise.npy` (VO; area sampling adds `moments_<l>.npy`, H_l × W_l × 2),
 //! and `params.json`. `ao.npy` is the method's raw occlusion, before SSAO's blur and before the
-//! bilateral blur.
+//! bilateral blur; with the bilateral blur `ao_blurred.npy` (H × W) is what it made of it, our
+//! extension.
 //!
 //! Object-space AO (our extension of CONTRACT.md) adds `octants.npy` (H × W × 8: the lines'
 //! octant visibilities per pixel, as the `volume_ao` pass reads them), `geometry_term.npy`
@@ -81,6 +82,10 @@ pub fn write(
         _ => &targets.ao,
     };
     write_npy(dir, "ao.npy", &[h, w], &read(&raw.texture)?.to_f32())?;
+    if let (Some(blurred), true) = (&targets.ao_blurred, s.blur.is_some() && s.method != AoMethod::None) {
+        // Our extension of CONTRACT.md: what the bilateral blur (the denoiser) made of `ao.npy`.
+        write_npy(dir, "ao_blurred.npy", &[h, w], &read(&blurred.texture)?.to_f32())?;
+    }
 
     let mut params = json!({
         "method": method,

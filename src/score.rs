@@ -47,6 +47,7 @@ pub fn method_settings(session: &Session, args: &crate::cli::RenderArgs, m: Scor
     let mut settings = session.settings(args, Method { screen: m.method, volume: None });
     settings.line_ao.variant = m.variant;
     settings.blur = None;
+    settings.raytraced.denoise = None;
     settings
 }
 

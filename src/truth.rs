@@ -42,6 +42,7 @@ pub fn gpu_settings(args: &RenderArgs) -> lineao::RayTracedSettings {
         distance_world: args.ao_distance,
         falloff: args.ao_falloff,
         seed: args.ray_seed,
+        denoise: args.denoise.then(lineao::RayDenoiseSettings::default),
     }
 }
 

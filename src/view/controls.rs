@@ -108,6 +108,9 @@ impl Params {
         chain.ssao.range_world *= zoom_unit;
         chain.vo.radius_world *= zoom_unit;
         chain.raytraced.distance_world *= zoom_unit;
+        // Few rays per pixel while the picture builds up: the edge-aware denoiser takes the
+        // error of the first frames to about half (docs/ground-truth.md) and fades out.
+        chain.raytraced.denoise = Some(lineao::RayDenoiseSettings::default());
         let mut volume = VolumeAoOptions::default();
         volume.density.occupancy_radius = 0.5 * zoom_unit;
         let mut params =
@@ -175,12 +178,12 @@ impl Controls {
     }
 
     /// The data's zoom unit changed (a new file): the parameters take the preset's values in it,
-    /// except the ray counts (`view --rays`), which are no lengths.
+    /// except the ray counts (`view --rays`) and the denoiser's switch, which are no lengths.
     pub fn set_zoom_unit(&mut self, zoom_unit: f32) {
         let rays = self.params.chain.raytraced.clone();
         self.params = Params::preset(self.preset, zoom_unit);
         let r = &mut self.params.chain.raytraced;
-        (r.rays_per_frame, r.max_rays) = (rays.rays_per_frame, rays.max_rays);
+        (r.rays_per_frame, r.max_rays, r.denoise) = (rays.rays_per_frame, rays.max_rays, rays.denoise);
     }
 
     /// The panels to render: one, or two in compare mode. `up` is the camera's (a cloudy sky
@@ -480,6 +483,12 @@ fn ray_ui(ui: &mut Ui, chain: &mut ChainSettings, moving: &mut Method) {
         ui.selectable_value(&mut r.falloff, lineao::truth::Falloff::None, "binary");
         ui.selectable_value(&mut r.falloff, lineao::truth::Falloff::Linear, "linear");
     });
+    let mut denoise = r.denoise.is_some();
+    ui.checkbox(&mut denoise, "denoise (edge-aware)")
+        .on_hover_text("Averages each pixel with its neighbours on the same line or surface; fades out as rays add up");
+    if denoise != r.denoise.is_some() {
+        r.denoise = denoise.then(lineao::RayDenoiseSettings::default);
+    }
     egui::ComboBox::from_label("while moving").selected_text(method_label(*moving)).show_ui(ui, |ui| {
         for m in METHODS.into_iter().filter(|m| m.volume.is_none() && *m != RAY_TRACED) {
             ui.selectable_value(moving, m, method_label(m));

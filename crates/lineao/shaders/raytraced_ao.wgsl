@@ -41,6 +41,8 @@ struct Trace {
     triangles_at: u32,
     width: u32,
     height: u32,
+    // 1: tube pixels find their own segment too (the denoiser's "same tube"; rays ignore it).
+    tube_own: u32,
 }
 
 @group(0) @binding(0) var<uniform> trace: Trace;
@@ -548,16 +550,17 @@ fn raytraced_ao(@builtin(global_invocation_id) id: vec3<u32>) {
             // A new picture: the pixel's own segment and whether its origin is buried, found once
             // and kept for the frames that continue it.
             var own = NONE;
-            if trace.lines != 0u {
+            if trace.lines != 0u || trace.tube_own != 0u {
                 // The segment holding p most deeply, within a pixel's footprint of its surface.
                 let footprint = select(depth, 1.0, trace.view.orthographic != 0u) / trace.view.f_px;
                 own = traverse(Query(OWN, p, vec3<f32>(1.0), footprint), Own(NONE, 0u, 0u, vec3<f32>(0.0))).v;
             }
-            let o = origin(p, n, own);
+            let o = origin(p, n, select(NONE, own, trace.lines != 0u));
             let buried = traverse(Query(INSIDE, o.start, vec3<f32>(1.0), 0.0), o.own).t == 0.0;
             state = vec4<u32>(0u, 0u, own, u32(buried));
         }
-        let o = origin(p, n, state.z);
+        // Tubes start at the surface whether or not they know their segment.
+        let o = origin(p, n, select(NONE, state.z, trace.lines != 0u));
         let rays = f32(trace.frame_rays);
         var sum = rays;
         if state.w == 0u {

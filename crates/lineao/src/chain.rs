@@ -30,8 +30,8 @@
 //!
 //! Every pass is labelled and the frame sits in a `lineao` debug group, so GPU debuggers show
 //! the chain by name. With [`AoChain::set_timing`] each pass also records timestamp queries under
-//! the names `lineao bench` uses (CONTRACT.md): `lines`, `nd-pyramid`, `lineao`, `raytraced`, `ssao`,
-//! `ssao-blur`, `vo-line`, `moments`, `vo-area`, `blur`, `volume-ao`, `composite`.
+//! the names `lineao bench` uses (CONTRACT.md): `lines`, `nd-pyramid`, `lineao`, `raytraced`,
+//! `ray-denoise`, `ssao`, `ssao-blur`, `vo-line`, `moments`, `vo-area`, `blur`, `volume-ao`, `composite`.
 
 use std::sync::Arc;
 
@@ -54,11 +54,12 @@ use crate::targets::{FrameTargets, Moments};
 use crate::timing::{PassTime, PassTimer, Span};
 
 /// The spans of a timed frame, in chain order.
-pub const PASS_NAMES: [&str; 12] = [
+pub const PASS_NAMES: [&str; 13] = [
     "lines",
     "nd-pyramid",
     "lineao",
     "raytraced",
+    "ray-denoise",
     "ssao",
     "ssao-blur",
     "vo-line",

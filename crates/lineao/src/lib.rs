@@ -82,8 +82,8 @@ pub use passes::tubes::TubeRenderer;
 pub use ray_scene::{RayGeometry, RayScene};
 pub use settings::{
     AoMethod, BilateralSettings, ChainSettings, Colormap, DebugView, LineAoOuter, LineAoSettings, LineAoVariant,
-    LineColor, Named, Preset, R0, RayTracedSettings, SsaoKernel, SsaoSettings, SurfaceSettings, TubeSettings,
-    VoCombine, VoSettings, VolumeAoSettings,
+    LineColor, Named, Preset, R0, RayDenoiseSettings, RayTracedSettings, SsaoKernel, SsaoSettings, SurfaceSettings,
+    TubeSettings, VoCombine, VoSettings, VolumeAoSettings,
 };
 
 /// Pyramid levels (and so LineAO hemispheres) the shaders can bind.

@@ -585,6 +585,62 @@ pub struct RayTracedSettings {
     pub falloff: crate::truth::Falloff,
     /// Seed of the per-pixel scramble (the CPU truth's `seed`).
     pub seed: u32,
+    /// The edge-aware denoiser ([`crate::passes::ray_denoise`]), or none. Default none: the
+    /// picture as traced (what `lineao score` scores).
+    pub denoise: Option<RayDenoiseSettings>,
+}
+
+/// The ray tracer's edge-aware denoiser: each pixel's mean averaged with its neighbours' on the
+/// same surface, in a window whose Gaussian narrows as 1/√rays, so it smooths the first frames
+/// and fades out as the picture converges.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RayDenoiseSettings {
+    /// Pixels on each side of the window, 1..=8. Default 3.
+    pub radius_px: u32,
+    /// σ of the spatial Gaussian at 4 rays per pixel, in pixels, > 0 (σ = sigma_px · √(4/rays);
+    /// below a quarter pixel the window is the pixel alone). Default 1.5.
+    pub sigma_px: f32,
+    /// Neighbours count with max(n·n', 0)^normal_power, ≥ 0. Default 32.
+    pub normal_power: f32,
+    /// Lines and tubes: neighbours whose own segments are at most this many vertices apart along
+    /// the polyline, ≥ 0. Default 2.
+    pub reach_vertices: u32,
+    /// Meshes: neighbours whose depth differs by at most this share of the pixel's, in (0, 1].
+    /// Default 0.02.
+    pub depth_tolerance: f32,
+}
+
+impl Default for RayDenoiseSettings {
+    fn default() -> Self {
+        RayDenoiseSettings { radius_px: 3, sigma_px: 1.5, normal_power: 32.0, reach_vertices: 2, depth_tolerance: 0.02 }
+    }
+}
+
+impl RayDenoiseSettings {
+    /// 1/(2σ²) of the spatial Gaussian after `rays` rays per pixel, or 0 where σ is below a
+    /// quarter pixel (the pixel alone). Tubes take half the σ: several pixels wide, their
+    /// occlusion changes across their width, which lines a pixel or two wide do not show
+    /// (measured against the truth in docs/ground-truth.md).
+    pub fn spatial(&self, rays: u32, tubes: bool) -> f32 {
+        let sigma = self.sigma_px * (4.0 / rays.max(1) as f32).sqrt() * if tubes { 0.5 } else { 1.0 };
+        if sigma < 0.25 { 0.0 } else { 1.0 / (2.0 * sigma * sigma) }
+    }
+
+    pub fn validate(&self) -> Result<(), crate::Error> {
+        let ok = (1..=8).contains(&self.radius_px)
+            && self.sigma_px.is_finite()
+            && self.sigma_px > 0.0
+            && self.normal_power.is_finite()
+            && self.normal_power >= 0.0
+            && self.depth_tolerance > 0.0
+            && self.depth_tolerance <= 1.0;
+        if ok {
+            return Ok(());
+        }
+        Err(crate::Error::InvalidSettings(format!(
+            "ray denoiser: radius 1..=8 px, σ > 0, normal power ≥ 0 and depth tolerance in (0, 1], got {self:?}"
+        )))
+    }
 }
 
 impl Default for RayTracedSettings {
@@ -596,6 +652,7 @@ impl Default for RayTracedSettings {
             distance_world: truth.distance_world,
             falloff: truth.falloff,
             seed: truth.seed,
+            denoise: None,
         }
     }
 }
@@ -619,6 +676,9 @@ impl RayTracedSettings {
                 "rays per frame and the ray cap must be at least 1, got {} and {}",
                 self.rays_per_frame, self.max_rays
             )));
+        }
+        if let Some(denoise) = &self.denoise {
+            denoise.validate()?;
         }
         self.truth(1).validate()
     }
@@ -659,7 +719,8 @@ pub struct ChainSettings {
     pub ssao: SsaoSettings,
     pub vo: VoSettings,
     pub raytraced: RayTracedSettings,
-    /// The bilateral blur after the method, or none. Default none.
+    /// The bilateral blur after the method, or none. Default none. After the ray tracer it is
+    /// its denoiser for low ray counts (`lineao score` scores the rays undenoised).
     pub blur: Option<BilateralSettings>,
     /// Object-space AO from the geometry's attributes, or none. Default none.
     pub volume: Option<VolumeAoSettings>,
@@ -817,9 +878,6 @@ impl ChainSettings {
     /// Checks every range documented above.
     pub fn validate(&self) -> Result<(), crate::Error> {
         let bad = |what: String| Err(crate::Error::InvalidSettings(what));
-        if self.method == AoMethod::RayTraced && self.blur.is_some() {
-            return bad("the ray-traced truth takes no blur: it is shown as traced".into());
-        }
         // Each method's own settings, then what the chain adds.
         self.line_ao.validate()?;
         self.ssao.validate()?;

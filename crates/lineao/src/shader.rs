@@ -24,6 +24,7 @@ pub const FILES: &[(&str, &str)] = &[
     ("moments.wgsl", include_str!("../shaders/moments.wgsl")),
     ("nd_from_depth.wgsl", include_str!("../shaders/nd_from_depth.wgsl")),
     ("nd_pyramid.wgsl", include_str!("../shaders/nd_pyramid.wgsl")),
+    ("ray_denoise.wgsl", include_str!("../shaders/ray_denoise.wgsl")),
     ("raytraced_ao.wgsl", include_str!("../shaders/raytraced_ao.wgsl")),
     ("ssao.wgsl", include_str!("../shaders/ssao.wgsl")),
     ("ssao_blur.wgsl", include_str!("../shaders/ssao_blur.wgsl")),

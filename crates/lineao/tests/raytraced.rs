@@ -8,7 +8,7 @@ use std::sync::Arc;
 
 use common::{OUTPUT_FORMAT, gpu};
 use glam::Vec3;
-use lineao::camera::{Bounds, Camera, Projection};
+use lineao::camera::{Bounds, Camera, FrameView, Projection};
 use lineao::passes::meshes::MeshGeometry;
 use lineao::reference::{Image, NdImage};
 use lineao::targets::Target;
@@ -324,4 +324,92 @@ fn a_host_renderers_depth_traces_like_the_cpu_truth_through_the_embedding_api() 
     let cancel = std::sync::atomic::AtomicBool::new(false);
     let cpu = truth::compute(&bvh, &frame, &s.raytraced.truth(16), &|_, _| {}, &cancel).unwrap().ao;
     assert_same_hits(&nd, &ao, &cpu, 16, "host depth, sphere on a ground");
+}
+
+/// The denoiser's inputs and output after `frames` frames of a standalone ray-traced pass over
+/// the G-buffer of a chain with no method: the accumulation, `nd[0]`, the denoised `ao`.
+fn denoised_frames(scene: &Scene, s: &ChainSettings, frames: u32) -> (Image<[u32; 4]>, NdImage, Image<f32>, FrameView) {
+    use lineao::passes::raytraced_ao::RayTracedAo;
+    let drawing = ChainSettings { method: AoMethod::None, ..s.clone() };
+    let mut tracer = Tracer::new(scene, drawing, None);
+    tracer.frame(&camera());
+    let (d, q) = (&tracer.gpu.device, &tracer.gpu.queue);
+    let (targets, view) = (tracer.chain.targets().unwrap(), *tracer.chain.frame_view().unwrap());
+    let meshes = scene.meshes();
+    let geometry = RayGeometry {
+        positions: &scene.positions,
+        offsets: &scene.offsets,
+        radii: scene.radii.as_deref(),
+        meshes: &meshes,
+    };
+    let mut pass = RayTracedAo::new(d);
+    pass.set_scene(d, Some(Arc::new(RayScene::new(d, &geometry).unwrap())));
+    pass.resize(d, targets);
+    for _ in 0..frames {
+        pass.prepare(q, targets, &view, s);
+        let mut encoder = d.create_command_encoder(&Default::default());
+        pass.encode(&mut encoder, targets, None, None);
+        q.submit([encoder.finish()]);
+    }
+    let bytes = lineao::readback::read_buffer(d, q, pass.accumulation().unwrap()).unwrap();
+    let (w, h) = (targets.size.0 as usize, targets.size.1 as usize);
+    let accumulation = Image { width: w, height: h, data: bytemuck::cast_slice(&bytes).to_vec() };
+    (accumulation, read_rgba(d, q, &targets.nd[0]).unwrap(), read_f32(d, q, &targets.ao).unwrap(), view)
+}
+
+#[test]
+fn the_denoiser_matches_its_cpu_reference_on_lines_and_tubes() {
+    use lineao::reference::{ViewParams, ray_denoise};
+    for tubes in [false, true] {
+        let scene = Scene::lines(60);
+        let mut s = settings(4);
+        s.tubes = tubes.then_some(lineao::TubeSettings { radius_world: 1.0 });
+        let denoise = lineao::RayDenoiseSettings::default();
+        s.raytraced.denoise = Some(denoise.clone());
+        let (accumulation, nd, gpu, view) = denoised_frames(&scene, &s, 2);
+        let cpu = ray_denoise(&accumulation, &nd, &ViewParams::of(&view), &denoise, (8, tubes));
+        let (mut worst, mut changed, mut geometry, mut own) = (0.0f32, 0usize, 0usize, 0usize);
+        for ((g, c), (a, texel)) in gpu.data.iter().zip(&cpu.data).zip(accumulation.data.iter().zip(&nd.data)) {
+            worst = worst.max((g - c).abs());
+            if common::is_geometry(*texel) {
+                geometry += 1;
+                own += (a[2] != u32::MAX) as usize;
+                changed += ((g - f32::from_bits(a[0]) / f32::from_bits(a[1])).abs() > 1e-3) as usize;
+            }
+        }
+        let what = if tubes { "tubes" } else { "lines" };
+        eprintln!(
+            "{what}: {geometry} pixels ({own} with a segment), {changed} denoised, worst |GPU − CPU| {worst:.2e}"
+        );
+        // exp and pow on the GPU against Rust's: a few ulps of weights summed over 49 taps.
+        assert!(worst < 1e-4, "{what}: {worst}");
+        assert!(changed * 3 > geometry, "{what}: the denoiser changed only {changed} of {geometry} pixels");
+        assert!(own * 100 > geometry * 99, "{what}: own segments on {own} of {geometry} pixels");
+    }
+}
+
+#[test]
+fn the_denoiser_brings_few_rays_closer_to_the_truth_and_fades_out() {
+    let scene = Scene::lines(60);
+    let mut s = settings(4);
+    s.raytraced.denoise = Some(lineao::RayDenoiseSettings::default());
+    let (accumulation, nd, denoised, _) = denoised_frames(&scene, &s, 1);
+    // The truth with 16 times the rays (rays 0..64, the first 4 of them the frame's).
+    let mut tracer = Tracer::new(&scene, settings(4), None);
+    let (nd_truth, _) = tracer.frame(&camera());
+    assert_eq!(nd_truth.data, nd.data, "the same G-buffer");
+    let truth = cpu_truth(&tracer, &scene, &nd, 64);
+    let rmse = |ao: &dyn Fn(usize) -> f32| {
+        let geometry: Vec<usize> = (0..nd.data.len()).filter(|&i| common::is_geometry(nd.data[i])).collect();
+        let sum: f64 = geometry.iter().map(|&i| ((ao(i) - truth.data[i]) as f64).powi(2)).sum();
+        (sum / geometry.len() as f64).sqrt()
+    };
+    let raw = rmse(&|i| f32::from_bits(accumulation.data[i][0]) / f32::from_bits(accumulation.data[i][1]));
+    let smooth = rmse(&|i| denoised.data[i]);
+    eprintln!("4 rays against 64: RMSE {raw:.4} as traced, {smooth:.4} denoised");
+    assert!(smooth < 0.8 * raw, "{smooth} vs {raw}");
+    // σ narrows as 1/√rays: past 4 · (σ/0.25)² rays per pixel the window is the pixel alone.
+    let d = lineao::RayDenoiseSettings::default();
+    assert!(d.spatial(4, false) > 0.0 && d.spatial(64, false) > 0.0);
+    assert_eq!(d.spatial(145, false), 0.0);
 }

@@ -10,6 +10,7 @@ pub mod meshes;
 pub mod moments;
 pub mod nd_from_depth;
 pub mod nd_pyramid;
+pub mod ray_denoise;
 pub mod raytraced_ao;
 pub mod ssao;
 pub mod ssao_blur;

@@ -14,6 +14,9 @@
 //! After `max_rays` rays a pixel is converged: the pass then only copies the sums into `ao`.
 //! [`RayTracedAo::progress`] says how far it is.
 //!
+//! **Denoiser.** With `RayTracedSettings::denoise` each frame ends with the edge-aware
+//! denoiser ([`crate::passes::ray_denoise`]) writing `ao` from the accumulation.
+//!
 //! **Scene.** The rays need the geometry itself, not only the G-buffer: a [`RayScene`] uploaded
 //! once per geometry ([`crate::AoChain::set_ray_scene`]). Without one there is nothing to hit
 //! and `ao` is 0.
@@ -23,6 +26,7 @@ use std::sync::{Arc, Mutex};
 use crate::binding::{self, Slot};
 use crate::camera::FrameView;
 use crate::passes::dispatch_full_screen;
+use crate::passes::ray_denoise::RayDenoise;
 use crate::ray_scene::{MAX_CHUNKS, RayScene};
 use crate::settings::{AoMethod, ChainSettings};
 use crate::targets::{AO_FORMAT, FrameTargets};
@@ -59,7 +63,8 @@ struct TraceUniform {
     triangles_at: u32,
     width: u32,
     height: u32,
-    _pad: [u32; 2],
+    tube_own: u32,
+    _pad: u32,
 }
 
 /// How far the accumulation has come.
@@ -94,6 +99,8 @@ impl Key {
         bits.extend([view.width, view.height, view.guard, view.near.to_bits(), view.far.to_bits()]);
         bits.extend([targets.size.0, targets.size.1]);
         bits.extend([r.rays_per_frame, r.distance_world.to_bits(), (r.falloff == Falloff::Linear) as u32, r.seed]);
+        // With the denoiser tube pixels find their own segment on the first frame.
+        bits.push(r.denoise.is_some() as u32);
         bits.push(settings.line_width_px.to_bits());
         bits.push(settings.tubes.as_ref().map_or(0, |t| t.radius_world.to_bits()));
         let generation = scene.map_or(0, |s| s.generation);
@@ -110,6 +117,8 @@ struct Progress {
     /// Rays the prepared frame traces.
     frame_rays: u32,
     max_rays: u32,
+    /// Whether the prepared frame ends with the denoiser.
+    denoise: bool,
 }
 
 pub struct RayTracedAo {
@@ -120,6 +129,7 @@ pub struct RayTracedAo {
     scene: Option<Arc<RayScene>>,
     accumulation: Option<wgpu::Buffer>,
     group: Option<wgpu::BindGroup>,
+    denoise: RayDenoise,
     progress: Mutex<Progress>,
 }
 
@@ -140,6 +150,7 @@ impl RayTracedAo {
             scene: None,
             accumulation: None,
             group: None,
+            denoise: RayDenoise::new(device),
             progress: Mutex::new(Progress::default()),
         }
     }
@@ -165,7 +176,8 @@ impl RayTracedAo {
         let accumulation = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("lineao::RayTracedAo::accumulation"),
             size: (w as u64 * h as u64 * ACCUMULATION_BYTES).max(ACCUMULATION_BYTES),
-            usage: wgpu::BufferUsages::STORAGE,
+            // Copied out by tests of the denoiser against its CPU reference.
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
         self.group = self.scene.as_ref().map(|scene| {
@@ -180,6 +192,7 @@ impl RayTracedAo {
                 .extend((0..MAX_CHUNKS).map(|i| scene.chunks.get(i).unwrap_or(&scene.chunks[0]).as_entire_binding()));
             binding::group(device, LABEL, &self.layout, &resources)
         });
+        self.denoise.resize(device, targets, &accumulation);
         self.accumulation = Some(accumulation);
         // A new buffer holds nothing yet.
         self.progress.lock().expect("the progress lock").key = Key::default();
@@ -195,6 +208,11 @@ impl RayTracedAo {
         }
         progress.max_rays = r.max_rays;
         progress.frame_rays = r.rays_per_frame.min(r.max_rays.saturating_sub(progress.traced));
+        progress.denoise = r.denoise.is_some();
+        if let Some(denoise) = &r.denoise {
+            let rays = progress.traced + progress.frame_rays;
+            self.denoise.prepare(queue, targets, view, denoise, (rays, settings.tubes.is_some()));
+        }
         let Some(scene) = &self.scene else { return };
         let regions = scene.regions;
         let inv_view = view.view.inverse();
@@ -226,18 +244,35 @@ impl RayTracedAo {
             triangles_at: regions.triangles,
             width: targets.size.0,
             height: targets.size.1,
-            _pad: [0; 2],
+            tube_own: (r.denoise.is_some() && settings.tubes.is_some()) as u32,
+            _pad: 0,
         };
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
     }
 
-    /// Records the frame's rays (or, once converged, only the copy into `ao`), timed into `span`.
-    /// One `encode` per `prepare`: the next `prepare` continues after these rays.
-    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, targets: &FrameTargets, span: Option<Span>) {
+    /// Records the frame's rays (or, once converged, only the copy into `ao`), timed into `span`,
+    /// and the denoiser when the settings have one, timed into `denoise_span`. One `encode` per
+    /// `prepare`: the next `prepare` continues after these rays.
+    pub fn encode<'t>(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &FrameTargets,
+        span: Option<Span<'t>>,
+        denoise_span: Option<Span<'t>>,
+    ) {
         let Some(group) = &self.group else { return };
         dispatch_full_screen(encoder, LABEL, &self.pipeline.1, group, targets.size, span);
         let mut progress = self.progress.lock().expect("the progress lock");
         progress.traced += progress.frame_rays;
+        if progress.denoise {
+            self.denoise.encode(encoder, targets, denoise_span);
+        }
+    }
+
+    /// The accumulation (16 bytes per pixel: the sum and the rays as f32 bits, the own segment,
+    /// the buried flag), once sized.
+    pub fn accumulation(&self) -> Option<&wgpu::Buffer> {
+        self.accumulation.as_ref()
     }
 
     /// How far the picture has come: rays per pixel so far, after the last recorded frame.
@@ -257,8 +292,8 @@ impl crate::stage::Stage for RayTracedAo {
         crate::stage::Reach::Pixels { radius_px: 0.0, levels: 1 }
     }
 
-    fn spans(&self, _: &ChainSettings) -> &'static [&'static str] {
-        &["raytraced"]
+    fn spans(&self, settings: &ChainSettings) -> &'static [&'static str] {
+        if settings.raytraced.denoise.is_some() { &["raytraced", "ray-denoise"] } else { &["raytraced"] }
     }
 
     fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets) {
@@ -286,6 +321,6 @@ impl crate::stage::Stage for RayTracedAo {
         targets: &FrameTargets,
         span: &dyn Fn(&'static str) -> Option<Span<'t>>,
     ) {
-        RayTracedAo::encode(self, encoder, targets, span("raytraced"));
+        RayTracedAo::encode(self, encoder, targets, span("raytraced"), span("ray-denoise"));
     }
 }

@@ -7,6 +7,7 @@
 
 mod bilateral;
 mod line_ao;
+mod ray_denoise;
 mod ssao;
 pub mod tubes;
 mod vo_area;
@@ -18,6 +19,7 @@ pub use line_ao::{
     LineAoParams, OUTER_DEPTH_TOLERANCE, delta, depth_weight, hermite, light_weight, line_ao, line_ao_pixel,
     representative_pixel, upsample_outer, whole_exponent, whole_pow,
 };
+pub use ray_denoise::ray_denoise;
 pub use ssao::{SSAO_EPSILON, SsaoParams, ViewParams, ssao, ssao_blur, ssao_pixel};
 pub use vo_area::{MomentsImage, moments_pyramid, moments_trilinear, vo_area, vo_sigma_floor};
 pub use vo_line::{
