@@ -26,7 +26,9 @@
 //!   per geometry pixel (binary AO to 2 mm): what each progressive frame costs per ray, against
 //!   `lineao-chain`; the table adds rays per second;
 //! - `raytraced-start-1spp`: a picture's first frame, which also finds each pixel's own segment
-//!   and tests its origin for being buried (kept for the frames after it).
+//!   and tests its origin for being buried (kept for the frames after it);
+//! - `ray-denoise`: the ray tracer's edge-aware denoiser (7 × 7 window) over that picture's
+//!   accumulation, against `raytraced-1spp`.
 //!
 //! The object-space passes run on the CPU (`"on": "cpu"`), `--frames` times up to 3 (each takes
 //! seconds) without warm-up, on the scene's streamlines:
@@ -54,6 +56,7 @@ use lineao::passes::line_ao::{Evaluation, LineAo};
 use lineao::passes::lines::{GeometryOptions, LineGeometry, LineRenderer, LineStyle};
 use lineao::passes::nd_from_depth::{HostConfig, HostInputs, NdFromDepth};
 use lineao::passes::nd_pyramid::NdPyramid;
+use lineao::passes::ray_denoise::RayDenoise;
 use lineao::passes::raytraced_ao::RayTracedAo;
 use lineao::passes::ssao::Ssao;
 use lineao::passes::ssao_blur::SsaoBlur;
@@ -66,7 +69,10 @@ use lineao::volume::density::{DensityOptions, voxelize};
 use lineao::volume::sweep::{self, SweepSettings};
 use lineao::volume::variance::{VarianceMaps, VarianceSettings};
 use lineao::volume::vertex_tangents;
-use lineao::{AoChain, BilateralSettings, ChainSettings, Gpu, LineAoOuter, LineAoSettings, SsaoSettings, VoSettings};
+use lineao::{
+    AoChain, BilateralSettings, ChainSettings, Gpu, LineAoOuter, LineAoSettings, RayDenoiseSettings, SsaoSettings,
+    VoSettings,
+};
 use serde_json::json;
 
 use crate::cli::{BenchArgs, GPU_PASSES};
@@ -99,6 +105,8 @@ struct Passes {
     /// One ray per pixel: every frame ray 1 of a picture, or ray 0 (prepared once).
     raytraced: RayTracedAo,
     raytraced_start: RayTracedAo,
+    /// Over `raytraced`'s accumulation, at 4 rays per pixel (its window at full width).
+    ray_denoise: RayDenoise,
     device: wgpu::Device,
     output: Target,
 }
@@ -134,6 +142,7 @@ impl Passes {
             nd_from_depth: NdFromDepth::new(device, HostConfig::default()),
             raytraced: RayTracedAo::new(device),
             raytraced_start: RayTracedAo::new(device),
+            ray_denoise: RayDenoise::new(device),
             device: device.clone(),
             output: Target::output(device, "lineao::bench::output", (view.width, view.height), format),
         };
@@ -180,6 +189,9 @@ impl Passes {
         passes.raytraced.encode(&mut encoder, targets, None, None);
         queue.submit([encoder.finish()]);
         passes.raytraced.prepare(queue, targets, view, &one_ray);
+        let accumulation = passes.raytraced.accumulation().expect("sized above");
+        passes.ray_denoise.resize(device, targets, accumulation);
+        passes.ray_denoise.prepare(queue, targets, view, &RayDenoiseSettings::default(), (4, false));
         passes.bilateral.resize(device, targets);
         passes.bilateral.prepare(queue, view, &BilateralSettings::default());
         passes.composite.resize(device, targets, &targets.ao);
@@ -235,6 +247,7 @@ impl Passes {
             "tubes" => self.tubes.encode(encoder, targets, geometry, Load::Clear(background), span),
             "raytraced-1spp" => self.raytraced.encode(encoder, targets, span, None),
             "raytraced-start-1spp" => self.raytraced_start.encode(encoder, targets, span, None),
+            "ray-denoise" => self.ray_denoise.encode(encoder, targets, span),
             "nd-from-depth" => {
                 let inputs = HostInputs { depth: &targets.depth.view, normals: None, color: None };
                 self.nd_from_depth.encode(&self.device, encoder, targets, &inputs, span);
@@ -528,6 +541,7 @@ fn print_table(report: &serde_json::Value, passes: &[serde_json::Value]) {
         ("vo-area-1", "ssao-12"),
         ("raytraced-1spp", "lineao-chain"),
         ("raytraced-start-1spp", "lineao-chain"),
+        ("ray-denoise", "raytraced-1spp"),
     ] {
         if let (Some(x), Some(y)) = (median(a), median(b)) {
             println!("{a} / {b}: {:.2}x", x / y);

@@ -649,7 +649,7 @@ fn named<T: Named>() -> impl clap::builder::TypedValueParser<Value = T> {
 // The passes `lineao bench --passes` names (its vocabulary, so the CLI needs nothing of the
 // bench itself).
 /// The GPU passes of one run, in CONTRACT.md's order.
-pub const GPU_PASSES: [&str; 19] = [
+pub const GPU_PASSES: [&str; 20] = [
     "lines",
     "lines-native-1px",
     "lines-full-strip",
@@ -669,6 +669,7 @@ pub const GPU_PASSES: [&str; 19] = [
     "nd-from-depth",
     "raytraced-1spp",
     "raytraced-start-1spp",
+    "ray-denoise",
 ];
 
 /// The CPU passes, after the GPU's.

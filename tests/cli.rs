@@ -282,6 +282,7 @@ fn bench_json_is_the_contract() {
             "nd-from-depth",
             "raytraced-1spp",
             "raytraced-start-1spp",
+            "ray-denoise",
             "density-256",
             "sweep-256",
             "variance-volume-256",
