@@ -248,9 +248,10 @@ pub fn write(
     Ok(())
 }
 
-/// The ray-traced truth's part of a dump (method `raytraced`; `ao.npy` holds its AO already):
-/// `ao_stderr.npy` and the `params.json` keys `rays`, `ao_distance_world`, `ao_falloff`,
-/// `ray_seed`, and our `buried_share` and `ray_epsilon_world`.
+/// The ray-traced truth's part of a dump (method `raytraced`, traced on the CPU or the GPU;
+/// `ao.npy` holds its AO already, denoised with `--denoise`): `ao_stderr.npy` (the rays' mean's
+/// standard error, before any denoising) and the `params.json` keys `rays`, `ao_distance_world`,
+/// `ao_falloff`, `ray_seed`, and our `buried_share` and `ray_epsilon_world`.
 pub fn write_truth(dir: &Path, truth: &lineao::truth::Truth, settings: &lineao::truth::TruthSettings) -> Result<()> {
     let (w, h) = (truth.stderr.width as u64, truth.stderr.height as u64);
     write_npy(dir, "ao_stderr.npy", &[h, w], &truth.stderr.data)?;

@@ -432,6 +432,9 @@ impl Session {
             chain.encode_composite(&mut encoder, &target.view);
             gpu.queue.submit([encoder.finish()]);
             Some(truth)
+        } else if gpu_rays && dump.is_some() {
+            // The dump's truth keys and standard error, from the GPU's accumulation.
+            Some(crate::truth::from_gpu(gpu, &chain)?)
         } else {
             None
         };

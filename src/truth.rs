@@ -7,6 +7,7 @@ use std::sync::OnceLock;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::{Context, Result};
+use lineao::reference::Image;
 use lineao::truth::{Bvh, LineShape, Truth, TruthSettings};
 use lineao::{AoChain, Gpu};
 use lineao_tracts::{Tractogram, TriangleMesh};
@@ -117,6 +118,35 @@ pub fn accumulate(gpu: &Gpu, chain: &mut AoChain, mut frame: impl FnMut(&mut AoC
         start.elapsed().as_secs_f64()
     );
     Ok(())
+}
+
+/// The GPU ray tracer's picture in `chain` as the truth's record: the mean, its standard error
+/// from the sums of the rays' values and of their squares (as the CPU truth computes it), the
+/// geometry and buried pixels. What `--dump` writes of a GPU-traced truth.
+pub fn from_gpu(gpu: &Gpu, chain: &AoChain) -> Result<Truth> {
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let progress = chain.ray_progress().context("the ray-traced method is not active")?;
+    let accumulation = chain.ray_accumulation().context("nothing was traced")?;
+    let targets = chain.targets().context("nothing was rendered")?;
+    let nd = lineao::verify::read_rgba(d, q, &targets.nd[0])?;
+    let words: Vec<[u32; 4]> = bytemuck::cast_slice(&lineao::readback::read_buffer(d, q, accumulation)?).to_vec();
+    let n = progress.rays_per_pixel as f64;
+    let (mut ao, mut stderr) = (Image::filled(nd.width, nd.height, 0.0), Image::filled(nd.width, nd.height, 0.0));
+    let (mut geometry_pixels, mut buried) = (0, 0);
+    for (i, (texel, w)) in nd.data.iter().zip(&words).enumerate() {
+        if texel[..3] == [0.0; 3] || n == 0.0 {
+            continue;
+        }
+        geometry_pixels += 1;
+        buried += (w[3] != 0) as usize;
+        let (sum, squares) = (f32::from_bits(w[0]) as f64, f32::from_bits(w[1]) as f64);
+        let mean = sum / n;
+        let variance = if n > 1.0 { ((squares - n * mean * mean) / (n - 1.0)).max(0.0) } else { 0.0 };
+        ao.data[i] = mean as f32;
+        stderr.data[i] = (variance / n).sqrt() as f32;
+    }
+    let rays = geometry_pixels as u64 * progress.rays_per_pixel as u64;
+    Ok(Truth { ao, stderr, vo: None, geometry_pixels, buried, rays })
 }
 
 /// Set by Ctrl-C while a truth runs.

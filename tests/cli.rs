@@ -680,9 +680,6 @@ fn lone_line(cpu: bool) {
     assert!(geometry > 200, "{geometry} line pixels");
     let worst = ao.iter().cloned().fold(0.0f32, f32::max);
     assert_eq!(worst, 0.0, "a lone line occludes itself");
-    if !cpu {
-        return;
-    }
     let params: Value = serde_json::from_str(&std::fs::read_to_string(dump.join("params.json")).unwrap()).unwrap();
     assert_eq!(params["method"], "raytraced");
     assert_eq!(params["rays"], 64);
@@ -691,6 +688,40 @@ fn lone_line(cpu: bool) {
     assert_eq!(params["ray_seed"], 1);
     assert_eq!(params["buried_share"], 0.0);
     assert!(dump.join("ao_stderr.npy").exists());
+}
+
+/// The truth's dump traced on the GPU equals the CPU's: the same rays give the same AO and the
+/// same standard error per pixel, and the same keys.
+#[test]
+fn the_gpu_dump_of_the_truth_is_the_cpu_dump() {
+    let dir = scratch("truth_dumps");
+    let dump = |cpu: bool| {
+        let to = dir.join(if cpu { "cpu" } else { "gpu" });
+        let mut args = vec!["render", "--vertices", "20000", "--method", "raytraced", "--rays", "12"];
+        args.extend(["--width", "160", "--height", "128", "--ao-falloff", "linear"]);
+        let png = dir.join("x.png");
+        args.extend(["-o", png.to_str().unwrap(), "--dump", to.to_str().unwrap()]);
+        if cpu {
+            args.push("--cpu");
+        }
+        let out = lineao(&args);
+        assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+        let params: Value = serde_json::from_str(&std::fs::read_to_string(to.join("params.json")).unwrap()).unwrap();
+        (read_npy(&to.join("ao.npy")).1, read_npy(&to.join("ao_stderr.npy")).1, params)
+    };
+    let ((gpu_ao, gpu_err, gpu), (cpu_ao, cpu_err, cpu)) = (dump(false), dump(true));
+    for key in ["rays", "ao_distance_world", "ao_falloff", "ray_seed", "ray_epsilon_world", "guard_px"] {
+        assert_eq!(gpu[key], cpu[key], "{key}");
+    }
+    let (gpu_buried, cpu_buried) = (gpu["buried_share"].as_f64().unwrap(), cpu["buried_share"].as_f64().unwrap());
+    assert!((gpu_buried - cpu_buried).abs() < 1e-3, "{gpu_buried} vs {cpu_buried}");
+    // Linear falloff: each ray adds 1 − t/R, f32 against f64 (the GPU tests' tolerance).
+    let close = |a: &[f32], b: &[f32]| a.iter().zip(b).filter(|(x, y)| (*x - *y).abs() < 1e-3).count();
+    let (pixels, occluded) = (gpu_ao.len(), cpu_ao.iter().filter(|&&v| v > 0.0).count());
+    assert!(occluded > 1000, "{occluded} occluded pixels");
+    assert!(close(&gpu_ao, &cpu_ao) * 1000 >= pixels * 999, "AO");
+    assert!(close(&gpu_err, &cpu_err) * 1000 >= pixels * 999, "standard error");
+    assert!(cpu_err.iter().any(|&e| e > 0.01), "a standard error to compare");
 }
 
 /// `score` on a built-in scene: the truth traced again with another seed agrees with the truth

@@ -1,5 +1,5 @@
 // The ray tracer's edge-aware denoiser (`lineao::passes::ray_denoise`): each geometry pixel's
-// running mean sum/rays averaged with its neighbours' in a (2r + 1)² window that see the same
+// running mean sum/rays (every pixel of a picture has traced `rays`) averaged with its neighbours' in a (2r + 1)² window that see the same
 // surface — the same stretch of the same line (own segments at most `reach` vertices apart),
 // or for surfaces and tubes a depth within `depth_tolerance` of the pixel's — weighted by
 // exp(−|Δ|² · spatial) · max(n·n', 0)^normal_power. `spatial` = 1/(2σ²), σ shrinking as
@@ -17,13 +17,13 @@ struct Denoise {
     reach: u32,
     width: u32,
     height: u32,
-    _pad: u32,
+    rays: u32,
 }
 
 @group(0) @binding(0) var<uniform> params: Denoise;
 @group(0) @binding(1) var nd0: texture_2d<f32>;
 @group(0) @binding(2) var ao_out: texture_storage_2d<r32float, write>;
-// The ray tracer's (sum, rays, own segment, buried) per pixel, as bits.
+// The ray tracer's (sum, sum of squares, own segment, buried) per pixel, as bits.
 @group(0) @binding(3) var<storage, read> accumulation: array<vec4<u32>>;
 
 const NONE: u32 = 0xffffffffu;
@@ -37,7 +37,7 @@ fn ray_denoise(@builtin(global_invocation_id) id: vec3<u32>) {
     }
     let here = textureLoad(nd0, pixel, 0);
     let centre = accumulation[u32(pixel.y) * params.width + u32(pixel.x)];
-    if nd_is_background(here) || centre.y == 0u {
+    if nd_is_background(here) || params.rays == 0u {
         textureStore(ao_out, pixel, vec4<f32>(0.0));
         return;
     }
@@ -58,7 +58,7 @@ fn ray_denoise(@builtin(global_invocation_id) id: vec3<u32>) {
             }
             let nd = textureLoad(nd0, q, 0);
             let s = accumulation[u32(q.y) * params.width + u32(q.x)];
-            if nd_is_background(nd) || s.y == 0u {
+            if nd_is_background(nd) {
                 continue;
             }
             var same: bool;
@@ -72,7 +72,7 @@ fn ray_denoise(@builtin(global_invocation_id) id: vec3<u32>) {
             }
             let facing = max(dot(n, normalize(nd.xyz)), 0.0);
             let w = exp(-f32(dx * dx + dy * dy) * params.spatial) * pow(facing, params.normal_power);
-            sum += w * (bitcast<f32>(s.x) / bitcast<f32>(s.y));
+            sum += w * (bitcast<f32>(s.x) / f32(params.rays));
             weight += w;
         }
     }

@@ -1,8 +1,9 @@
 // Ray-traced ambient occlusion, progressive: per geometry pixel `frame_rays` cosine-weighted
 // rays from the CPU truth's scrambled Sobol' sequence (rays first_ray .. first_ray + frame_rays),
 // traced through the scene's BVH (`lineao::ray_scene`) against rounded cones and triangles, and
-// added to the pixel's running (sum, rays); `ao` = sum / rays. The origin, its own segment, the
-// buried test and both falloffs are `lineao::truth`'s, step by step, in f32 relative to the ray's
+// added to the pixel's running sums of the rays' values and of their squares; `ao` = sum / rays,
+// every geometry pixel of a picture having traced first_ray + frame_rays rays. The origin, its
+// own segment, the buried test and both falloffs are `lineao::truth`'s, step by step, in f32 relative to the ray's
 // origin (the CPU truth is f64). The own segment and the buried test are found on a picture's
 // first frame and kept for the frames that continue it.
 #import shared/nd.wgsl
@@ -48,8 +49,8 @@ struct Trace {
 @group(0) @binding(0) var<uniform> trace: Trace;
 @group(0) @binding(1) var nd0: texture_2d<f32>;
 @group(0) @binding(2) var ao_out: texture_storage_2d<r32float, write>;
-// Per pixel of the guard-banded frame: the sum of ray values and the rays (f32 bits), the own
-// segment's first vertex (NONE for none) and whether the origin is buried.
+// Per pixel of the guard-banded frame: the sums of the rays' values and of their squares (f32
+// bits), the own segment's first vertex (NONE for none) and whether the origin is buried.
 @group(0) @binding(3) var<storage, read_write> accumulation: array<vec4<u32>>;
 @group(0) @binding(4) var<storage, read> scene0: array<u32>;
 @group(0) @binding(5) var<storage, read> scene1: array<u32>;
@@ -539,7 +540,7 @@ fn raytraced_ao(@builtin(global_invocation_id) id: vec3<u32>) {
         textureStore(ao_out, vec2<i32>(pixel), vec4<f32>(0.0));
         return;
     }
-    // (sum, rays, own segment, buried) as bits.
+    // (sum, sum of squares, own segment, buried) as bits.
     var state = accumulation[index];
     if trace.frame_rays > 0u {
         // The pixel's world position and normal.
@@ -561,25 +562,29 @@ fn raytraced_ao(@builtin(global_invocation_id) id: vec3<u32>) {
         }
         // Tubes start at the surface whether or not they know their segment.
         let o = origin(p, n, select(NONE, state.z, trace.lines != 0u));
-        let rays = f32(trace.frame_rays);
-        var sum = rays;
+        // A buried origin's rays all count 1.
+        var sum = f32(trace.frame_rays);
+        var squares = sum;
         if state.w == 0u {
             let guard = i32(trace.guard);
             let seed = pixel_seed(i32(pixel.x) - guard, i32(pixel.y) - guard, trace.seed);
             let mode = select(RAY_ANY, RAY_NEAREST, trace.falloff != 0u);
             sum = 0.0;
+            squares = 0.0;
             for (var i = 0u; i < trace.frame_rays; i++) {
                 let d = cosine_direction(sample_2d(trace.first_ray + i, seed), n);
                 let t = traverse(Query(mode, o.start, d, trace.distance), o.own).t;
                 if t != NO_HIT {
-                    sum += select(1.0, 1.0 - t / trace.distance, mode == RAY_NEAREST);
+                    let value = select(1.0, 1.0 - t / trace.distance, mode == RAY_NEAREST);
+                    sum += value;
+                    squares += value * value;
                 }
             }
         }
         state.x = bitcast<u32>(bitcast<f32>(state.x) + sum);
-        state.y = bitcast<u32>(bitcast<f32>(state.y) + rays);
+        state.y = bitcast<u32>(bitcast<f32>(state.y) + squares);
         accumulation[index] = state;
     }
-    let acc = vec2<f32>(bitcast<f32>(state.x), bitcast<f32>(state.y));
-    textureStore(ao_out, vec2<i32>(pixel), vec4<f32>(select(0.0, acc.x / acc.y, acc.y > 0.0)));
+    let rays = trace.first_ray + trace.frame_rays;
+    textureStore(ao_out, vec2<i32>(pixel), vec4<f32>(select(0.0, bitcast<f32>(state.x) / f32(rays), rays > 0u)));
 }

@@ -210,6 +210,14 @@ impl AoChain {
         self.stages.active().and_then(|stage| stage.progress())
     }
 
+    /// The ray-traced method's accumulation per pixel of the guard-banded frame
+    /// ([`crate::passes::raytraced_ao::ACCUMULATION_BYTES`] each: the sums of the rays' values
+    /// and of their squares, the own segment, the buried flag), for reading back its standard
+    /// error; `None` for the other methods.
+    pub fn ray_accumulation(&self) -> Option<&wgpu::Buffer> {
+        self.stages.active().and_then(|stage| stage.accumulation())
+    }
+
     /// Turns per-pass GPU timing on or off. Returns whether timing is on: it stays off on
     /// adapters without timestamp queries.
     pub fn set_timing(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, enabled: bool) -> bool {

@@ -48,6 +48,10 @@ pub trait Stage: Send + Sync {
     fn progress(&self) -> Option<RayProgress> {
         None
     }
+    /// A progressive stage's per-pixel accumulation (`COPY_SRC`); `None` for the others.
+    fn accumulation(&self) -> Option<&wgpu::Buffer> {
+        None
+    }
     /// Writes the frame's uniforms.
     fn prepare(&self, queue: &wgpu::Queue, targets: &FrameTargets, view: &FrameView, settings: &ChainSettings);
     /// Records the stage; `span(name)` times one of [`Stage::spans`].

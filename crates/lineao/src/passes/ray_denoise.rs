@@ -42,7 +42,7 @@ struct DenoiseUniform {
     reach: u32,
     width: u32,
     height: u32,
-    _pad: u32,
+    rays: u32,
 }
 
 const LABEL: &str = "lineao::RayDenoise";
@@ -96,7 +96,7 @@ impl RayDenoise {
             reach: settings.reach_vertices,
             width: targets.size.0,
             height: targets.size.1,
-            _pad: 0,
+            rays,
         };
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
     }

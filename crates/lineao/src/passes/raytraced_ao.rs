@@ -135,7 +135,10 @@ pub struct RayTracedAo {
 
 const LABEL: &str = "lineao::RayTracedAo";
 
-/// Bytes of the accumulation per pixel: the sum, the rays, the own segment, the buried flag.
+/// Bytes of the accumulation per pixel: the sums of the rays' values and of their squares (f32),
+/// the own segment, the buried flag (u32). Every geometry pixel of a picture has traced the same
+/// rays ([`RayProgress::rays_per_pixel`]): the mean is sum / rays, the standard error
+/// √((squares − rays · mean²) / (rays − 1) / rays).
 pub const ACCUMULATION_BYTES: u64 = 16;
 
 impl RayTracedAo {
@@ -269,8 +272,7 @@ impl RayTracedAo {
         }
     }
 
-    /// The accumulation (16 bytes per pixel: the sum and the rays as f32 bits, the own segment,
-    /// the buried flag), once sized.
+    /// The accumulation ([`ACCUMULATION_BYTES`] per pixel), once sized.
     pub fn accumulation(&self) -> Option<&wgpu::Buffer> {
         self.accumulation.as_ref()
     }
@@ -309,6 +311,10 @@ impl crate::stage::Stage for RayTracedAo {
 
     fn progress(&self) -> Option<RayProgress> {
         Some(RayTracedAo::progress(self))
+    }
+
+    fn accumulation(&self) -> Option<&wgpu::Buffer> {
+        RayTracedAo::accumulation(self)
     }
 
     fn prepare(&self, queue: &wgpu::Queue, targets: &FrameTargets, view: &FrameView, settings: &ChainSettings) {

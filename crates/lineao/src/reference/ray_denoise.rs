@@ -7,9 +7,9 @@ use crate::settings::RayDenoiseSettings;
 /// The own segment of a pixel without one (surfaces, tubes).
 const NONE: u32 = u32::MAX;
 
-/// The denoised AO of the ray tracer's `accumulation` (per pixel: the sum and the rays as f32
-/// bits, the own segment, the buried flag) over `nd` after `rays` rays per pixel of lines or
-/// `tubes`.
+/// The denoised AO of the ray tracer's `accumulation` (per pixel: the sums of the rays' values
+/// and of their squares as f32 bits, the own segment, the buried flag) over `nd` after `rays`
+/// rays per pixel of lines or `tubes`.
 pub fn ray_denoise(
     accumulation: &Image<[u32; 4]>,
     nd: &NdImage,
@@ -26,7 +26,7 @@ pub fn ray_denoise(
     };
     Image::from_fn(nd.width, nd.height, |x, y| {
         let (here, centre) = (nd.get(x, y), accumulation.get(x, y));
-        if background(here) || centre[1] == 0 {
+        if background(here) || rays == 0 {
             return 0.0;
         }
         let n = unit(here);
@@ -40,7 +40,7 @@ pub fn ray_denoise(
                     continue;
                 }
                 let (texel, s) = (nd.get(qx as usize, qy as usize), accumulation.get(qx as usize, qy as usize));
-                if background(texel) || s[1] == 0 {
+                if background(texel) {
                     continue;
                 }
                 let same = if own != NONE {
@@ -54,7 +54,7 @@ pub fn ray_denoise(
                 let m = unit(texel);
                 let facing = (n[0] * m[0] + n[1] * m[1] + n[2] * m[2]).max(0.0);
                 let w = (-((dx * dx + dy * dy) as f32) * spatial).exp() * facing.powf(settings.normal_power);
-                sum += w * (f32::from_bits(s[0]) / f32::from_bits(s[1]));
+                sum += w * (f32::from_bits(s[0]) / rays as f32);
                 weight += w;
             }
         }
