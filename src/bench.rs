@@ -107,7 +107,14 @@ struct Passes {
     raytraced_start: RayTracedAo,
     /// Over `raytraced`'s accumulation, at 4 rays per pixel (its window at full width).
     ray_denoise: RayDenoise,
+    /// What the ray tracer's frames are prepared with, before each (one `encode` per `prepare`):
+    /// one ray per pixel, and the view.
+    one_ray: ChainSettings,
+    view: FrameView,
+    /// Seeds of `raytraced-start-1spp`'s pictures: a new seed each frame starts a new picture.
+    start_seed: std::cell::Cell<u32>,
     device: wgpu::Device,
+    queue: wgpu::Queue,
     output: Target,
 }
 
@@ -143,7 +150,14 @@ impl Passes {
             raytraced: RayTracedAo::new(device),
             raytraced_start: RayTracedAo::new(device),
             ray_denoise: RayDenoise::new(device),
+            one_ray: ChainSettings {
+                raytraced: lineao::RayTracedSettings { rays_per_frame: 1, ..Default::default() },
+                ..settings.clone()
+            },
+            view: *view,
+            start_seed: std::cell::Cell::new(1),
             device: device.clone(),
+            queue: queue.clone(),
             output: Target::output(device, "lineao::bench::output", (view.width, view.height), format),
         };
         for renderer in [&passes.lines, &passes.lines_native, &passes.lines_full] {
@@ -174,21 +188,16 @@ impl Passes {
             view,
             &VoSettings { area_samples: 1, ..settings.vo.clone() },
         );
-        let one_ray = ChainSettings {
-            raytraced: lineao::RayTracedSettings { rays_per_frame: 1, ..Default::default() },
-            ..settings.clone()
-        };
         for pass in [&mut passes.raytraced, &mut passes.raytraced_start] {
             pass.set_scene(device, Some(scene.clone()));
             pass.resize(device, targets);
-            pass.prepare(queue, targets, view, &one_ray);
         }
         // `raytraced` continues the picture its first frame started.
+        passes.raytraced.prepare(queue, targets, view, &passes.one_ray);
         let mut encoder =
             device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::bench") });
         passes.raytraced.encode(&mut encoder, targets, None, None);
         queue.submit([encoder.finish()]);
-        passes.raytraced.prepare(queue, targets, view, &one_ray);
         let accumulation = passes.raytraced.accumulation().expect("sized above");
         passes.ray_denoise.resize(device, targets, accumulation);
         passes.ray_denoise.prepare(queue, targets, view, &RayDenoiseSettings::default(), (4, false));
@@ -245,8 +254,18 @@ impl Passes {
             }
             "bilateral" => self.bilateral.encode(encoder, targets, span),
             "tubes" => self.tubes.encode(encoder, targets, geometry, Load::Clear(background), span),
-            "raytraced-1spp" => self.raytraced.encode(encoder, targets, span, None),
-            "raytraced-start-1spp" => self.raytraced_start.encode(encoder, targets, span, None),
+            "raytraced-1spp" => {
+                // The picture's next ray.
+                self.raytraced.prepare(&self.queue, targets, &self.view, &self.one_ray);
+                self.raytraced.encode(encoder, targets, span, None)
+            }
+            "raytraced-start-1spp" => {
+                // Another seed: a new picture, whose first frame this is.
+                let mut settings = self.one_ray.clone();
+                settings.raytraced.seed = self.start_seed.replace(self.start_seed.get() + 1);
+                self.raytraced_start.prepare(&self.queue, targets, &self.view, &settings);
+                self.raytraced_start.encode(encoder, targets, span, None)
+            }
             "ray-denoise" => self.ray_denoise.encode(encoder, targets, span),
             "nd-from-depth" => {
                 let inputs = HostInputs { depth: &targets.depth.view, normals: None, color: None };

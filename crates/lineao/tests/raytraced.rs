@@ -160,6 +160,13 @@ fn lines_accumulate_to_the_cpu_truth_with_the_same_rays_and_restart_when_the_cam
     let (nd, third) = tracer.frame(&camera());
     assert_eq!(tracer.chain.ray_progress().unwrap().rays_per_pixel, 12);
     assert_same_hits(&nd, &third, &cpu_truth(&tracer, &scene, &nd, 12), 12, "lines, 3 frames × 4");
+    // A second encode without a prepare records nothing: the same rays are not added twice.
+    let (d, q) = (&tracer.gpu.device, &tracer.gpu.queue);
+    let mut encoder = d.create_command_encoder(&Default::default());
+    tracer.chain.encode(&mut encoder, &tracer.lines, &tracer.output.view);
+    q.submit([encoder.finish()]);
+    assert_eq!(tracer.chain.ray_progress().unwrap().rays_per_pixel, 12);
+    assert_eq!(read_f32(d, q, &tracer.chain.targets().unwrap().ao).unwrap().data, third.data);
     // The camera moves: the count starts again, and the picture is the new view's 4 rays.
     let moved = Camera { eye: Vec3::new(-60.0, 20.0, 120.0), ..camera() };
     let (nd, restarted) = tracer.frame(&moved);

@@ -119,6 +119,8 @@ struct Progress {
     max_rays: u32,
     /// Whether the prepared frame ends with the denoiser.
     denoise: bool,
+    /// Whether a frame was prepared and not yet recorded.
+    prepared: bool,
 }
 
 pub struct RayTracedAo {
@@ -212,6 +214,7 @@ impl RayTracedAo {
         progress.max_rays = r.max_rays;
         progress.frame_rays = r.rays_per_frame.min(r.max_rays.saturating_sub(progress.traced));
         progress.denoise = r.denoise.is_some();
+        progress.prepared = true;
         if let Some(denoise) = &r.denoise {
             let rays = progress.traced + progress.frame_rays;
             self.denoise.prepare(queue, targets, view, denoise, (rays, settings.tubes.is_some()));
@@ -255,7 +258,8 @@ impl RayTracedAo {
 
     /// Records the frame's rays (or, once converged, only the copy into `ao`), timed into `span`,
     /// and the denoiser when the settings have one, timed into `denoise_span`. One `encode` per
-    /// `prepare`: the next `prepare` continues after these rays.
+    /// `prepare`: the next `prepare` continues after these rays, and an `encode` without a new
+    /// `prepare` records nothing (it would add the same rays again).
     pub fn encode<'t>(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -264,8 +268,11 @@ impl RayTracedAo {
         denoise_span: Option<Span<'t>>,
     ) {
         let Some(group) = &self.group else { return };
-        dispatch_full_screen(encoder, LABEL, &self.pipeline.1, group, targets.size, span);
         let mut progress = self.progress.lock().expect("the progress lock");
+        if !std::mem::take(&mut progress.prepared) {
+            return;
+        }
+        dispatch_full_screen(encoder, LABEL, &self.pipeline.1, group, targets.size, span);
         progress.traced += progress.frame_rays;
         if progress.denoise {
             self.denoise.encode(encoder, targets, denoise_span);
