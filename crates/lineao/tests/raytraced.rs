@@ -160,18 +160,25 @@ fn lines_accumulate_to_the_cpu_truth_with_the_same_rays_and_restart_when_the_cam
     let (nd, third) = tracer.frame(&camera());
     assert_eq!(tracer.chain.ray_progress().unwrap().rays_per_pixel, 12);
     assert_same_hits(&nd, &third, &cpu_truth(&tracer, &scene, &nd, 12), 12, "lines, 3 frames × 4");
+    // More rays per frame continue the picture: rays 12..20, the CPU truth's 20.
+    let mut more = tracer.chain.settings().clone();
+    more.raytraced.rays_per_frame = 8;
+    tracer.chain.set_settings(&tracer.gpu.device, more).unwrap();
+    let (nd, fourth) = tracer.frame(&camera());
+    assert_eq!(tracer.chain.ray_progress().unwrap().rays_per_pixel, 20);
+    assert_same_hits(&nd, &fourth, &cpu_truth(&tracer, &scene, &nd, 20), 20, "lines, 3 frames × 4 + 8");
     // A second encode without a prepare records nothing: the same rays are not added twice.
     let (d, q) = (&tracer.gpu.device, &tracer.gpu.queue);
     let mut encoder = d.create_command_encoder(&Default::default());
     tracer.chain.encode(&mut encoder, &tracer.lines, &tracer.output.view);
     q.submit([encoder.finish()]);
-    assert_eq!(tracer.chain.ray_progress().unwrap().rays_per_pixel, 12);
-    assert_eq!(read_f32(d, q, &tracer.chain.targets().unwrap().ao).unwrap().data, third.data);
-    // The camera moves: the count starts again, and the picture is the new view's 4 rays.
+    assert_eq!(tracer.chain.ray_progress().unwrap().rays_per_pixel, 20);
+    assert_eq!(read_f32(d, q, &tracer.chain.targets().unwrap().ao).unwrap().data, fourth.data);
+    // The camera moves: the count starts again, and the picture is the new view's first 8 rays.
     let moved = Camera { eye: Vec3::new(-60.0, 20.0, 120.0), ..camera() };
     let (nd, restarted) = tracer.frame(&moved);
-    assert_eq!(tracer.chain.ray_progress().unwrap().rays_per_pixel, 4);
-    assert_same_hits(&nd, &restarted, &cpu_truth(&tracer, &scene, &nd, 4), 4, "lines, moved");
+    assert_eq!(tracer.chain.ray_progress().unwrap().rays_per_pixel, 8);
+    assert_same_hits(&nd, &restarted, &cpu_truth(&tracer, &scene, &nd, 8), 8, "lines, moved");
 }
 
 #[test]

@@ -10,7 +10,9 @@
 //! own segment, buried origins and both falloffs follow [`crate::truth`] step by step.
 //!
 //! **Progressive.** The stage remembers what the last frame traced — view, size, the settings
-//! the picture depends on, the scene — and starts again from ray 0 when any of it changes.
+//! the picture depends on, the scene — and starts again from ray 0 when any of it changes. The
+//! rays per frame may change between frames (a host adapting them to its frame time): the
+//! picture goes on with the next rays of the sequence.
 //! After `max_rays` rays a pixel is converged: the pass then only copies the sums into `ao`.
 //! [`RayTracedAo::progress`] says how far it is.
 //!
@@ -98,7 +100,8 @@ impl Key {
         bits.extend(view.proj.to_cols_array().map(f32::to_bits));
         bits.extend([view.width, view.height, view.guard, view.near.to_bits(), view.far.to_bits()]);
         bits.extend([targets.size.0, targets.size.1]);
-        bits.extend([r.rays_per_frame, r.distance_world.to_bits(), (r.falloff == Falloff::Linear) as u32, r.seed]);
+        // Not the rays per frame: ray i of a picture is ray i whatever the frames it came in.
+        bits.extend([r.distance_world.to_bits(), (r.falloff == Falloff::Linear) as u32, r.seed]);
         // With the denoiser tube pixels find their own segment on the first frame.
         bits.push(r.denoise.is_some() as u32);
         bits.push(settings.line_width_px.to_bits());
