@@ -184,7 +184,7 @@ impl RayTracedAo {
         let accumulation = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("lineao::RayTracedAo::accumulation"),
             size: (w as u64 * h as u64 * ACCUMULATION_BYTES).max(ACCUMULATION_BYTES),
-            // Copied out by tests of the denoiser against its CPU reference.
+            // Read back for the standard error (`AoChain::ray_accumulation`) and by the tests.
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
