@@ -6,6 +6,7 @@
 // own segment, the buried test and both falloffs are `lineao::truth`'s, step by step, in f32 relative to the ray's
 // origin (the CPU truth is f64). The own segment and the buried test are found on a picture's
 // first frame and kept for the frames that continue it.
+#import shared/cone.wgsl
 #import shared/nd.wgsl
 #import shared/view.wgsl
 
@@ -193,40 +194,23 @@ fn cone(v: u32) -> Cone {
 }
 
 // The nearest hit of ro + t rd with t in (0, t_max), or NO_HIT; `ro` is 0 (the cone is given
-// relative to the ray's origin).
+// relative to the ray's origin). Every root counts: the ray may start inside the cone.
 fn intersect_cone(rd: vec3<f32>, pa: vec3<f32>, pb: vec3<f32>, ra: f32, rb: f32, t_max: f32) -> f32 {
-    let ba = pb - pa;
-    let oa = -pa;
-    let ob = -pb;
-    let rr = ra - rb;
-    let m0 = dot(ba, ba);
-    let m1 = dot(ba, oa);
-    let m2 = dot(ba, rd);
-    let m3 = dot(rd, oa);
-    let m5 = dot(oa, oa);
-    let m6 = dot(ob, rd);
-    let m7 = dot(ob, ob);
+    let c = cone_terms(vec3<f32>(0.0), rd, pa, pb, ra, rb);
     var best = NO_HIT;
-    let d2 = m0 - rr * rr;
-    if d2 > 0.0 {
-        let k2 = d2 - m2 * m2;
-        let k1 = d2 * m3 - m1 * m2 + m2 * rr * ra;
-        let k0 = d2 * m5 - m1 * m1 + m1 * rr * ra * 2.0 - m0 * ra * ra;
-        let h = k1 * k1 - k0 * k2;
-        if h >= 0.0 && k2 != 0.0 {
-            let s = sqrt(h);
-            for (var i = 0; i < 2; i++) {
-                let t = (select(s, -s, i == 0) - k1) / k2;
-                let y = m1 - ra * rr + t * m2;
-                if y > 0.0 && y < d2 && t > 0.0 && t < t_max && t < best {
-                    best = t;
-                }
+    if c.d2 > 0.0 && c.h >= 0.0 && c.k2 != 0.0 {
+        let s = sqrt(c.h);
+        for (var i = 0; i < 2; i++) {
+            let t = (select(s, -s, i == 0) - c.k1) / c.k2;
+            let y = c.m1 - ra * c.rr + t * c.m2;
+            if y > 0.0 && y < c.d2 && t > 0.0 && t < t_max && t < best {
+                best = t;
             }
         }
     }
     for (var e = 0; e < 2; e++) {
-        let m = select(m6, m3, e == 0);
-        let c2 = select(m7, m5, e == 0);
+        let m = select(c.m6, c.m3, e == 0);
+        let c2 = select(c.m7, c.m5, e == 0);
         let r = select(rb, ra, e == 0);
         let h = m * m - c2 + r * r;
         if h >= 0.0 {

@@ -4,6 +4,7 @@
 // billboards at the joints each ray-cast their own segment and the depth test keeps the nearest
 // hit, so a polyline renders as the exact union of its segments' solids: seamless joints.
 // `lineao::passes::tubes` documents the instancing; `lineao::reference::tubes` is the CPU side.
+#import shared/cone.wgsl
 #import shared/geometry.wgsl
 
 // The strip buffer read per instance with twice its stride: every left vertex (a point) and,
@@ -145,58 +146,41 @@ fn vs_tube_attributes(@builtin(vertex_index) vertex: u32, s: Segment, at: Segmen
 // and (pb, rb): (t, outward unit normal), or t < 0 for none. The body is the quadratic
 // k2 t² + 2 k1 t + k0 = 0 (either root may be the body's: squaring admits the mirrored cone
 // beyond the apex); the solid is convex, so its entry is the smallest t among the valid body
-// roots and the end spheres' entries. Derived in `lineao::reference::tubes::intersect_rounded_cone`;
-// keep the two in sync.
+// roots and the end spheres' entries (the terms: `shared/cone.wgsl`). Derived in
+// `lineao::reference::tubes::intersect_rounded_cone`; keep the two in sync.
 fn intersect_rounded_cone(ro: vec3<f32>, rd: vec3<f32>, pa: vec3<f32>, pb: vec3<f32>, ra: f32, rb: f32) -> vec4<f32> {
-    let ba = pb - pa;
-    let oa = ro - pa;
-    let ob = ro - pb;
-    let rr = ra - rb;
-    let m0 = dot(ba, ba);
-    let m1 = dot(ba, oa);
-    let m2 = dot(ba, rd);
-    let m3 = dot(rd, oa);
-    let m5 = dot(oa, oa);
-    let m6 = dot(ob, rd);
-    let m7 = dot(ob, ob);
+    let c = cone_terms(ro, rd, pa, pb, ra, rb);
     // x: t of the best hit so far (none: +inf), yzw: its normal.
     var best = vec4<f32>(1e30, 0.0, 0.0, 0.0);
-    let d2 = m0 - rr * rr;
-    if d2 > 0.0 {
-        let k2 = d2 - m2 * m2;
-        let k1 = d2 * m3 - m1 * m2 + m2 * rr * ra;
-        let k0 = d2 * m5 - m1 * m1 + m1 * rr * ra * 2.0 - m0 * ra * ra;
-        let h = k1 * k1 - k0 * k2;
-        if h >= 0.0 && k2 != 0.0 {
-            let roots = array<f32, 2>((-sqrt(h) - k1) / k2, (sqrt(h) - k1) / k2);
-            // For k2 > 0 the first root enters the infinite cone, which holds the solid: on the
-            // body, it is the entry (the common case, decided without the spheres).
-            let y0 = m1 - ra * rr + roots[0] * m2;
-            if k2 > 0.0 && y0 > 0.0 && y0 < d2 {
-                return vec4<f32>(roots[0], normalize(d2 * (oa + roots[0] * rd) - ba * y0));
-            }
-            for (var i = 0; i < 2; i++) {
-                let t = roots[i];
-                let y = m1 - ra * rr + t * m2;
-                if y > 0.0 && y < d2 && t < best.x {
-                    best = vec4<f32>(t, normalize(d2 * (oa + t * rd) - ba * y));
-                }
+    if c.d2 > 0.0 && c.h >= 0.0 && c.k2 != 0.0 {
+        let roots = array<f32, 2>((-sqrt(c.h) - c.k1) / c.k2, (sqrt(c.h) - c.k1) / c.k2);
+        // For k2 > 0 the first root enters the infinite cone, which holds the solid: on the
+        // body, it is the entry (the common case, decided without the spheres).
+        let y0 = c.m1 - ra * c.rr + roots[0] * c.m2;
+        if c.k2 > 0.0 && y0 > 0.0 && y0 < c.d2 {
+            return vec4<f32>(roots[0], normalize(c.d2 * (c.oa + roots[0] * rd) - c.ba * y0));
+        }
+        for (var i = 0; i < 2; i++) {
+            let t = roots[i];
+            let y = c.m1 - ra * c.rr + t * c.m2;
+            if y > 0.0 && y < c.d2 && t < best.x {
+                best = vec4<f32>(t, normalize(c.d2 * (c.oa + t * rd) - c.ba * y));
             }
         }
     }
     // The end spheres' entries (a sphere holding the other leaves no body).
-    let h1 = m3 * m3 - m5 + ra * ra;
+    let h1 = c.m3 * c.m3 - c.m5 + ra * ra;
     if h1 > 0.0 {
-        let t = -m3 - sqrt(h1);
+        let t = -c.m3 - sqrt(h1);
         if t < best.x {
-            best = vec4<f32>(t, (oa + t * rd) / ra);
+            best = vec4<f32>(t, (c.oa + t * rd) / ra);
         }
     }
-    let h2 = m6 * m6 - m7 + rb * rb;
+    let h2 = c.m6 * c.m6 - c.m7 + rb * rb;
     if h2 > 0.0 {
-        let t = -m6 - sqrt(h2);
+        let t = -c.m6 - sqrt(h2);
         if t < best.x {
-            best = vec4<f32>(t, (ob + t * rd) / rb);
+            best = vec4<f32>(t, (c.ob + t * rd) / rb);
         }
     }
     return select(best, vec4<f32>(-1.0), best.x >= 1e30);

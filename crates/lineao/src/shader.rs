@@ -8,6 +8,7 @@ use std::borrow::Cow;
 
 /// Every WGSL file under `shaders/`, by path relative to that folder.
 pub const FILES: &[(&str, &str)] = &[
+    ("shared/cone.wgsl", include_str!("../shaders/shared/cone.wgsl")),
     ("shared/fullscreen.wgsl", include_str!("../shaders/shared/fullscreen.wgsl")),
     ("shared/gbuffer.wgsl", include_str!("../shaders/shared/gbuffer.wgsl")),
     ("shared/geometry.wgsl", include_str!("../shaders/shared/geometry.wgsl")),
