@@ -11,7 +11,10 @@ use crate::cli::{ConvertArgs, InfoArgs};
 /// Loads a file, with a progress bar on a terminal for files over 32 MiB.
 pub fn load(path: &Path) -> Result<Loaded> {
     let Some(bar) = crate::source::progress_bar(path) else { return Ok(lineao_tracts::load(path)?) };
-    let mut report = |p: lineao_tracts::Progress| bar.set_position(p.bytes);
+    let mut report = |p: lineao_tracts::Progress| {
+        bar.set_position(p.bytes);
+        std::ops::ControlFlow::Continue(())
+    };
     let loaded = lineao_tracts::load_with(path, &LoadOptions::default(), Some(&mut report));
     bar.finish_and_clear();
     Ok(loaded?)

@@ -3,23 +3,10 @@
 //! Exit codes (CONTRACT.md): 0 success, 1 bad input or a failed operation (message on stderr),
 //! 2 bad command line. A panic is a bug; it is reported and exits 1, never 101.
 
-mod bench;
-mod bench_load;
-mod cli;
-mod dump;
-mod fit;
-mod info;
-mod label;
-mod output;
-mod render;
-mod score;
-mod source;
-mod truth;
-mod view;
-
 use std::process::ExitCode;
 
 use clap::Parser;
+use lineao_cli::{bench, bench_load, cli, fit, info, render, score};
 
 fn main() -> ExitCode {
     if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
@@ -33,7 +20,12 @@ fn main() -> ExitCode {
         cli::Command::Info(args) => info::run(&args),
         cli::Command::Convert(args) => info::convert(&args),
         cli::Command::BenchLoad(args) => bench_load::run(&args),
-        cli::Command::View(args) => view::run(&args),
+        #[cfg(feature = "viewer")]
+        cli::Command::View(args) => lineao_cli::view::run(&args),
+        #[cfg(not(feature = "viewer"))]
+        cli::Command::View(_) => {
+            Err(anyhow::anyhow!("this lineao was built without the viewer (cargo feature `viewer`)"))
+        }
         cli::Command::Score(args) if args.fit => fit::run(&args),
         cli::Command::Score(args) => score::run(&args),
     });

@@ -19,7 +19,7 @@ use lineao_tracts::scenes::ViewHint;
 
 use crate::cli::{ColorArg, GeometryArg, Method, RenderArgs, SkyArg, VolumeNormal};
 use crate::label::Rgba8;
-use crate::source::{AttributeKey, Lines, Source, submit_frame, vertex_field};
+use crate::source::{AttributeKey, Lines, Loaded, Source, submit_frame, vertex_field};
 
 /// The sky of object-space AO: open, or lit from the world axis nearest to the camera's `up`.
 pub fn sky(args: &RenderArgs, up: Vec3) -> Sky {
@@ -228,18 +228,12 @@ impl Session {
                 seed: args.seed,
             },
         };
-        let loaded = source.load_on_terminal()?;
-        let hint = loaded.hint;
-        let camera = Camera {
-            eye: Vec3::from_array(args.eye.unwrap_or(hint.eye)),
-            target: Vec3::from_array(args.target.unwrap_or(hint.target)),
-            up: Vec3::from_array(args.up.unwrap_or(hint.up)),
-            projection: match (args.ortho, args.fov) {
-                (Some(height), _) => Projection::Orthographic { height },
-                (None, fov) => Projection::Perspective { fov_y_deg: fov.unwrap_or(hint.fov_y_deg) },
-            },
-        };
-        validate_camera(&camera)?;
+        Session::with_loaded(args, source.load_on_terminal()?)
+    }
+
+    /// [`Session::open`] on streamlines already in memory (the Python package's).
+    pub fn with_loaded(args: &RenderArgs, loaded: Loaded) -> Result<Session> {
+        let camera = camera(args, &loaded.hint)?;
         let sky = sky(args, camera.up);
         let surfaces = args
             .surfaces
@@ -293,66 +287,82 @@ impl Session {
 
 pub fn run(args: &RenderArgs) -> Result<()> {
     let mut session = Session::open(args)?;
-    let mut panels = panels(args, session.lines.hint.zoom_unit, session.sky);
-    for panel in &mut panels {
-        panel.settings.validate().with_context(|| format!("method {}", panel.label))?;
-        session.fit_color_range(&mut panel.settings);
-    }
-    let (sky, zoom_unit) = (session.sky, session.lines.hint.zoom_unit);
-    let volume_options = |method| volume_options(args, method, sky, zoom_unit);
-    if panels.iter().any(|p| p.volume.is_some()) {
-        volume_options(VolumeMethod::Sweep).sweep.validate()?;
-    }
-    // Object-space AO once per method (the session keeps it), uploaded as the geometry's
-    // attributes when a panel needs another method's than the last.
-    let mut images = Vec::new();
-    for panel in &panels {
-        if let Some(method) = panel.volume {
-            let wanted = AttributeKey { volume: Some(volume_options(method)), ..session.base.clone() };
-            let (start, mut computed) = (std::time::Instant::now(), false);
-            let gpu = &session.gpu;
-            session.lines.hold((&gpu.device, &gpu.queue), &wanted, || computed = true)?;
-            if computed {
-                eprintln!(
-                    "lineao: {} at {} voxels along the longest axis: {:.2} s on the CPU",
-                    method.name(),
-                    args.volume_resolution,
-                    start.elapsed().as_secs_f64()
-                );
-            }
-        }
-        // One method dumps into DIR itself, several into DIR/<label>/.
-        let dump = args.dump.as_ref().map(|dir| match panels.len() {
-            1 => dir.clone(),
-            _ => dir.join(panel.label.replace(" (reference)", "-reference")),
-        });
-        let volume = panel.volume.map(&volume_options);
-        images.push(session.render(args, panel, dump.as_deref(), volume.as_ref())?.image);
-    }
-    let (width, height) = (args.width, args.height);
-    let image = match &images[..] {
-        [single] => single.clone(),
-        [a, b] if args.compare.is_some() => {
-            crate::label::split(a, b, [&panels[0].label, &panels[1].label]).context("composing --compare")?
-        }
-        tiles => {
-            let labelled: Vec<(&str, &Rgba8)> = panels.iter().map(|p| p.label.as_str()).zip(tiles).collect();
-            crate::label::grid(&labelled, 3)
-        }
-    };
+    let (image, panels) = session.compose(args, &mut Vec::new())?;
     let output = args.output.clone().unwrap_or_else(|| "lineao.png".into());
     crate::output::write_png(&output, image.width, image.height, &image.data)?;
     let methods: Vec<&str> = panels.iter().map(|p| p.label.as_str()).collect();
     eprintln!(
-        "lineao: {} ({} streamlines, {} vertices) with {} at {width} x {height} on {} -> {}",
+        "lineao: {} ({} streamlines, {} vertices) with {} at {} x {} on {} -> {}",
         session.lines.name,
         session.lines.geometry.streamlines,
         session.lines.geometry.vertices,
         methods.join(", "),
+        args.width,
+        args.height,
         session.gpu.describe(),
         output.display()
     );
     Ok(())
+}
+
+impl Session {
+    /// The image the command line asks for: one method, a split screen (--compare) or the
+    /// labelled grid (--grid), with the panels it shows. `chains` keeps a chain per panel
+    /// between calls (pipelines and targets are made once for many frames); pass an empty
+    /// `Vec` for one image.
+    pub fn compose(&mut self, args: &RenderArgs, chains: &mut Vec<AoChain>) -> Result<(Rgba8, Vec<Panel>)> {
+        let mut panels = panels(args, self.lines.hint.zoom_unit, self.sky);
+        for panel in &mut panels {
+            panel.settings.validate().with_context(|| format!("method {}", panel.label))?;
+            self.fit_color_range(&mut panel.settings);
+        }
+        let (sky, zoom_unit) = (self.sky, self.lines.hint.zoom_unit);
+        let volume_options = |method| volume_options(args, method, sky, zoom_unit);
+        if panels.iter().any(|p| p.volume.is_some()) {
+            volume_options(VolumeMethod::Sweep).sweep.validate()?;
+        }
+        let mut kept: Vec<Option<AoChain>> = std::mem::take(chains).into_iter().map(Some).collect();
+        kept.resize_with(panels.len(), || None);
+        // Object-space AO once per method (the session keeps it), uploaded as the geometry's
+        // attributes when a panel needs another method's than the last.
+        let mut images = Vec::new();
+        for (i, panel) in panels.iter().enumerate() {
+            if let Some(method) = panel.volume {
+                let wanted = AttributeKey { volume: Some(volume_options(method)), ..self.base.clone() };
+                let (start, mut computed) = (std::time::Instant::now(), false);
+                let gpu = &self.gpu;
+                self.lines.hold((&gpu.device, &gpu.queue), &wanted, || computed = true)?;
+                if computed {
+                    eprintln!(
+                        "lineao: {} at {} voxels along the longest axis: {:.2} s on the CPU",
+                        method.name(),
+                        args.volume_resolution,
+                        start.elapsed().as_secs_f64()
+                    );
+                }
+            }
+            // One method dumps into DIR itself, several into DIR/<label>/.
+            let dump = args.dump.as_ref().map(|dir| match panels.len() {
+                1 => dir.clone(),
+                _ => dir.join(panel.label.replace(" (reference)", "-reference")),
+            });
+            let volume = panel.volume.map(&volume_options);
+            let rendered = self.render(args, panel, dump.as_deref(), volume.as_ref(), kept[i].take())?;
+            images.push(rendered.image);
+            chains.push(rendered.chain);
+        }
+        let image = match &images[..] {
+            [single] => single.clone(),
+            [a, b] if args.compare.is_some() => {
+                crate::label::split(a, b, [&panels[0].label, &panels[1].label]).context("composing --compare")?
+            }
+            tiles => {
+                let labelled: Vec<(&str, &Rgba8)> = panels.iter().map(|p| p.label.as_str()).zip(tiles).collect();
+                crate::label::grid(&labelled, 3)
+            }
+        };
+        Ok((image, panels))
+    }
 }
 
 /// The 2nd and 98th percentiles of the finite `values` (robust to outliers), or [0, 1].
@@ -384,10 +394,17 @@ impl Session {
         panel: &Panel,
         dump: Option<&Path>,
         volume: Option<&VolumeAoOptions>,
+        kept: Option<AoChain>,
     ) -> Result<Rendered> {
         let gpu = &self.gpu;
         let format = wgpu::TextureFormat::Rgba8UnormSrgb;
-        let mut chain = AoChain::new(&gpu.device, format, panel.settings.clone())?;
+        let mut chain = match kept {
+            Some(mut chain) => {
+                chain.set_settings(&gpu.device, panel.settings.clone())?;
+                chain
+            }
+            None => AoChain::new(&gpu.device, format, panel.settings.clone())?,
+        };
         if args.timings {
             chain.set_timing(&gpu.device, &gpu.queue, true);
         }
@@ -477,6 +494,21 @@ impl Session {
         );
         Ok(truth)
     }
+}
+
+/// The camera of the command line (--eye, --target, --up, --fov, --ortho), the rest from `hint`.
+pub fn camera(args: &RenderArgs, hint: &ViewHint) -> Result<Camera> {
+    let camera = Camera {
+        eye: Vec3::from_array(args.eye.unwrap_or(hint.eye)),
+        target: Vec3::from_array(args.target.unwrap_or(hint.target)),
+        up: Vec3::from_array(args.up.unwrap_or(hint.up)),
+        projection: match (args.ortho, args.fov) {
+            (Some(height), _) => Projection::Orthographic { height },
+            (None, fov) => Projection::Perspective { fov_y_deg: fov.unwrap_or(hint.fov_y_deg) },
+        },
+    };
+    validate_camera(&camera)?;
+    Ok(camera)
 }
 
 /// The camera a built-in scene suggests.

@@ -128,7 +128,7 @@ pub fn score(session: &Session, args: &crate::cli::RenderArgs, methods: &[ScoreM
     let quiet = crate::cli::RenderArgs { timings: false, dump: None, ..args.clone() };
     let plain = ScoreMethod { method: AoMethod::None, variant: Default::default() };
     let panel = Panel::new(Method { screen: AoMethod::None, volume: None }, method_settings(session, args, plain));
-    let rendered = session.render(&quiet, &panel, None, None)?;
+    let rendered = session.render(&quiet, &panel, None, None, None)?;
     let start = std::time::Instant::now();
     let truth = session.trace(&rendered.chain, &truth_settings)?;
     let truth_seconds = start.elapsed().as_secs_f64();

@@ -62,14 +62,17 @@ impl Source {
             Source::Scene { .. } => None,
         };
         let Some(bar) = bar else { return self.load(None) };
-        let loaded = self.load(Some(&mut |p: Progress| bar.set_position(p.bytes)));
+        let loaded = self.load(Some(&mut |p: Progress| {
+            bar.set_position(p.bytes);
+            std::ops::ControlFlow::Continue(())
+        }));
         bar.finish_and_clear();
         loaded
     }
 
     /// Builds the scene or loads the file, reporting the bytes read to `progress` (files only).
     /// A file of values without points (a .tsf) is an error that says what to render instead.
-    pub fn load(&self, progress: Option<&mut dyn FnMut(Progress)>) -> Result<Loaded> {
+    pub fn load(&self, progress: Option<lineao_tracts::ProgressFn<'_>>) -> Result<Loaded> {
         match self {
             Source::Scene { kind, vertices, seed } => {
                 let scene = kind.build(*seed, *vertices);

@@ -217,7 +217,10 @@ pub fn run(rx: Receiver<ToWorker>, tx: Sender<FromWorker>, repaint: impl Fn() + 
 }
 
 fn load(gpu: &Gpu, source: &Source, send: &dyn Fn(FromWorker)) -> Result<(Scene, Dataset), String> {
-    let mut report = |p: lineao_tracts::Progress| send(FromWorker::Progress { bytes: p.bytes, total: p.total });
+    let mut report = |p: lineao_tracts::Progress| {
+        send(FromWorker::Progress { bytes: p.bytes, total: p.total });
+        std::ops::ControlFlow::Continue(())
+    };
     let loaded = source.load(Some(&mut report)).map_err(|e| format!("{e:#}"))?;
     let lines = Lines::new(loaded, &gpu.device, &gpu.queue).map_err(|e| format!("{e:#}"))?;
     let fields = lines

@@ -33,6 +33,9 @@ pub enum ErrorKind {
     /// Valid input that asks for something we do not do (e.g. writing to a format we only read).
     #[error("unsupported: {0}")]
     Unsupported(String),
+    /// The progress callback cancelled the load.
+    #[error("loading was cancelled")]
+    Cancelled,
 }
 
 impl ErrorKind {

@@ -6,6 +6,7 @@
 //! lying header runs into the end of the file, not into the allocator.
 
 use std::io::{self, Read, Seek, SeekFrom};
+use std::ops::ControlFlow;
 
 use crate::error::{ErrorKind, Parse, bad};
 
@@ -16,8 +17,9 @@ pub struct Progress {
     pub total: Option<u64>,
 }
 
-/// A callback that receives [`Progress`] every few MiB.
-pub type ProgressFn<'a> = &'a mut dyn FnMut(Progress);
+/// A callback that receives [`Progress`] every few MiB; `ControlFlow::Break` cancels the load
+/// (which then fails with [`ErrorKind::Cancelled`]: a Ctrl-C, a closed dialog).
+pub type ProgressFn<'a> = &'a mut dyn FnMut(Progress) -> ControlFlow<()>;
 
 /// Counts the bytes read from the file and reports them, every `STEP` bytes and at the end.
 /// Seeks (a zip's directory first, then its members) do not move the count: it is the bytes
@@ -29,13 +31,15 @@ pub(crate) struct ProgressRead<'p, R> {
     total: Option<u64>,
     reported: u64,
     progress: Option<ProgressFn<'p>>,
+    /// The callback asked to stop: every read fails from then on.
+    pub cancelled: bool,
 }
 
 impl<'p, R> ProgressRead<'p, R> {
     const STEP: u64 = 4 << 20;
 
     pub fn new(inner: R, total: Option<u64>, progress: Option<ProgressFn<'p>>) -> Self {
-        ProgressRead { inner, position: 0, total, reported: 0, progress }
+        ProgressRead { inner, position: 0, total, reported: 0, progress, cancelled: false }
     }
 
     fn report(&mut self, force: bool) {
@@ -44,7 +48,9 @@ impl<'p, R> ProgressRead<'p, R> {
         {
             self.reported = self.position;
             let bytes = self.total.map_or(self.position, |t| self.position.min(t));
-            cb(Progress { bytes, total: self.total });
+            if cb(Progress { bytes, total: self.total }).is_break() {
+                self.cancelled = true;
+            }
         }
     }
 
@@ -56,6 +62,9 @@ impl<'p, R> ProgressRead<'p, R> {
 
 impl<R: Read> Read for ProgressRead<'_, R> {
     fn read(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+        if self.cancelled {
+            return Err(io::Error::other("loading was cancelled"));
+        }
         let n = self.inner.read(buf)?;
         self.position += n as u64;
         self.report(false);

@@ -130,7 +130,9 @@ fn load_inner(path: &Path, options: &LoadOptions, progress: Option<ProgressFn<'_
     let file = File::open(path)?;
     let len = file.metadata()?.len();
     let mut file = ProgressRead::new(file, Some(len), progress);
-    let loaded = load_from(&mut file, len, path, path.parent(), None, options)?;
+    let loaded = load_from(&mut file, len, path, path.parent(), None, options);
+    // Whatever a parser made of the failed read, the load was cancelled.
+    let loaded = if file.cancelled { Err(ErrorKind::Cancelled) } else { loaded }?;
     file.finish();
     Ok(loaded)
 }

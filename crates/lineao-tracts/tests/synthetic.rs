@@ -387,7 +387,10 @@ fn progress_reports_bytes_of_the_file_up_to_its_size() {
         save(&t, &p).unwrap();
         let len = std::fs::metadata(&p).unwrap().len();
         let mut seen = Vec::new();
-        let mut report = |p: lineao_tracts::Progress| seen.push(p);
+        let mut report = |p: lineao_tracts::Progress| {
+            seen.push(p);
+            std::ops::ControlFlow::Continue(())
+        };
         let loaded = lineao_tracts::load_with(&p, &lineao_tracts::LoadOptions::default(), Some(&mut report)).unwrap();
         assert_eq!(loaded.tractogram.vertices(), 500_000);
         assert!(seen.len() >= 2, "{ext}: {} reports for {len} bytes", seen.len());
@@ -396,5 +399,28 @@ fn progress_reports_bytes_of_the_file_up_to_its_size() {
         // A zip's members are most of it; its directory and local headers are read by the zip
         // crate in small pieces.
         assert!(seen.last().unwrap().bytes as f64 >= 0.99 * len as f64, "{ext}: {:?} of {len}", seen.last());
+    }
+}
+
+#[test]
+fn a_progress_callback_cancels_the_load_after_its_first_report() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut t = Tractogram::new();
+    for i in 0..5000 {
+        t.push((0..100).map(|k| [i as f32, k as f32, 0.5]));
+    }
+    for ext in ["tck", "trk", "trx"] {
+        let p = dir.path().join(format!("big.{ext}"));
+        save(&t, &p).unwrap();
+        let mut reports = 0;
+        let mut cancel = |_: lineao_tracts::Progress| {
+            reports += 1;
+            std::ops::ControlFlow::Break(())
+        };
+        let error =
+            lineao_tracts::load_with(&p, &lineao_tracts::LoadOptions::default(), Some(&mut cancel)).unwrap_err();
+        assert!(matches!(error.kind, lineao_tracts::ErrorKind::Cancelled), "{ext}: {error}");
+        assert_eq!(reports, 1, "{ext}: nothing read after the callback said stop");
+        assert!(error.to_string().contains("cancelled"), "{error}");
     }
 }
