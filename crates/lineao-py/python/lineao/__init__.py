@@ -1,0 +1,379 @@
+"""lineao: ambient occlusion for dense 3D lines (LineAO), and fast tractography loaders.
+
+>>> import lineao
+>>> t = lineao.load("bundle.trk")                  # .tck .trk .trx .vtk .vtp .tt.gz .fib …
+>>> t.points.shape, t.offsets.shape                # (N, 3) float32 RAS+ mm, (streamlines,)
+>>> image = lineao.render(t, method="lineao")      # (1024, 1280, 4) uint8, sRGB
+>>> lineao.save_png(image, "bundle.png")
+
+``render`` takes a lineao ``Tractogram``, nibabel's ``Tractogram``, ``ArraySequence``,
+``TrkFile`` or ``TckFile``, DIPY's ``StatefulTractogram``, a list of (n, 3) arrays, or a
+file's path. Its keyword arguments are ``lineao render``'s options with ``_`` for ``-``
+(``lineao.settings()`` lists them with their defaults; ``lineao.methods()`` the methods): the
+command line and Python share one definition, and the same settings give the same pixels.
+
+Arrays are handed over without copies where the memory allows: ``load`` gives numpy the
+loader's own buffers, and ``render`` reads float32 C-contiguous points (nibabel's
+``ArraySequence._data``) in place. Anything else (float64, a strided view, a list of arrays)
+is converted once to float32 C order — a copy, as ``np.ascontiguousarray(x, np.float32)``.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from typing import Any, Iterable, Optional
+
+import numpy as np
+
+# The Vulkan loader warns on every device made without it (headless, in containers); the
+# command line sets it the same way.
+if "XDG_RUNTIME_DIR" not in os.environ:
+    import tempfile
+
+    os.environ["XDG_RUNTIME_DIR"] = tempfile.gettempdir()
+
+from . import _lineao  # noqa: E402 (after the environment it reads)
+from ._lineao import LoadError  # noqa: E402
+
+__all__ = [
+    "LoadError",
+    "Image",
+    "Renderer",
+    "Tractogram",
+    "info",
+    "load",
+    "methods",
+    "render",
+    "save",
+    "save_png",
+    "settings",
+]
+
+
+class Image(np.ndarray):
+    """An (H, W, 4) uint8 sRGB picture: a numpy array that Jupyter shows as a PNG."""
+
+    def _repr_png_(self) -> bytes:
+        return _lineao.png(np.ascontiguousarray(self, dtype=np.uint8))
+
+
+class Tractogram:
+    """Streamlines as one array of points: streamline ``i`` is
+    ``points[offsets[i] : offsets[i] + lengths[i]]``.
+
+    ``points`` is (N, 3) float32 in RAS+ millimetres; ``offsets`` and ``lengths`` are int64
+    (nibabel's ``ArraySequence`` layout). ``vertex_fields`` and ``streamline_fields`` map names
+    to float32 arrays of N or ``len(self)`` rows (one column: 1-D); ``groups`` maps names to
+    uint32 streamline indices; ``affine`` (4 × 4), ``dimensions`` and ``voxel_sizes`` describe the
+    reference image where the file records one; ``format`` is the format read (``"trk"``…).
+    """
+
+    def __init__(
+        self,
+        points: Any,
+        offsets: Any = None,
+        lengths: Any = None,
+        *,
+        vertex_fields: Optional[dict] = None,
+        streamline_fields: Optional[dict] = None,
+        groups: Optional[dict] = None,
+        affine: Any = None,
+        dimensions: Optional[Iterable[int]] = None,
+        voxel_sizes: Optional[Iterable[float]] = None,
+        format: Optional[str] = None,
+    ):
+        self.points = _points(points, "points")
+        if offsets is None and lengths is None:
+            offsets, lengths = np.zeros(1, np.int64), np.array([len(self.points)], np.int64)
+            if len(self.points) == 0:
+                offsets, lengths = offsets[:0], lengths[:0]
+        elif lengths is None:
+            raise ValueError("lengths: required with offsets")
+        elif offsets is None:
+            lengths = _int64(lengths, "lengths")
+            offsets = np.cumsum(lengths) - lengths
+        self.offsets = _int64(offsets, "offsets")
+        self.lengths = _int64(lengths, "lengths")
+        if self.offsets.shape != self.lengths.shape:
+            raise ValueError(f"offsets {self.offsets.shape} and lengths {self.lengths.shape} differ in shape")
+        self.vertex_fields = dict(vertex_fields or {})
+        self.streamline_fields = dict(streamline_fields or {})
+        self.groups = dict(groups or {})
+        self.affine = None if affine is None else np.asarray(affine, dtype=np.float64)
+        self.dimensions = None if dimensions is None else tuple(int(d) for d in dimensions)
+        self.voxel_sizes = None if voxel_sizes is None else tuple(float(v) for v in voxel_sizes)
+        self.format = format
+
+    @classmethod
+    def from_streamlines(cls, streamlines: Iterable[Any]) -> "Tractogram":
+        """A tractogram of (n, 3) arrays (copied once into one float32 array)."""
+        arrays = [_points(s, f"streamlines[{i}]") for i, s in enumerate(streamlines)]
+        lengths = np.array([len(a) for a in arrays], dtype=np.int64)
+        points = np.concatenate(arrays) if arrays else np.zeros((0, 3), np.float32)
+        return cls(points, None, lengths)
+
+    def __len__(self) -> int:
+        return len(self.offsets)
+
+    def __getitem__(self, i: int) -> np.ndarray:
+        start = int(self.offsets[i])
+        return self.points[start : start + int(self.lengths[i])]
+
+    def __iter__(self):
+        for i in range(len(self)):
+            yield self[i]
+
+    def __repr__(self) -> str:
+        kind = f" from .{self.format}" if self.format else ""
+        return f"<lineao.Tractogram{kind}: {len(self)} streamlines, {len(self.points)} points>"
+
+
+def _points(x: Any, name: str) -> np.ndarray:
+    """(N, 3) float32 C-contiguous: the array itself when it is one, else one copy."""
+    try:
+        a = np.asarray(x)
+    except Exception as e:  # noqa: BLE001 (numpy raises many kinds)
+        raise TypeError(f"{name}: expected an (N, 3) array of numbers, got {type(x).__name__}") from e
+    if a.dtype.kind not in "fiu":
+        raise TypeError(f"{name}: expected an (N, 3) array of numbers, got dtype {a.dtype}")
+    if a.size == 0 and a.ndim <= 2:
+        a = a.reshape(0, 3)
+    if a.ndim != 2 or a.shape[1] != 3:
+        raise ValueError(f"{name}: expected shape (N, 3), got {a.shape}")
+    return np.ascontiguousarray(a, dtype=np.float32)
+
+
+def _int64(x: Any, name: str) -> np.ndarray:
+    a = np.asarray(x)
+    if a.dtype.kind not in "iu":
+        raise TypeError(f"{name}: expected integers, got dtype {a.dtype}")
+    if a.ndim != 1:
+        raise ValueError(f"{name}: expected a 1-D array, got shape {a.shape}")
+    return np.ascontiguousarray(a, dtype=np.int64)
+
+
+def load(path: "os.PathLike[str] | str", *, progress: Any = False) -> Tractogram:
+    """Loads a tractography file (any format ``lineao info`` reads) into a ``Tractogram``.
+
+    The arrays own the loader's memory (no copy). The GIL is released while the file is read;
+    Ctrl-C interrupts a long load (``KeyboardInterrupt``). ``progress=True`` draws a bar on a
+    terminal for files over 32 MiB; a callable is called as ``progress(bytes_read, total)``.
+    A file that cannot be read raises ``LoadError`` (a ``ValueError``) with ``file``,
+    ``offset`` and ``expected``.
+    """
+    parts = _lineao.load(os.fspath(path), progress)
+    return Tractogram(**parts)
+
+
+def info(path: "os.PathLike[str] | str") -> dict:
+    """``lineao info --json`` of a file: format, counts, fields, groups, bounds, voxel space."""
+    import json
+
+    return json.loads(_lineao.info(os.fspath(path)))
+
+
+def save(tractogram: Any, path: "os.PathLike[str] | str") -> None:
+    """Writes streamlines as .tck, .trk or .trx (by the extension), with their fields, groups
+    and voxel space where the format holds them (a field it cannot hold is warned about)."""
+    t = _tractogram(tractogram)
+    dropped = _lineao.save(
+        os.fspath(path),
+        t.points,
+        t.offsets,
+        t.lengths,
+        {k: np.ascontiguousarray(v, np.float32) for k, v in t.vertex_fields.items()},
+        {k: np.ascontiguousarray(v, np.float32) for k, v in t.streamline_fields.items()},
+        {k: np.asarray(v, np.uint32) for k, v in t.groups.items()},
+        None if t.affine is None else np.ascontiguousarray(t.affine, np.float64),
+        t.dimensions,
+        t.voxel_sizes,
+    )
+    if dropped:
+        import warnings
+
+        warnings.warn(f"{os.fspath(path)}: the format cannot hold the fields {', '.join(dropped)}", stacklevel=2)
+
+
+def _tractogram(x: Any) -> Tractogram:
+    """Any streamline container as a lineao ``Tractogram`` over the same memory where it can."""
+    if isinstance(x, Tractogram):
+        return x
+    # DIPY's StatefulTractogram: to RAS+ mm with the NIfTI (voxel-centre) origin, on a copy
+    # when it is in another space (to_rasmm and to_center change the object in place).
+    if hasattr(x, "to_rasmm") and hasattr(x, "space") and hasattr(x, "streamlines"):
+        from dipy.io.stateful_tractogram import Origin, Space
+
+        if x.space != Space.RASMM or x.origin != Origin.NIFTI:
+            import copy
+
+            x = copy.deepcopy(x)
+            x.to_rasmm()
+            x.to_center()
+        return _tractogram(x.streamlines)
+    # nibabel's TrkFile/TckFile (tractogram in RAS+ mm) and Tractogram.
+    if hasattr(x, "tractogram") and hasattr(x, "header"):
+        x = x.tractogram
+    if hasattr(x, "streamlines") and hasattr(x, "affine_to_rasmm"):
+        to_rasmm = np.asarray(x.affine_to_rasmm)
+        if not np.allclose(to_rasmm, np.eye(4)):
+            x = x.copy().to_world()
+        x = x.streamlines
+    # nibabel's ArraySequence: its buffer, offsets and lengths, without a copy.
+    if hasattr(x, "_data") and hasattr(x, "_offsets") and hasattr(x, "_lengths"):
+        data = x._data
+        if data.size == 0:
+            data = np.zeros((0, 3), np.float32)
+        return Tractogram(data, x._offsets, x._lengths)
+    if isinstance(x, np.ndarray):
+        return Tractogram(x)
+    if isinstance(x, (list, tuple)) or hasattr(x, "__iter__"):
+        return Tractogram.from_streamlines(x)
+    raise TypeError(
+        "streamlines: expected a lineao or nibabel Tractogram, an ArraySequence, a TrkFile or TckFile, "
+        f"a DIPY StatefulTractogram, a list of (n, 3) arrays or a path, got {type(x).__name__}"
+    )
+
+
+def _camera_settings(camera: Optional[dict]) -> dict:
+    """A camera dict (eye, target, up, fov or ortho) as render's settings."""
+    if camera is None:
+        return {}
+    unknown = set(camera) - {"eye", "target", "up", "fov", "ortho"}
+    if unknown:
+        raise TypeError(f"camera: unexpected keys {sorted(unknown)}; a camera has eye, target, up, fov or ortho")
+    return {k: v for k, v in camera.items() if v is not None}
+
+
+class Renderer:
+    """Keeps the device, the streamlines on the GPU and the pipelines for many frames.
+
+    >>> r = lineao.Renderer(lineao.load("bundle.tck"), method="lineao", width=640, height=512)
+    >>> first = r.render()
+    >>> turntable = r.orbit(36)                     # 36 frames around the up axis
+    """
+
+    def __init__(self, streamlines: Any, **settings: Any):
+        # The first camera is the session's; later frames keep the last one they were given.
+        camera = _camera_settings(settings.pop("camera", None))
+        opening = {**settings, **camera}
+        self._settings = settings
+        if isinstance(streamlines, (str, os.PathLike)):
+            self._native = _lineao.Renderer(opening, path=os.fspath(streamlines))
+        elif streamlines is None:
+            self._native = _lineao.Renderer(opening)  # the built-in `scene`
+        else:
+            t = _tractogram(streamlines)
+            name = getattr(streamlines, "name", None) or "streamlines"
+            self._native = _lineao.Renderer(opening, points=t.points, offsets=t.offsets, lengths=t.lengths, name=str(name))
+
+    def render(self, *, camera: Optional[dict] = None, **settings: Any) -> Image:
+        """One frame with this renderer's settings, `settings` changed for this frame, seen by
+        `camera` (a dict of eye, target, up, fov or ortho; by default the last frame's, at
+        first the view that frames the streamlines)."""
+        merged = {**self._settings, **settings}
+        if camera is not None:
+            whole = {**self.camera, **_camera_settings(camera)}
+            if "ortho" in camera:
+                whole.pop("fov", None)
+            elif "fov" in camera:
+                whole.pop("ortho", None)
+            merged.update(whole)
+        return self._native.render(merged).view(Image)
+
+    def __repr__(self) -> str:
+        streamlines, vertices = self._native.counts()
+        return f"<lineao.Renderer: {streamlines} streamlines, {vertices} vertices on {self.device}>"
+
+    @property
+    def camera(self) -> dict:
+        """The last frame's camera: eye, target, up, and fov (degrees) or ortho (height)."""
+        return self._native.camera()
+
+    @property
+    def device(self) -> str:
+        """The GPU adapter, e.g. ``llvmpipe (LLVM 19.1.7, 256 bits) (Vulkan, Cpu)``."""
+        return self._native.device()
+
+    def orbit(self, n_frames: int, *, degrees: float = 360.0, **settings: Any) -> list:
+        """A turntable: `n_frames` images with the eye turned about the target around the
+        camera's up axis, `degrees` in all (the last frame one step short of a full turn)."""
+        if n_frames < 1:
+            raise ValueError(f"n_frames: expected at least 1, got {n_frames}")
+        start = self.camera
+        settings = dict(settings)
+        camera = _camera_settings(settings.pop("camera", None))
+        start.update(camera)
+        eye, target, up = (np.asarray(start[k], np.float64) for k in ("eye", "target", "up"))
+        axis = up / np.linalg.norm(up)
+        frames = []
+        for i in range(n_frames):
+            angle = math.radians(degrees) * i / n_frames
+            v = eye - target
+            # Rodrigues' rotation of the eye about the axis through the target.
+            rotated = (
+                v * math.cos(angle)
+                + np.cross(axis, v) * math.sin(angle)
+                + axis * np.dot(axis, v) * (1 - math.cos(angle))
+            )
+            camera = {**start, "eye": tuple(target + rotated)}
+            frames.append(self.render(camera=camera, **settings))
+        return frames
+
+
+def render(
+    streamlines: Any,
+    *,
+    method: Optional[str] = None,
+    width: Optional[int] = None,
+    height: Optional[int] = None,
+    camera: Optional[dict] = None,
+    line_width: Optional[float] = None,
+    geometry: Optional[str] = None,
+    color: Any = None,
+    background: Optional[Iterable[float]] = None,
+    **settings: Any,
+) -> Image:
+    """Renders streamlines with ambient occlusion: an (height, width, 4) uint8 sRGB image.
+
+    ``streamlines`` is any container ``Tractogram`` names, a file's path, or None for the
+    built-in ``scene=``. The keyword arguments are ``lineao render``'s options
+    (``lineao.settings()``): None leaves the library's default (method ``"lineao"``, 1280 ×
+    1024, lines 2 px wide, tangent colours on white). ``compare=("lineao", "ssao")`` gives a
+    split screen, ``grid=True`` every method, ``preset="paper"``, ``s_h=…`` a setting; the same
+    settings give the same pixels as the command line. ``color`` is ``"tangent"``,
+    ``(r, g, b)`` in [0, 1] or ``"field:NAME"``. Bad settings raise ``ValueError`` with the
+    library's message; with no Vulkan driver, ``RuntimeError`` says what to install.
+    """
+    if color is not None and not isinstance(color, str):
+        color = ",".join(str(c) for c in color)
+    given = dict(
+        method=method,
+        width=width,
+        height=height,
+        line_width=line_width,
+        geometry=geometry,
+        color=color,
+        background=None if background is None else tuple(background),
+    )
+    settings.update({k: v for k, v in given.items() if v is not None})
+    return Renderer(streamlines, camera=camera, **settings).render()
+
+
+def save_png(image: np.ndarray, path: "os.PathLike[str] | str") -> None:
+    """Writes an (H, W, 4) uint8 image as an sRGB PNG."""
+    image = np.asarray(image)
+    if image.dtype != np.uint8 or image.ndim != 3 or image.shape[2] != 4:
+        raise ValueError(f"image: expected an (H, W, 4) uint8 array, got {image.dtype} {image.shape}")
+    _lineao.png(np.ascontiguousarray(image), os.fspath(path))
+
+
+def settings() -> dict:
+    """``render``'s keyword arguments: name → (help, default), from the command line's
+    definition (the one source of names and defaults)."""
+    return {name: (help, default) for name, help, default in _lineao.settings()}
+
+
+def methods() -> list:
+    """The method names ``render`` accepts, in the grid's order."""
+    return list(_lineao.methods())

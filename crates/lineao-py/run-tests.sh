@@ -1,0 +1,16 @@
+#!/usr/bin/env bash
+# The Python package's tests, from a fresh clone: a virtual environment in target/python-venv
+# (made once), the package built by pip from this checkout into it — in the workspace's target
+# directory and dev profile, so after `cargo test --workspace` only the bindings compile — and
+# pytest, which compares with the `lineao` binary of the same build.
+set -euo pipefail
+cd "$(dirname "$0")"
+root="$(cd ../.. && pwd)"
+venv="$root/target/python-venv"
+[ -x "$venv/bin/python" ] || python3 -m venv "$venv"
+export PATH="$venv/bin:$PATH"   # as `activate` does: the build backend runs `maturin`
+pip=("$venv/bin/pip" install -q --disable-pip-version-check)
+"${pip[@]}" -r tests/requirements.txt
+"${pip[@]}" --no-build-isolation --force-reinstall --no-deps .
+cargo build -q -p lineao-demo --bin lineao
+LINEAO_BIN="$root/target/debug/lineao" "$venv/bin/python" -m pytest -q tests

@@ -1,0 +1,530 @@
+//! `lineao._lineao`: the compiled half of the Python package `lineao` (its Python half,
+//! `python/lineao/__init__.py`, converts nibabel's and DIPY's objects and documents the API).
+//!
+//! - **Loading** hands numpy the loaders' own buffers: a `Vec` becomes an array's memory
+//!   without a copy (the array's `base` is the Rust allocation), and the GIL is released while
+//!   the file is read; the progress callback takes the GIL back every 4 MiB to check for
+//!   Ctrl-C, which cancels the load (`KeyboardInterrupt`).
+//! - **Rendering** parses the keyword arguments as `lineao render`'s command line (the names
+//!   with `_` for `-`), so the methods, settings, defaults and checks are the binary's, and the
+//!   picture is the binary's pixel for pixel: [`Renderer`] holds a `lineao_cli` render session
+//!   (device, geometry on the GPU, one chain per panel) for many frames.
+
+use std::ops::ControlFlow;
+use std::path::PathBuf;
+
+use clap::{Args, FromArgMatches};
+use lineao_cli::cli::RenderArgs;
+use lineao_cli::render::Session;
+use lineao_cli::source::Loaded;
+use lineao_tracts::{Field, Group, Tractogram, ViewHint, VoxelSpace};
+use numpy::ndarray::{Array2, Array3};
+use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
+use pyo3::create_exception;
+use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyTypeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList, PyString, PyTuple};
+
+create_exception!(
+    _lineao,
+    LoadError,
+    PyValueError,
+    "A file could not be loaded or saved: `file`, `offset` (the byte, or None) and `expected` (what the \
+     format requires there, or None) say where and why."
+);
+
+/// The Python exception of a loader's error: `KeyboardInterrupt` for a cancelled load, else a
+/// `LoadError` carrying the file, the byte offset and the expectation.
+fn load_error(py: Python<'_>, error: lineao_tracts::Error) -> PyErr {
+    if matches!(error.kind, lineao_tracts::ErrorKind::Cancelled) {
+        return PyKeyboardInterrupt::new_err(error.to_string());
+    }
+    let expected = match &error.kind {
+        lineao_tracts::ErrorKind::Format { expected, .. } => Some(expected.clone()),
+        _ => None,
+    };
+    let err = LoadError::new_err(error.to_string());
+    let value = err.value(py);
+    // Setting attributes on a fresh exception cannot fail.
+    let _ = value.setattr("file", error.path.display().to_string());
+    let _ = value.setattr("offset", error.kind.offset());
+    let _ = value.setattr("expected", expected);
+    err
+}
+
+/// `Vec<[f32; 3]>` as the flat `Vec<f32>` of its coordinates, in the same allocation.
+fn flatten(points: Vec<[f32; 3]>) -> Vec<f32> {
+    let mut points = std::mem::ManuallyDrop::new(points);
+    let (ptr, len, cap) = (points.as_mut_ptr(), points.len(), points.capacity());
+    // SAFETY: [f32; 3] and f32 have the same alignment, and an allocation of `cap` [f32; 3]
+    // is one of `3 cap` f32 (the same size and layout), so the Vec may own it as f32.
+    unsafe { Vec::from_raw_parts(ptr.cast::<f32>(), 3 * len, 3 * cap) }
+}
+
+/// A field's values as (rows, columns) float32, or (rows,) for one column, without a copy.
+fn field_array<'py>(py: Python<'py>, field: Field, rows: usize) -> PyResult<Bound<'py, PyAny>> {
+    if field.columns == 1 {
+        return Ok(field.values.into_pyarray(py).into_any());
+    }
+    let array = Array2::from_shape_vec((rows, field.columns), field.values)
+        .map_err(|e| PyValueError::new_err(format!("field '{}': {e}", field.name)))?;
+    Ok(array.into_pyarray(py).into_any())
+}
+
+/// Loads `path` with the GIL released; `progress` is None, True (a bar on a terminal) or a
+/// callable(bytes, total). Returns the tractogram's parts as a dict of arrays.
+#[pyfunction]
+#[pyo3(signature = (path, progress = None))]
+fn load<'py>(py: Python<'py>, path: PathBuf, progress: Option<Bound<'py, PyAny>>) -> PyResult<Bound<'py, PyDict>> {
+    // True: a bar on a terminal (as the CLI's, for files over 32 MiB); a callable: called.
+    let wants_bar = progress.as_ref().is_some_and(|p| !p.is_callable() && p.is_truthy().unwrap_or(false));
+    let callback = progress.filter(|p| p.is_callable()).map(Bound::unbind);
+    let bar = if wants_bar { lineao_cli::source::progress_bar(&path) } else { None };
+    let mut interrupted: Option<PyErr> = None;
+    let loaded = py.detach(|| {
+        let mut report = |p: lineao_tracts::Progress| {
+            if let Some(bar) = &bar {
+                bar.set_position(p.bytes);
+            }
+            Python::attach(|py| {
+                let result = py.check_signals().and_then(|()| match &callback {
+                    Some(f) => f.call1(py, (p.bytes, p.total)).map(drop),
+                    None => Ok(()),
+                });
+                match result {
+                    Ok(()) => ControlFlow::Continue(()),
+                    Err(e) => {
+                        interrupted = Some(e);
+                        ControlFlow::Break(())
+                    }
+                }
+            })
+        };
+        lineao_tracts::load_with(&path, &Default::default(), Some(&mut report))
+    });
+    if let Some(bar) = bar {
+        bar.finish_and_clear();
+    }
+    if let Some(e) = interrupted {
+        return Err(e);
+    }
+    let loaded = loaded.map_err(|e| load_error(py, e))?;
+    tractogram_dict(py, loaded.tractogram, loaded.format.name())
+}
+
+/// The parts of `t` as arrays that own the loader's memory (points, offsets, fields).
+fn tractogram_dict<'py>(py: Python<'py>, t: Tractogram, format: &str) -> PyResult<Bound<'py, PyDict>> {
+    let dict = PyDict::new(py);
+    let (n, streamlines) = (t.positions.len(), t.streamlines());
+    let lengths: Vec<i64> = t.offsets.windows(2).map(|w| (w[1] - w[0]) as i64).collect();
+    let mut offsets = t.offsets;
+    offsets.truncate(streamlines);
+    let offsets: Vec<i64> = bytemuck::allocation::cast_vec(offsets);
+    let points = Array2::from_shape_vec((n, 3), flatten(t.positions)).expect("3 coordinates a point");
+    dict.set_item("points", points.into_pyarray(py))?;
+    dict.set_item("offsets", offsets.into_pyarray(py))?;
+    dict.set_item("lengths", lengths.into_pyarray(py))?;
+    let fields = |fields: Vec<Field>, rows: usize| -> PyResult<Bound<'py, PyDict>> {
+        let dict = PyDict::new(py);
+        for field in fields {
+            dict.set_item(field.name.clone(), field_array(py, field, rows)?)?;
+        }
+        Ok(dict)
+    };
+    dict.set_item("vertex_fields", fields(t.vertex_fields, n)?)?;
+    dict.set_item("streamline_fields", fields(t.streamline_fields, streamlines)?)?;
+    let groups = PyDict::new(py);
+    for group in t.groups {
+        groups.set_item(group.name, group.streamlines.into_pyarray(py))?;
+    }
+    dict.set_item("groups", groups)?;
+    if let Some(space) = t.space {
+        let affine = Array2::from_shape_fn((4, 4), |(i, j)| space.affine[i][j]);
+        dict.set_item("affine", affine.into_pyarray(py))?;
+        dict.set_item("dimensions", PyTuple::new(py, space.dimensions)?)?;
+        dict.set_item("voxel_sizes", space.voxel_sizes.map(|v| PyTuple::new(py, v)).transpose()?)?;
+    } else {
+        dict.set_item("affine", py.None())?;
+        dict.set_item("dimensions", py.None())?;
+        dict.set_item("voxel_sizes", py.None())?;
+    }
+    dict.set_item("format", format)?;
+    Ok(dict)
+}
+
+/// `lineao info --json` of `path`, as its JSON text (CONTRACT.md's keys).
+#[pyfunction]
+fn info(py: Python<'_>, path: PathBuf) -> PyResult<String> {
+    let loaded = py.detach(|| lineao_tracts::load(&path)).map_err(|e| load_error(py, e))?;
+    Ok(lineao_cli::info::describe(&loaded).to_string())
+}
+
+/// Streamlines handed over from Python: points (N, 3) float32 C-contiguous, and per
+/// streamline its first point and its length (int64), in any order (nibabel's selections
+/// share points with offsets out of order).
+struct Streamlines<'py> {
+    points: PyReadonlyArray2<'py, f32>,
+    offsets: PyReadonlyArray1<'py, i64>,
+    lengths: PyReadonlyArray1<'py, i64>,
+}
+
+impl<'py> Streamlines<'py> {
+    fn extract(points: &Bound<'py, PyAny>, offsets: &Bound<'py, PyAny>, lengths: &Bound<'py, PyAny>) -> PyResult<Self> {
+        let points: PyReadonlyArray2<'py, f32> = points.extract().map_err(|_| {
+            PyTypeError::new_err("points: expected a 2-D numpy array of float32 (lineao converts other inputs first)")
+        })?;
+        let offsets: PyReadonlyArray1<'py, i64> =
+            offsets.extract().map_err(|_| PyTypeError::new_err("offsets: expected a 1-D numpy array of int64"))?;
+        let lengths: PyReadonlyArray1<'py, i64> =
+            lengths.extract().map_err(|_| PyTypeError::new_err("lengths: expected a 1-D numpy array of int64"))?;
+        if points.shape()[1] != 3 {
+            return Err(PyValueError::new_err(format!("points: expected shape (N, 3), got {:?}", points.shape())));
+        }
+        if !points.is_c_contiguous() {
+            return Err(PyValueError::new_err("points: expected a C-contiguous array"));
+        }
+        if offsets.len() != lengths.len() {
+            let (o, l) = (offsets.len(), lengths.len());
+            return Err(PyValueError::new_err(format!("offsets ({o}) and lengths ({l}) differ in length")));
+        }
+        Ok(Streamlines { points, offsets, lengths })
+    }
+
+    /// The streamlines gathered into a `Tractogram` (the GPU upload and the ray tracer read
+    /// it), checked against the points; called with the GIL released.
+    fn gather(points: &[f32], offsets: &[i64], lengths: &[i64]) -> Result<Tractogram, String> {
+        let n = points.len() / 3;
+        let mut t = Tractogram::new();
+        let total: i64 = lengths.iter().map(|&l| l.max(0)).sum();
+        t.positions.reserve(total.min(n as i64 * 4) as usize);
+        t.offsets.reserve(offsets.len());
+        for (i, (&start, &length)) in offsets.iter().zip(lengths).enumerate() {
+            let end = start.checked_add(length).filter(|&e| start >= 0 && length >= 0 && e <= n as i64);
+            let Some(end) = end else {
+                return Err(format!("streamline {i}: offset {start} and length {length} are outside the {n} points"));
+            };
+            let coords = &points[3 * start as usize..3 * end as usize];
+            t.push(coords.chunks_exact(3).map(|c| [c[0], c[1], c[2]]));
+        }
+        Ok(t)
+    }
+}
+
+/// Saves streamlines (points, offsets, lengths) with their fields, groups and voxel space as
+/// `.tck`, `.trk` or `.trx` (by the extension); returns the names of fields the format dropped.
+#[pyfunction]
+#[pyo3(signature = (path, points, offsets, lengths, vertex_fields, streamline_fields, groups, affine=None, dimensions=None, voxel_sizes=None))]
+#[allow(clippy::too_many_arguments)]
+fn save(
+    py: Python<'_>,
+    path: PathBuf,
+    points: &Bound<'_, PyAny>,
+    offsets: &Bound<'_, PyAny>,
+    lengths: &Bound<'_, PyAny>,
+    vertex_fields: &Bound<'_, PyDict>,
+    streamline_fields: &Bound<'_, PyDict>,
+    groups: &Bound<'_, PyDict>,
+    affine: Option<PyReadonlyArray2<'_, f64>>,
+    dimensions: Option<[u32; 3]>,
+    voxel_sizes: Option<[f32; 3]>,
+) -> PyResult<Vec<String>> {
+    let lines = Streamlines::extract(points, offsets, lengths)?;
+    let (p, o, l) = (lines.points.as_slice()?, lines.offsets.as_slice()?, lines.lengths.as_slice()?);
+    let mut t = py.detach(|| Streamlines::gather(p, o, l)).map_err(PyValueError::new_err)?;
+    let field = |name: String, values: &Bound<'_, PyAny>, rows: usize, what: &str| -> PyResult<Field> {
+        let values: numpy::PyReadonlyArrayDyn<'_, f32> = values
+            .extract()
+            .map_err(|_| PyTypeError::new_err(format!("{what} '{name}': expected a float32 numpy array")))?;
+        let columns = if values.ndim() == 1 { 1 } else { values.shape()[1] };
+        if values.ndim() > 2 || values.shape()[0] != rows {
+            let shape = values.shape().to_vec();
+            return Err(PyValueError::new_err(format!("{what} '{name}': expected {rows} rows, got shape {shape:?}")));
+        }
+        Ok(Field { name, columns, values: values.as_array().iter().copied().collect() })
+    };
+    for (name, values) in vertex_fields {
+        t.vertex_fields.push(field(name.extract()?, &values, t.positions.len(), "vertex field")?);
+    }
+    for (name, values) in streamline_fields {
+        t.streamline_fields.push(field(name.extract()?, &values, t.streamlines(), "streamline field")?);
+    }
+    for (name, members) in groups {
+        let members: Vec<u32> = members.extract()?;
+        t.groups.push(Group { name: name.extract()?, streamlines: members, data: Vec::new() });
+    }
+    if let (Some(affine), Some(dimensions)) = (affine, dimensions) {
+        let a = affine.as_array();
+        if a.shape() != [4, 4] {
+            return Err(PyValueError::new_err(format!("affine: expected shape (4, 4), got {:?}", a.shape())));
+        }
+        let affine = std::array::from_fn(|i| std::array::from_fn(|j| a[[i, j]]));
+        t.space = Some(VoxelSpace { affine, dimensions, voxel_sizes });
+    }
+    py.detach(|| lineao_tracts::save(&t, &path)).map_err(|e| load_error(py, e))
+}
+
+/// `render`'s command line from keyword arguments: `line_width=2.0` → `--line-width 2.0`,
+/// `grid=True` → `--grid`, `compare=("lineao", "ssao")` → `--compare lineao,ssao`, `None` and
+/// `False` → left out. Unknown names are a `TypeError` that lists the known ones.
+fn argv(settings: &Bound<'_, PyDict>) -> PyResult<Vec<String>> {
+    let command = RenderArgs::augment_args(clap::Command::new("render"));
+    let mut argv = vec!["render".to_string()];
+    for (key, value) in settings {
+        let key: String = key.extract()?;
+        let Some(arg) = command.get_arguments().find(|a| a.get_id() == key.as_str() && a.get_long().is_some()) else {
+            let known: Vec<&str> = settings_names(&command).collect();
+            return Err(PyTypeError::new_err(format!(
+                "unexpected keyword argument '{key}'; the settings are: {}",
+                known.join(", ")
+            )));
+        };
+        let flag = format!("--{}", arg.get_long().expect("found with a long name"));
+        let is_switch = matches!(arg.get_action(), clap::ArgAction::SetTrue);
+        if value.is_none() {
+            continue;
+        }
+        if is_switch {
+            let on: bool = value
+                .extract()
+                .map_err(|_| PyTypeError::new_err(format!("{key}: expected True or False, got {value}")))?;
+            if on {
+                argv.push(flag);
+            }
+            continue;
+        }
+        let text = if value.is_instance_of::<PyString>() {
+            value.extract::<String>()?
+        } else if let Ok(items) = value
+            .cast::<PyTuple>()
+            .map(|t| t.as_any().clone())
+            .or_else(|_| value.cast::<PyList>().map(|l| l.as_any().clone()))
+        {
+            let items: Vec<String> =
+                items.try_iter()?.map(|x| x.and_then(|x| x.str().map(|s| s.to_string()))).collect::<PyResult<_>>()?;
+            items.join(",")
+        } else {
+            value.str()?.to_string()
+        };
+        argv.push(flag);
+        argv.push(text);
+    }
+    Ok(argv)
+}
+
+/// The keyword arguments `render` takes: `render`'s options, less the input and the output
+/// file (Python passes the streamlines and gets the image back).
+fn settings_names(command: &clap::Command) -> impl Iterator<Item = &str> {
+    command
+        .get_arguments()
+        .filter(|a| a.get_long().is_some() && !matches!(a.get_id().as_str(), "output" | "help"))
+        .map(|a| a.get_id().as_str())
+}
+
+/// `render`'s arguments from `argv`, or a `ValueError` with clap's message (the bad value,
+/// what is allowed) with the flag named as the keyword argument.
+fn parse(argv: &[String]) -> PyResult<RenderArgs> {
+    let command = RenderArgs::augment_args(clap::Command::new("render").no_binary_name(false));
+    let matches = command.try_get_matches_from(argv).map_err(|e| PyValueError::new_err(clap_message(&e)))?;
+    RenderArgs::from_arg_matches(&matches).map_err(|e| PyValueError::new_err(clap_message(&e)))
+}
+
+fn clap_message(e: &clap::Error) -> String {
+    let text = e.render().to_string();
+    let first = text.lines().next().unwrap_or("invalid settings").trim_start_matches("error: ");
+    first.to_string()
+}
+
+/// The settings `render` takes, each as (name, help, default): for the Python docs and
+/// `lineao.settings()`, read from the command line's definition.
+#[pyfunction]
+fn settings() -> Vec<(String, String, Option<String>)> {
+    let command = RenderArgs::augment_args(clap::Command::new("render"));
+    let names: Vec<String> = settings_names(&command).map(str::to_string).collect();
+    names
+        .into_iter()
+        .filter_map(|name| {
+            let arg = command.get_arguments().find(|a| a.get_id().as_str() == name)?;
+            let help = arg.get_help().map(|h| h.to_string()).unwrap_or_default();
+            let default = arg.get_default_values().first().map(|d| d.to_string_lossy().into_owned());
+            Some((name, help, default))
+        })
+        .collect()
+}
+
+/// The method names `render` accepts (`method=`, `compare=`): the screen-space ones (the
+/// ray-traced truth among them), then the object-space ones and their sums with LineAO.
+#[pyfunction]
+fn methods() -> Vec<String> {
+    let screen = lineao::AoMethod::ALL.into_iter().chain([lineao::AoMethod::RayTraced]);
+    let mut names: Vec<String> = screen.map(|m| m.name().to_string()).collect();
+    for method in lineao_cli::cli::Method::ALL {
+        if !names.contains(&method.name()) {
+            names.push(method.name());
+        }
+    }
+    names
+}
+
+/// A render session: the device, the streamlines on the GPU and one chain per panel, kept
+/// for many frames. Made by `lineao.Renderer`; `render(settings)` returns (H, W, 4) uint8.
+#[pyclass(module = "lineao._lineao")]
+struct Renderer {
+    session: Session,
+    chains: Vec<lineao::AoChain>,
+    /// What the session was opened with: what later frames may not change.
+    opened: RenderArgs,
+}
+
+/// A `RuntimeError` with the whole chain of causes (`lineao: error: …` on the command line),
+/// or a `ValueError` for settings the library refuses.
+fn render_error(e: anyhow::Error) -> PyErr {
+    let text = format!("{e:#}");
+    if e.chain().any(|c| matches!(c.downcast_ref::<lineao::Error>(), Some(lineao::Error::InvalidSettings(_)))) {
+        PyValueError::new_err(text)
+    } else {
+        PyRuntimeError::new_err(text)
+    }
+}
+
+#[pymethods]
+impl Renderer {
+    /// Opens a session on `path` (a file `lineao info` reads; None: the built-in `scene`) or on
+    /// streamlines (points, offsets, lengths) named `name`, with `settings` (a dict of
+    /// render's keyword arguments). Device and upload run with the GIL released.
+    #[new]
+    #[pyo3(signature = (settings, path=None, points=None, offsets=None, lengths=None, name="streamlines".to_string()))]
+    fn new(
+        py: Python<'_>,
+        settings: &Bound<'_, PyDict>,
+        path: Option<PathBuf>,
+        points: Option<&Bound<'_, PyAny>>,
+        offsets: Option<&Bound<'_, PyAny>>,
+        lengths: Option<&Bound<'_, PyAny>>,
+        name: String,
+    ) -> PyResult<Renderer> {
+        let mut argv = argv(settings)?;
+        if let Some(path) = &path {
+            argv.push(path.display().to_string());
+        }
+        let args = parse(&argv)?;
+        let session = match (points, offsets, lengths) {
+            (Some(points), Some(offsets), Some(lengths)) => {
+                let lines = Streamlines::extract(points, offsets, lengths)?;
+                let (p, o, l) = (lines.points.as_slice()?, lines.offsets.as_slice()?, lines.lengths.as_slice()?);
+                py.detach(|| -> PyResult<Session> {
+                    let tracts = Streamlines::gather(p, o, l).map_err(PyValueError::new_err)?;
+                    if !tracts.positions.iter().flatten().any(|c| c.is_finite()) {
+                        return Err(PyValueError::new_err(format!("{name} has no finite points")));
+                    }
+                    let hint = ViewHint::for_tractogram(&tracts);
+                    Session::with_loaded(&args, Loaded { name, tracts, hint }).map_err(render_error)
+                })?
+            }
+            _ => py.detach(|| Session::open(&args)).map_err(|e| {
+                match e.downcast::<lineao_cli::source::SourceError>() {
+                    Ok(lineao_cli::source::SourceError::Load(load)) => load_error(py, load),
+                    Ok(other) => render_error(other.into()),
+                    Err(e) => render_error(e),
+                }
+            })?,
+        };
+        Ok(Renderer { session, chains: Vec::new(), opened: args })
+    }
+
+    /// Renders with `settings` (the session's, with a camera or methods of this frame): the
+    /// picture as (height, width, 4) uint8, sRGB with alpha.
+    fn render<'py>(&mut self, py: Python<'py>, settings: &Bound<'py, PyDict>) -> PyResult<Bound<'py, PyAny>> {
+        let mut args = parse(&argv(settings)?)?;
+        args.file.clone_from(&self.opened.file);
+        let same = |a: &RenderArgs| {
+            let field = match &a.color {
+                lineao_cli::cli::ColorArg::Field(name) => Some(name.clone()),
+                _ => None,
+            };
+            (a.surfaces.clone(), a.tube_radius_field.clone(), field, a.scene, a.vertices, a.seed, a.file.clone())
+        };
+        if same(&args) != same(&self.opened) {
+            return Err(PyValueError::new_err(
+                "surfaces, tube_radius_field, a colour field and the scene are set when the Renderer is made",
+            ));
+        }
+        // A frame without a camera keeps the last one (Python passes whole cameras).
+        if args.eye.is_some()
+            || args.target.is_some()
+            || args.up.is_some()
+            || args.fov.is_some()
+            || args.ortho.is_some()
+        {
+            let hint = self.session.lines.hint;
+            self.session.camera = lineao_cli::render::camera(&args, &hint).map_err(render_error)?;
+        }
+        self.session.sky = lineao_cli::render::sky(&args, self.session.camera.up);
+        let (session, chains) = (&mut self.session, &mut self.chains);
+        let (image, _) = py.detach(|| session.compose(&args, chains)).map_err(render_error)?;
+        let (w, h) = (image.width as usize, image.height as usize);
+        let array = Array3::from_shape_vec((h, w, 4), image.data).expect("4 bytes a pixel");
+        Ok(array.into_pyarray(py).into_any())
+    }
+
+    /// The camera of the last frame: eye, target, up, and fov (degrees) or ortho (height).
+    fn camera<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let camera = &self.session.camera;
+        let dict = PyDict::new(py);
+        dict.set_item("eye", PyTuple::new(py, camera.eye.to_array())?)?;
+        dict.set_item("target", PyTuple::new(py, camera.target.to_array())?)?;
+        dict.set_item("up", PyTuple::new(py, camera.up.to_array())?)?;
+        match camera.projection {
+            lineao::camera::Projection::Perspective { fov_y_deg } => dict.set_item("fov", fov_y_deg)?,
+            lineao::camera::Projection::Orthographic { height } => dict.set_item("ortho", height)?,
+        }
+        Ok(dict)
+    }
+
+    /// The adapter the session renders on, e.g. "llvmpipe (LLVM 19.1.7, 256 bits) (Vulkan, Cpu)".
+    fn device(&self) -> String {
+        self.session.gpu.describe()
+    }
+
+    /// Streamlines and vertices on the GPU.
+    fn counts(&self) -> (usize, usize) {
+        (self.session.lines.geometry.streamlines, self.session.lines.geometry.vertices)
+    }
+}
+
+/// Writes `image` ((H, W, 4) uint8) as an sRGB PNG at `path`, or returns the PNG's bytes when
+/// `path` is None.
+#[pyfunction]
+#[pyo3(name = "png", signature = (image, path=None))]
+fn encode_png(
+    py: Python<'_>,
+    image: numpy::PyReadonlyArray3<'_, u8>,
+    path: Option<PathBuf>,
+) -> PyResult<Option<Vec<u8>>> {
+    let shape = image.shape();
+    if shape[2] != 4 {
+        return Err(PyValueError::new_err(format!("image: expected shape (height, width, 4), got {shape:?}")));
+    }
+    let (h, w) = (shape[0] as u32, shape[1] as u32);
+    let bytes: Vec<u8> = match image.as_slice() {
+        Ok(bytes) => bytes.to_vec(),
+        Err(_) => image.as_array().iter().copied().collect(),
+    };
+    py.detach(|| match path {
+        Some(path) => lineao_cli::output::write_png(&path, w, h, &bytes).map(|()| None),
+        None => lineao_cli::output::encode_png(w, h, &bytes).map(Some),
+    })
+    .map_err(|e| PyRuntimeError::new_err(format!("{e:#}")))
+}
+
+#[pymodule]
+fn _lineao(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("LoadError", m.py().get_type::<LoadError>())?;
+    m.add_function(wrap_pyfunction!(load, m)?)?;
+    m.add_function(wrap_pyfunction!(info, m)?)?;
+    m.add_function(wrap_pyfunction!(save, m)?)?;
+    m.add_function(wrap_pyfunction!(settings, m)?)?;
+    m.add_function(wrap_pyfunction!(methods, m)?)?;
+    m.add_function(wrap_pyfunction!(encode_png, m)?)?;
+    m.add_class::<Renderer>()?;
+    Ok(())
+}

@@ -1,0 +1,168 @@
+"""lineao.render and Renderer: the command line's picture pixel for pixel (its PNG read back
+by Pillow), from every container a script has, without copies of nibabel's memory."""
+
+import os
+import subprocess
+import sys
+import tracemalloc
+
+import nibabel as nib
+import numpy as np
+import pytest
+from PIL import Image as PilImage
+
+import lineao
+from conftest import DATA
+
+TRK = DATA / "dipy+dipy/dipy/data/files/tracks300.trk"
+SMALL = dict(width=320, height=256)
+
+
+def cli_render(lineao_bin, tmp_path, *args):
+    out = tmp_path / "cli.png"
+    subprocess.run([str(lineao_bin), "render", *map(str, args), "-o", str(out)], check=True, capture_output=True)
+    return np.asarray(PilImage.open(out).convert("RGBA"))
+
+
+def test_render_equals_the_command_line_pixel_for_pixel(lineao_bin, tmp_path):
+    expected = cli_render(lineao_bin, tmp_path, TRK, "--width", 320, "--height", 256, "--line-width", 3)
+    for streamlines in (TRK, lineao.load(TRK), nib.streamlines.load(str(TRK)), nib.streamlines.load(str(TRK)).streamlines):
+        image = lineao.render(streamlines, line_width=3, **SMALL)
+        assert isinstance(image, lineao.Image) and image.shape == (256, 320, 4) and image.dtype == np.uint8
+        assert (image != expected).sum() == 0, type(streamlines).__name__
+    # The picture is not blank: lines over the white background, shaded by AO.
+    assert (expected[..., :3] < 200).any(axis=2).mean() > 0.02
+
+
+def test_settings_compare_and_grid_are_the_command_lines(lineao_bin, tmp_path):
+    t = lineao.load(TRK)
+    compare = lineao.render(t, compare=("lineao", "ssao"), preset="paper", s_h=4, **SMALL)
+    expected = cli_render(
+        lineao_bin, tmp_path, TRK, "--compare", "lineao,ssao", "--preset", "paper", "--s-h", 4, "--width", 320, "--height", 256
+    )
+    assert (compare != expected).sum() == 0
+    grid = lineao.render(t, grid=True, width=96, height=80)
+    expected = cli_render(lineao_bin, tmp_path, TRK, "--grid", "--width", 96, "--height", 80)
+    assert grid.shape == expected.shape and (grid != expected).sum() == 0
+    coloured = lineao.render(t, color=(0.8, 0.2, 0.1), background=(0, 0, 0), method="vo-line", **SMALL)
+    expected = cli_render(
+        lineao_bin, tmp_path, TRK, "--color", "0.8,0.2,0.1", "--background", "0,0,0", "--method", "vo-line", "--width", 320, "--height", 256
+    )
+    assert (coloured != expected).sum() == 0
+
+
+def test_names_and_defaults_come_from_the_library():
+    settings = lineao.settings()
+    assert settings["width"][1] == "1280" and settings["line_width"][1] == "2"
+    assert settings["method"][1] == "lineao" and "s_h" in settings and "output" not in settings
+    assert {"lineao", "ssao", "vo-line", "raytraced", "sweep", "lineao+sweep"} <= set(lineao.methods())
+
+
+def test_a_renderer_keeps_its_session_for_many_frames():
+    t = lineao.load(TRK)
+    r = lineao.Renderer(t, **SMALL)
+    first, again = r.render(), r.render()
+    assert (first != again).sum() == 0
+    camera = r.camera
+    assert set(camera) == {"eye", "target", "up", "fov"}
+    closer = {**camera, "eye": tuple(np.add(camera["target"], np.subtract(camera["eye"], camera["target"]) * 0.5))}
+    near = r.render(camera=closer)
+    assert (near != first).any(axis=2).mean() > 0.05
+    assert r.camera["eye"] == pytest.approx(closer["eye"])
+    frames = r.orbit(4)
+    assert len(frames) == 4 and (frames[0] != near).sum() == 0
+    assert all((a != b).any(axis=2).mean() > 0.05 for a, b in zip(frames, frames[1:]))
+    # A frame may change the method; not what the session was opened with.
+    assert r.render(method="ssao").shape == first.shape
+    with pytest.raises(ValueError, match="set when the Renderer is made"):
+        r.render(color="field:fa")
+
+
+def test_an_out_of_order_selection_renders_as_its_streamlines():
+    seq = nib.streamlines.load(str(TRK)).streamlines
+    selection = seq[[200, 3, 100, 7]]
+    assert selection._data is seq._data and selection._offsets[0] > selection._offsets[1]
+    a = lineao.render(selection, **SMALL)
+    b = lineao.render([np.asarray(s, np.float64) for s in selection], **SMALL)
+    assert (a != b).sum() == 0
+
+
+def test_a_nibabel_array_sequence_is_read_in_place():
+    """No copy on the Python side: numpy's allocations during render (traced by tracemalloc)
+    stay far below the 12 MB of points."""
+    rng = np.random.default_rng(3)
+    n, length = 10_000, 100
+    steps = rng.normal(scale=0.5, size=(n, length, 3)).astype(np.float32)
+    points = (np.cumsum(steps, axis=1) + rng.uniform(-50, 50, size=(n, 1, 3)).astype(np.float32)).reshape(-1, 3)
+    seq = nib.streamlines.ArraySequence()
+    seq._data, seq._offsets, seq._lengths = points, np.arange(n) * length, np.full(n, length)
+    tracemalloc.start()
+    image = lineao.render(seq, width=64, height=48)
+    _, peak = tracemalloc.get_traced_memory()
+    tracemalloc.stop()
+    assert image.shape == (48, 64, 4)
+    assert peak < 0.05 * points.nbytes, f"{peak} bytes traced for {points.nbytes} bytes of points"
+
+
+def test_dipy_stateful_tractograms_are_rendered_in_ras_mm():
+    from dipy.io.stateful_tractogram import Space, StatefulTractogram
+
+    seq = nib.streamlines.load(str(TRK))
+    reference = str(TRK)
+    in_mm = StatefulTractogram(seq.streamlines, reference, Space.RASMM)
+    expected = lineao.render(seq.streamlines, **SMALL)
+    assert (lineao.render(in_mm, **SMALL) != expected).sum() == 0
+    in_voxels = StatefulTractogram(seq.streamlines, reference, Space.RASMM)
+    in_voxels.to_vox()
+    got = lineao.render(in_voxels, **SMALL)
+    assert in_voxels.space == Space.VOX, "the caller's object is left as it was"
+    # Voxel → mm and back in float32: a few pixels may round differently.
+    assert (got != expected).any(axis=2).mean() < 0.002
+
+
+def test_bad_input_names_the_argument(tmp_path):
+    with pytest.raises(ValueError, match=r"points: expected shape \(N, 3\)"):
+        lineao.render(np.zeros((10, 2), np.float32))
+    with pytest.raises(TypeError, match="points"):
+        lineao.render(np.array([["a", "b", "c"]]))
+    with pytest.raises(TypeError, match="unexpected keyword argument 'linewidth'"):
+        lineao.render(lineao.load(TRK), linewidth=3)
+    with pytest.raises(ValueError, match="width"):
+        lineao.render(lineao.load(TRK), width=0)
+    with pytest.raises(ValueError, match="unknown method 'bogus'"):
+        lineao.render(lineao.load(TRK), method="bogus")
+    with pytest.raises(ValueError, match="no finite points"):
+        lineao.render([])
+    with pytest.raises(ValueError, match="outside the"):
+        lineao.render(lineao.Tractogram(np.zeros((4, 3), np.float32), [2], [5]))
+    with pytest.raises(lineao.LoadError):
+        lineao.render(tmp_path / "missing.trk")
+    with pytest.raises(ValueError, match="image"):
+        lineao.save_png(np.zeros((4, 4, 3), np.uint8), tmp_path / "x.png")
+
+
+def test_strided_and_float64_points_are_copied_by_the_rule():
+    t = lineao.load(TRK)
+    wide = np.zeros((len(t.points), 6), np.float64)
+    wide[:, ::2] = t.points
+    strided = wide[:, ::2]
+    assert not strided.flags["C_CONTIGUOUS"]
+    converted = lineao.Tractogram(strided, t.offsets, t.lengths)
+    assert converted.points.flags["C_CONTIGUOUS"] and converted.points.dtype == np.float32
+    assert (lineao.render(converted, **SMALL) != lineao.render(t, **SMALL)).sum() == 0
+
+
+def test_images_save_and_show_as_png(tmp_path):
+    image = lineao.render(lineao.load(TRK), width=64, height=48)
+    lineao.save_png(image, tmp_path / "x.png")
+    assert (np.asarray(PilImage.open(tmp_path / "x.png").convert("RGBA")) == image).all()
+    png = image._repr_png_()
+    assert png.startswith(b"\x89PNG") and len(png) > 100
+
+
+def test_without_a_vulkan_driver_render_says_what_to_install():
+    env = {**os.environ, "WGPU_BACKEND": "vulkan", "VK_ICD_FILENAMES": "/nonexistent.json", "VK_DRIVER_FILES": "/nonexistent.json"}
+    code = "import lineao, numpy as np; lineao.render([np.eye(3)])"
+    result = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    assert result.returncode == 1, result.stderr
+    assert "RuntimeError" in result.stderr and "mesa-vulkan-drivers" in result.stderr, result.stderr
