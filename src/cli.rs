@@ -90,7 +90,7 @@ impl ScoreMethod {
     }
 }
 
-fn parse_score_method(s: &str) -> Result<ScoreMethod, String> {
+pub fn parse_score_method(s: &str) -> Result<ScoreMethod, String> {
     ScoreMethod::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| {
         let names: Vec<_> = ScoreMethod::ALL.iter().map(|m| m.name()).collect();
         format!("unknown method '{s}' (one of {})", names.join(", "))

@@ -292,21 +292,27 @@ fn argv(settings: &Bound<'_, PyDict>) -> PyResult<Vec<String>> {
             }
             continue;
         }
-        let text = if value.is_instance_of::<PyString>() {
-            value.extract::<String>()?
-        } else if let Ok(items) = value
-            .cast::<PyTuple>()
-            .map(|t| t.as_any().clone())
-            .or_else(|_| value.cast::<PyList>().map(|l| l.as_any().clone()))
-        {
-            let items: Vec<String> =
-                items.try_iter()?.map(|x| x.and_then(|x| x.str().map(|s| s.to_string()))).collect::<PyResult<_>>()?;
-            items.join(",")
+        let items: Option<Vec<String>> = if value.is_instance_of::<PyString>() {
+            None
+        } else if value.is_instance_of::<PyTuple>() || value.is_instance_of::<PyList>() {
+            let items = value.try_iter()?.map(|x| x.and_then(|x| x.str().map(|s| s.to_string())));
+            Some(items.collect::<PyResult<_>>()?)
         } else {
-            value.str()?.to_string()
+            None
         };
-        argv.push(flag);
-        argv.push(text);
+        match items {
+            // An option given several times (`surfaces=[a, b]` → `--surface a --surface b`).
+            Some(items)
+                if matches!(arg.get_action(), clap::ArgAction::Append) && arg.get_value_delimiter().is_none() =>
+            {
+                for item in items {
+                    argv.extend([flag.clone(), item]);
+                }
+            }
+            // A value of several numbers or names (`background=(0, 0, 0)` → `0,0,0`).
+            Some(items) => argv.extend([flag, items.join(",")]),
+            None => argv.extend([flag, value.str()?.to_string()]),
+        }
     }
     Ok(argv)
 }
@@ -434,6 +440,70 @@ impl Renderer {
     /// Renders with `settings` (the session's, with a camera or methods of this frame): the
     /// picture as (height, width, 4) uint8, sRGB with alpha.
     fn render<'py>(&mut self, py: Python<'py>, settings: &Bound<'py, PyDict>) -> PyResult<Bound<'py, PyAny>> {
+        let args = self.frame_args(settings)?;
+        let (session, chains) = (&mut self.session, &mut self.chains);
+        let (image, _) = py.detach(|| session.compose(&args, chains)).map_err(render_error)?;
+        let (w, h) = (image.width as usize, image.height as usize);
+        let array = Array3::from_shape_vec((h, w, 4), image.data).expect("4 bytes a pixel");
+        Ok(array.into_pyarray(py).into_any())
+    }
+
+    /// `lineao score --json` on this session's view: each of `methods` (None: all) against
+    /// the ray-traced truth, as the JSON text of CONTRACT.md's `score --json`.
+    #[pyo3(signature = (settings, methods=None))]
+    fn score(
+        &mut self,
+        py: Python<'_>,
+        settings: &Bound<'_, PyDict>,
+        methods: Option<Vec<String>>,
+    ) -> PyResult<String> {
+        let args = self.frame_args(settings)?;
+        let methods = match methods {
+            None => lineao_cli::cli::ScoreMethod::ALL.to_vec(),
+            Some(names) => names
+                .iter()
+                .map(|n| {
+                    lineao_cli::cli::parse_score_method(n).map_err(|e| PyValueError::new_err(format!("methods: {e}")))
+                })
+                .collect::<PyResult<_>>()?,
+        };
+        let session = &self.session;
+        py.detach(|| {
+            let report = lineao_cli::score::score(session, &args, &methods)?;
+            anyhow::Ok(lineao_cli::score::to_json(session, &args, &report).to_string())
+        })
+        .map_err(render_error)
+    }
+
+    /// The camera of the last frame: eye, target, up, and fov (degrees) or ortho (height).
+    fn camera<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let camera = &self.session.camera;
+        let dict = PyDict::new(py);
+        dict.set_item("eye", PyTuple::new(py, camera.eye.to_array())?)?;
+        dict.set_item("target", PyTuple::new(py, camera.target.to_array())?)?;
+        dict.set_item("up", PyTuple::new(py, camera.up.to_array())?)?;
+        match camera.projection {
+            lineao::camera::Projection::Perspective { fov_y_deg } => dict.set_item("fov", fov_y_deg)?,
+            lineao::camera::Projection::Orthographic { height } => dict.set_item("ortho", height)?,
+        }
+        Ok(dict)
+    }
+
+    /// The adapter the session renders on, e.g. "llvmpipe (LLVM 19.1.7, 256 bits) (Vulkan, Cpu)".
+    fn device(&self) -> String {
+        self.session.gpu.describe()
+    }
+
+    /// Streamlines and vertices on the GPU.
+    fn counts(&self) -> (usize, usize) {
+        (self.session.lines.geometry.streamlines, self.session.lines.geometry.vertices)
+    }
+}
+
+impl Renderer {
+    /// A frame's arguments from `settings`, checked against what the session was opened with;
+    /// the session's camera (when they name one) and sky follow them.
+    fn frame_args(&mut self, settings: &Bound<'_, PyDict>) -> PyResult<RenderArgs> {
         let mut args = parse(&argv(settings)?)?;
         args.file.clone_from(&self.opened.file);
         let same = |a: &RenderArgs| {
@@ -459,35 +529,7 @@ impl Renderer {
             self.session.camera = lineao_cli::render::camera(&args, &hint).map_err(render_error)?;
         }
         self.session.sky = lineao_cli::render::sky(&args, self.session.camera.up);
-        let (session, chains) = (&mut self.session, &mut self.chains);
-        let (image, _) = py.detach(|| session.compose(&args, chains)).map_err(render_error)?;
-        let (w, h) = (image.width as usize, image.height as usize);
-        let array = Array3::from_shape_vec((h, w, 4), image.data).expect("4 bytes a pixel");
-        Ok(array.into_pyarray(py).into_any())
-    }
-
-    /// The camera of the last frame: eye, target, up, and fov (degrees) or ortho (height).
-    fn camera<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let camera = &self.session.camera;
-        let dict = PyDict::new(py);
-        dict.set_item("eye", PyTuple::new(py, camera.eye.to_array())?)?;
-        dict.set_item("target", PyTuple::new(py, camera.target.to_array())?)?;
-        dict.set_item("up", PyTuple::new(py, camera.up.to_array())?)?;
-        match camera.projection {
-            lineao::camera::Projection::Perspective { fov_y_deg } => dict.set_item("fov", fov_y_deg)?,
-            lineao::camera::Projection::Orthographic { height } => dict.set_item("ortho", height)?,
-        }
-        Ok(dict)
-    }
-
-    /// The adapter the session renders on, e.g. "llvmpipe (LLVM 19.1.7, 256 bits) (Vulkan, Cpu)".
-    fn device(&self) -> String {
-        self.session.gpu.describe()
-    }
-
-    /// Streamlines and vertices on the GPU.
-    fn counts(&self) -> (usize, usize) {
-        (self.session.lines.geometry.streamlines, self.session.lines.geometry.vertices)
+        Ok(args)
     }
 }
 

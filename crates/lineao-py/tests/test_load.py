@@ -210,3 +210,20 @@ def test_ctrl_c_interrupts_a_long_load(tmp_path):
     with pytest.raises(KeyboardInterrupt):
         lineao.load(big, progress=slow)
     assert len(calls) < 8, f"the load stopped at the next report, not after {len(calls)}"
+
+
+@pytest.mark.parametrize("path", data_files(""), ids=lambda p: str(p.relative_to(DATA)))
+def test_every_shared_file_loads_or_is_a_load_error(path):
+    """Every file of ../shared/data, tractogram or not: a Tractogram whose counts are what
+    `info` says, or a LoadError naming the file — never another exception or a crash."""
+    try:
+        t = lineao.load(path)
+    except lineao.LoadError as error:
+        assert error.file == str(path)
+        return
+    facts = lineao.info(path)
+    assert int(t.lengths.sum()) == facts["vertices"] and len(t) == facts["streamlines"]
+    if path.suffix == ".tsf":  # values without points: the offsets index the values
+        assert len(t.points) == 0 and all(len(v) == facts["vertices"] for v in t.vertex_fields.values())
+    else:
+        assert t.points.shape == (facts["vertices"], 3)

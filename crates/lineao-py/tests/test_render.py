@@ -166,3 +166,42 @@ def test_without_a_vulkan_driver_render_says_what_to_install():
     result = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
     assert result.returncode == 1, result.stderr
     assert "RuntimeError" in result.stderr and "mesa-vulkan-drivers" in result.stderr, result.stderr
+
+
+def test_score_is_the_command_lines_json(lineao_bin):
+    import json
+
+    args = ["--width", "160", "--height", "128", "--rays", "16"]
+    cli = subprocess.run(
+        [str(lineao_bin), "score", str(TRK), *args, "--methods", "lineao,vo-line", "--json"],
+        check=True,
+        capture_output=True,
+        text=True,
+    )
+    expected = json.loads(cli.stdout)
+    got = lineao.score(lineao.load(TRK), ["lineao", "vo-line"], width=160, height=128, rays=16)
+    assert got["methods"] == expected["methods"] and got["geometry_pixels"] == expected["geometry_pixels"]
+    with pytest.raises(ValueError, match="methods: unknown method 'bogus'"):
+        lineao.score(TRK, ["bogus"])
+
+
+def test_renders_and_loads_release_the_gil(tmp_path):
+    """While another thread is inside render (or load), this thread keeps running Python: a
+    call that held the GIL would stop it for the whole call (one or two ticks in all)."""
+    import threading
+    import time
+
+    big = tmp_path / "big.tck"
+    rng = np.random.default_rng(4)
+    lineao.save([np.cumsum(rng.normal(size=(200, 3)), axis=0).astype(np.float32) for _ in range(20000)], big)
+    for work in (lambda: lineao.render(big, width=320, height=256), lambda: lineao.load(big, progress=True)):
+        ticks, done = 0, threading.Event()
+        thread = threading.Thread(target=lambda: (work(), done.set()))
+        start = time.perf_counter()
+        thread.start()
+        while not done.is_set():
+            ticks += 1
+            done.wait(0.001)
+        thread.join()
+        ms = (time.perf_counter() - start) * 1e3
+        assert ticks > max(5, 0.2 * ms / 1.0) * 0.5, f"only {ticks} ticks in the other thread's {ms:.0f} ms"

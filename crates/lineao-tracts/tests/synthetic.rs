@@ -375,16 +375,27 @@ fn unwritable_formats_and_value_only_files_are_clear_errors() {
     assert!(!dir.path().join("x.tck").exists(), "nothing half-written");
 }
 
-#[test]
-fn progress_reports_bytes_of_the_file_up_to_its_size() {
-    let dir = tempfile::tempdir().unwrap();
+/// 500 000 vertices (several progress reports) as .tck, .trk and .trx in `dir`.
+fn big_files(dir: &Path) -> Vec<PathBuf> {
     let mut t = Tractogram::new();
     for i in 0..5000 {
         t.push((0..100).map(|k| [i as f32, k as f32, 0.5]));
     }
-    for ext in ["tck", "trk", "trx"] {
-        let p = dir.path().join(format!("big.{ext}"));
-        save(&t, &p).unwrap();
+    ["tck", "trk", "trx"]
+        .iter()
+        .map(|ext| {
+            let p = dir.join(format!("big.{ext}"));
+            save(&t, &p).unwrap();
+            p
+        })
+        .collect()
+}
+
+#[test]
+fn progress_reports_bytes_of_the_file_up_to_its_size() {
+    let dir = tempfile::tempdir().unwrap();
+    for p in big_files(dir.path()) {
+        let ext = p.extension().unwrap().to_string_lossy().to_string();
         let len = std::fs::metadata(&p).unwrap().len();
         let mut seen = Vec::new();
         let mut report = |p: lineao_tracts::Progress| {
@@ -405,13 +416,8 @@ fn progress_reports_bytes_of_the_file_up_to_its_size() {
 #[test]
 fn a_progress_callback_cancels_the_load_after_its_first_report() {
     let dir = tempfile::tempdir().unwrap();
-    let mut t = Tractogram::new();
-    for i in 0..5000 {
-        t.push((0..100).map(|k| [i as f32, k as f32, 0.5]));
-    }
-    for ext in ["tck", "trk", "trx"] {
-        let p = dir.path().join(format!("big.{ext}"));
-        save(&t, &p).unwrap();
+    for p in big_files(dir.path()) {
+        let ext = p.extension().unwrap().to_string_lossy().to_string();
         let mut reports = 0;
         let mut cancel = |_: lineao_tracts::Progress| {
             reports += 1;

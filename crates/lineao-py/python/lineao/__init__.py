@@ -47,6 +47,7 @@ __all__ = [
     "render",
     "save",
     "save_png",
+    "score",
     "settings",
 ]
 
@@ -67,6 +68,8 @@ class Tractogram:
     to float32 arrays of N or ``len(self)`` rows (one column: 1-D); ``groups`` maps names to
     uint32 streamline indices; ``affine`` (4 × 4), ``dimensions`` and ``voxel_sizes`` describe the
     reference image where the file records one; ``format`` is the format read (``"trk"``…).
+    A ``.tsf`` holds values without points: ``points`` is empty, and ``offsets`` and
+    ``lengths`` index its ``vertex_fields``.
     """
 
     def __init__(
@@ -271,6 +274,10 @@ class Renderer:
         """One frame with this renderer's settings, `settings` changed for this frame, seen by
         `camera` (a dict of eye, target, up, fov or ortho; by default the last frame's, at
         first the view that frames the streamlines)."""
+        return self._native.render(self._frame_settings(camera, settings)).view(Image)
+
+    def _frame_settings(self, camera: Optional[dict], settings: dict) -> dict:
+        """The session's settings with this frame's, and a whole camera when one is given."""
         merged = {**self._settings, **settings}
         if camera is not None:
             whole = {**self.camera, **_camera_settings(camera)}
@@ -279,7 +286,17 @@ class Renderer:
             elif "fov" in camera:
                 whole.pop("ortho", None)
             merged.update(whole)
-        return self._native.render(merged).view(Image)
+        return merged
+
+    def score(self, methods: Optional[Iterable[str]] = None, *, camera: Optional[dict] = None, **settings: Any) -> dict:
+        """``lineao score --json`` on this renderer's view: each method's AO against the
+        ray-traced truth (``methods``: ``lineao``, ``lineao-reference``, ``vo-line``,
+        ``vo-area``, ``ssao``, ``raytraced``; None: all), with the truth's settings
+        (``rays``, ``ao_distance``, ``ao_falloff``…) among ``settings``."""
+        merged = self._frame_settings(camera, settings)
+        import json
+
+        return json.loads(self._native.score(merged, None if methods is None else list(methods)))
 
     def __repr__(self) -> str:
         streamlines, vertices = self._native.counts()
@@ -358,6 +375,13 @@ def render(
     )
     settings.update({k: v for k, v in given.items() if v is not None})
     return Renderer(streamlines, camera=camera, **settings).render()
+
+
+def score(streamlines: Any, methods: Optional[Iterable[str]] = None, **settings: Any) -> dict:
+    """``lineao score --json`` of streamlines (any container ``render`` takes): each method's
+    AO against the ray-traced truth on one view, as a dict (CONTRACT.md's keys)."""
+    camera = settings.pop("camera", None)
+    return Renderer(streamlines, camera=camera, **settings).score(methods)
 
 
 def save_png(image: np.ndarray, path: "os.PathLike[str] | str") -> None:
