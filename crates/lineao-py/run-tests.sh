@@ -12,5 +12,7 @@ export PATH="$venv/bin:$PATH"   # as `activate` does: the build backend runs `ma
 pip=("$venv/bin/pip" install -q --disable-pip-version-check)
 "${pip[@]}" -r tests/requirements.txt
 "${pip[@]}" --no-build-isolation --force-reinstall --no-deps .
-cargo build -q -p lineao-demo --bin lineao
+# The binary the tests compare with, from the same build as `cargo test --workspace` (a no-op
+# right after it; a build of the binary alone would resolve features differently and rebuild).
+cargo test -q --workspace --no-run
 LINEAO_BIN="$root/target/debug/lineao" "$venv/bin/python" -m pytest -q tests
