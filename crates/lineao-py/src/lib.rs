@@ -62,10 +62,11 @@ fn flatten(points: Vec<[f32; 3]>) -> Vec<f32> {
 }
 
 /// A field's values as (rows, columns) float32, or (rows,) for one column, without a copy.
-fn field_array<'py>(py: Python<'py>, field: Field, rows: usize) -> PyResult<Bound<'py, PyAny>> {
-    if field.columns == 1 {
+fn field_array(py: Python<'_>, field: Field) -> PyResult<Bound<'_, PyAny>> {
+    if field.columns <= 1 {
         return Ok(field.values.into_pyarray(py).into_any());
     }
+    let rows = field.values.len() / field.columns;
     let array = Array2::from_shape_vec((rows, field.columns), field.values)
         .map_err(|e| PyValueError::new_err(format!("field '{}': {e}", field.name)))?;
     Ok(array.into_pyarray(py).into_any())
@@ -124,15 +125,15 @@ fn tractogram_dict<'py>(py: Python<'py>, t: Tractogram, format: &str) -> PyResul
     dict.set_item("points", points.into_pyarray(py))?;
     dict.set_item("offsets", offsets.into_pyarray(py))?;
     dict.set_item("lengths", lengths.into_pyarray(py))?;
-    let fields = |fields: Vec<Field>, rows: usize| -> PyResult<Bound<'py, PyDict>> {
+    let fields = |fields: Vec<Field>| -> PyResult<Bound<'py, PyDict>> {
         let dict = PyDict::new(py);
         for field in fields {
-            dict.set_item(field.name.clone(), field_array(py, field, rows)?)?;
+            dict.set_item(field.name.clone(), field_array(py, field)?)?;
         }
         Ok(dict)
     };
-    dict.set_item("vertex_fields", fields(t.vertex_fields, n)?)?;
-    dict.set_item("streamline_fields", fields(t.streamline_fields, streamlines)?)?;
+    dict.set_item("vertex_fields", fields(t.vertex_fields)?)?;
+    dict.set_item("streamline_fields", fields(t.streamline_fields)?)?;
     let groups = PyDict::new(py);
     for group in t.groups {
         groups.set_item(group.name, group.streamlines.into_pyarray(py))?;
@@ -242,8 +243,16 @@ fn save(
         }
         Ok(Field { name, columns, values: values.as_array().iter().copied().collect() })
     };
+    // Per-vertex rows follow the points: gathered in the streamlines' order, as the points were.
     for (name, values) in vertex_fields {
-        t.vertex_fields.push(field(name.extract()?, &values, t.positions.len(), "vertex field")?);
+        let Field { name, columns, values } = field(name.extract()?, &values, p.len() / 3, "vertex field")?;
+        let values = o
+            .iter()
+            .zip(l)
+            .flat_map(|(&start, &length)| &values[columns * start as usize..columns * (start + length) as usize])
+            .copied()
+            .collect();
+        t.vertex_fields.push(Field { name, columns, values });
     }
     for (name, values) in streamline_fields {
         t.streamline_fields.push(field(name.extract()?, &values, t.streamlines(), "streamline field")?);

@@ -227,3 +227,15 @@ def test_every_shared_file_loads_or_is_a_load_error(path):
         assert len(t.points) == 0 and all(len(v) == facts["vertices"] for v in t.vertex_fields.values())
     else:
         assert t.points.shape == (facts["vertices"], 3)
+
+
+def test_save_gathers_out_of_order_streamlines_with_their_vertex_fields(tmp_path):
+    points = np.arange(15, dtype=np.float32).reshape(5, 3)
+    fa = np.arange(5, dtype=np.float32)
+    t = lineao.Tractogram(points, offsets=[3, 0], lengths=[2, 3], vertex_fields={"fa": fa})
+    lineao.save(t, tmp_path / "out.trk")
+    back = lineao.load(tmp_path / "out.trk")
+    np.testing.assert_array_equal(back.points, points[[3, 4, 0, 1, 2]])
+    np.testing.assert_array_equal(back.vertex_fields["fa"], fa[[3, 4, 0, 1, 2]])
+    with pytest.raises(ValueError, match="vertex field 'fa': expected 5 rows"):
+        lineao.save(lineao.Tractogram(points, [0], [5], vertex_fields={"fa": fa[:4]}), tmp_path / "x.trk")
