@@ -171,6 +171,9 @@ def test_save_round_trips_and_keeps_fields(tmp_path):
     same_streamlines(lineao.load(tmp_path / "list.tck"), nib.streamlines.load(str(tmp_path / "list.tck")).streamlines)
     with pytest.raises(lineao.LoadError, match="we write"):
         lineao.save(lines, tmp_path / "out.vtk")
+    # A path is loaded first: a conversion.
+    lineao.save(DATA / "nipy+nibabel/nibabel/tests/data/complex.trk", tmp_path / "converted.trx")
+    same_streamlines(lineao.load(tmp_path / "converted.trx"), list(t))
 
 
 def test_a_progress_callback_sees_the_bytes_and_can_interrupt(tmp_path):

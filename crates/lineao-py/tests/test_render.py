@@ -5,6 +5,7 @@ import os
 import subprocess
 import sys
 import tracemalloc
+from pathlib import Path
 
 import nibabel as nib
 import numpy as np
@@ -205,3 +206,13 @@ def test_renders_and_loads_release_the_gil(tmp_path):
         thread.join()
         ms = (time.perf_counter() - start) * 1e3
         assert ticks > max(5, 0.2 * ms / 1.0) * 0.5, f"only {ticks} ticks in the other thread's {ms:.0f} ms"
+
+
+def test_the_render_trk_example_runs(tmp_path):
+    example = Path(__file__).parents[1] / "examples" / "render_trk.py"
+    result = subprocess.run([sys.executable, str(example), str(TRK)], cwd=tmp_path, capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
+    written = sorted(p.name for p in tmp_path.glob("*.png"))
+    assert written == ["tracks300-orbit-%d.png" % i for i in range(8)] + ["tracks300.png"]
+    split = np.asarray(PilImage.open(tmp_path / "tracks300.png"))
+    assert split.shape == (1024, 1280, 4)

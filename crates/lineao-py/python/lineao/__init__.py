@@ -202,6 +202,8 @@ def _tractogram(x: Any) -> Tractogram:
     """Any streamline container as a lineao ``Tractogram`` over the same memory where it can."""
     if isinstance(x, Tractogram):
         return x
+    if isinstance(x, (str, os.PathLike)):
+        return load(x)
     # DIPY's StatefulTractogram: to RAS+ mm with the NIfTI (voxel-centre) origin, on a copy
     # when it is in another space (to_rasmm and to_center change the object in place).
     if hasattr(x, "to_rasmm") and hasattr(x, "space") and hasattr(x, "streamlines"):
