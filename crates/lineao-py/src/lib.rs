@@ -346,7 +346,17 @@ fn parse(argv: &[String]) -> PyResult<RenderArgs> {
 fn clap_message(e: &clap::Error) -> String {
     let text = e.render().to_string();
     let first = text.lines().next().unwrap_or("invalid settings").trim_start_matches("error: ");
-    first.to_string()
+    // "invalid value 'abc' for '--line-width <LINE_WIDTH>': …" names the keyword: 'line_width'.
+    match first.split_once("'--") {
+        Some((before, rest)) => match rest.split_once('\'') {
+            Some((flag, after)) => {
+                let name = flag.split(' ').next().unwrap_or(flag).replace('-', "_");
+                format!("{before}'{name}'{after}")
+            }
+            None => first.to_string(),
+        },
+        None => first.to_string(),
+    }
 }
 
 /// The settings `render` takes, each as (name, help, default): for the Python docs and

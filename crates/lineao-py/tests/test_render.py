@@ -128,7 +128,7 @@ def test_bad_input_names_the_argument(tmp_path):
         lineao.render(np.array([["a", "b", "c"]]))
     with pytest.raises(TypeError, match="unexpected keyword argument 'linewidth'"):
         lineao.render(lineao.load(TRK), linewidth=3)
-    with pytest.raises(ValueError, match="width"):
+    with pytest.raises(ValueError, match="invalid value '0' for 'width'"):
         lineao.render(lineao.load(TRK), width=0)
     with pytest.raises(ValueError, match="unknown method 'bogus'"):
         lineao.render(lineao.load(TRK), method="bogus")
