@@ -258,11 +258,7 @@ fn render(width: u32, height: u32) -> Result<Rendered, Box<dyn std::error::Error
         },
     )?;
     let bounds = Bounds { center: Vec3::new(0.0, 4.0, 0.0), radius: 45.0 };
-    chain.prepare_view(
-        &device,
-        &queue,
-        FrameView::from_matrices(view, proj, width, height, &bounds, settings.zoom_unit),
-    )?;
+    chain.prepare_view(&device, &queue, FrameView::from_matrices(view, proj, width, height, &bounds))?;
 
     let mut encoder = device.create_command_encoder(&Default::default());
     let clear = |r, g, b| wgpu::Operations {

@@ -207,9 +207,9 @@ impl Passes {
         passes.composite.prepare(
             queue,
             targets,
+            view,
             settings.strength,
             settings.debug_view,
-            view.zoom_max(),
             lineao::passes::composite::Shown::Screen,
         );
         passes

@@ -1,5 +1,8 @@
 // Composite (paper §3.3): color · (1 - clamp(strength · ao, 0, 1)) + illuminated-lines specular,
-// cropped from the guard-banded G-buffer into the caller's target; plus the debug views.
+// cropped from the guard-banded G-buffer into the caller's target; plus the debug views. The
+// overlay entry points draw only the geometry's pixels over a host's frame, keeping its colour
+// on the background, and with a depth attachment write the geometry's depth in the host's
+// projection.
 #import shared/fullscreen.wgsl
 #import shared/nd.wgsl
 
@@ -16,6 +19,13 @@ struct CompositeUniform {
     // 0: ao_map, 1: volume_map, 2: both, brightness multiplied, 3: both, the darker.
     combine: u32,
     _pad0: u32,
+    // The host projection's z and w rows (overlay with depth): depth = (x·z + y) / (z·z + w) of
+    // the view-space z.
+    host_depth_rows: vec4<f32>,
+    // The normalized depth range, to undo nd.w.
+    near: f32,
+    far: f32,
+    _pad1: vec2<u32>,
 }
 
 @group(0) @binding(0) var<uniform> params: CompositeUniform;
@@ -51,9 +61,8 @@ fn pyramid_level(k: u32, pixel: vec2<u32>) -> vec4<f32> {
     }
 }
 
-@fragment
-fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
-    let pixel = vec2<u32>(position.xy) + params.guard;
+// The shown colour of the guard-banded pixel `pixel`.
+fn shade(pixel: vec2<u32>) -> vec3<f32> {
     let screen = textureLoad(ao_map, pixel, 0).r;
     let volume = textureLoad(volume_map, pixel, 0).r;
     var ao = screen;
@@ -76,5 +85,39 @@ fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
             rgb = color * (1.0 - clamp(params.strength * ao, 0.0, 1.0)) + vec3<f32>(specular);
         }
     }
-    return vec4<f32>(rgb, 1.0);
+    return rgb;
+}
+
+@fragment
+fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
+    return vec4<f32>(shade(vec2<u32>(position.xy) + params.guard), 1.0);
+}
+
+// The geometry's pixel of the G-buffer under `position`; background pixels are discarded, so
+// the host's colour (and depth) stay.
+fn overlay_pixel(position: vec4<f32>) -> vec2<u32> {
+    let pixel = vec2<u32>(position.xy) + params.guard;
+    if nd_is_background(textureLoad(nd0, pixel, 0)) {
+        discard;
+    }
+    return pixel;
+}
+
+@fragment
+fn fs_overlay(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
+    return vec4<f32>(shade(overlay_pixel(position)), 1.0);
+}
+
+struct OverlayOut {
+    @location(0) color: vec4<f32>,
+    @builtin(frag_depth) depth: f32,
+}
+
+@fragment
+fn fs_overlay_depth(@builtin(position) position: vec4<f32>) -> OverlayOut {
+    let pixel = overlay_pixel(position);
+    let z = -(params.near + textureLoad(nd0, pixel, 0).w * (params.far - params.near));
+    let rows = params.host_depth_rows;
+    let depth = clamp((rows.x * z + rows.y) / (rows.z * z + rows.w), 0.0, 1.0);
+    return OverlayOut(vec4<f32>(shade(pixel), 1.0), depth);
 }

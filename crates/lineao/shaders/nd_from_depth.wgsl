@@ -42,6 +42,11 @@ override NORMALS: u32 = 0u;
 // x: whether a host color texture is bound (else the color is white: the composite shows AO).
 // One of two constant buffers, chosen per frame, so recording writes nothing to the queue.
 @group(0) @binding(8) var<uniform> has_color: vec4<u32>;
+// Pixels whose geometry lies outside the bounds' depth range [near, far] (cleared per frame):
+// their normalized depth is clamped, so they get wrong occlusion; the chain reports the count.
+@group(0) @binding(9) var<storage, read_write> outside: atomic<u32>;
+
+var<workgroup> outside_here: atomic<u32>;
 
 // The pixel's depth. Under MSAA: background unless at least half the samples hold geometry,
 // else the mean of those (the standard sample patterns are symmetric about the pixel's centre,
@@ -136,17 +141,32 @@ fn normal_at(p: vec2<i32>, centre: vec3<f32>) -> vec3<f32> {
 }
 
 @compute @workgroup_size(8, 8)
-fn nd_from_depth(@builtin(global_invocation_id) id: vec3<u32>) {
+fn nd_from_depth(@builtin(global_invocation_id) id: vec3<u32>, @builtin(local_invocation_index) local: u32) {
     let p = vec2<i32>(id.xy);
-    if any(p >= vec2<i32>(host.size)) {
-        return;
+    if all(p < vec2<i32>(host.size)) && write_pixel(p) {
+        atomicAdd(&outside_here, 1u);
     }
+    // One global add per workgroup, not one per pixel.
+    workgroupBarrier();
+    if local == 0u {
+        let count = atomicLoad(&outside_here);
+        if count > 0u {
+            atomicAdd(&outside, count);
+        }
+    }
+}
+
+// Writes the G-buffer at `p`; whether its geometry lies outside the depth range (by more than
+// rounding).
+fn write_pixel(p: vec2<i32>) -> bool {
+    var beyond = false;
     let d = depth_at(p);
     var nd = vec4<f32>(0.0, 0.0, 0.0, 1.0);
     var zoom = 0.0;
     if !is_background(d) {
         let centre = view_position(p, d);
         let ortho = host.orthographic != 0u;
+        beyond = -centre.z < host.near * (1.0 - 1e-4) || -centre.z > host.far * (1.0 + 1e-4);
         nd = gbuffer_nd(centre, normal_at(p, centre), host.near, host.far, ortho);
         zoom = gbuffer_zoom(centre, host.f_px, host.zoom_unit, ortho);
     }
@@ -155,4 +175,5 @@ fn nd_from_depth(@builtin(global_invocation_id) id: vec3<u32>) {
     let color = select(vec4<f32>(1.0), textureLoad(host_color, p, 0), has_color.x != 0u);
     textureStore(color_out, p, vec4<f32>(color.rgb, 1.0));
     textureStore(specular_out, p, vec4<f32>(0.0));
+    return beyond;
 }

@@ -142,7 +142,10 @@ impl FrameView {
     /// image without a guard band. The normalized depth range comes from `bounds` as for
     /// [`FrameView::new`]; f_px = `proj[1][1]` · H / 2; the projection is orthographic when
     /// its last row is (0, 0, 0, 1). The frustum must be symmetric.
-    pub fn from_matrices(view: Mat4, proj: Mat4, width: u32, height: u32, bounds: &Bounds, zoom_unit: f32) -> Self {
+    ///
+    /// The zoom unit is the chain's ([`crate::ChainSettings::zoom_unit`]): [`crate::AoChain::prepare_view`]
+    /// sets it, so it is said in one place; this view holds 1 until then.
+    pub fn from_matrices(view: Mat4, proj: Mat4, width: u32, height: u32, bounds: &Bounds) -> Self {
         let c_z = view.transform_point3(bounds.center).z;
         let r = bounds.radius;
         let near = (-c_z - r).max(1e-3 * r);
@@ -156,7 +159,7 @@ impl FrameView {
             near,
             far,
             f_px: proj.y_axis.y * height.max(1) as f32 / 2.0,
-            zoom_unit,
+            zoom_unit: 1.0,
             orthographic: proj.row(3) == glam::Vec4::W,
             scene_radius: r,
         }

@@ -39,7 +39,7 @@ use crate::Error;
 use crate::camera::{self, Bounds, Camera, FrameView};
 use crate::gbuffer::Load;
 use crate::passes::bilateral::Bilateral;
-use crate::passes::composite::{Composite, Shown};
+use crate::passes::composite::{Composite, OverlayDepth, Shown};
 use crate::passes::lines::LineStyle;
 use crate::passes::lines::{LineGeometry, LineRenderer};
 use crate::passes::meshes::{MeshGeometry, MeshRenderer};
@@ -335,7 +335,8 @@ impl AoChain {
     /// [`AoChain::prepare`] for a view made elsewhere: a host's own matrices
     /// ([`FrameView::from_matrices`], no guard band) for [`AoChain::encode_host`]. `Ok(None)`
     /// while the chain is 0 × 0 (nothing is recorded then); a view of another size than the
-    /// chain's is an [`Error::Usage`].
+    /// chain's is an [`Error::Usage`]. The view's zoom unit is replaced by
+    /// [`ChainSettings::zoom_unit`], the one place it is set.
     pub fn prepare_view(
         &mut self,
         device: &wgpu::Device,
@@ -350,6 +351,7 @@ impl AoChain {
                 view.width, view.height
             )));
         }
+        let view = FrameView { zoom_unit: self.settings.zoom_unit, ..view };
         Ok(self.prepare_frame(device, queue, view))
     }
 
@@ -417,7 +419,7 @@ impl AoChain {
             (_, Some(volume)) => Shown::Both(volume.combine),
         };
         let strength = if s.method == AoMethod::None && s.volume.is_none() { 0.0 } else { s.strength };
-        self.composite.prepare(queue, targets, strength, s.debug_view, view.zoom_max(), shown);
+        self.composite.prepare(queue, targets, &view, strength, s.debug_view, shown);
         self.view = Some(view);
         Some(view)
     }
@@ -474,7 +476,7 @@ impl AoChain {
     ///     chain.enable_host(device, HostConfig { depth_samples: 1, reversed_z: false, normals: None })?;
     ///     // Per frame: the host's matrices, and the sphere that holds the scene (its depth range).
     ///     let bounds = Bounds { center: Vec3::ZERO, radius: 100.0 };
-    ///     chain.prepare_view(device, queue, FrameView::from_matrices(view, proj, width, height, &bounds, 1.0))?;
+    ///     chain.prepare_view(device, queue, FrameView::from_matrices(view, proj, width, height, &bounds))?;
     ///     let mut encoder = device.create_command_encoder(&Default::default());
     ///     let inputs = HostInputs { depth, normals: None, color: Some(color) };
     ///     chain.encode_host(device, &mut encoder, &inputs, Some(output))?;
@@ -516,6 +518,18 @@ impl AoChain {
         }
         encoder.pop_debug_group();
         Ok(())
+    }
+
+    /// Never waits: how many pixels of an earlier [`AoChain::encode_host`] frame showed geometry
+    /// outside the bounds given to [`FrameView::from_matrices`] (nearer than their near end or
+    /// beyond their far end: clamped there, so their occlusion is wrong), once the GPU has
+    /// finished that frame; `None` while it has not, or without [`AoChain::enable_host`]. A host
+    /// asks once per frame and, seeing a count above 0, grows its bounds.
+    pub fn pixels_outside_bounds(&self, device: &wgpu::Device) -> Result<Option<u32>, Error> {
+        match &self.host {
+            Some(host) => host.try_outside(device),
+            None => Ok(None),
+        }
     }
 
     /// The composite's target: a render attachment of the chain's format and visible size.
@@ -567,6 +581,104 @@ impl AoChain {
         meshes: &[&MeshGeometry],
         target: &wgpu::TextureView,
     ) {
+        self.encode_frame(encoder, geometry, meshes, |composite, encoder, span| {
+            composite.encode(encoder, target, span)
+        });
+    }
+
+    /// Makes the chain ready to draw into a host's frame ([`AoChain::encode_overlay`]), keeping
+    /// the host's picture; with `depth`, the lines also write (and test against) the host's
+    /// depth as its projection `depth.proj` puts them, so the host can draw after lineao. Call
+    /// again when the host's projection changes (cheap: the pipeline is rebuilt only for a new
+    /// depth format or direction); it takes effect at the next `prepare`. A `depth.format`
+    /// without a depth aspect is an [`Error::Usage`].
+    pub fn enable_overlay(&mut self, device: &wgpu::Device, depth: Option<OverlayDepth>) -> Result<(), Error> {
+        if let Some(d) = depth
+            && !d.format.has_depth_aspect()
+        {
+            return Err(Error::Usage(format!("the overlay's depth format {:?} is not a depth format", d.format)));
+        }
+        self.composite.set_overlay(device, depth);
+        Ok(())
+    }
+
+    /// [`AoChain::encode_with_meshes`] drawn into a host's frame (after
+    /// [`AoChain::enable_overlay`] and `prepare`): `target`'s colour is loaded, not cleared, and
+    /// only the geometry's pixels are written (the background shows the host's picture);
+    /// `depth`, required when the overlay was enabled with depth and refused otherwise, gets the
+    /// lines' depth at the visible size. Both are the chain's visible size, one sample;
+    /// `target` of the chain's format with `RENDER_ATTACHMENT`, `depth` of the overlay's format
+    /// with `RENDER_ATTACHMENT` and its stored contents (`StoreOp::Store` where the host drew
+    /// it). A mismatch is an [`Error::Usage`] with nothing recorded.
+    pub fn encode_overlay(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        geometry: &LineGeometry,
+        meshes: &[&MeshGeometry],
+        target: &wgpu::TextureView,
+        depth: Option<&wgpu::TextureView>,
+    ) -> Result<(), Error> {
+        let Some(config) = self.composite.overlay_depth() else {
+            return Err(Error::Usage(
+                "encode_overlay before enable_overlay: call AoChain::enable_overlay once first".into(),
+            ));
+        };
+        if self.size.0 == 0 || self.size.1 == 0 {
+            return Ok(());
+        }
+        self.check_target(target)?;
+        match (config, depth) {
+            (None, Some(_)) => {
+                return Err(Error::Usage(
+                    "a depth was passed but the overlay was enabled without one: call enable_overlay with                      Some(OverlayDepth { format, proj })"
+                        .into(),
+                ));
+            }
+            (Some(_), None) => {
+                return Err(Error::Usage("the overlay was enabled with depth but encode_overlay got none".into()));
+            }
+            (Some(config), Some(view)) => self.check_overlay_depth(&config, view.texture())?,
+            (None, None) => {}
+        }
+        self.encode_frame(encoder, geometry, meshes, |composite, encoder, span| {
+            composite.encode_overlay(encoder, target, depth, span)
+        });
+        Ok(())
+    }
+
+    /// The overlay's depth: a render attachment of the configured format at the visible size.
+    fn check_overlay_depth(&self, config: &OverlayDepth, texture: &wgpu::Texture) -> Result<(), Error> {
+        let (width, height) = self.size;
+        if texture.format() != config.format || texture.sample_count() != 1 {
+            return Err(Error::Usage(format!(
+                "the overlay's depth is {:?} with {} samples; enable_overlay said {:?}, and it must have 1 sample",
+                texture.format(),
+                texture.sample_count(),
+                config.format
+            )));
+        }
+        if !texture.usage().contains(wgpu::TextureUsages::RENDER_ATTACHMENT) {
+            return Err(Error::Usage("the overlay's depth lacks TextureUsages::RENDER_ATTACHMENT".into()));
+        }
+        if (texture.width(), texture.height()) != (width, height) {
+            return Err(Error::Usage(format!(
+                "the overlay's depth is {}×{} but the chain is {width}×{height}: call AoChain::resize with the host's size",
+                texture.width(),
+                texture.height()
+            )));
+        }
+        Ok(())
+    }
+
+    /// Records the geometry, the method and `composite` (the last step, which targets the
+    /// caller's views). Does nothing before the first `prepare` with a non-zero size.
+    fn encode_frame<'s>(
+        &'s self,
+        encoder: &mut wgpu::CommandEncoder,
+        geometry: &LineGeometry,
+        meshes: &[&MeshGeometry],
+        composite: impl FnOnce(&'s Composite, &mut wgpu::CommandEncoder, Option<Span<'s>>),
+    ) {
         let Some(targets) = &self.targets else { return };
         if self.view.is_none() {
             return;
@@ -587,7 +699,7 @@ impl AoChain {
             renderer.encode(encoder, targets, meshes, Load::Keep, meshes_span);
         }
         self.encode_method(encoder, targets, &span);
-        self.composite.encode(encoder, target, span("composite"));
+        composite(&self.composite, encoder, span("composite"));
         if let Some(timer) = &self.timer {
             timer.resolve(encoder);
         }

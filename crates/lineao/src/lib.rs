@@ -75,6 +75,7 @@ pub use wgpu;
 pub use camera::{Bounds, Camera, FrameView, Projection};
 pub use chain::AoChain;
 pub use gpu::Gpu;
+pub use passes::composite::OverlayDepth;
 pub use passes::lines::{LineGeometry, LineRenderer, LineStyle};
 pub use passes::meshes::{MeshGeometry, MeshRenderer};
 pub use passes::nd_from_depth::{HostConfig, HostInputs};

@@ -137,3 +137,68 @@ pub fn read_buffer(device: &wgpu::Device, queue: &wgpu::Queue, buffer: &wgpu::Bu
     staging.unmap();
     Ok(bytes)
 }
+
+/// A small buffer read back without waiting: [`LateReadback::copy`] records a copy into it and
+/// asks for it to be mapped once that submission has run; [`LateReadback::try_take`] returns
+/// the bytes when it has. While one copy waits to be read, later frames' copies are skipped
+/// (a host's render loop asks once per frame and gets an earlier frame's values). A copy
+/// recorded but never submitted stops the readback until it is made again.
+pub struct LateReadback {
+    buffer: wgpu::Buffer,
+    /// [`FREE`], [`PENDING`] or [`MAPPED`]; the map callback writes it.
+    state: std::sync::Arc<std::sync::atomic::AtomicU8>,
+}
+
+/// Where the buffer stands: free (the next copy goes into it), waiting for its submission to
+/// run, or mapped and readable.
+const FREE: u8 = 0;
+const PENDING: u8 = 1;
+const MAPPED: u8 = 2;
+
+impl LateReadback {
+    pub fn new(device: &wgpu::Device, label: &str, bytes: u64) -> LateReadback {
+        LateReadback {
+            buffer: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: bytes,
+                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+                mapped_at_creation: false,
+            }),
+            state: std::sync::Arc::new(std::sync::atomic::AtomicU8::new(FREE)),
+        }
+    }
+
+    /// Records the copy of `source` (as large as this buffer) unless an earlier copy waits to
+    /// be read; returns whether it did.
+    pub fn copy(&self, encoder: &mut wgpu::CommandEncoder, source: &wgpu::Buffer) -> bool {
+        use std::sync::atomic::Ordering;
+        if self.state.compare_exchange(FREE, PENDING, Ordering::AcqRel, Ordering::Acquire).is_err() {
+            return false;
+        }
+        encoder.copy_buffer_to_buffer(source, 0, &self.buffer, 0, self.buffer.size());
+        let state = std::sync::Arc::clone(&self.state);
+        encoder.map_buffer_on_submit(&self.buffer, wgpu::MapMode::Read, .., move |result| {
+            state.store(if result.is_ok() { MAPPED } else { FREE }, Ordering::Release);
+        });
+        true
+    }
+
+    /// Never waits: the bytes of the last copy once its submission has run, else `None`.
+    pub fn try_take(&self, device: &wgpu::Device) -> Result<Option<Vec<u8>>, Error> {
+        use std::sync::atomic::Ordering;
+        device.poll(wgpu::PollType::Poll).map_err(|e| Error::Gpu(e.to_string()))?;
+        if self.state.load(Ordering::Acquire) != MAPPED {
+            return Ok(None);
+        }
+        let bytes = self.buffer.slice(..).get_mapped_range().map_err(|e| Error::Gpu(e.to_string()))?.to_vec();
+        self.buffer.unmap();
+        self.state.store(FREE, Ordering::Release);
+        Ok(Some(bytes))
+    }
+
+    /// Waits for the submitted copy; `None` when none was recorded.
+    pub fn take(&self, device: &wgpu::Device) -> Result<Option<Vec<u8>>, Error> {
+        device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| Error::Gpu(e.to_string()))?;
+        self.try_take(device)
+    }
+}

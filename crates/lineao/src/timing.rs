@@ -12,16 +12,8 @@
 //! Adapters without `TIMESTAMP_QUERY` get no timer ([`PassTimer::new`] returns `None`); callers
 //! then fall back to CPU wall time around submit + wait, and say so.
 
-use std::sync::Arc;
-use std::sync::atomic::{AtomicU8, Ordering};
-
 use crate::Error;
-
-/// Where the readback buffer stands: free (the next `resolve` copies into it and asks for it
-/// to be mapped once that frame has run), waiting for a frame to run, or mapped and readable.
-const FREE: u8 = 0;
-const PENDING: u8 = 1;
-const MAPPED: u8 = 2;
+use crate::readback::LateReadback;
 
 /// The timestamps of one span inside a [`PassTimer`]'s query set.
 #[derive(Clone, Copy)]
@@ -89,10 +81,8 @@ pub struct PassTimer {
     names: Vec<&'static str>,
     query_set: wgpu::QuerySet,
     resolve: wgpu::Buffer,
-    readback: wgpu::Buffer,
+    readback: LateReadback,
     period_ns: f64,
-    /// [`FREE`], [`COPIED`], [`MAPPING`] or [`MAPPED`]; the map callback writes it.
-    state: Arc<AtomicU8>,
 }
 
 impl PassTimer {
@@ -103,14 +93,6 @@ impl PassTimer {
         }
         let count = 2 * names.len() as u32;
         let bytes = count as u64 * wgpu::QUERY_SIZE as u64;
-        let buffer = |label, usage| {
-            device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size: bytes,
-                usage,
-                mapped_at_creation: false,
-            })
-        };
         Some(PassTimer {
             names: names.to_vec(),
             query_set: device.create_query_set(&wgpu::QuerySetDescriptor {
@@ -118,16 +100,14 @@ impl PassTimer {
                 ty: wgpu::QueryType::Timestamp,
                 count,
             }),
-            resolve: buffer(
-                "lineao::PassTimer::resolve",
-                wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-            ),
-            readback: buffer(
-                "lineao::PassTimer::readback",
-                wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            ),
+            resolve: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("lineao::PassTimer::resolve"),
+                size: bytes,
+                usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            }),
+            readback: LateReadback::new(device, "lineao::PassTimer::readback", bytes),
             period_ns: queue.get_timestamp_period() as f64,
-            state: Arc::new(AtomicU8::new(FREE)),
         })
     }
 
@@ -145,14 +125,7 @@ impl PassTimer {
     pub fn resolve(&self, encoder: &mut wgpu::CommandEncoder) {
         let count = 2 * self.names.len() as u32;
         encoder.resolve_query_set(&self.query_set, 0..count, &self.resolve, 0);
-        if self.state.compare_exchange(FREE, PENDING, Ordering::AcqRel, Ordering::Acquire).is_err() {
-            return;
-        }
-        encoder.copy_buffer_to_buffer(&self.resolve, 0, &self.readback, 0, self.resolve.size());
-        let state = Arc::clone(&self.state);
-        encoder.map_buffer_on_submit(&self.readback, wgpu::MapMode::Read, .., move |result| {
-            state.store(if result.is_ok() { MAPPED } else { FREE }, Ordering::Release);
-        });
+        self.readback.copy(encoder, &self.resolve);
     }
 
     /// Waits for the submitted frame and returns the duration of every span it wrote, in the
@@ -166,17 +139,8 @@ impl PassTimer {
     /// Never waits: the durations of the last timed frame once the GPU has finished it, else
     /// `None` (ask again next frame).
     pub fn try_read(&self, device: &wgpu::Device, only: &[&str]) -> Result<Option<Vec<PassTime>>, Error> {
-        device.poll(wgpu::PollType::Poll).map_err(|e| Error::Gpu(e.to_string()))?;
-        if self.state.load(Ordering::Acquire) != MAPPED {
-            return Ok(None);
-        }
-        let slice = self.readback.slice(..);
-        let ticks: Vec<u64> = {
-            let mapped = slice.get_mapped_range().map_err(|e| Error::Gpu(e.to_string()))?;
-            bytemuck::pod_collect_to_vec(&mapped)
-        };
-        self.readback.unmap();
-        self.state.store(FREE, Ordering::Release);
+        let Some(bytes) = self.readback.try_take(device)? else { return Ok(None) };
+        let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&bytes);
         Ok(Some(
             self.names
                 .iter()

@@ -90,7 +90,7 @@ fn maps_derived_from_depth_match_the_ones_the_renderers_write() {
         let (nd, zoom) = (read_rgba(d, q, &t.nd[0]).unwrap(), read_f32(d, q, &t.zoom).unwrap());
 
         // The host path over that depth, with the same matrices.
-        let host_view = FrameView::from_matrices(view.view, view.proj, size.0, size.1, &geometry.bounds.unwrap(), 1.0);
+        let host_view = FrameView::from_matrices(view.view, view.proj, size.0, size.1, &geometry.bounds.unwrap());
         assert_eq!((host_view.near, host_view.far, host_view.f_px), (view.near, view.far, view.f_px));
         assert_eq!(host_view.orthographic, view.orthographic);
         let derived = run_host(&gpu, ChainSettings::default(), HostConfig::default(), host_view, &t.depth.view, None);
@@ -179,7 +179,7 @@ fn reversed_z_msaa_and_both_projections_against_an_analytic_sphere() {
             );
             let proj = if reversed_z { reversed(standard) } else { standard };
             let depth = host_depth(&gpu, &triangles, proj * view_matrix, size, samples, reversed_z);
-            let view = FrameView::from_matrices(view_matrix, proj, size.0, size.1, &bounds, 1.0);
+            let view = FrameView::from_matrices(view_matrix, proj, size.0, size.1, &bounds);
             let config = HostConfig { depth_samples: samples, reversed_z, normals: None };
             let frame =
                 run_host(&gpu, ChainSettings::default(), config, view, &depth.create_view(&Default::default()), None);
@@ -396,4 +396,191 @@ fn host_api_misuse_is_an_error_that_says_what_to_change() {
     assert!(chain.prepare_view(d, q, view((0, 0))).unwrap().is_none());
     let mut encoder = d.create_command_encoder(&Default::default());
     chain.encode_host(d, &mut encoder, &inputs, None).unwrap();
+}
+
+/// `encode_overlay` draws the lines into a host's frame: the host's colour stays on the
+/// background and where its depth is nearer; the lines' pixels equal `encode`'s, and the depth
+/// they leave is the host projection's depth of their view-space z (reversed-Z with an infinite
+/// far plane, and standard depth), tested against what the host drew before.
+#[test]
+fn the_overlay_keeps_the_hosts_frame_and_writes_its_depth() {
+    let gpu = gpu();
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let (positions, offsets) = polylines(30, 0.3);
+    let (camera, _) = cameras_for_polylines();
+    let geometry = LineGeometry::new(d, q, &positions, &offsets).unwrap();
+    let bounds = geometry.bounds.unwrap();
+    let size = (96u32, 72u32);
+    let host_color = [0.25f32, 0.5, 0.75, 1.0];
+    let Projection::Perspective { fov_y_deg } = camera.projection else { unreachable!() };
+    let (fov, aspect) = (fov_y_deg.to_radians(), size.0 as f32 / size.1 as f32);
+    use glam::camera::rh::proj::directx;
+    let reversed_infinite = directx::perspective_infinite_reverse(fov, aspect, 0.1);
+    let standard = directx::perspective(fov, aspect, 0.1, 1000.0);
+
+    let mut chain = AoChain::new(d, common::OUTPUT_FORMAT, ChainSettings::default()).unwrap();
+    chain.resize(size.0, size.1).unwrap();
+    let view = chain.prepare(d, q, &camera, &bounds).unwrap();
+    let plain = lineao::targets::Target::output(d, "test::plain", size, common::OUTPUT_FORMAT);
+    let mut encoder = d.create_command_encoder(&Default::default());
+    chain.encode(&mut encoder, &geometry, &plain.view);
+    q.submit([encoder.finish()]);
+    let plain: Vec<[f32; 4]> = read_texture_vec4(&gpu, &plain.texture);
+    let nd = read_rgba(d, q, &chain.targets().unwrap().nd[0]).unwrap();
+    let g = view.guard as usize;
+    let nd_at = |x: usize, y: usize| nd.data[(y + g) * nd.width + x + g];
+    let z_of = |x, y| -(view.near + nd_at(x, y)[3] * (view.far - view.near));
+
+    for (name, proj) in [("reversed-Z, infinite far", reversed_infinite), ("standard", standard)] {
+        let depth_at = |z: f32| proj.project_point3(Vec3::new(0.0, 0.0, z)).z;
+        // The host drew a wall at the depth of the lines' middle: lines behind it stay hidden.
+        let wall_z = -0.5 * (view.near + view.far);
+        let wall = depth_at(wall_z);
+        let color = lineao::targets::Target::output(d, "test::host_color", size, common::OUTPUT_FORMAT);
+        let depth = d.create_texture(&wgpu::TextureDescriptor {
+            label: Some("test::host_depth"),
+            size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Depth32Float,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let depth_view = depth.create_view(&Default::default());
+        let mut encoder = d.create_command_encoder(&Default::default());
+        let [r, g_, b, a] = host_color.map(f64::from);
+        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("test::host_frame"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &color.view,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color { r, g: g_, b, a }),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &depth_view,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(wall), store: wgpu::StoreOp::Store }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        chain
+            .enable_overlay(d, Some(lineao::OverlayDepth { format: wgpu::TextureFormat::Depth32Float, proj }))
+            .unwrap();
+        chain.prepare(d, q, &camera, &bounds).unwrap();
+        chain.encode_overlay(&mut encoder, &geometry, &[], &color.view, Some(&depth_view)).unwrap();
+        q.submit([encoder.finish()]);
+        let shown = read_texture_vec4(&gpu, &color.texture);
+        let depths: Vec<f32> =
+            bytemuck::pod_collect_to_vec(&lineao::readback::read_texture(d, q, &depth).unwrap().bytes);
+        let (mut drawn, mut hidden, mut worst) = (0, 0, 0.0f32);
+        for y in 0..size.1 as usize {
+            for x in 0..size.0 as usize {
+                let i = y * size.0 as usize + x;
+                let in_front = is_geometry(nd_at(x, y)) && z_of(x, y) > wall_z;
+                if in_front {
+                    drawn += 1;
+                    assert_eq!(shown[i], plain[i], "{name}: a line pixel ({x}, {y}) as encode draws it");
+                    let expected = depth_at(z_of(x, y));
+                    worst = worst.max((depths[i] - expected).abs() / expected.abs().max(1e-6));
+                } else {
+                    hidden += is_geometry(nd_at(x, y)) as usize;
+                    assert_eq!(shown[i], host_color, "{name}: the host's pixel ({x}, {y}) stays");
+                    assert_eq!(depths[i], wall, "{name}: the host's depth at ({x}, {y}) stays");
+                }
+            }
+        }
+        println!("{name}: {drawn} line pixels drawn, {hidden} behind the wall, worst relative depth error {worst:.1e}");
+        assert!(
+            drawn > 100 && hidden > 100,
+            "{name}: the wall should split the lines ({drawn} drawn, {hidden} hidden)"
+        );
+        assert!(worst < 1e-5, "{name}: depth {worst}");
+    }
+
+    // Misuse: a depth the overlay was not enabled for, or none where it was.
+    let other = texture(&gpu, size, wgpu::TextureFormat::Depth24Plus, wgpu::TextureUsages::RENDER_ATTACHMENT, 1);
+    let output = lineao::targets::Target::output(d, "test::output", size, common::OUTPUT_FORMAT);
+    let mut encoder = d.create_command_encoder(&Default::default());
+    let result = chain.encode_overlay(&mut encoder, &geometry, &[], &output.view, Some(&other));
+    assert!(matches!(&result, Err(lineao::Error::Usage(t)) if t.contains("Depth24Plus")), "{result:?}");
+    let result = chain.encode_overlay(&mut encoder, &geometry, &[], &output.view, None);
+    assert!(matches!(&result, Err(lineao::Error::Usage(t)) if t.contains("got none")), "{result:?}");
+    chain.enable_overlay(d, None).unwrap();
+    let result = chain.encode_overlay(&mut encoder, &geometry, &[], &output.view, Some(&other));
+    assert!(matches!(&result, Err(lineao::Error::Usage(t)) if t.contains("without one")), "{result:?}");
+    let fresh = AoChain::new(d, common::OUTPUT_FORMAT, ChainSettings::default()).unwrap();
+    let result = fresh.encode_overlay(&mut encoder, &geometry, &[], &output.view, None);
+    assert!(matches!(&result, Err(lineao::Error::Usage(t)) if t.contains("enable_overlay")), "{result:?}");
+    let bad = lineao::OverlayDepth { format: wgpu::TextureFormat::Rgba8Unorm, proj: standard };
+    assert!(matches!(chain.enable_overlay(d, Some(bad)), Err(lineao::Error::Usage(_))));
+}
+
+fn read_texture_vec4(gpu: &lineao::Gpu, texture: &wgpu::Texture) -> Vec<[f32; 4]> {
+    bytemuck::pod_collect_to_vec(&lineao::readback::read_texture(&gpu.device, &gpu.queue, texture).unwrap().bytes)
+}
+
+/// Geometry outside the bounds' depth range is counted (`pixels_outside_bounds`), never
+/// silently clamped: none with the sphere's own bounds, and with bounds of half its radius the
+/// pixels whose analytic depth lies outside the smaller range.
+#[test]
+fn geometry_outside_the_bounds_is_counted() {
+    let gpu = gpu();
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let (centre, radius) = (Vec3::new(1.0, -2.0, 0.0), 10.0f32);
+    let triangles = sphere_triangles(centre, radius, 64);
+    let size = (160u32, 120u32);
+    let camera = Camera {
+        eye: Vec3::new(6.0, 9.0, 42.0),
+        target: centre,
+        up: Vec3::Y,
+        projection: Projection::Perspective { fov_y_deg: 45.0 },
+    };
+    let view_matrix = camera.view_matrix();
+    let proj = glam::camera::rh::proj::directx::perspective(45f32.to_radians(), 4.0 / 3.0, 5.0, 200.0);
+    let depth = host_depth(&gpu, &triangles, proj * view_matrix, size, 1, false);
+    let depth = depth.create_view(&Default::default());
+    let mut chain = AoChain::new(d, common::OUTPUT_FORMAT, ChainSettings::default()).unwrap();
+    chain.resize(size.0, size.1).unwrap();
+    assert_eq!(chain.pixels_outside_bounds(d).unwrap(), None, "no host frame yet");
+    chain.enable_host(d, HostConfig::default()).unwrap();
+    for (scale, name) in [(1.0, "the sphere's bounds"), (0.5, "half its radius")] {
+        let bounds = Bounds { center: centre, radius: radius * scale };
+        let view = FrameView::from_matrices(view_matrix, proj, size.0, size.1, &bounds);
+        chain.prepare_view(d, q, view).unwrap();
+        let mut encoder = d.create_command_encoder(&Default::default());
+        chain.encode_host(d, &mut encoder, &HostInputs { depth: &depth, normals: None, color: None }, None).unwrap();
+        q.submit([encoder.finish()]);
+        d.poll(wgpu::PollType::wait_indefinitely()).unwrap();
+        let counted = chain.pixels_outside_bounds(d).unwrap().expect("the frame has run");
+        // The analytic count: pixels whose sphere hit lies outside [near, far].
+        let inv_proj = proj.inverse();
+        let sphere_view = (view_matrix * centre.extend(1.0)).xyz();
+        let mut expected = 0;
+        for y in 0..size.1 {
+            for x in 0..size.0 {
+                let (o, dir) = pixel_ray(&view, inv_proj, [x, y]);
+                let oc = o - sphere_view;
+                let (b, c) = (oc.dot(dir), oc.dot(oc) - radius * radius);
+                if b * b - c > 0.0 {
+                    let z = -(o + (-b - (b * b - c).sqrt()) * dir).z;
+                    expected += (z < view.near * (1.0 - 1e-4) || z > view.far * (1.0 + 1e-4)) as u32;
+                }
+            }
+        }
+        println!("{name}: {counted} pixels outside counted, {expected} analytic");
+        let slack = (expected as f32 * 0.03).max(0.0) as u32 + 2 * (size.0 + size.1) / 10;
+        assert!(counted.abs_diff(expected) <= slack, "{name}: {counted} vs {expected}");
+        if scale == 1.0 {
+            assert_eq!(counted, 0, "{name}: nothing lies outside the sphere's own bounds");
+        } else {
+            assert!(counted > 1000, "{name}: {counted}");
+        }
+    }
 }

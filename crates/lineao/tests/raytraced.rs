@@ -320,7 +320,7 @@ fn a_host_renderers_depth_traces_like_the_cpu_truth_through_the_embedding_api() 
     let meshes = [(&triangles[..], &indices[..])];
     let geometry = RayGeometry { meshes: &meshes, ..Default::default() };
     chain.set_ray_scene(d, Some(Arc::new(RayScene::new(d, &geometry).unwrap())));
-    let view = lineao::FrameView::from_matrices(view_matrix, proj, SIZE.0, SIZE.1, &bounds, 1.0);
+    let view = lineao::FrameView::from_matrices(view_matrix, proj, SIZE.0, SIZE.1, &bounds);
     let inputs = HostInputs { depth: &depth, normals: None, color: None };
     for _ in 0..2 {
         chain.prepare_view(d, q, view).unwrap();

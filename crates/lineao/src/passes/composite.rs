@@ -13,8 +13,21 @@
 //!
 //! Debug views show the AO alone, the normals, the depth, the zoom map or one pyramid level.
 //! The CPU reference is [`crate::reference::composite`].
+//!
+//! As an overlay ([`Composite::set_overlay`], [`crate::AoChain::encode_overlay`]) it draws only
+//! the geometry's pixels into a host's frame: the background is discarded, so the host's colour
+//! stays, and with the host's depth attachment each pixel writes the geometry's depth as the
+//! host's projection puts it, tested against what the host drew before (so lines hide behind
+//! the host's nearer surfaces) and kept for what it draws after:
+//!
+//! ```text
+//!   z = −(near + nd.w · (far − near)),   depth = (P₂₂ z + P₂₃) / (P₃₂ z + P₃₃)
+//! ```
+
+use glam::Mat4;
 
 use crate::binding::{self, Slot};
+use crate::camera::FrameView;
 use crate::settings::DebugView;
 use crate::targets::{FrameTargets, LevelsUniform, Target};
 use crate::timing::{self, Span};
@@ -33,6 +46,41 @@ pub struct CompositeUniform {
     /// 3: both, the darker.
     pub combine: u32,
     pub _pad: u32,
+    /// The overlay depth's projection rows: depth = (x z + y) / (z z + w).
+    pub host_depth_rows: [f32; 4],
+    pub near: f32,
+    pub far: f32,
+    pub _pad1: [u32; 2],
+}
+
+/// The depth of a host's frame that an overlay writes and tests against: its format and the
+/// projection the host draws with (any convention: standard or reversed-Z, finite or infinite
+/// far plane; perspective or orthographic).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OverlayDepth {
+    pub format: wgpu::TextureFormat,
+    pub proj: Mat4,
+}
+
+impl OverlayDepth {
+    /// The z and w rows of the projection: depth = (x z + y) / (z z + w) of a view-space z.
+    fn rows(&self) -> [f32; 4] {
+        let (z, w) = (self.proj.row(2), self.proj.row(3));
+        [z.z, z.w, w.z, w.w]
+    }
+
+    /// Whether depth grows toward the eye (reversed-Z), so the test keeps the greater.
+    fn reversed(&self) -> bool {
+        let [a, b, c, d] = self.rows();
+        let depth = |z: f32| (a * z + b) / (c * z + d);
+        depth(-1.0) > depth(-2.0)
+    }
+}
+
+/// The overlay pipeline and the depth it was made for.
+struct Overlay {
+    depth: Option<OverlayDepth>,
+    pipeline: wgpu::RenderPipeline,
 }
 
 /// Which occlusion the composite shows.
@@ -56,6 +104,11 @@ impl Shown {
 
 pub struct Composite {
     pipeline: wgpu::RenderPipeline,
+    /// Made by [`Composite::set_overlay`].
+    overlay: Option<Overlay>,
+    format: wgpu::TextureFormat,
+    module: wgpu::ShaderModule,
+    pipeline_layout: wgpu::PipelineLayout,
     layout: wgpu::BindGroupLayout,
     uniform: wgpu::Buffer,
     group: Option<wgpu::BindGroup>,
@@ -68,33 +121,51 @@ impl Composite {
         slots.extend([Slot::Texture; crate::MAX_LEVELS as usize]);
         let layout = binding::layout(device, "lineao::Composite::layout", wgpu::ShaderStages::FRAGMENT, &slots);
         let module = crate::shader::module(device, "composite.wgsl");
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("lineao::Composite::pipeline"),
-            layout: Some(&binding::pipeline_layout(device, "lineao::Composite::pipeline_layout", &layout)),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline_layout = binding::pipeline_layout(device, "lineao::Composite::pipeline_layout", &layout);
+        let pipeline = render_pipeline(device, &pipeline_layout, &module, format, "fs_main", None);
         Composite {
             pipeline,
+            overlay: None,
+            format,
+            module,
+            pipeline_layout,
             layout,
             uniform: binding::uniform_buffer::<CompositeUniform>(device, "lineao::Composite::uniform"),
             group: None,
         }
+    }
+
+    /// Makes the composite ready to draw as an overlay ([`Composite::encode_overlay`]), with or
+    /// without the host's depth; the pipeline is rebuilt only when the depth's format or
+    /// direction changes, so a new projection each frame is cheap. Takes effect at the next
+    /// `prepare`.
+    pub fn set_overlay(&mut self, device: &wgpu::Device, depth: Option<OverlayDepth>) {
+        let key = |d: &Option<OverlayDepth>| d.map(|d| (d.format, d.reversed()));
+        if let Some(overlay) = &mut self.overlay
+            && key(&overlay.depth) == key(&depth)
+        {
+            overlay.depth = depth;
+            return;
+        }
+        let stencil = depth.map(|d| wgpu::DepthStencilState {
+            format: d.format,
+            depth_write_enabled: Some(true),
+            depth_compare: Some(if d.reversed() {
+                wgpu::CompareFunction::GreaterEqual
+            } else {
+                wgpu::CompareFunction::LessEqual
+            }),
+            stencil: Default::default(),
+            bias: Default::default(),
+        });
+        let entry = if depth.is_some() { "fs_overlay_depth" } else { "fs_overlay" };
+        let pipeline = render_pipeline(device, &self.pipeline_layout, &self.module, self.format, entry, stencil);
+        self.overlay = Some(Overlay { depth, pipeline });
+    }
+
+    /// The overlay's depth, if [`Composite::set_overlay`] asked for one.
+    pub fn overlay_depth(&self) -> Option<Option<OverlayDepth>> {
+        self.overlay.as_ref().map(|o| o.depth)
     }
 
     /// Shows `ao` (`targets.ao`, or `targets.ao_blurred` after the bilateral blur) and, where
@@ -117,11 +188,12 @@ impl Composite {
         &self,
         queue: &wgpu::Queue,
         targets: &FrameTargets,
+        view: &FrameView,
         strength: f32,
         debug_view: DebugView,
-        zoom_max: f32,
         shown: Shown,
     ) {
+        let rows = self.overlay.as_ref().and_then(|o| o.depth).map_or([0.0, 0.0, 0.0, 1.0], |d| d.rows());
         let (debug_view, debug_level) = debug_view.code();
         let uniform = CompositeUniform {
             levels: targets.levels_uniform(),
@@ -129,16 +201,44 @@ impl Composite {
             strength,
             debug_view,
             debug_level,
-            zoom_max: zoom_max.max(1e-12),
+            zoom_max: view.zoom_max().max(1e-12),
             combine: shown.code(),
             _pad: 0,
+            host_depth_rows: rows,
+            near: view.near,
+            far: view.far,
+            _pad1: [0; 2],
         };
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
     }
 
-    /// Draws the visible window into `target` (the visible size).
-    /// Records the composite into `target`, timed into `span` when given.
+    /// Records the composite into `target` (the visible size), timed into `span` when given.
     pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, target: &wgpu::TextureView, span: Option<Span>) {
+        let load = wgpu::LoadOp::Clear(wgpu::Color::BLACK);
+        self.record(encoder, &self.pipeline, (target, load), None, span);
+    }
+
+    /// Records the overlay (after [`Composite::set_overlay`]) into the host's `target` and, when
+    /// the overlay has depth, its `depth`: both loaded, so the host's frame stays.
+    pub fn encode_overlay(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        depth: Option<&wgpu::TextureView>,
+        span: Option<Span>,
+    ) {
+        let Some(overlay) = &self.overlay else { return };
+        self.record(encoder, &overlay.pipeline, (target, wgpu::LoadOp::Load), depth, span);
+    }
+
+    fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        pipeline: &wgpu::RenderPipeline,
+        (target, load): (&wgpu::TextureView, wgpu::LoadOp<wgpu::Color>),
+        depth: Option<&wgpu::TextureView>,
+        span: Option<Span>,
+    ) {
         let Some(group) = &self.group else { return };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("lineao::Composite"),
@@ -146,15 +246,51 @@ impl Composite {
                 view: target,
                 depth_slice: None,
                 resolve_target: None,
-                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store },
+                ops: wgpu::Operations { load, store: wgpu::StoreOp::Store },
             })],
-            depth_stencil_attachment: None,
+            depth_stencil_attachment: depth.map(|view| wgpu::RenderPassDepthStencilAttachment {
+                view,
+                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store }),
+                stencil_ops: None,
+            }),
             timestamp_writes: timing::render_writes(span),
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        pass.set_pipeline(&self.pipeline);
+        pass.set_pipeline(pipeline);
         pass.set_bind_group(0, group, &[]);
         pass.draw(0..3, 0..1);
     }
+}
+
+/// The composite's full-screen pipeline with fragment entry point `entry`.
+fn render_pipeline(
+    device: &wgpu::Device,
+    layout: &wgpu::PipelineLayout,
+    module: &wgpu::ShaderModule,
+    format: wgpu::TextureFormat,
+    entry: &str,
+    depth_stencil: Option<wgpu::DepthStencilState>,
+) -> wgpu::RenderPipeline {
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("lineao::Composite::pipeline"),
+        layout: Some(layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: Default::default(),
+        depth_stencil,
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some(entry),
+            compilation_options: Default::default(),
+            targets: &[Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
 }

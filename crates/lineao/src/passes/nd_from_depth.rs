@@ -17,6 +17,11 @@
 //!   host's lit color (linear: sRGB textures decode on load) with no specular, for the
 //!   composite: color · (1 − strength · ao).
 //!
+//! The scene's bounds ([`FrameView::from_matrices`]) set the normalized depth range: geometry
+//! nearer than their near end or beyond their far end is clamped to it and gets wrong
+//! occlusion. Each frame counts such pixels ([`NdFromDepth::try_outside`], through
+//! `AoChain::pixels_outside_bounds`), so a host whose bounds miss part of its scene hears of it.
+//!
 //! Background is where the depth equals the host's clear depth (1, or 0 for reversed-Z). The
 //! projection must be symmetric (the optical axis at the image centre), as the VO and SSAO passes
 //! assume. The host's textures must be the chain's size (no guard band: AO fades within the
@@ -28,6 +33,7 @@ use crate::Error;
 use crate::binding::{self, Slot};
 use crate::camera::FrameView;
 use crate::passes::dispatch_full_screen;
+use crate::readback::LateReadback;
 use crate::targets::{AO_FORMAT, COLOR_FORMAT, FrameTargets, ND_FORMAT, Target};
 use crate::timing::Span;
 
@@ -179,6 +185,10 @@ pub struct NdFromDepth {
     placeholder: Target,
     /// `has_color` = 0 and 1, bound per frame.
     has_color: [wgpu::Buffer; 2],
+    /// The count of pixels outside the depth range (one u32, cleared per frame), and its way
+    /// back to the CPU.
+    outside: wgpu::Buffer,
+    outside_readback: LateReadback,
 }
 
 impl NdFromDepth {
@@ -198,6 +208,7 @@ impl NdFromDepth {
                 Slot::StorageTexture(COLOR_FORMAT),
                 Slot::StorageTexture(AO_FORMAT),
                 Slot::Uniform,
+                Slot::StorageReadWrite,
             ],
         );
         let replacements: &[(&str, &str)] =
@@ -234,7 +245,20 @@ impl NdFromDepth {
                     usage: wgpu::BufferUsages::UNIFORM,
                 })
             }),
+            outside: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("lineao::NdFromDepth::outside"),
+                size: 4,
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+            outside_readback: LateReadback::new(device, "lineao::NdFromDepth::outside_readback", 4),
         }
+    }
+
+    /// Never waits: how many pixels of an earlier frame held geometry outside the bounds'
+    /// depth range, once the GPU has finished that frame; else `None` (ask again next frame).
+    pub fn try_outside(&self, device: &wgpu::Device) -> Result<Option<u32>, Error> {
+        Ok(self.outside_readback.try_take(device)?.map(|bytes| bytemuck::pod_read_unaligned(&bytes[..4])))
     }
 
     pub fn config(&self) -> HostConfig {
@@ -285,8 +309,11 @@ impl NdFromDepth {
                 wgpu::BindingResource::TextureView(&targets.color.view),
                 wgpu::BindingResource::TextureView(&targets.specular.view),
                 self.has_color[inputs.color.is_some() as usize].as_entire_binding(),
+                self.outside.as_entire_binding(),
             ],
         );
+        encoder.clear_buffer(&self.outside, 0, None);
         dispatch_full_screen(encoder, "lineao::NdFromDepth", &self.pipeline, &group, targets.size, span);
+        self.outside_readback.copy(encoder, &self.outside);
     }
 }
