@@ -93,6 +93,23 @@ pub fn vo_sample((lo, hi): (f32, f32), mu: f32, sigma: f32, thickness: f32) -> (
     (free.min(allowed), allowed)
 }
 
+/// Linear depth at which the view ray through texel `t` crosses the plane through `p` with
+/// normal `n` (facing the eye); huge where the ray stays on the eye's side ahead of it
+/// (`shaders/vo_line.wgsl`).
+pub fn tangent_plane_depth(view: &ViewParams, p: [f32; 3], n: [f32; 3], t: [usize; 2]) -> f32 {
+    let s = [(t[0] as f32 + 0.5 - view.center[0]) / view.f_px, (view.center[1] - (t[1] as f32 + 0.5)) / view.f_px];
+    let np = n[0] * p[0] + n[1] * p[1] + n[2] * p[2];
+    if view.orthographic {
+        let side = n[0] * s[0] + n[1] * s[1] - np;
+        if n[2].abs() < 1e-12 {
+            return if side > 0.0 { 3.0e38 } else { -3.0e38 };
+        }
+        return side / n[2];
+    }
+    let nr = n[0] * s[0] + n[1] * s[1] - n[2];
+    if nr < 0.0 { np / nr } else { 3.0e38 }
+}
+
 /// A line sample: the chord at s against the visible surface at d_r (§4.1, σ = 0).
 pub fn vo_line_sample(s: [f32; 2], d_r: f32, n: [f32; 3], clamp: bool, thickness: f32) -> (f32, f32) {
     let chord = vo_chord(s, vo_chord_half(s[0], s[1]), n, vo_plane(n), clamp);
@@ -159,8 +176,8 @@ pub fn vo_line_pixel(
 ) -> f32 {
     let here = nd.get(x as usize, y as usize);
     let n = [here[0], here[1], here[2]];
-    let g = vo_plane(n);
     vo_pixel(nd, zoom, noise, p, (x, y), |depth, z, u, radius| {
+        let at = p.view.view_position(x, y, depth);
         let scale = radius * z / p.zoom_unit;
         let thickness = p.thickness / radius;
         let d_scale = (p.view.far - p.view.near) / radius;
@@ -171,7 +188,13 @@ pub fn vo_line_pixel(
             let tx = (x as f32 + 0.5 + s[0] * scale).floor().clamp(0.0, (nd.width - 1) as f32) as usize;
             let ty = (y as f32 + 0.5 - s[1] * scale).floor().clamp(0.0, (nd.height - 1) as f32) as usize;
             let d_r = nd.get(tx, ty)[3] * d_scale + d_offset;
-            let chord = vo_chord(s, vo_chord_half(sample[0], sample[1]), n, g, p.normal_clamp);
+            // At the centre of the texel read (the shader's doc).
+            let s_t = [(tx as f32 - x as f32) / scale.max(1e-20), (y as f32 - ty as f32) / scale.max(1e-20)];
+            let z_s = vo_chord_half(s_t[0], s_t[1]);
+            let mut chord = (-z_s, z_s);
+            if p.normal_clamp {
+                chord.1 = z_s.min((tangent_plane_depth(&p.view, at, n, [tx, ty]) - depth) / radius);
+            }
             let (f, a) = vo_sample(chord, d_r, 0.0, thickness);
             free += sample[2] * f;
             allowed += sample[2] * a;
