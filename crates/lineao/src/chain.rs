@@ -534,23 +534,33 @@ impl AoChain {
 
     /// The composite's target: a render attachment of the chain's format and visible size.
     fn check_target(&self, target: &wgpu::TextureView) -> Result<(), Error> {
-        let texture = target.texture();
+        self.check_attachment("the composite's target", target.texture(), self.format, "the chain was made for")
+    }
+
+    /// A texture the chain draws into: `RENDER_ATTACHMENT`, `format` (or, for color, its sRGB
+    /// twin: a view may reinterpret it), one sample, the visible size; `source` says where the
+    /// format was set.
+    fn check_attachment(
+        &self,
+        what: &str,
+        texture: &wgpu::Texture,
+        format: wgpu::TextureFormat,
+        source: &str,
+    ) -> Result<(), Error> {
         let (width, height) = self.size;
         if !texture.usage().contains(wgpu::TextureUsages::RENDER_ATTACHMENT) {
-            return Err(Error::Usage("the composite's target lacks TextureUsages::RENDER_ATTACHMENT".into()));
+            return Err(Error::Usage(format!("{what} lacks TextureUsages::RENDER_ATTACHMENT")));
         }
-        // A view may be the sRGB twin of its texture's format (`view_formats`).
-        if texture.format().remove_srgb_suffix() != self.format.remove_srgb_suffix() || texture.sample_count() != 1 {
+        if texture.format().remove_srgb_suffix() != format.remove_srgb_suffix() || texture.sample_count() != 1 {
             return Err(Error::Usage(format!(
-                "the composite's target is {:?} with {} samples; the chain was made for {:?}, 1 sample",
+                "{what} is {:?} with {} samples; {source} {format:?}, 1 sample",
                 texture.format(),
                 texture.sample_count(),
-                self.format
             )));
         }
         if (texture.width(), texture.height()) != (width, height) {
             return Err(Error::Usage(format!(
-                "the composite's target is {}×{} but the chain is {width}×{height}",
+                "{what} is {}×{} but the chain is {width}×{height}: call AoChain::resize with the host's size",
                 texture.width(),
                 texture.height()
             )));
@@ -637,36 +647,14 @@ impl AoChain {
             (Some(_), None) => {
                 return Err(Error::Usage("the overlay was enabled with depth but encode_overlay got none".into()));
             }
-            (Some(config), Some(view)) => self.check_overlay_depth(&config, view.texture())?,
+            (Some(config), Some(view)) => {
+                self.check_attachment("the overlay's depth", view.texture(), config.format, "enable_overlay said")?
+            }
             (None, None) => {}
         }
         self.encode_frame(encoder, geometry, meshes, |composite, encoder, span| {
             composite.encode_overlay(encoder, target, depth, span)
         });
-        Ok(())
-    }
-
-    /// The overlay's depth: a render attachment of the configured format at the visible size.
-    fn check_overlay_depth(&self, config: &OverlayDepth, texture: &wgpu::Texture) -> Result<(), Error> {
-        let (width, height) = self.size;
-        if texture.format() != config.format || texture.sample_count() != 1 {
-            return Err(Error::Usage(format!(
-                "the overlay's depth is {:?} with {} samples; enable_overlay said {:?}, and it must have 1 sample",
-                texture.format(),
-                texture.sample_count(),
-                config.format
-            )));
-        }
-        if !texture.usage().contains(wgpu::TextureUsages::RENDER_ATTACHMENT) {
-            return Err(Error::Usage("the overlay's depth lacks TextureUsages::RENDER_ATTACHMENT".into()));
-        }
-        if (texture.width(), texture.height()) != (width, height) {
-            return Err(Error::Usage(format!(
-                "the overlay's depth is {}×{} but the chain is {width}×{height}: call AoChain::resize with the host's size",
-                texture.width(),
-                texture.height()
-            )));
-        }
         Ok(())
     }
 

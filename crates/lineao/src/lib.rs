@@ -87,6 +87,11 @@ pub use settings::{
     TubeSettings, VoCombine, VoSettings, VolumeAoSettings,
 };
 
+// docs/embedding.md's code compiles as it stands: `cargo test --doc` checks it.
+#[cfg(doctest)]
+#[doc = include_str!("../../../docs/embedding.md")]
+pub struct EmbeddingGuide;
+
 /// Pyramid levels (and so LineAO hemispheres) the shaders can bind.
 pub const MAX_LEVELS: u32 = 5;
 

@@ -152,19 +152,24 @@ fn reversed(proj: Mat4) -> Mat4 {
     flip * proj
 }
 
-#[test]
-fn reversed_z_msaa_and_both_projections_against_an_analytic_sphere() {
-    let gpu = gpu();
+/// A sphere (centre, radius, its triangles) and a camera looking at it from above and aside.
+fn sphere_scene() -> (Vec3, f32, Vec<[f32; 3]>, Camera) {
     let (centre, radius) = (Vec3::new(1.0, -2.0, 0.0), 10.0f32);
-    let triangles = sphere_triangles(centre, radius, 64);
-    let bounds = Bounds { center: centre, radius };
-    let size = (200u32, 150u32);
     let camera = Camera {
         eye: Vec3::new(6.0, 9.0, 42.0),
         target: centre,
         up: Vec3::Y,
         projection: Projection::Perspective { fov_y_deg: 45.0 },
     };
+    (centre, radius, sphere_triangles(centre, radius, 64), camera)
+}
+
+#[test]
+fn reversed_z_msaa_and_both_projections_against_an_analytic_sphere() {
+    let gpu = gpu();
+    let (centre, radius, triangles, camera) = sphere_scene();
+    let bounds = Bounds { center: centre, radius };
+    let size = (200u32, 150u32);
     let view_matrix = camera.view_matrix();
     let aspect = size.0 as f32 / size.1 as f32;
     use glam::camera::rh::proj::directx;
@@ -533,15 +538,8 @@ fn read_texture_vec4(gpu: &lineao::Gpu, texture: &wgpu::Texture) -> Vec<[f32; 4]
 fn geometry_outside_the_bounds_is_counted() {
     let gpu = gpu();
     let (d, q) = (&gpu.device, &gpu.queue);
-    let (centre, radius) = (Vec3::new(1.0, -2.0, 0.0), 10.0f32);
-    let triangles = sphere_triangles(centre, radius, 64);
+    let (centre, radius, triangles, camera) = sphere_scene();
     let size = (160u32, 120u32);
-    let camera = Camera {
-        eye: Vec3::new(6.0, 9.0, 42.0),
-        target: centre,
-        up: Vec3::Y,
-        projection: Projection::Perspective { fov_y_deg: 45.0 },
-    };
     let view_matrix = camera.view_matrix();
     let proj = glam::camera::rh::proj::directx::perspective(45f32.to_radians(), 4.0 / 3.0, 5.0, 200.0);
     let depth = host_depth(&gpu, &triangles, proj * view_matrix, size, 1, false);
