@@ -132,25 +132,27 @@ impl PassTimer {
     /// order of `names`. A span that was not recorded this frame reads as garbage: only ask for
     /// the spans the frame used (`only`), or all when `only` is empty.
     pub fn read(&self, device: &wgpu::Device, only: &[&str]) -> Result<Vec<PassTime>, Error> {
-        device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| Error::Gpu(e.to_string()))?;
-        self.try_read(device, only)?.ok_or_else(|| Error::Gpu("no timed frame was submitted".into()))
+        let bytes = self.readback.take(device)?.ok_or_else(|| Error::Gpu("no timed frame was submitted".into()))?;
+        Ok(self.times(&bytes, only))
     }
 
     /// Never waits: the durations of the last timed frame once the GPU has finished it, else
     /// `None` (ask again next frame).
     pub fn try_read(&self, device: &wgpu::Device, only: &[&str]) -> Result<Option<Vec<PassTime>>, Error> {
-        let Some(bytes) = self.readback.try_take(device)? else { return Ok(None) };
-        let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(&bytes);
-        Ok(Some(
-            self.names
-                .iter()
-                .enumerate()
-                .filter(|(_, name)| only.is_empty() || only.contains(name))
-                .map(|(i, &name)| PassTime {
-                    name,
-                    ms: ticks[2 * i + 1].wrapping_sub(ticks[2 * i]) as f64 * self.period_ns * 1e-6,
-                })
-                .collect(),
-        ))
+        Ok(self.readback.try_take(device)?.map(|bytes| self.times(&bytes, only)))
+    }
+
+    /// The spans' durations from the resolved timestamps.
+    fn times(&self, bytes: &[u8], only: &[&str]) -> Vec<PassTime> {
+        let ticks: Vec<u64> = bytemuck::pod_collect_to_vec(bytes);
+        self.names
+            .iter()
+            .enumerate()
+            .filter(|(_, name)| only.is_empty() || only.contains(name))
+            .map(|(i, &name)| PassTime {
+                name,
+                ms: ticks[2 * i + 1].wrapping_sub(ticks[2 * i]) as f64 * self.period_ns * 1e-6,
+            })
+            .collect()
     }
 }
