@@ -189,7 +189,7 @@ impl Passes {
             &VoSettings { area_samples: 1, ..settings.vo.clone() },
         );
         for pass in [&mut passes.raytraced, &mut passes.raytraced_start] {
-            pass.set_scene(device, Some(scene.clone()));
+            pass.set_scene(Some(scene.clone()));
             pass.resize(device, targets);
         }
         // `raytraced` continues the picture its first frame started.
@@ -313,7 +313,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let tractogram = &scene.tracts;
     let ray_geometry =
         lineao::RayGeometry { positions: &tractogram.positions, offsets: &tractogram.offsets, ..Default::default() };
-    let ray_scene = std::sync::Arc::new(lineao::RayScene::new(device, &ray_geometry)?);
+    let ray_scene = std::sync::Arc::new(lineao::RayScene::new(device, queue, &ray_geometry)?);
     let passes = Passes::new(&gpu, &settings, targets, &view, ray_scene.clone());
     let timer = if args.no_timestamps { None } else { PassTimer::new(device, queue, &GPU_PASSES) };
 
@@ -379,7 +379,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let mut ms = Vec::new();
         for _ in 0..runs {
             let start = Instant::now();
-            let scene = lineao::RayScene::new(device, &ray_geometry)?;
+            let scene = lineao::RayScene::new(device, queue, &ray_geometry)?;
             gpu.wait()?;
             ms.push(start.elapsed().as_secs_f64() * 1e3);
             drop(scene);
@@ -394,12 +394,12 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             .count();
         let ms = passes.iter().find(|p| p["name"] == "raytraced-1spp").and_then(|p| p["ms_median"].as_f64());
         eprintln!(
-            "lineao: raytraced-1spp: {geometry_pixels} rays, {:.1} M rays/s; the scene {} bytes, {:.1} bytes per vertex \
-             in {} buffers",
+            "lineao: raytraced-1spp: {geometry_pixels} rays, {:.1} M rays/s; the scene {} bytes, {:.1} bytes per vertex, \
+             {} layer(s) per texture",
             geometry_pixels as f64 / ms.unwrap_or(f64::NAN) / 1e3,
             ray_scene.bytes(),
             ray_scene.bytes_per_vertex(),
-            ray_scene.chunk_count()
+            ray_scene.layers()
         );
     }
     let info = gpu.adapter.get_info();

@@ -64,12 +64,12 @@ pub fn ray_scene(gpu: &Gpu, scene: &Scene) -> Result<lineao::RayScene> {
         radii: scene.radii,
         meshes: &meshes,
     };
-    let ray_scene = lineao::RayScene::new(&gpu.device, &geometry)?;
+    let ray_scene = lineao::RayScene::new(&gpu.device, &gpu.queue, &geometry)?;
     eprintln!(
-        "lineao: ray tracer's scene: {} MB on the GPU ({:.1} bytes per vertex, {} buffers), built in {:.2} s",
+        "lineao: ray tracer's scene: {} MB on the GPU ({:.1} bytes per vertex, {} layer(s) per texture), built in {:.2} s",
         ray_scene.bytes() >> 20,
         ray_scene.bytes_per_vertex(),
-        ray_scene.chunk_count(),
+        ray_scene.layers(),
         start.elapsed().as_secs_f64()
     );
     Ok(ray_scene)

@@ -344,7 +344,7 @@ fn the_ray_traced_method_accumulates_while_the_camera_rests_and_shows_lineao_whi
     let rays = lineao::RayGeometry { positions: &t.positions, offsets: &t.offsets, ..Default::default() };
     let format = wgpu::TextureFormat::Rgba8UnormSrgb;
     let mut chain = lineao::AoChain::new(d, format, frame.view.panels[0].settings.clone()).unwrap();
-    chain.set_ray_scene(d, Some(std::sync::Arc::new(lineao::RayScene::new(d, &rays).unwrap())));
+    chain.set_ray_scene(d, Some(std::sync::Arc::new(lineao::RayScene::new(d, q, &rays).unwrap())));
     chain.resize(frame.size.0, frame.size.1).unwrap();
     let target = lineao::targets::Target::output(d, "test", frame.size, format);
     for _ in 0..3 {

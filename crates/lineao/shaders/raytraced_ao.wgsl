@@ -6,12 +6,26 @@
 // own segment, the buried test and both falloffs are `lineao::truth`'s, step by step, in f32 relative to the ray's
 // origin (the CPU truth is f64). The own segment and the buried test are found on a picture's
 // first frame and kept for the frames that continue it.
+//
+// The scene is read from textures (`lineao::ray_scene` says why), and each pipeline is
+// specialized by the `override` flags below: lavapipe runs both sides of every branch, so what
+// a frame cannot need is compiled out, not branched around.
 #import shared/cone.wgsl
 #import shared/nd.wgsl
 #import shared/view.wgsl
 
-// How many buffers the scene's words are split over (1: no chunk switch).
-override CHUNKS: u32 = 1u;
+// Fixed-width lines, radius line_half · max(−z_view, near) (orthographic: line_half); else tubes.
+override LINES: bool = true;
+// The scene has triangles.
+override TRIANGLES: bool = true;
+// The vertices carry per-vertex tube radii.
+override RADII: bool = false;
+// Linear falloff: rays look for the nearest hit; else for any hit (binary).
+override NEAREST: bool = false;
+// A picture's first frame: find each pixel's own segment and whether its origin is buried.
+override START: bool = true;
+// Tube pixels find their own segment too (the denoiser's "same tube"; rays ignore it).
+override TUBE_OWN: bool = false;
 
 // Keep in sync with `TraceUniform` in `passes/raytraced_ao.rs`.
 struct Trace {
@@ -22,29 +36,21 @@ struct Trace {
     frame_rays: u32,
     first_ray: u32,
     seed: u32,
-    falloff: u32,
     distance: f32,
     epsilon: f32,
-    // 1: fixed-width lines, radius line_half · max(−z_view, near) (orthographic: line_half).
-    lines: u32,
     line_half: f32,
     tube_radius: f32,
     // The largest tube radius (per vertex or the settings'): what node boxes grow by.
     max_radius: f32,
     guard: u32,
-    chunk_shift: u32,
-    nodes_at: u32,
     node_count: u32,
-    refs_at: u32,
-    positions_at: u32,
-    radii_at: u32,
+    // Where the streamline starts begin in `words`.
     starts_at: u32,
     streamlines: u32,
-    triangles_at: u32,
+    // log2 of the widths of the scene's textures: nodes, vertices, words, triangles.
+    shifts: vec4<u32>,
     width: u32,
     height: u32,
-    // 1: tube pixels find their own segment too (the denoiser's "same tube"; rays ignore it).
-    tube_own: u32,
 }
 
 @group(0) @binding(0) var<uniform> trace: Trace;
@@ -53,39 +59,36 @@ struct Trace {
 // Per pixel of the guard-banded frame: the sums of the rays' values and of their squares (f32
 // bits), the own segment's first vertex (NONE for none) and whether the origin is buried.
 @group(0) @binding(3) var<storage, read_write> accumulation: array<vec4<u32>>;
-@group(0) @binding(4) var<storage, read> scene0: array<u32>;
-@group(0) @binding(5) var<storage, read> scene1: array<u32>;
-@group(0) @binding(6) var<storage, read> scene2: array<u32>;
-@group(0) @binding(7) var<storage, read> scene3: array<u32>;
-@group(0) @binding(8) var<storage, read> scene4: array<u32>;
-@group(0) @binding(9) var<storage, read> scene5: array<u32>;
+// The scene (`lineao::ray_scene`): two texels per node, one per vertex (xyz, tube radius), one
+// word per primitive reference and streamline start, one texel per triangle.
+@group(0) @binding(4) var nodes: texture_2d_array<u32>;
+@group(0) @binding(5) var vertices: texture_2d_array<u32>;
+@group(0) @binding(6) var words: texture_2d_array<u32>;
+@group(0) @binding(7) var triangles: texture_2d_array<u32>;
 
 const TRIANGLE_BIT: u32 = 0x80000000u;
 const NO_HIT: f32 = 3.0e38;
 const STACK: u32 = 48u;
 
-fn word(i: u32) -> u32 {
-    if CHUNKS == 1u {
-        return scene0[i];
-    }
-    let j = i & ((1u << trace.chunk_shift) - 1u);
-    switch i >> trace.chunk_shift {
-        case 0u: { return scene0[j]; }
-        case 1u: { return scene1[j]; }
-        case 2u: { return scene2[j]; }
-        case 3u: { return scene3[j]; }
-        case 4u: { return scene4[j]; }
-        default: { return scene5[j]; }
-    }
+// Texel i of a texture whose square layers are 2^shift wide: (x, y, layer).
+fn texel(i: u32, shift: u32) -> vec3<u32> {
+    let mask = (1u << shift) - 1u;
+    return vec3<u32>(i & mask, (i >> shift) & mask, i >> (2u * shift));
 }
 
-fn wordf(i: u32) -> f32 {
-    return bitcast<f32>(word(i));
+fn word(i: u32) -> u32 {
+    let at = texel(i, trace.shifts.z);
+    return textureLoad(words, at.xy, at.z, 0).x;
+}
+
+// Vertex v: its position and, with RADII, its tube radius (≤ 0: the settings').
+fn vertex4(v: u32) -> vec4<f32> {
+    let at = texel(v, trace.shifts.y);
+    return bitcast<vec4<f32>>(textureLoad(vertices, at.xy, at.z, 0));
 }
 
 fn vertex(v: u32) -> vec3<f32> {
-    let at = trace.positions_at + 3u * v;
-    return vec3<f32>(wordf(at), wordf(at + 1u), wordf(at + 2u));
+    return vertex4(v).xyz;
 }
 
 // ---- The sample sequence (`lineao::truth::sequence`, bit for bit) ----
@@ -171,26 +174,24 @@ struct Cone {
     rb: f32,
 }
 
-fn radius_at(v: u32, p: vec3<f32>) -> f32 {
-    if trace.lines != 0u {
+// The radius at vertex `a` (position xyz, tube radius w).
+fn radius_at(a: vec4<f32>) -> f32 {
+    if LINES {
         if trace.view.orthographic != 0u {
             return trace.line_half;
         }
-        return trace.line_half * max(-(dot(trace.view_z.xyz, p) + trace.view_z.w), trace.view.near);
+        return trace.line_half * max(-(dot(trace.view_z.xyz, a.xyz) + trace.view_z.w), trace.view.near);
     }
-    if trace.radii_at != 0xffffffffu {
-        let r = wordf(trace.radii_at + v);
-        if r > 0.0 {
-            return r;
-        }
+    if RADII && a.w > 0.0 {
+        return a.w;
     }
     return trace.tube_radius;
 }
 
 fn cone(v: u32) -> Cone {
-    let a = vertex(v);
-    let b = vertex(v + 1u);
-    return Cone(a, b, radius_at(v, a), radius_at(v + 1u, b));
+    let a = vertex4(v);
+    let b = vertex4(v + 1u);
+    return Cone(a.xyz, b.xyz, radius_at(a), radius_at(b));
 }
 
 // The nearest hit of ro + t rd with t in (0, t_max), or NO_HIT; `ro` is 0 (the cone is given
@@ -289,14 +290,15 @@ struct Own {
 
 // Whether a ray from `own`'s surface ignores segment v: the same streamline, and a neighbour or
 // a segment still holding the axis point (a tight bend).
-fn skips(own: Own, v: u32) -> bool {
+// `c` is segment v's cone.
+fn skips(own: Own, v: u32, c: Cone) -> bool {
     if own.v == 0xffffffffu || v < own.first || v >= own.end {
         return false;
     }
     if max(v, own.v) - min(v, own.v) <= 1u {
         return true;
     }
-    return cone_distance(own.c, cone(v)) < 0.0;
+    return cone_distance(own.c, c) < 0.0;
 }
 
 // The streamline holding vertex v: its [first, end) by binary search over the starts.
@@ -318,7 +320,7 @@ fn streamline_of(v: u32) -> vec2<u32> {
 
 // How far a node's box grows: the largest cone radius inside it.
 fn box_growth(lo: vec3<f32>, hi: vec3<f32>) -> f32 {
-    if trace.lines == 0u {
+    if !LINES {
         return trace.max_radius;
     }
     if trace.view.orthographic != 0u {
@@ -339,11 +341,14 @@ struct Node {
 }
 
 fn node(n: u32) -> Node {
-    let at = trace.nodes_at + 8u * n;
-    let lo = vec3<f32>(wordf(at), wordf(at + 1u), wordf(at + 2u));
-    let hi = vec3<f32>(wordf(at + 4u), wordf(at + 5u), wordf(at + 6u));
+    let at = texel(2u * n, trace.shifts.x);
+    // Both texels share a row: the width is even.
+    let a = textureLoad(nodes, at.xy, at.z, 0);
+    let b = textureLoad(nodes, at.xy + vec2<u32>(1u, 0u), at.z, 0);
+    let lo = bitcast<vec3<f32>>(a.xyz);
+    let hi = bitcast<vec3<f32>>(b.xyz);
     let g = box_growth(lo, hi);
-    return Node(lo - g, hi + g, word(at + 3u), word(at + 7u));
+    return Node(lo - g, hi + g, a.w, b.w);
 }
 
 // The ray's entry into the box before t_max (relative to the ray's origin ro), or NO_HIT.
@@ -407,15 +412,16 @@ fn traverse(q: Query, own: Own) -> Found {
         var descend = false;
         if n.count > 0u {
             for (var k = 0u; k < n.count; k++) {
-                let r = word(trace.refs_at + n.first + k);
-                if (r & TRIANGLE_BIT) != 0u {
+                let r = word(n.first + k);
+                if TRIANGLES && (r & TRIANGLE_BIT) != 0u {
                     if q.mode > RAY_NEAREST {
                         continue;
                     }
-                    let at = trace.triangles_at + 3u * (r & ~TRIANGLE_BIT);
-                    let v0 = vertex(word(at)) - q.ro;
-                    let v1 = vertex(word(at + 1u)) - q.ro;
-                    let v2 = vertex(word(at + 2u)) - q.ro;
+                    let at = texel(r & ~TRIANGLE_BIT, trace.shifts.w);
+                    let t3 = textureLoad(triangles, at.xy, at.z, 0).xyz;
+                    let v0 = vertex(t3.x) - q.ro;
+                    let v1 = vertex(t3.y) - q.ro;
+                    let v2 = vertex(t3.z) - q.ro;
                     let t = intersect_triangle(q.rd, v0, v1, v2, found.t);
                     if t != NO_HIT {
                         found.t = t;
@@ -425,10 +431,10 @@ fn traverse(q: Query, own: Own) -> Found {
                     }
                     continue;
                 }
-                if q.mode != OWN && skips(own, r) {
+                let c = cone(r);
+                if q.mode != OWN && skips(own, r, c) {
                     continue;
                 }
-                let c = cone(r);
                 if q.mode <= RAY_NEAREST {
                     let t = intersect_cone(q.rd, c.a - q.ro, c.b - q.ro, c.ra, c.rb, found.t);
                     if t != NO_HIT {
@@ -531,28 +537,28 @@ fn raytraced_ao(@builtin(global_invocation_id) id: vec3<u32>) {
         let depth = linear_depth(trace.view, texel.w);
         let p = (trace.inv_view * vec4<f32>(view_position(trace.view, pixel, depth), 1.0)).xyz;
         let n = normalize((trace.inv_view * vec4<f32>(texel.xyz, 0.0)).xyz);
-        if trace.first_ray == 0u {
+        if START {
             // A new picture: the pixel's own segment and whether its origin is buried, found once
             // and kept for the frames that continue it.
             var own = NONE;
-            if trace.lines != 0u || trace.tube_own != 0u {
+            if LINES || TUBE_OWN {
                 // The segment holding p most deeply, within a pixel's footprint of its surface.
                 let footprint = select(depth, 1.0, trace.view.orthographic != 0u) / trace.view.f_px;
                 own = traverse(Query(OWN, p, vec3<f32>(1.0), footprint), Own(NONE, 0u, 0u, vec3<f32>(0.0))).v;
             }
-            let o = origin(p, n, select(NONE, own, trace.lines != 0u));
+            let o = origin(p, n, select(NONE, own, LINES));
             let buried = traverse(Query(INSIDE, o.start, vec3<f32>(1.0), 0.0), o.own).t == 0.0;
             state = vec4<u32>(0u, 0u, own, u32(buried));
         }
         // Tubes start at the surface whether or not they know their segment.
-        let o = origin(p, n, select(NONE, state.z, trace.lines != 0u));
+        let o = origin(p, n, select(NONE, state.z, LINES));
         // A buried origin's rays all count 1.
         var sum = f32(trace.frame_rays);
         var squares = sum;
         if state.w == 0u {
             let guard = i32(trace.guard);
             let seed = pixel_seed(i32(pixel.x) - guard, i32(pixel.y) - guard, trace.seed);
-            let mode = select(RAY_ANY, RAY_NEAREST, trace.falloff != 0u);
+            let mode = select(RAY_ANY, RAY_NEAREST, NEAREST);
             sum = 0.0;
             squares = 0.0;
             for (var i = 0u; i < trace.frame_rays; i++) {

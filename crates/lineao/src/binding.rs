@@ -13,6 +13,8 @@ pub enum Slot {
     Texture,
     /// `texture_2d<u32>` read with `textureLoad`.
     UintTexture,
+    /// `texture_2d_array<u32>` read with `textureLoad`.
+    UintTextureArray,
     /// `texture_depth_2d`, or `texture_depth_multisampled_2d` when `multisampled`.
     DepthTexture {
         multisampled: bool,
@@ -55,9 +57,13 @@ pub fn layout(
                     view_dimension: wgpu::TextureViewDimension::D2,
                     multisampled,
                 },
-                Slot::UintTexture => wgpu::BindingType::Texture {
+                Slot::UintTexture | Slot::UintTextureArray => wgpu::BindingType::Texture {
                     sample_type: wgpu::TextureSampleType::Uint,
-                    view_dimension: wgpu::TextureViewDimension::D2,
+                    view_dimension: if matches!(slot, Slot::UintTexture) {
+                        wgpu::TextureViewDimension::D2
+                    } else {
+                        wgpu::TextureViewDimension::D2Array
+                    },
                     multisampled: false,
                 },
                 Slot::StorageTexture(format) => wgpu::BindingType::StorageTexture {

@@ -1,5 +1,5 @@
 //! The ray tracer's scene on the GPU: the ground truth's BVH ([`crate::truth::bvh`]) flattened
-//! into storage buffers, built on the CPU and uploaded once per geometry.
+//! into textures, built on the CPU and uploaded once per geometry.
 //!
 //! **View-independent.** A fixed-width line's volume depends on the view (its radius is the
 //! line's half-width on screen, (w/2)·(−z_view)/f_px), a tube's on the settings (its radius).
@@ -9,27 +9,35 @@
 //! largest tube radius. Camera moves and radius changes then need no rebuild, only new
 //! geometry does.
 //!
-//! **Layout**: one array of 32-bit words, regions in this order (offsets in words):
+//! **Textures, not storage buffers.** Every word the traversal reads is a texel fetch. On a GPU
+//! a node read through the texture unit costs what a buffer load does (Aila and Laine's 2009
+//! GPU traversal fetches its nodes so). On lavapipe it is what decides the speed: llvmpipe
+//! (Mesa 22.3) loads a storage buffer one SIMD lane at a time, in a loop with a branch per lane
+//! and per 32-bit word, while a texel fetch of 16 bytes is one unrolled gather — and a BVH walk
+//! is little else but such loads. Moving the scene from storage buffers into textures, with
+//! the pass's specialized pipelines, made a one-ray frame 2.4–2.6× faster there
+//! (docs/measurements.md, session 17).
 //!
-//! | region    | words                  | content                                                     |
-//! |-----------|------------------------|-------------------------------------------------------------|
-//! | nodes     | 8 per node             | min xyz (f32), first, max xyz (f32), count: [`Node`]       |
-//! | refs      | 1 per primitive        | a segment's first vertex v (joins v, v + 1), or a triangle's index with bit 31 |
-//! | positions | 3 per vertex           | the lines' vertices, then every mesh's (f32)                |
-//! | radii     | 1 per line vertex      | per-vertex tube radii, ≤ 0 = the settings' (only when given) |
-//! | starts    | 1 per streamline, + 1  | each streamline's first vertex, then the vertex count       |
-//! | triangles | 3 per triangle         | vertex indices into `positions`                              |
+//! **Layout**: four textures, one per region (texel i of a region is its i-th element):
 //!
-//! Leaves hold up to [`GPU_LEAF`] primitives, so there are about 0.3 nodes per segment:
-//! 12 B of position + 4 B of reference + about 10 B of nodes + 4 B of radius where tubes have
-//! per-vertex radii, under 32 bytes per vertex ([`RayScene::bytes_per_vertex`] says exactly;
-//! `lineao bench` prints it).
+//! | texture   | format       | texels                      | content                                              |
+//! |-----------|--------------|-----------------------------|------------------------------------------------------|
+//! | nodes     | `Rgba32Uint` | 2 per node                  | (min xyz (f32), first), (max xyz (f32), count): [`Node`] |
+//! | vertices  | `Rgba32Uint` | 1 per vertex                | xyz (f32) and the tube radius (f32, ≤ 0 = the settings'): the lines' vertices, then every mesh's |
+//! | words     | `R32Uint`    | 1 per primitive, then 1 per streamline + 1 | references (a segment's first vertex v, joining v and v + 1, or a triangle's index with bit 31), then each streamline's first vertex and the vertex count |
+//! | triangles | `Rgba32Uint` | 1 per triangle              | vertex indices into `vertices`, and 0               |
 //!
-//! **Split over bindings.** A storage binding holds at most the adapter's
-//! `max_storage_buffer_binding_size` (128 MiB on lavapipe, 11 M segments need more), so the
-//! words are cut into chunks of 2^k words, each its own buffer and binding, up to
-//! [`MAX_CHUNKS`]; the shader reads word i from chunk i ≫ k. A scene beyond that is
-//! [`Error::TooLarge`].
+//! Leaves hold up to [`GPU_LEAF`] primitives, so there are about 0.34 nodes per segment: 16 B of
+//! vertex + 4 B of reference + about 11 B of nodes, under 32 bytes per vertex
+//! ([`RayScene::bytes_per_vertex`] says exactly, padding included; `lineao bench` prints it).
+//!
+//! **Addressing, and scenes larger than a texture.** Each texture is an array of square layers
+//! 2^k texels wide: texel i lies at (i mod 2^k, ⌊i / 2^k⌋ mod 2^k) of layer ⌊i / 4^k⌋. k is the
+//! least that holds the region in one layer (whose height is then only the rows it fills), up
+//! to the adapter's largest 2D texture (8192 texels in wgpu's defaults: 67 M texels a layer);
+//! past that more layers hold the rest, up to the adapter's `max_texture_array_layers`. A
+//! region beyond that is [`Error::TooLarge`]. A texture binding so holds what several storage
+//! bindings would (lavapipe's hold 128 MiB each, its largest texture array 32 GiB).
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -42,9 +50,6 @@ use crate::truth::{RoundedCone, Triangle};
 
 /// Most primitives in a leaf of the GPU tree.
 pub const GPU_LEAF: usize = 8;
-/// Most bindings the words are split over (with the pass's uniform, G-buffer, `ao` and
-/// accumulation buffer, within wgpu's default 8 storage buffers per stage).
-pub const MAX_CHUNKS: usize = 6;
 
 /// What the scene is made of: streamlines (as `Tractogram` holds them) and triangle meshes.
 #[derive(Clone, Copy, Debug, Default)]
@@ -58,107 +63,95 @@ pub struct RayGeometry<'a> {
     pub meshes: &'a [(&'a [[f32; 3]], &'a [u32])],
 }
 
-/// Word offsets of the regions, as the shader's uniform takes them.
+/// What the shader needs to know of the scene besides its textures.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Regions {
-    pub nodes: u32,
     pub node_count: u32,
-    pub refs: u32,
-    pub positions: u32,
-    /// `u32::MAX` when there are no per-vertex radii.
-    pub radii: u32,
+    /// Where the streamline starts begin in `words` (after the references).
     pub starts: u32,
     pub streamlines: u32,
     pub triangles: u32,
+    /// Whether the vertices carry per-vertex tube radii.
+    pub radii: bool,
+}
+
+/// One region as a texture array (see the module doc).
+pub(crate) struct SceneTexture {
+    pub(crate) view: wgpu::TextureView,
+    /// log2 of the layers' width.
+    pub(crate) shift: u32,
+    layers: u32,
+    bytes: u64,
 }
 
 /// The scene on the GPU (see the module doc).
 pub struct RayScene {
-    pub(crate) chunks: Vec<wgpu::Buffer>,
-    /// log2 of the words per chunk.
-    pub(crate) chunk_shift: u32,
+    pub(crate) nodes: SceneTexture,
+    pub(crate) vertices: SceneTexture,
+    pub(crate) words: SceneTexture,
+    pub(crate) triangles: SceneTexture,
     pub(crate) regions: Regions,
     /// The largest per-vertex tube radius (0 without).
     pub(crate) max_vertex_radius: f32,
     /// Changes with every upload: what tells the progressive tracer to start again.
     pub(crate) generation: u64,
-    vertices: usize,
-    bytes: u64,
+    vertex_count: usize,
 }
 
 static GENERATION: AtomicU64 = AtomicU64::new(1);
 
 impl RayScene {
-    /// Builds the tree over `geometry` on all cores and uploads it, split over as many bindings
-    /// as the device's limits need.
-    pub fn new(device: &wgpu::Device, geometry: &RayGeometry) -> Result<RayScene, Error> {
-        let limits = device.limits();
-        let binding = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
-        // The largest power of two of words a binding holds.
-        let chunk_words = 1u64 << (63 - (binding / 4).max(1).leading_zeros());
-        Self::with_chunk_words(device, geometry, chunk_words)
+    /// Builds the tree over `geometry` on all cores and uploads it, in textures as wide as the
+    /// device allows.
+    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, geometry: &RayGeometry) -> Result<RayScene, Error> {
+        let widest = device.limits().max_texture_dimension_2d.max(1);
+        Self::with_max_width(device, queue, geometry, 1 << (31 - widest.leading_zeros()))
     }
 
-    /// [`RayScene::new`] with chunks of `chunk_words` words (a power of two): how tests split a
-    /// small scene over several bindings.
-    pub fn with_chunk_words(
+    /// [`RayScene::new`] with layers at most `max_width` texels wide (a power of two ≥ 2): how
+    /// tests spread a small scene over many layers.
+    pub fn with_max_width(
         device: &wgpu::Device,
+        queue: &wgpu::Queue,
         geometry: &RayGeometry,
-        chunk_words: u64,
+        max_width: u32,
     ) -> Result<RayScene, Error> {
-        if !chunk_words.is_power_of_two() || chunk_words < 64 {
-            return Err(Error::Usage(format!("chunk_words must be a power of two ≥ 64, got {chunk_words}")));
+        if !max_width.is_power_of_two() || max_width < 2 {
+            return Err(Error::Usage(format!("max_width must be a power of two ≥ 2, got {max_width}")));
         }
-        let vertices = geometry.positions.len() + geometry.meshes.iter().map(|m| m.0.len()).sum::<usize>();
-        let estimate = 4 * (vertices as u64) * 8;
-        let capacity = MAX_CHUNKS as u64 * chunk_words * 4;
-        if vertices >= TRIANGLE_BIT as usize || estimate > 2 * capacity {
-            return Err(too_large(vertices, estimate, capacity));
+        let limits = Limits { max_width, max_layers: device.limits().max_texture_array_layers };
+        let vertex_count = geometry.positions.len() + geometry.meshes.iter().map(|m| m.0.len()).sum::<usize>();
+        // Before building the tree: a vertex is a texel, a segment up to two.
+        let capacity = limits.texels();
+        if vertex_count >= TRIANGLE_BIT as usize || 2 * vertex_count as u64 > capacity {
+            return Err(too_large("vertices", vertex_count as u64, &limits));
         }
-        let (words, regions, max_vertex_radius) = flatten(geometry);
-        let bytes = words.len() as u64 * 4;
-        if bytes > capacity {
-            return Err(too_large(vertices, bytes, capacity));
-        }
-        let chunks = words
-            .chunks(chunk_words as usize)
-            .enumerate()
-            .map(|(i, chunk)| {
-                device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some(&format!("lineao::RayScene[{i}]")),
-                    contents: bytemuck::cast_slice(chunk),
-                    usage: wgpu::BufferUsages::STORAGE,
-                })
-            })
-            .collect::<Vec<_>>();
-        let chunks = if chunks.is_empty() {
-            vec![device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("lineao::RayScene[empty]"),
-                contents: &[0; 32],
-                usage: wgpu::BufferUsages::STORAGE,
-            })]
-        } else {
-            chunks
-        };
+        let flat = flatten(geometry);
         Ok(RayScene {
-            chunks,
-            chunk_shift: chunk_words.trailing_zeros(),
-            regions,
-            max_vertex_radius,
+            nodes: upload(device, queue, "nodes", &flat.nodes, 4, &limits)?,
+            vertices: upload(device, queue, "vertices", &flat.vertices, 4, &limits)?,
+            words: upload(device, queue, "words", &flat.words, 1, &limits)?,
+            triangles: upload(device, queue, "triangles", &flat.triangles, 4, &limits)?,
+            regions: flat.regions,
+            max_vertex_radius: flat.max_vertex_radius,
             generation: GENERATION.fetch_add(1, Ordering::Relaxed),
-            vertices,
-            bytes,
+            vertex_count,
         })
     }
 
-    /// Bytes on the GPU.
+    /// Its textures in binding order: nodes, vertices, words, triangles.
+    pub(crate) fn textures(&self) -> [&SceneTexture; 4] {
+        [&self.nodes, &self.vertices, &self.words, &self.triangles]
+    }
+
+    /// Bytes on the GPU, the textures' padding included.
     pub fn bytes(&self) -> u64 {
-        self.bytes
+        self.textures().iter().map(|t| t.bytes).sum()
     }
 
     /// GPU bytes per vertex (lines and meshes).
     pub fn bytes_per_vertex(&self) -> f64 {
-        self.bytes as f64 / self.vertices.max(1) as f64
+        self.bytes() as f64 / self.vertex_count.max(1) as f64
     }
 
     /// A number no other scene of this process has: what tells a renderer holding scenes that
@@ -167,9 +160,9 @@ impl RayScene {
         self.generation
     }
 
-    /// The buffers the words are split over.
-    pub fn chunk_count(&self) -> usize {
-        self.chunks.len()
+    /// The layers of its largest texture (1 unless a region outgrows one layer).
+    pub fn layers(&self) -> u32 {
+        self.textures().iter().map(|t| t.layers).max().unwrap_or(1)
     }
 
     /// Whether there is nothing to hit.
@@ -178,15 +171,85 @@ impl RayScene {
     }
 }
 
-fn too_large(vertices: usize, bytes: u64, capacity: u64) -> Error {
+/// How large the scene's textures may be.
+struct Limits {
+    max_width: u32,
+    max_layers: u32,
+}
+
+impl Limits {
+    /// Texels a texture holds.
+    fn texels(&self) -> u64 {
+        (self.max_width as u64).pow(2) * self.max_layers as u64
+    }
+}
+
+fn too_large(what: &str, count: u64, limits: &Limits) -> Error {
     Error::TooLarge(format!(
-        "the ray tracer's scene of {vertices} vertices needs {bytes} bytes on the GPU, more than the {capacity} bytes \
-         of {MAX_CHUNKS} storage bindings this adapter allows"
+        "the ray tracer's scene has {count} {what}, more than a texture of this adapter holds: {} layers of \
+         {w} × {w} texels (max_texture_array_layers, max_texture_dimension_2d), {} texels",
+        limits.max_layers,
+        limits.texels(),
+        w = limits.max_width,
     ))
 }
 
-/// The words of the scene, their regions, and the largest per-vertex radius.
-fn flatten(geometry: &RayGeometry) -> (Vec<u32>, Regions, f32) {
+/// Uploads `data` (`texel_words` words a texel) as a texture array of square layers.
+fn upload(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    region: &str,
+    data: &[u32],
+    texel_words: usize,
+    limits: &Limits,
+) -> Result<SceneTexture, Error> {
+    let texels = (data.len() / texel_words).max(1) as u64;
+    if texels > limits.texels() {
+        return Err(too_large(&format!("texels of {region}"), texels, limits));
+    }
+    // The least width whose square layer holds every texel, within the limit.
+    let mut shift = 0;
+    while (1u64 << (2 * shift)) < texels && (1u32 << shift) < limits.max_width {
+        shift += 1;
+    }
+    let width = 1u64 << shift;
+    let layers = texels.div_ceil(width * width);
+    let rows = if layers == 1 { texels.div_ceil(width) } else { width };
+    let mut padded = vec![0u32; (width * rows * layers) as usize * texel_words];
+    padded[..data.len()].copy_from_slice(data);
+    let texture = device.create_texture_with_data(
+        queue,
+        &wgpu::TextureDescriptor {
+            label: Some(&format!("lineao::RayScene::{region}")),
+            size: wgpu::Extent3d { width: width as u32, height: rows as u32, depth_or_array_layers: layers as u32 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: if texel_words == 4 { wgpu::TextureFormat::Rgba32Uint } else { wgpu::TextureFormat::R32Uint },
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        },
+        wgpu::util::TextureDataOrder::LayerMajor,
+        bytemuck::cast_slice(&padded),
+    );
+    let view = texture.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2Array),
+        ..Default::default()
+    });
+    Ok(SceneTexture { view, shift, layers: layers as u32, bytes: padded.len() as u64 * 4 })
+}
+
+/// The regions' words (see the module doc).
+struct Flat {
+    nodes: Vec<u32>,
+    vertices: Vec<u32>,
+    words: Vec<u32>,
+    triangles: Vec<u32>,
+    regions: Regions,
+    max_vertex_radius: f32,
+}
+
+fn flatten(geometry: &RayGeometry) -> Flat {
     let positions = geometry.positions;
     // Bare axes (radius 0), with the vertex each segment starts at.
     let mut cones = Vec::with_capacity(positions.len());
@@ -210,42 +273,44 @@ fn flatten(geometry: &RayGeometry) -> (Vec<u32>, Regions, f32) {
                 continue;
             };
             triangles.push(Triangle { v: [v[0], v[1], v[2]].map(|p| Vec3::from(*p)) });
-            triangle_vertices.extend(t.iter().map(|&i| base + i));
+            triangle_vertices.extend(t.iter().map(|&i| base + i).chain([0]));
         }
         base += mesh_positions.len() as u32;
     }
     let bvh = Bvh::build_with_leaves(cones, triangles, GPU_LEAF);
-    let mut words: Vec<u32> = Vec::new();
-    let mut regions = Regions { nodes: 0, node_count: bvh.nodes.len() as u32, ..Regions::default() };
-    words.extend_from_slice(bytemuck::cast_slice::<Node, u32>(&bvh.nodes));
-    regions.refs = words.len() as u32;
-    words.extend(bvh.refs.iter().map(|&r| if r & TRIANGLE_BIT != 0 { r } else { first_vertex[r as usize] }));
-    regions.positions = words.len() as u32;
-    words.extend_from_slice(bytemuck::cast_slice(positions));
-    for (mesh_positions, _) in geometry.meshes {
-        words.extend_from_slice(bytemuck::cast_slice(mesh_positions));
-    }
     let mut max_vertex_radius = 0.0f32;
-    regions.radii = match geometry.radii {
-        Some(radii) => {
-            let at = words.len() as u32;
-            words.extend((0..positions.len()).map(|v| {
-                let r = radii.get(v).copied().unwrap_or(0.0);
-                let r = if r > 0.0 && r.is_finite() { r } else { 0.0 };
-                max_vertex_radius = max_vertex_radius.max(r);
-                r.to_bits()
-            }));
-            at
-        }
-        None => u32::MAX,
+    let radius = |v: usize| {
+        let r = geometry.radii.and_then(|radii| radii.get(v)).copied().unwrap_or(0.0);
+        if r > 0.0 && r.is_finite() { r } else { 0.0 }
     };
-    regions.starts = words.len() as u32;
+    let mut vertices = Vec::with_capacity(4 * base as usize);
+    for (v, p) in positions.iter().enumerate() {
+        let r = radius(v);
+        max_vertex_radius = max_vertex_radius.max(r);
+        vertices.extend([p[0], p[1], p[2], r].map(f32::to_bits));
+    }
+    for (mesh_positions, _) in geometry.meshes {
+        vertices.extend(mesh_positions.iter().flat_map(|p| [p[0], p[1], p[2], 0.0].map(f32::to_bits)));
+    }
+    let mut words: Vec<u32> =
+        bvh.refs.iter().map(|&r| if r & TRIANGLE_BIT != 0 { r } else { first_vertex[r as usize] }).collect();
     let streamlines = geometry.offsets.len().saturating_sub(1);
-    regions.streamlines = streamlines as u32;
+    let regions = Regions {
+        node_count: bvh.nodes.len() as u32,
+        starts: words.len() as u32,
+        streamlines: streamlines as u32,
+        triangles: (triangle_vertices.len() / 4) as u32,
+        radii: geometry.radii.is_some(),
+    };
     words.extend(geometry.offsets.iter().map(|&o| o.min(positions.len() as u64) as u32));
-    regions.triangles = words.len() as u32;
-    words.extend_from_slice(&triangle_vertices);
-    (words, regions, max_vertex_radius)
+    Flat {
+        nodes: bytemuck::cast_slice::<Node, u32>(&bvh.nodes).to_vec(),
+        vertices,
+        words,
+        triangles: triangle_vertices,
+        regions,
+        max_vertex_radius,
+    }
 }
 
 #[cfg(test)]
@@ -256,20 +321,28 @@ mod tests {
     fn regions_hold_what_the_module_doc_says() {
         let positions = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 1.0, 0.0], [f32::NAN, 0.0, 0.0]];
         let offsets = [0, 3, 5];
+        let radii = [0.5, -1.0, f32::INFINITY, 0.25];
         let mesh_positions = [[0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [0.0, 1.0, 1.0]];
         let indices = [0, 1, 2, 0, 1, 7];
         let meshes = [(&mesh_positions[..], &indices[..])];
-        let geometry = RayGeometry { positions: &positions, offsets: &offsets, radii: None, meshes: &meshes };
-        let (words, r, _) = flatten(&geometry);
+        let geometry = RayGeometry { positions: &positions, offsets: &offsets, radii: Some(&radii), meshes: &meshes };
+        let flat = flatten(&geometry);
+        let r = flat.regions;
         // Two finite segments (0–1, 1–2; 3–4 has a NaN end) and one valid triangle.
-        let refs = &words[r.refs as usize..r.positions as usize];
+        let refs = &flat.words[..r.starts as usize];
         let mut sorted = refs.to_vec();
         sorted.sort();
         assert_eq!(sorted, vec![0, 1, TRIANGLE_BIT]);
-        assert_eq!(f32::from_bits(words[r.positions as usize + 3]), 1.0);
-        assert_eq!(r.radii, u32::MAX);
-        assert_eq!(&words[r.starts as usize..r.triangles as usize], &[0, 3, 5]);
-        // The triangle's vertices follow the 5 line vertices.
-        assert_eq!(&words[r.triangles as usize..], &[5, 6, 7]);
+        assert_eq!(&flat.words[r.starts as usize..], &[0, 3, 5]);
+        assert_eq!((r.streamlines, r.triangles, r.radii), (2, 1, true));
+        // Vertex 1: x = 1, and its radius −1 reads as none (0); vertex 3's 0.25 is kept.
+        assert_eq!(flat.vertices[4..8], [1.0f32, 0.0, 0.0, 0.0].map(f32::to_bits));
+        assert_eq!(f32::from_bits(flat.vertices[4 * 3 + 3]), 0.25);
+        assert_eq!((f32::from_bits(flat.vertices[3]), f32::from_bits(flat.vertices[4 * 2 + 3])), (0.5, 0.0));
+        assert_eq!(flat.max_vertex_radius, 0.5);
+        // 5 line vertices, then the mesh's 3; the triangle's vertices follow the line vertices.
+        assert_eq!(flat.vertices.len(), 4 * 8);
+        assert_eq!(flat.triangles, [5, 6, 7, 0]);
+        assert_eq!(flat.nodes.len(), 8 * r.node_count as usize);
     }
 }

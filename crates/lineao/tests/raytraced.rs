@@ -1,5 +1,5 @@
 //! The GPU ray tracer against the CPU truth with the same rays (sequence, seed, frame indices):
-//! lines, tubes and a mesh, a scene split over several bindings, progressive accumulation and
+//! lines, tubes and a mesh, a scene spread over many texture layers, progressive accumulation and
 //! its restart, the cap, and linear falloff.
 
 mod common;
@@ -54,7 +54,7 @@ struct Tracer {
 }
 
 impl Tracer {
-    fn new(scene: &Scene, settings: ChainSettings, chunk_words: Option<u64>) -> Tracer {
+    fn new(scene: &Scene, settings: ChainSettings, max_width: Option<u32>) -> Tracer {
         let gpu = gpu();
         let (d, q) = (&gpu.device, &gpu.queue);
         let lines = LineGeometry::new(d, q, &scene.positions, &scene.offsets).unwrap();
@@ -66,12 +66,12 @@ impl Tracer {
         let meshes = scene.meshes();
         let radii = scene.radii.as_deref();
         let geometry = RayGeometry { positions: &scene.positions, offsets: &scene.offsets, radii, meshes: &meshes };
-        let ray_scene = match chunk_words {
-            Some(words) => RayScene::with_chunk_words(d, &geometry, words).unwrap(),
-            None => RayScene::new(d, &geometry).unwrap(),
+        let ray_scene = match max_width {
+            Some(width) => RayScene::with_max_width(d, q, &geometry, width).unwrap(),
+            None => RayScene::new(d, q, &geometry).unwrap(),
         };
-        if chunk_words.is_some() {
-            assert!(ray_scene.chunk_count() >= 3, "{} chunks", ray_scene.chunk_count());
+        if max_width.is_some() {
+            assert!(ray_scene.layers() >= 3, "{} layers", ray_scene.layers());
         }
         let mut chain = AoChain::new(d, OUTPUT_FORMAT, settings).unwrap();
         chain.resize(SIZE.0, SIZE.1).unwrap();
@@ -182,14 +182,15 @@ fn lines_accumulate_to_the_cpu_truth_with_the_same_rays_and_restart_when_the_cam
 }
 
 #[test]
-fn tubes_with_per_vertex_radii_and_a_mesh_split_over_several_bindings_match_the_cpu_truth() {
+fn tubes_with_per_vertex_radii_and_a_mesh_spread_over_many_texture_layers_match_the_cpu_truth() {
     let mut scene = Scene::lines(40).with_mesh();
     // Every third vertex carries its own radius; the others take the settings'.
     scene.radii = Some((0..scene.positions.len()).map(|v| if v % 3 == 0 { 1.6 } else { 0.0 }).collect());
     let mut s = settings(8);
     s.tubes = Some(lineao::TubeSettings { radius_world: 1.0 });
     s.surfaces = Some(SurfaceSettings::default());
-    let mut tracer = Tracer::new(&scene, s, Some(4096));
+    // Layers of 16 × 16 texels: every region wraps rows and spans layers.
+    let mut tracer = Tracer::new(&scene, s, Some(16));
     let (nd, ao) = tracer.frame(&camera());
     assert_same_hits(&nd, &ao, &cpu_truth(&tracer, &scene, &nd, 8), 8, "tubes + mesh, split");
 }
@@ -238,16 +239,24 @@ fn linear_falloff_matches_the_cpu_truth() {
 }
 
 #[test]
-fn a_scene_beyond_six_bindings_is_too_large_and_no_scene_is_no_occlusion() {
+fn a_scene_beyond_the_adapters_texture_arrays_is_too_large_and_no_scene_is_no_occlusion() {
     let gpu = gpu();
-    let scene = Scene::lines(200);
+    let (d, q) = (&gpu.device, &gpu.queue);
+    // Layers of 2 × 2 texels: the adapter's layers hold 4 per layer, and 60 vertices a line
+    // need more than that.
+    let layers = d.limits().max_texture_array_layers as usize;
+    let scene = Scene::lines(layers / 20 + 1);
     let geometry = RayGeometry { positions: &scene.positions, offsets: &scene.offsets, ..Default::default() };
-    match RayScene::with_chunk_words(&gpu.device, &geometry, 64) {
-        Err(lineao::Error::TooLarge(message)) => assert!(message.contains("bytes"), "{message}"),
+    match RayScene::with_max_width(d, q, &geometry, 2) {
+        Err(lineao::Error::TooLarge(message)) => {
+            assert!(message.contains(&format!("{} vertices", scene.positions.len())), "{message}");
+            assert!(message.contains("max_texture_array_layers"), "{message}");
+        }
         other => panic!("expected TooLarge, got {:?}", other.map(|s| s.bytes())),
     }
-    // An empty scene uploads (one empty chunk) and hits nothing.
-    let empty = RayScene::new(&gpu.device, &RayGeometry::default()).unwrap();
+    assert!(matches!(RayScene::with_max_width(d, q, &geometry, 3), Err(lineao::Error::Usage(_))));
+    // An empty scene uploads (a texel per texture) and hits nothing.
+    let empty = RayScene::new(d, q, &RayGeometry::default()).unwrap();
     assert!(empty.is_empty());
 }
 
@@ -280,12 +289,12 @@ fn the_scene_takes_at_most_32_bytes_per_vertex_on_the_gpu() {
     let gpu = gpu();
     let (positions, offsets) = common::polylines(3000, 0.3);
     let geometry = RayGeometry { positions: &positions, offsets: &offsets, ..Default::default() };
-    let scene = RayScene::new(&gpu.device, &geometry).unwrap();
-    // The positions alone are 12 bytes per vertex; the rest is the BVH.
+    let scene = RayScene::new(&gpu.device, &gpu.queue, &geometry).unwrap();
+    // The vertices alone are 16 bytes per vertex; the rest is the BVH.
     let (bytes, per_vertex) = (scene.bytes(), scene.bytes_per_vertex());
     eprintln!("{} vertices: {bytes} bytes, {per_vertex:.1} bytes per vertex", positions.len());
     assert_eq!(per_vertex, bytes as f64 / positions.len() as f64);
-    assert!((12.0..=32.0).contains(&per_vertex), "{per_vertex} bytes per vertex");
+    assert!((16.0..=32.0).contains(&per_vertex), "{per_vertex} bytes per vertex");
 }
 
 #[test]
@@ -319,7 +328,7 @@ fn a_host_renderers_depth_traces_like_the_cpu_truth_through_the_embedding_api() 
     chain.enable_host(d, HostConfig::default()).unwrap();
     let meshes = [(&triangles[..], &indices[..])];
     let geometry = RayGeometry { meshes: &meshes, ..Default::default() };
-    chain.set_ray_scene(d, Some(Arc::new(RayScene::new(d, &geometry).unwrap())));
+    chain.set_ray_scene(d, Some(Arc::new(RayScene::new(d, q, &geometry).unwrap())));
     let view = lineao::FrameView::from_matrices(view_matrix, proj, SIZE.0, SIZE.1, &bounds);
     let inputs = HostInputs { depth: &depth, normals: None, color: None };
     for _ in 0..2 {
@@ -357,7 +366,7 @@ fn denoised_frames(scene: &Scene, s: &ChainSettings, frames: u32) -> (Image<[u32
         meshes: &meshes,
     };
     let mut pass = RayTracedAo::new(d);
-    pass.set_scene(d, Some(Arc::new(RayScene::new(d, &geometry).unwrap())));
+    pass.set_scene(Some(Arc::new(RayScene::new(d, q, &geometry).unwrap())));
     pass.resize(d, targets);
     for _ in 0..frames {
         pass.prepare(q, targets, &view, s);

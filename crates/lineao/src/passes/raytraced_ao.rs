@@ -23,13 +23,14 @@
 //! once per geometry ([`crate::AoChain::set_ray_scene`]). Without one there is nothing to hit
 //! and `ao` is 0.
 
+use std::collections::HashMap;
 use std::sync::{Arc, Mutex};
 
 use crate::binding::{self, Slot};
 use crate::camera::FrameView;
 use crate::passes::dispatch_full_screen;
 use crate::passes::ray_denoise::RayDenoise;
-use crate::ray_scene::{MAX_CHUNKS, RayScene};
+use crate::ray_scene::RayScene;
 use crate::settings::{AoMethod, ChainSettings};
 use crate::targets::{AO_FORMAT, FrameTargets};
 use crate::timing::Span;
@@ -46,27 +47,55 @@ struct TraceUniform {
     frame_rays: u32,
     first_ray: u32,
     seed: u32,
-    falloff: u32,
     distance: f32,
     epsilon: f32,
-    lines: u32,
     line_half: f32,
     tube_radius: f32,
     max_radius: f32,
     guard: u32,
-    chunk_shift: u32,
-    nodes_at: u32,
     node_count: u32,
-    refs_at: u32,
-    positions_at: u32,
-    radii_at: u32,
     starts_at: u32,
     streamlines: u32,
-    triangles_at: u32,
+    // log2 of the scene textures' widths: nodes, vertices, words, triangles.
+    shifts: [u32; 4],
     width: u32,
     height: u32,
-    tube_own: u32,
-    _pad: u32,
+    _pad: [u32; 2],
+}
+
+/// What a pipeline is specialized for (the shader's `override` constants): llvmpipe runs both
+/// sides of every branch of a SIMD group, uniform or not, so code a frame cannot need (triangles
+/// in a scene of lines, the first frame's point queries in the frames after it) is compiled out
+/// rather than branched around. With the scene in textures ([`crate::ray_scene`]) a one-ray
+/// frame became 2.4–2.6× faster on lavapipe (docs/measurements.md, session 17).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+struct Variant {
+    /// Fixed-width lines (else tubes).
+    lines: bool,
+    /// The scene has triangles.
+    triangles: bool,
+    /// The vertices carry tube radii.
+    radii: bool,
+    /// Linear falloff: the nearest hit (else any hit).
+    nearest: bool,
+    /// A picture's first frame: find each pixel's own segment and whether it is buried.
+    start: bool,
+    /// Tube pixels find their own segment too (the denoiser's "same tube").
+    tube_own: bool,
+}
+
+impl Variant {
+    fn constants(&self) -> [(&'static str, f64); 6] {
+        let flag = |b: bool| b as u32 as f64;
+        [
+            ("LINES", flag(self.lines)),
+            ("TRIANGLES", flag(self.triangles)),
+            ("RADII", flag(self.radii)),
+            ("NEAREST", flag(self.nearest)),
+            ("START", flag(self.start)),
+            ("TUBE_OWN", flag(self.tube_own)),
+        ]
+    }
 }
 
 /// How far the accumulation has come.
@@ -124,12 +153,15 @@ struct Progress {
     denoise: bool,
     /// Whether a frame was prepared and not yet recorded.
     prepared: bool,
+    /// The prepared frame's pipeline.
+    pipeline: Option<wgpu::ComputePipeline>,
 }
 
 pub struct RayTracedAo {
+    device: wgpu::Device,
     layout: wgpu::BindGroupLayout,
-    /// (chunks, pipeline): rebuilt when a scene comes with another chunk count.
-    pipeline: (usize, wgpu::ComputePipeline),
+    /// The pipelines compiled so far, made when a frame first needs them.
+    pipelines: Mutex<HashMap<Variant, wgpu::ComputePipeline>>,
     uniform: wgpu::Buffer,
     scene: Option<Arc<RayScene>>,
     accumulation: Option<wgpu::Buffer>,
@@ -149,10 +181,12 @@ pub const ACCUMULATION_BYTES: u64 = 16;
 impl RayTracedAo {
     pub fn new(device: &wgpu::Device) -> RayTracedAo {
         let mut slots = vec![Slot::Uniform, Slot::Texture, Slot::StorageTexture(AO_FORMAT), Slot::StorageReadWrite];
-        slots.extend([Slot::Storage; MAX_CHUNKS]);
+        // The scene: nodes, vertices, words, triangles.
+        slots.extend([Slot::UintTextureArray; 4]);
         let layout = binding::layout(device, LABEL, wgpu::ShaderStages::COMPUTE, &slots);
         RayTracedAo {
-            pipeline: (1, Self::pipeline(device, &layout, 1)),
+            device: device.clone(),
+            pipelines: Mutex::new(HashMap::new()),
             layout,
             uniform: binding::uniform_buffer::<TraceUniform>(device, LABEL),
             scene: None,
@@ -163,17 +197,25 @@ impl RayTracedAo {
         }
     }
 
-    fn pipeline(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, chunks: usize) -> wgpu::ComputePipeline {
-        let constants = [("CHUNKS", chunks as f64)];
-        binding::compute_pipeline(device, LABEL, layout, "raytraced_ao.wgsl", "raytraced_ao", &constants)
+    /// The pipeline for `variant`, compiled on first use.
+    fn pipeline(&self, variant: Variant) -> wgpu::ComputePipeline {
+        let mut pipelines = self.pipelines.lock().expect("the pipelines lock");
+        let pipeline = pipelines.entry(variant).or_insert_with(|| {
+            let constants = variant.constants();
+            binding::compute_pipeline(
+                &self.device,
+                LABEL,
+                &self.layout,
+                "raytraced_ao.wgsl",
+                "raytraced_ao",
+                &constants,
+            )
+        });
+        pipeline.clone()
     }
 
     /// Traces against `scene` from now on (and starts again).
-    pub fn set_scene(&mut self, device: &wgpu::Device, scene: Option<Arc<RayScene>>) {
-        let chunks = scene.as_ref().map_or(1, |s| s.chunk_count());
-        if chunks != self.pipeline.0 {
-            self.pipeline = (chunks, Self::pipeline(device, &self.layout, chunks));
-        }
+    pub fn set_scene(&mut self, scene: Option<Arc<RayScene>>) {
         self.scene = scene;
         self.group = None;
     }
@@ -195,9 +237,7 @@ impl RayTracedAo {
                 wgpu::BindingResource::TextureView(&targets.ao.view),
                 accumulation.as_entire_binding(),
             ];
-            // Bindings past the scene's chunks repeat its first (the shader never reads them).
-            resources
-                .extend((0..MAX_CHUNKS).map(|i| scene.chunks.get(i).unwrap_or(&scene.chunks[0]).as_entire_binding()));
+            resources.extend(scene.textures().map(|t| wgpu::BindingResource::TextureView(&t.view)));
             binding::group(device, LABEL, &self.layout, &resources)
         });
         self.denoise.resize(device, targets, &accumulation);
@@ -224,6 +264,15 @@ impl RayTracedAo {
         }
         let Some(scene) = &self.scene else { return };
         let regions = scene.regions;
+        let variant = Variant {
+            lines: settings.tubes.is_none(),
+            triangles: regions.triangles > 0,
+            radii: regions.radii,
+            nearest: r.falloff == Falloff::Linear,
+            start: progress.traced == 0,
+            tube_own: r.denoise.is_some() && settings.tubes.is_some(),
+        };
+        progress.pipeline = Some(self.pipeline(variant));
         let inv_view = view.view.inverse();
         let row = view.view.row(2);
         let tube_radius = settings.tubes.as_ref().map_or(0.0, |t| t.radius_world);
@@ -234,27 +283,19 @@ impl RayTracedAo {
             frame_rays: progress.frame_rays,
             first_ray: progress.traced,
             seed: r.seed,
-            falloff: (r.falloff == Falloff::Linear) as u32,
             distance: r.distance_world,
             epsilon: (EPSILON_PER_DISTANCE * r.distance_world as f64) as f32,
-            lines: settings.tubes.is_none() as u32,
             line_half: 0.5 * settings.line_width_px / view.f_px,
             tube_radius,
             max_radius: tube_radius.max(scene.max_vertex_radius),
             guard: view.guard,
-            chunk_shift: scene.chunk_shift,
-            nodes_at: regions.nodes,
             node_count: regions.node_count,
-            refs_at: regions.refs,
-            positions_at: regions.positions,
-            radii_at: regions.radii,
             starts_at: regions.starts,
             streamlines: regions.streamlines,
-            triangles_at: regions.triangles,
+            shifts: scene.textures().map(|t| t.shift),
             width: targets.size.0,
             height: targets.size.1,
-            tube_own: (r.denoise.is_some() && settings.tubes.is_some()) as u32,
-            _pad: 0,
+            _pad: [0; 2],
         };
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
     }
@@ -275,7 +316,8 @@ impl RayTracedAo {
         if !std::mem::take(&mut progress.prepared) {
             return;
         }
-        dispatch_full_screen(encoder, LABEL, &self.pipeline.1, group, targets.size, span);
+        let Some(pipeline) = progress.pipeline.take() else { return };
+        dispatch_full_screen(encoder, LABEL, &pipeline, group, targets.size, span);
         progress.traced += progress.frame_rays;
         if progress.denoise {
             self.denoise.encode(encoder, targets, denoise_span);
@@ -313,7 +355,7 @@ impl crate::stage::Stage for RayTracedAo {
     }
 
     fn set_scene(&mut self, device: &wgpu::Device, scene: Option<&Arc<RayScene>>, targets: Option<&FrameTargets>) {
-        RayTracedAo::set_scene(self, device, scene.cloned());
+        RayTracedAo::set_scene(self, scene.cloned());
         if let Some(targets) = targets {
             RayTracedAo::resize(self, device, targets);
         }
