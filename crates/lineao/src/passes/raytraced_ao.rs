@@ -80,7 +80,8 @@ struct Variant {
     nearest: bool,
     /// A picture's first frame: find each pixel's own segment and whether it is buried.
     start: bool,
-    /// Tube pixels find their own segment too (the denoiser's "same tube").
+    /// Tube pixels find their own segment too (the denoiser's "same tube"; with `start` and
+    /// tubes only).
     tube_own: bool,
 }
 
@@ -264,13 +265,15 @@ impl RayTracedAo {
         }
         let Some(scene) = &self.scene else { return };
         let regions = scene.regions;
+        let (lines, start) = (settings.tubes.is_none(), progress.traced == 0);
         let variant = Variant {
-            lines: settings.tubes.is_none(),
+            lines,
             triangles: regions.triangles > 0,
             radii: regions.radii,
             nearest: r.falloff == Falloff::Linear,
-            start: progress.traced == 0,
-            tube_own: r.denoise.is_some() && settings.tubes.is_some(),
+            start,
+            // Only a first frame of tubes looks for own segments: no second pipeline elsewhere.
+            tube_own: start && !lines && r.denoise.is_some(),
         };
         progress.pipeline = Some(self.pipeline(variant));
         let inv_view = view.view.inverse();
