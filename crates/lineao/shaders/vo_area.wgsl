@@ -9,6 +9,9 @@
 // lod_i = log2(R z(P)/zoom_unit) + ½ log2(π A_i/ΣA): one log2 per pixel, the second term comes
 // precomputed in the table's w. Reads are trilinear, by hand (the CPU reference repeats the
 // arithmetic exactly; a sampler would add the hardware's 8-bit weights).
+//
+// The normal clamp cuts each chord where the sample's own view ray, through the sample's point
+// on screen, crosses P's tangent plane (`tangent_plane_depth`), as line sampling does.
 #import shared/nd.wgsl
 #import shared/vo.wgsl
 #import shared/moments.wgsl
@@ -57,7 +60,8 @@ fn obscurance(pixel: vec2<u32>, here: vec4<f32>, depth: f32, zoom: f32, u: vec2<
     let scale = radius * zoom / params.zoom_unit;
     let thickness = params.thickness / radius;
     let lod_sphere = log2(scale);
-    let g = vo_plane(here.xyz);
+    let clamp_on = params.normal_clamp != 0u;
+    let p = view_position(params.view, pixel, depth);
     var sums = vec2<f32>(0.0);
     for (var i = 0u; i < params.samples; i++) {
         let sample = tables[i];
@@ -70,7 +74,10 @@ fn obscurance(pixel: vec2<u32>, here: vec4<f32>, depth: f32, zoom: f32, u: vec2<
         }
         let mu = (m.x - depth) / radius;
         let z_s = sqrt(max(1.0 - (s.x * s.x + s.y * s.y), 0.0));
-        let chord = vo_chord(s, z_s, here.xyz, g, params.normal_clamp != 0u);
+        var chord = vec2<f32>(-z_s, z_s);
+        if clamp_on {
+            chord.y = min(z_s, (tangent_plane_depth(params.view, p, here.xyz, at + 0.5) - depth) / radius);
+        }
         sums += sample.z * vo_sample(chord, mu, sigma / radius, thickness);
     }
     return vo_ao(sums);

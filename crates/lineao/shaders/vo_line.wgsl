@@ -11,10 +11,9 @@
 // √(1 − |s_t|²). The depth of that centre is the surface's there, so a tilted plane stays
 // wholly free under the clamp; measured at s itself, half a texel's depth step put the plane
 // in front of the sample half the time. The normal clamp cuts each chord where the sample's
-// own view ray crosses P's tangent plane (its linear depth D = n·P / n·r along the ray r through
-// the texel; orthographic: (n.xy·s − n·P) / n_z), not at s · n.xy / n_z, which holds only for
-// rays parallel to P's: off the optical axis and at grazing angles that plane lay up to half a
-// radius behind the surface, and open ground darkened by 5 %.
+// own view ray, through the texel's centre, crosses P's tangent plane (`tangent_plane_depth`:
+// D = n·P / n·r along the ray r; orthographic (n.xy·s − n·P) / n_z); cut at s · n.xy / n_z
+// as if rays were parallel, open ground darkened by 5 %.
 // Each pixel reflects its samples about a 2D direction from a 4 x 4 tile. With RADII = 2 the
 // sphere is evaluated at two radii and the results combined (Fig. 8).
 #import shared/nd.wgsl
@@ -28,22 +27,6 @@ override RADII: u32 = 1u;
 @group(0) @binding(2) var nd0: texture_2d<f32>;
 @group(0) @binding(3) var zoom_map: texture_2d<f32>;
 @group(0) @binding(4) var ao_out: texture_storage_2d<r32float, write>;
-
-// Linear depth at which the view ray through texel `t` crosses the plane through `p` with normal
-// `n` (facing the eye); a huge value where the ray stays on the eye's side ahead of it.
-fn tangent_plane_depth(v: ViewParams, p: vec3<f32>, n: vec3<f32>, t: vec2<f32>) -> f32 {
-    let s = vec2<f32>(t.x + 0.5 - v.center.x, v.center.y - (t.y + 0.5)) / v.f_px;
-    let np = dot(n, p);
-    if v.orthographic != 0u {
-        let side = dot(n.xy, s) - np;
-        if abs(n.z) < 1e-12 {
-            return select(-3.0e38, 3.0e38, side > 0.0);
-        }
-        return side / n.z;
-    }
-    let nr = dot(n, vec3<f32>(s, -1.0));
-    return select(3.0e38, np / nr, nr < 0.0);
-}
 
 fn obscurance(pixel: vec2<u32>, here: vec4<f32>, depth: f32, zoom: f32, u: vec2<f32>, radius: f32) -> f32 {
     let v = params.view;
@@ -66,7 +49,7 @@ fn obscurance(pixel: vec2<u32>, here: vec4<f32>, depth: f32, zoom: f32, u: vec2<
         let z_s = sqrt(max(1.0 - dot(s_t, s_t), 0.0));
         var chord = vec2<f32>(-z_s, z_s);
         if clamp_on {
-            chord.y = min(z_s, (tangent_plane_depth(v, p, here.xyz, t) - depth) / radius);
+            chord.y = min(z_s, (tangent_plane_depth(v, p, here.xyz, t + 0.5) - depth) / radius);
         }
         sums += sample.z * vo_sample(chord, d_r, 0.0, thickness);
     }

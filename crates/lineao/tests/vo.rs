@@ -116,11 +116,13 @@ fn a_plane_facing_the_camera_is_half_obscured_and_not_at_all_with_the_normal_cla
     }
 }
 
-/// A plane tilted away to a grazing angle, seen in perspective and off the optical axis: with
-/// the normal clamp nothing of it is obscured at any pixel (each chord is cut where the
-/// sample's own ray crosses the tangent plane, and the plane's depth there is exactly the
+/// A plane tilted away to a grazing angle, seen in perspective and off the optical axis. Line
+/// samples: with the normal clamp nothing of it is obscured at any pixel (each chord is cut where
+/// the sample's own ray crosses the tangent plane, and the plane's depth there is exactly the
 /// texel's); without it about half. Cut at s · n.xy / n_z (rays taken parallel), pixels of this
-/// plane read 0.04.
+/// plane read 0.04. Area samples (16) cut the same way read 0.092 on average (0.099 cut at
+/// s · n.xy / n_z): what remains is the box model's, the spread of the plane's own depth over
+/// each footprint (σ) counted as half in front of the cut, not the clamp's.
 #[test]
 fn a_tilted_plane_off_axis_is_not_obscured_with_the_normal_clamp() {
     let gpu = gpu();
@@ -151,9 +153,21 @@ fn a_tilted_plane_off_axis_is_not_obscured_with_the_normal_clamp() {
     }
     let plane_pixels = zoom.data.iter().filter(|&&z| z > 0.0).count();
     assert!(plane_pixels > (w * h / 2) as usize, "the plane fills most of the frame: {plane_pixels}");
-    for (clamp, range) in [(true, 0.0..=1e-4f32), (false, 0.3..=0.7)] {
-        let settings = VoSettings { samples: 16, radius_world: 1.0, normal_clamp: clamp, ..VoSettings::default() };
-        let (gpu_ao, cpu_ao) = vo_on(&gpu, Sampling::Line, &nd0, &zoom, &settings, &view);
+    let cases = [
+        (Sampling::Line, true, 0.0..=1e-4f32),
+        (Sampling::Line, false, 0.3..=0.7),
+        (Sampling::Area, true, 0.0..=0.095),
+        (Sampling::Area, false, 0.3..=0.7),
+    ];
+    for (sampling, clamp, range) in cases {
+        let settings = VoSettings {
+            samples: 16,
+            area_samples: 16,
+            radius_world: 1.0,
+            normal_clamp: clamp,
+            ..VoSettings::default()
+        };
+        let (gpu_ao, cpu_ao) = vo_on(&gpu, sampling, &nd0, &zoom, &settings, &view);
         // Away from the plane's far edge (where samples read background) and the border.
         let inner = |i: usize| {
             let (x, y) = (i % w as usize, i / w as usize);
@@ -169,12 +183,12 @@ fn a_tilted_plane_off_axis_is_not_obscured_with_the_normal_clamp() {
         assert!(values.len() > 500, "{} inner pixels", values.len());
         let mean = values.iter().map(|v| v.0).sum::<f32>() / values.len() as f32;
         for &(g, c) in &values {
-            if clamp {
+            if clamp && sampling == Sampling::Line {
                 assert!(range.contains(&g) && range.contains(&c), "clamp {clamp}: GPU {g}, CPU {c}");
             }
-            assert!((g - c).abs() < 1e-4, "clamp {clamp}: GPU {g} vs CPU {c}");
+            assert!((g - c).abs() < 1e-4, "{sampling:?}, clamp {clamp}: GPU {g} vs CPU {c}");
         }
-        assert!(range.contains(&mean), "clamp {clamp}: mean {mean}");
+        assert!(range.contains(&mean), "{sampling:?}, clamp {clamp}: mean {mean}");
     }
 }
 

@@ -26,24 +26,26 @@ struct VoUniform {
     _pad: u32,
 }
 
-// The allowed part [lo, hi] of the chord at s (z_s = √(1 − |s|²), which the caller has): all
-// of it, or with the normal clamp (§4.4) the part above the tangent plane
-// n_x x + n_y y − n_z z_d ≥ 0, whose depth at s is s · g with g = n.xy / n_z. Empty when
-// hi ≤ lo. Selects, not branches: the normal differs between the pixels of a SIMD group, where
-// branches run both ways (this loop was 2.3× SSAO's per sample on lavapipe with them).
-fn vo_chord(s: vec2<f32>, z_s: f32, n: vec3<f32>, g: vec2<f32>, normal_clamp: bool) -> vec2<f32> {
-    let plane = s.x * g.x + s.y * g.y;
-    let vertical = abs(n.z) < 1e-6;
-    // A vertical plane: the chord is all allowed or not at all.
-    let hidden = normal_clamp && vertical && n.x * s.x + n.y * s.y < 0.0;
-    let hi = select(select(z_s, min(z_s, plane), normal_clamp && !vertical && n.z > 0.0), -z_s, hidden);
-    let lo = select(-z_s, max(-z_s, plane), normal_clamp && !vertical && n.z <= 0.0);
-    return vec2<f32>(lo, hi);
-}
-
-// g = n.xy / n_z of the tangent plane (`vo_chord`), once per pixel; 0 when n_z is 0.
-fn vo_plane(n: vec3<f32>) -> vec2<f32> {
-    return select(vec2<f32>(0.0), n.xy / n.z, abs(n.z) >= 1e-6);
+// The normal clamp (§4.4) keeps the part of a chord in front of P's tangent plane (through `p`,
+// view space, with normal `n` facing the eye). A sample reads the depth along its own view ray,
+// so the chord is cut where that ray crosses the plane: this is the plane's linear depth along
+// the ray through screen position `c` (pixels from the frame's corner; a texel's centre is
+// t + 0.5), or a huge value where the ray stays on the eye's side of it. Not at s · n.xy / n_z,
+// the paper's depth of the plane at s, which holds only where rays are parallel
+// (orthographic): in perspective, off the optical axis and at grazing angles that plane lay up
+// to half a radius behind the surface, and open ground darkened.
+fn tangent_plane_depth(v: ViewParams, p: vec3<f32>, n: vec3<f32>, c: vec2<f32>) -> f32 {
+    let s = vec2<f32>(c.x - v.center.x, v.center.y - c.y) / v.f_px;
+    let np = dot(n, p);
+    if v.orthographic != 0u {
+        let side = dot(n.xy, s) - np;
+        if abs(n.z) < 1e-12 {
+            return select(-3.0e38, 3.0e38, side > 0.0);
+        }
+        return side / n.z;
+    }
+    let nr = dot(n, vec3<f32>(s, -1.0));
+    return select(3.0e38, np / nr, nr < 0.0);
 }
 
 // ∫ from lo to hi (lo < hi) of the chance that z_d lies in front of the visible surface, whose

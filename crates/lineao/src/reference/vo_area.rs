@@ -2,7 +2,7 @@
 //! pass (`shaders/vo_area.wgsl`), in the shaders' f32 operation order.
 
 use super::ssao::ViewParams;
-use super::vo_line::{VoParams, vo_ao, vo_chord, vo_chord_half, vo_pixel, vo_plane, vo_reflect, vo_sample};
+use super::vo_line::{VoParams, tangent_plane_depth, vo_ao, vo_chord_half, vo_pixel, vo_reflect, vo_sample};
 use super::{Image, NdImage, binomial_5x5};
 
 /// A level of the moments pyramid: (E\[z\], E\[z²\]) of linear depth, world units.
@@ -85,8 +85,8 @@ pub fn vo_area(
         let (x, y) = (x as u32, y as u32);
         let here = nd.get(x as usize, y as usize);
         let n = [here[0], here[1], here[2]];
-        let g = vo_plane(n);
         vo_pixel(nd, zoom, noise, p, (x, y), |depth, z, u, radius| {
+            let position = p.view.view_position(x, y, depth);
             let scale = radius * z / p.zoom_unit;
             let thickness = p.thickness / radius;
             let lod_sphere = scale.log2();
@@ -102,7 +102,13 @@ pub fn vo_area(
                     sigma = 0.0;
                 }
                 let mu = (m[0] - depth) / radius;
-                let chord = vo_chord(s, vo_chord_half(s[0], s[1]), n, g, p.normal_clamp);
+                let z_s = vo_chord_half(s[0], s[1]);
+                let mut chord = (-z_s, z_s);
+                if p.normal_clamp {
+                    // Where the sample's own view ray crosses the tangent plane (vo_line's doc).
+                    let cut = tangent_plane_depth(&p.view, position, n, [at[0] + 0.5, at[1] + 0.5]);
+                    chord.1 = z_s.min((cut - depth) / radius);
+                }
                 let (f, a) = vo_sample(chord, mu, sigma / radius, thickness);
                 free += sample[2] * f;
                 allowed += sample[2] * a;

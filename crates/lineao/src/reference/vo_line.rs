@@ -48,7 +48,9 @@ pub fn vo_plane(n: [f32; 3]) -> [f32; 2] {
 
 /// The allowed part (lo, hi) of the chord at disk point s (half length z_s): [−z_s, z_s], or
 /// with the normal clamp the part above the tangent plane n_x x + n_y y − n_z z_d ≥ 0, at depth
-/// s · g (`g` from [`vo_plane`]). Empty when hi ≤ lo.
+/// s · g (`g` from [`vo_plane`]). Empty when hi ≤ lo. This is the paper's form, exact where
+/// rays are parallel (orthographic); the passes cut each chord along the sample's own view ray
+/// ([`tangent_plane_depth`]), which perspective needs.
 pub fn vo_chord(s: [f32; 2], z_s: f32, n: [f32; 3], g: [f32; 2], clamp: bool) -> (f32, f32) {
     let (mut lo, mut hi) = (-z_s, z_s);
     if clamp {
@@ -93,11 +95,12 @@ pub fn vo_sample((lo, hi): (f32, f32), mu: f32, sigma: f32, thickness: f32) -> (
     (free.min(allowed), allowed)
 }
 
-/// Linear depth at which the view ray through texel `t` crosses the plane through `p` with
-/// normal `n` (facing the eye); huge where the ray stays on the eye's side ahead of it
-/// (`shaders/vo_line.wgsl`).
-pub fn tangent_plane_depth(view: &ViewParams, p: [f32; 3], n: [f32; 3], t: [usize; 2]) -> f32 {
-    let s = [(t[0] as f32 + 0.5 - view.center[0]) / view.f_px, (view.center[1] - (t[1] as f32 + 0.5)) / view.f_px];
+/// The normal clamp's cut: the linear depth at which the view ray through screen position `c`
+/// (pixels from the frame's corner; a texel's centre is t + 0.5) crosses the plane through `p`
+/// with normal `n` (facing the eye); huge where the ray stays on the eye's side ahead of it
+/// (`shaders/shared/vo.wgsl`).
+pub fn tangent_plane_depth(view: &ViewParams, p: [f32; 3], n: [f32; 3], c: [f32; 2]) -> f32 {
+    let s = [(c[0] - view.center[0]) / view.f_px, (view.center[1] - c[1]) / view.f_px];
     let np = n[0] * p[0] + n[1] * p[1] + n[2] * p[2];
     if view.orthographic {
         let side = n[0] * s[0] + n[1] * s[1] - np;
@@ -193,7 +196,8 @@ pub fn vo_line_pixel(
             let z_s = vo_chord_half(s_t[0], s_t[1]);
             let mut chord = (-z_s, z_s);
             if p.normal_clamp {
-                chord.1 = z_s.min((tangent_plane_depth(&p.view, at, n, [tx, ty]) - depth) / radius);
+                chord.1 =
+                    z_s.min((tangent_plane_depth(&p.view, at, n, [tx as f32 + 0.5, ty as f32 + 0.5]) - depth) / radius);
             }
             let (f, a) = vo_sample(chord, d_r, 0.0, thickness);
             free += sample[2] * f;
