@@ -104,8 +104,8 @@ impl RayScene {
     /// Builds the tree over `geometry` on all cores and uploads it, in textures as wide as the
     /// device allows.
     pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, geometry: &RayGeometry) -> Result<RayScene, Error> {
-        let widest = device.limits().max_texture_dimension_2d.max(1);
-        Self::with_max_width(device, queue, geometry, 1 << (31 - widest.leading_zeros()))
+        let widest = device.limits().max_texture_dimension_2d.max(2);
+        Self::with_max_width(device, queue, geometry, 1 << widest.ilog2())
     }
 
     /// [`RayScene::new`] with layers at most `max_width` texels wide (a power of two ≥ 2): how
@@ -128,10 +128,10 @@ impl RayScene {
         }
         let flat = flatten(geometry);
         Ok(RayScene {
-            nodes: upload(device, queue, "nodes", &flat.nodes, 4, &limits)?,
-            vertices: upload(device, queue, "vertices", &flat.vertices, 4, &limits)?,
-            words: upload(device, queue, "words", &flat.words, 1, &limits)?,
-            triangles: upload(device, queue, "triangles", &flat.triangles, 4, &limits)?,
+            nodes: upload(device, queue, "nodes", flat.nodes, 4, &limits)?,
+            vertices: upload(device, queue, "vertices", flat.vertices, 4, &limits)?,
+            words: upload(device, queue, "words", flat.words, 1, &limits)?,
+            triangles: upload(device, queue, "triangles", flat.triangles, 4, &limits)?,
             regions: flat.regions,
             max_vertex_radius: flat.max_vertex_radius,
             generation: GENERATION.fetch_add(1, Ordering::Relaxed),
@@ -194,12 +194,13 @@ fn too_large(what: &str, count: u64, limits: &Limits) -> Error {
     ))
 }
 
-/// Uploads `data` (`texel_words` words a texel) as a texture array of square layers.
+/// Uploads `data` (`texel_words` words a texel) as a texture array of square layers, padded
+/// in place to whole rows and layers.
 fn upload(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     region: &str,
-    data: &[u32],
+    mut data: Vec<u32>,
     texel_words: usize,
     limits: &Limits,
 ) -> Result<SceneTexture, Error> {
@@ -215,8 +216,7 @@ fn upload(
     let width = 1u64 << shift;
     let layers = texels.div_ceil(width * width);
     let rows = if layers == 1 { texels.div_ceil(width) } else { width };
-    let mut padded = vec![0u32; (width * rows * layers) as usize * texel_words];
-    padded[..data.len()].copy_from_slice(data);
+    data.resize((width * rows * layers) as usize * texel_words, 0);
     let texture = device.create_texture_with_data(
         queue,
         &wgpu::TextureDescriptor {
@@ -230,13 +230,13 @@ fn upload(
             view_formats: &[],
         },
         wgpu::util::TextureDataOrder::LayerMajor,
-        bytemuck::cast_slice(&padded),
+        bytemuck::cast_slice(&data),
     );
     let view = texture.create_view(&wgpu::TextureViewDescriptor {
         dimension: Some(wgpu::TextureViewDimension::D2Array),
         ..Default::default()
     });
-    Ok(SceneTexture { view, shift, layers: layers as u32, bytes: padded.len() as u64 * 4 })
+    Ok(SceneTexture { view, shift, layers: layers as u32, bytes: data.len() as u64 * 4 })
 }
 
 /// The regions' words (see the module doc).
