@@ -387,7 +387,7 @@ fn candidates(reach: f32) -> Vec<(&'static str, ChainSettings)> {
         |line_ao| ChainSettings { zoom_unit: 0.5 * reach, line_ao, blur: blur.clone(), ..ChainSettings::default() };
     vec![
         ("lineao (paper)", line_ao(LineAoSettings::default())),
-        ("lineao (calibrated)", line_ao(LineAoSettings::default()).with_preset(Preset::Calibrated)),
+        ("lineao (legible)", line_ao(LineAoSettings::default()).with_preset(Preset::Legible)),
         ("lineao (eps 5e-4)", line_ao(LineAoSettings { epsilon: 5e-4, delta0: 1e-3, ..Default::default() })),
         ("vo-line", with_reach(AoMethod::VoLine, true, 0.0)),
         ("vo-line (no clamp)", with_reach(AoMethod::VoLine, false, 0.0)),

@@ -47,6 +47,11 @@ pub struct ScoreArgs {
     /// Print JSON (CONTRACT.md `lineao score --json`) instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// The bundle-scale truth's reach (obscurance with the linear falloff, the second truth
+    /// beside the local one of --ao-distance and --ao-falloff): world units or a share of the
+    /// scene's longest side.
+    #[arg(long, default_value = "20%", value_parser = parse_ao_distance)]
+    pub bundle_distance: AoDistance,
     /// Calibrate: search each method's main parameters and strength for the least RMSE against
     /// the truth over every built-in scene and every tractogram under --data, --views cameras
     /// each; fit on half the views, report on the other half.
@@ -97,11 +102,46 @@ pub fn parse_score_method(s: &str) -> Result<ScoreMethod, String> {
     })
 }
 
-fn parse_distance(s: &str) -> Result<f32, String> {
-    match s.parse::<f32>() {
-        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
-        Ok(v) => Err(format!("must be positive and finite, got {v}")),
-        Err(e) => Err(format!("'{s}': {e}")),
+/// How far a truth's rays look: world units, or a share of the scene's longest side (`20%`,
+/// LineVis's default reach), resolved against the scene's bounds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AoDistance {
+    World(f32),
+    /// A share in (0, 1] of the longest side of the scene's axis-aligned bounds.
+    Share(f32),
+}
+
+impl AoDistance {
+    /// The reach in world units in a scene whose bounds' longest side is `longest_side`.
+    pub fn world(self, longest_side: f32) -> f32 {
+        match self {
+            AoDistance::World(d) => d,
+            AoDistance::Share(s) => s * longest_side,
+        }
+    }
+}
+
+impl std::fmt::Display for AoDistance {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            AoDistance::World(d) => write!(f, "{d}"),
+            AoDistance::Share(s) => write!(f, "{}%", s * 100.0),
+        }
+    }
+}
+
+fn parse_ao_distance(s: &str) -> Result<AoDistance, String> {
+    match s.trim().strip_suffix('%') {
+        Some(share) => match share.trim().parse::<f32>() {
+            Ok(p) if p > 0.0 && p <= 100.0 => Ok(AoDistance::Share(p / 100.0)),
+            Ok(p) => Err(format!("a share of the scene's longest side must be in (0 %, 100 %], got {p} %")),
+            Err(e) => Err(format!("'{s}': {e} (a distance in world units, or a share such as 20%)")),
+        },
+        None => match s.trim().parse::<f32>() {
+            Ok(v) if v.is_finite() && v > 0.0 => Ok(AoDistance::World(v)),
+            Ok(v) => Err(format!("must be positive and finite, got {v}")),
+            Err(e) => Err(format!("'{s}': {e} (a distance in world units, or a share such as 20%)")),
+        },
     }
 }
 
@@ -125,8 +165,9 @@ pub struct ViewArgs {
     /// Streamlines as lines or tubes.
     #[arg(long, value_enum, default_value_t = GeometryArg::Lines)]
     pub geometry: GeometryArg,
-    /// Parameters for dense tractography (the paper's) or sparse streamlines.
-    #[arg(long, value_enum, default_value_t = PresetArg::Calibrated)]
+    /// Parameters: lineao's default (legible), fitted to the local truth (physical), for dense
+    /// tractography (the paper's) or for sparse streamlines.
+    #[arg(long, value_enum, default_value_t = PresetArg::Legible)]
     pub preset: PresetArg,
     /// How lines are lit (as `render --line-shading`).
     #[arg(long, value_parser = named::<LineShading>(), default_value = "specular")]
@@ -164,8 +205,11 @@ pub struct ViewArgs {
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
 pub enum PresetArg {
-    /// Each method's strength and reach fitted to the ray-traced truth (`score --fit`).
-    Calibrated,
+    /// Each method's strength and reach chosen so that darker lines lie deeper (`score --fit`).
+    Legible,
+    /// Fitted to binary AO within 2 mm (was `calibrated`; faint on whole brains).
+    #[value(alias = "calibrated")]
+    Physical,
     /// Whole-brain tractography: the paper's values.
     Dense,
     /// Few streamlines far apart: wider lines, every method reaching farther.
@@ -402,9 +446,10 @@ pub struct RenderArgs {
     #[arg(long, value_parser = named::<LineAoVariant>(), default_value = "paper")]
     pub variant: LineAoVariant,
     /// LineAO (variant paper): hemispheres j ≥ 1 at every pixel (`full`) or at their pyramid
-    /// level's resolution, upsampled depth-aware (`level`: faster).
-    #[arg(long, value_parser = named::<LineAoOuter>(), default_value = "full")]
-    pub outer: LineAoOuter,
+    /// level's resolution, upsampled depth-aware (`level`: faster) [default: the preset's;
+    /// paper full].
+    #[arg(long, value_parser = named::<LineAoOuter>())]
+    pub outer: Option<LineAoOuter>,
     /// Output PNG [default: lineao.png; `score`: no grid].
     #[arg(short, long)]
     pub output: Option<PathBuf>,
@@ -516,9 +561,10 @@ pub struct RenderArgs {
     /// AO strength in the composite [default: the preset's for the method; paper 1].
     #[arg(long)]
     pub strength: Option<f32>,
-    /// Parameter set: `calibrated` (each method's strength and reach fitted to the ray-traced
-    /// truth, `lineao score --fit`) or `paper` (the papers' values). Explicit options win.
-    #[arg(long, default_value = "calibrated", value_parser = parse_preset)]
+    /// Parameter set: `legible` (each method's strength and reach chosen so that visibly darker
+    /// lines lie deeper, `lineao score --fit`), `physical` (fitted to binary AO within 2 mm, was
+    /// `calibrated`: faint) or `paper` (the papers' values). Explicit options win.
+    #[arg(long, default_value = "legible", value_parser = parse_preset)]
     pub preset: lineao::Preset,
     /// Disable LineAO's light attenuation (g_light = 1).
     #[arg(long)]
@@ -566,10 +612,12 @@ pub struct RenderArgs {
     /// reference count: a standard error of at most 0.03 per pixel.
     #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
     pub rays: u32,
-    /// Ray-traced AO: how far a ray looks, world units. 2 is the reach VO and SSAO sample by
-    /// default and that of LineAO's widest hemisphere (r0 + 2 z(P) px).
-    #[arg(long, default_value_t = 2.0, value_parser = parse_distance)]
-    pub ao_distance: f32,
+    /// Ray-traced AO: how far a ray looks, in world units, or as a share of the longest side of
+    /// the scene's bounds (`20%`, LineVis's default reach; `score`'s bundle-scale truth). 2 is
+    /// the reach VO and SSAO sample by default and that of LineAO's widest hemisphere
+    /// (r0 + 2 z(P) px).
+    #[arg(long, default_value = "2", value_parser = parse_ao_distance)]
+    pub ao_distance: AoDistance,
     /// Ray-traced AO: binary (`none`) or obscurance with a linear falloff (`linear`).
     #[arg(long, value_parser = named::<Falloff>(), default_value = "none")]
     pub ao_falloff: Falloff,
@@ -601,7 +649,7 @@ pub enum ColorArg {
 }
 
 fn parse_preset(s: &str) -> Result<lineao::Preset, String> {
-    lineao::Preset::from_name(s).ok_or_else(|| format!("unknown preset '{s}' (paper, calibrated)"))
+    lineao::Preset::from_name(s).ok_or_else(|| format!("unknown preset '{s}' (legible, physical, paper)"))
 }
 
 fn parse_scene(s: &str) -> Result<SceneKind, String> {

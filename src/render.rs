@@ -57,8 +57,9 @@ fn tube_radius(args: &RenderArgs, zoom_unit: f32) -> f32 {
     args.tube_radius.unwrap_or(0.5 * zoom_unit)
 }
 
-/// The chain's settings from the command line, for `method` (object-space AO lit by `sky`).
-pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky) -> ChainSettings {
+/// The chain's settings from the command line, for `method` (object-space AO lit by `sky`), in
+/// a scene whose bounds' longest side is `longest_side` world units.
+pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky, longest_side: f32) -> ChainSettings {
     let volume = method.volume.map(|_| VolumeAoSettings {
         // The view-independent forms hold the sky already.
         sky: if args.volume_normal == VolumeNormal::Pixel { sky.weights() } else { [1.0; 8] },
@@ -102,9 +103,9 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky) -> 
             noise_seed: args.noise_seed,
             variant: args.variant,
             reference_radius_px: LineAoSettings::default().reference_radius_px,
-            outer: args.outer,
+            outer: LineAoSettings::default().outer,
         },
-        raytraced: crate::truth::gpu_settings(args),
+        raytraced: crate::truth::gpu_settings(args, longest_side),
         line_width_px: args.line_width,
         lighting: lineao::lighting::Lighting {
             line_shading: args.line_shading,
@@ -138,6 +139,9 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky) -> 
     }
     if let Some(scale) = args.delta_scale {
         settings.line_ao.delta_scale = scale;
+    }
+    if let Some(outer) = args.outer {
+        settings.line_ao.outer = outer;
     }
     if let Some(radius) = args.reference_radius {
         settings.line_ao.reference_radius_px = radius;
@@ -180,8 +184,8 @@ fn grid_methods() -> Vec<Method> {
 }
 
 /// The panels the command line asks for: one method, two (--compare) or all (--grid).
-fn panels(args: &RenderArgs, zoom_unit: f32, sky: Sky) -> Vec<Panel> {
-    let panel = |method| Panel::new(method, settings(args, method, zoom_unit, sky));
+fn panels(args: &RenderArgs, zoom_unit: f32, sky: Sky, longest_side: f32) -> Vec<Panel> {
+    let panel = |method| Panel::new(method, settings(args, method, zoom_unit, sky, longest_side));
     if let Some(pair) = args.compare {
         return pair.into_iter().map(panel).collect();
     }
@@ -191,9 +195,10 @@ fn panels(args: &RenderArgs, zoom_unit: f32, sky: Sky) -> Vec<Panel> {
     let mut all: Vec<Panel> = grid_methods().into_iter().map(panel).collect();
     // The third tile: LineAO as the authors' code computes it, next to the paper's.
     let lineao = Method { screen: AoMethod::LineAo, volume: None };
-    let mut reference = settings(args, lineao, zoom_unit, sky);
-    reference.line_ao.variant =
+    let variant =
         if args.variant == LineAoVariant::Reference { LineAoVariant::Paper } else { LineAoVariant::Reference };
+    let other = RenderArgs { variant, ..args.clone() };
+    let reference = settings(&other, lineao, zoom_unit, sky, longest_side);
     all.insert(2, Panel::new(lineao, reference));
     all
 }
@@ -212,6 +217,9 @@ pub struct Session {
     pub gpu: Gpu,
     pub meshes: Vec<MeshGeometry>,
     pub bounds: Bounds,
+    /// The longest side of the axis-aligned box around the streamlines and surfaces, world
+    /// units: what `--ao-distance 20%` is a share of.
+    pub longest_side: f32,
     /// The ray tracer's scene on the GPU, built when a panel first needs it.
     ray_scene: std::sync::OnceLock<std::sync::Arc<lineao::RayScene>>,
 }
@@ -261,12 +269,25 @@ impl Session {
             .collect::<Result<Vec<_>, _>>()?;
         let lines_bounds = lines.geometry.bounds.expect("checked at upload");
         let bounds = meshes.iter().filter_map(|m| m.bounds).fold(lines_bounds, |b, m| b.union(&m));
-        Ok(Session { lines, base, camera, sky, surfaces, gpu, meshes, bounds, ray_scene: Default::default() })
+        let points = lines.tracts.positions.iter().chain(surfaces.iter().flat_map(|m| &m.positions));
+        let longest_side = longest_side(points);
+        Ok(Session {
+            lines,
+            base,
+            camera,
+            sky,
+            surfaces,
+            gpu,
+            meshes,
+            bounds,
+            longest_side,
+            ray_scene: Default::default(),
+        })
     }
 
     /// The chain's settings for `method` from the command line, the colour range from the data.
     pub fn settings(&self, args: &RenderArgs, method: Method) -> ChainSettings {
-        let mut settings = settings(args, method, self.lines.hint.zoom_unit, self.sky);
+        let mut settings = settings(args, method, self.lines.hint.zoom_unit, self.sky, self.longest_side);
         self.fit_color_range(&mut settings);
         settings
     }
@@ -311,7 +332,7 @@ impl Session {
     /// between calls (pipelines and targets are made once for many frames); pass an empty
     /// `Vec` for one image.
     pub fn compose(&mut self, args: &RenderArgs, chains: &mut Vec<AoChain>) -> Result<(Rgba8, Vec<Panel>)> {
-        let mut panels = panels(args, self.lines.hint.zoom_unit, self.sky);
+        let mut panels = panels(args, self.lines.hint.zoom_unit, self.sky, self.longest_side);
         for panel in &mut panels {
             panel.settings.validate().with_context(|| format!("method {}", panel.label))?;
             self.fit_color_range(&mut panel.settings);
@@ -440,7 +461,7 @@ impl Session {
             }
         }
         let truth = if panel.settings.method == AoMethod::RayTraced && args.cpu {
-            let truth = self.trace(&chain, &crate::truth::settings(args))?;
+            let truth = self.trace(&chain, &crate::truth::settings(args, self.longest_side))?;
             let targets = chain.targets().context("nothing was rendered")?;
             lineao::verify::write_target(&gpu.queue, &targets.ao, &truth.ao);
             let mut encoder = gpu
@@ -459,7 +480,7 @@ impl Session {
         if let Some(dir) = dump {
             crate::dump::write(dir, gpu, &chain, &self.camera, &panel.name, volume)?;
             if let Some(truth) = &truth {
-                crate::dump::write_truth(dir, truth, &crate::truth::settings(args))?;
+                crate::dump::write_truth(dir, truth, &crate::truth::settings(args, self.longest_side))?;
             }
         }
         let image = Rgba8 { width: args.width, height: args.height, data: image.bytes };
@@ -478,22 +499,48 @@ impl Session {
 
     /// The truth on `chain`'s last frame, with a line on stderr saying what it cost.
     pub fn trace(&self, chain: &AoChain, settings: &lineao::truth::TruthSettings) -> Result<lineao::truth::Truth> {
+        Ok(self.trace_all(chain, &[settings])?.remove(0).0)
+    }
+
+    /// The truth of `chain`'s frame for each of `settings`, over one BVH, with the seconds each
+    /// took to trace.
+    pub fn trace_all(
+        &self,
+        chain: &AoChain,
+        settings: &[&lineao::truth::TruthSettings],
+    ) -> Result<Vec<(lineao::truth::Truth, f64)>> {
         let start = std::time::Instant::now();
         let bvh = crate::truth::bvh(chain, &self.truth_scene())?;
         let built = start.elapsed().as_secs_f64();
-        let truth = crate::truth::trace(&self.gpu, chain, &bvh, settings)?;
-        let seconds = start.elapsed().as_secs_f64() - built;
-        eprintln!(
-            "lineao: ray traced {} rays over {} geometry pixels in {seconds:.1} s ({:.0} k rays/s; BVH {built:.2} s, {} \
-             MB); {:.1} % of the pixels buried in another line",
-            truth.rays,
-            truth.geometry_pixels,
-            truth.rays as f64 / seconds.max(1e-9) / 1e3,
-            bvh.bytes() >> 20,
-            100.0 * truth.buried_share()
-        );
-        Ok(truth)
+        let mut truths = Vec::new();
+        for settings in settings {
+            let start = std::time::Instant::now();
+            let truth = crate::truth::trace(&self.gpu, chain, &bvh, settings)?;
+            let seconds = start.elapsed().as_secs_f64();
+            eprintln!(
+                "lineao: ray traced {} rays to {} ({} falloff) over {} geometry pixels in {seconds:.1} s ({:.0} k rays/s; \
+                 BVH {built:.2} s, {} MB); {:.1} % of the pixels buried in another line",
+                truth.rays,
+                settings.distance_world,
+                settings.falloff.name(),
+                truth.geometry_pixels,
+                truth.rays as f64 / seconds.max(1e-9) / 1e3,
+                bvh.bytes() >> 20,
+                100.0 * truth.buried_share()
+            );
+            truths.push((truth, seconds));
+        }
+        Ok(truths)
     }
+}
+
+/// The longest side of the axis-aligned box around the finite `points` (0 without any).
+fn longest_side<'a>(points: impl Iterator<Item = &'a [f32; 3]>) -> f32 {
+    let (lo, hi) = points
+        .map(|p| Vec3::from_array(*p))
+        .filter(|p| p.is_finite())
+        .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(p), hi.max(p)));
+    if lo.is_finite() { (hi - lo).max_element() } else { 0.0 }
 }
 
 /// The camera of the command line (--eye, --target, --up, --fov, --ortho), the rest from `hint`.

@@ -10,12 +10,13 @@
 
 use anyhow::{Context, Result};
 use lineao::reference::Image;
+use lineao::truth::legibility::{self, Absent, Legibility};
 use lineao::truth::metrics::{self, Scores};
-use lineao::truth::{Truth, TruthSettings, VoBall};
+use lineao::truth::{Falloff, Truth, TruthSettings, VoBall};
 use lineao::{AoMethod, ChainSettings};
 use serde_json::json;
 
-use crate::cli::{Method, ScoreArgs, ScoreMethod};
+use crate::cli::{AoDistance, Method, ScoreArgs, ScoreMethod};
 use crate::label::Rgba8;
 use crate::render::{Panel, Session};
 
@@ -27,8 +28,25 @@ pub struct Row {
     pub scores: Scores,
     /// SSIM of the composited image's luminance against the composite with the truth's AO.
     pub image_ssim: f64,
+    /// Its AO against the bundle-scale truth.
+    pub bundle: Scores,
+    /// How legible its composite is (darker is deeper).
+    pub legibility: Result<Legibility, Absent>,
     /// Its AO over the visible frame, for the grid.
     pub ao: Image<f32>,
+}
+
+/// The reach of `score`'s bundle-scale truth by default: a fifth of the scene's longest side,
+/// LineVis's default for its ray-traced AO of lines.
+pub const BUNDLE_DISTANCE: AoDistance = AoDistance::Share(0.2);
+
+/// The second truth: obscurance with the linear falloff at a bundle's reach (CONTRACT.md
+/// "Bundle-scale truth").
+pub struct Bundle {
+    pub truth: Truth,
+    pub settings: TruthSettings,
+    pub distance: AoDistance,
+    pub seconds: f64,
 }
 
 /// The truth of one view and every method's scores.
@@ -38,14 +56,22 @@ pub struct Report {
     /// The visible truth (AO, and VO where asked).
     pub ao: Image<f32>,
     pub vo: Option<Image<f32>>,
+    pub bundle: Bundle,
     pub mask: Vec<bool>,
     pub rows: Vec<Row>,
+    /// The legibility of the pictures that are no method's: `none`, and each truth's AO
+    /// composited at strength 1 (`truth`, `bundle-truth`).
+    pub pictures: Vec<(&'static str, Result<Legibility, Absent>)>,
+    /// Seconds spent on legibility (pairs drawn once, then every picture).
+    pub legibility_seconds: f64,
 }
 
 /// The methods' chain settings: the command line's, the method and variant set.
 pub fn method_settings(session: &Session, args: &crate::cli::RenderArgs, m: ScoreMethod) -> ChainSettings {
-    let mut settings = session.settings(args, Method { screen: m.method, volume: None });
-    settings.line_ao.variant = m.variant;
+    // The variant first, so that the preset gives this variant's values and explicit options
+    // still win.
+    let args = crate::cli::RenderArgs { variant: m.variant, ..args.clone() };
+    let mut settings = session.settings(&args, Method { screen: m.method, volume: None });
     settings.blur = None;
     settings.raytraced.denoise = None;
     settings
@@ -116,22 +142,35 @@ pub fn raw_ao(
     Ok(MethodAo { ao, geometry })
 }
 
-/// Scores `methods` on `session`'s view.
-pub fn score(session: &Session, args: &crate::cli::RenderArgs, methods: &[ScoreMethod]) -> Result<Report> {
+/// Scores `methods` on `session`'s view against the local truth of `args` and the bundle-scale
+/// truth reaching `bundle_distance`.
+pub fn score(
+    session: &Session,
+    args: &crate::cli::RenderArgs,
+    methods: &[ScoreMethod],
+    bundle_distance: AoDistance,
+) -> Result<Report> {
     let gpu = &session.gpu;
     let (w, h) = (args.width as usize, args.height as usize);
     let vo_ball = if args.no_normal_clamp { VoBall::Whole } else { VoBall::Half };
     let wants_vo = methods.iter().any(|m| matches!(m.method, AoMethod::VoLine | AoMethod::VoArea));
-    let truth_settings = TruthSettings { vo: wants_vo.then_some(vo_ball), ..crate::truth::settings(args) };
+    let local = crate::truth::settings(args, session.longest_side);
+    let truth_settings = TruthSettings { vo: wants_vo.then_some(vo_ball), ..local.clone() };
+    let bundle_settings = TruthSettings {
+        distance_world: bundle_distance.world(session.longest_side),
+        falloff: Falloff::Linear,
+        vo: None,
+        ..local
+    };
 
     // The truth's G-buffer: a chain without a method (and so without a guard band).
     let quiet = crate::cli::RenderArgs { timings: false, dump: None, ..args.clone() };
     let plain = ScoreMethod { method: AoMethod::None, variant: Default::default() };
     let panel = Panel::new(Method { screen: AoMethod::None, volume: None }, method_settings(session, args, plain));
     let rendered = session.render(&quiet, &panel, None, None, None)?;
-    let start = std::time::Instant::now();
-    let truth = session.trace(&rendered.chain, &truth_settings)?;
-    let truth_seconds = start.elapsed().as_secs_f64();
+    let mut truths = session.trace_all(&rendered.chain, &[&truth_settings, &bundle_settings])?.into_iter();
+    let ((truth, truth_seconds), (bundle_truth, bundle_seconds)) =
+        (truths.next().context("the truth")?, truths.next().context("the bundle truth")?);
     let truth_targets = rendered.chain.targets().context("nothing was rendered")?;
     let nd = lineao::verify::read_rgba(&gpu.device, &gpu.queue, &truth_targets.nd[0])?;
     let color = lineao::readback::read_texture(&gpu.device, &gpu.queue, &truth_targets.color.texture)?.to_vec4();
@@ -144,13 +183,20 @@ pub fn score(session: &Session, args: &crate::cli::RenderArgs, methods: &[ScoreM
     let ao_truth = truth.ao.clone();
     let vo_truth = truth.vo.clone();
     let strength_of = |m: ScoreMethod| method_settings(session, args, m).strength;
+    let luminance: Vec<f32> = color.iter().map(|c| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]).collect();
     let composite = |ao: &Image<f32>| -> Image<f32> {
         Image::from_fn(w, h, |x, y| {
-            let c = color[y * w + x];
             let a = ao.get(x, y).clamp(0.0, 1.0);
-            let luminance = 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
-            srgb(luminance * (1.0 - a) + specular.get(x, y))
+            srgb(luminance[y * w + x] * (1.0 - a) + specular.get(x, y))
         })
+    };
+    // D = 1 − Y/Y_none of the composite with occlusion `ao` (clamped as the composite does):
+    // Y = lum (1 − a) + specular, Y_none = lum + specular.
+    let darkening = |ao: &Image<f32>| -> Vec<f32> {
+        let lit: Vec<f32> = (0..w * h).map(|i| luminance[i] + specular.data[i]).collect();
+        let y: Vec<f32> =
+            (0..w * h).map(|i| luminance[i] * (1.0 - ao.data[i].clamp(0.0, 1.0)) + specular.data[i]).collect();
+        legibility::darkening(&y, &lit)
     };
 
     let mut rows = Vec::new();
@@ -185,15 +231,31 @@ pub fn score(session: &Session, args: &crate::cli::RenderArgs, methods: &[ScoreM
     }
     let all = vec![true; w * h];
     let true_image = composite(&ao_truth);
+    let start = std::time::Instant::now();
+    let depth = Image { data: nd.data.iter().map(|t| t[3]).collect(), width: w, height: h };
+    let pairs = legibility::Pairs::sample(&depth, &mask);
+    let legible = |ao: &Image<f32>| pairs.as_ref().map(|p| p.measure(&darkening(ao), &mask)).map_err(Clone::clone);
+    let pictures = vec![
+        ("none", legible(&Image::filled(w, h, 0.0))),
+        ("truth", legible(&ao_truth)),
+        ("bundle-truth", legible(&bundle_truth.ao)),
+    ];
+    let mut legibility_seconds = start.elapsed().as_secs_f64();
     let rows = rows
         .into_iter()
         .map(|(method, truth_name, target, ao)| {
             let scores = metrics::score(&ao, &target, &mask);
+            let bundle = metrics::score(&ao, &bundle_truth.ao, &mask);
             let image_ssim = metrics::mean_ssim(&composite(&ao), &true_image, &all);
-            Row { method, truth: truth_name, scores, image_ssim, ao }
+            let start = std::time::Instant::now();
+            let legibility = legible(&ao);
+            legibility_seconds += start.elapsed().as_secs_f64();
+            Row { method, truth: truth_name, scores, image_ssim, bundle, legibility, ao }
         })
         .collect();
-    Ok(Report { truth, truth_seconds, ao: ao_truth, vo: vo_truth, mask, rows })
+    let bundle =
+        Bundle { truth: bundle_truth, settings: bundle_settings, distance: bundle_distance, seconds: bundle_seconds };
+    Ok(Report { truth, truth_seconds, ao: ao_truth, vo: vo_truth, bundle, mask, rows, pictures, legibility_seconds })
 }
 
 /// sRGB encoding of a linear value in [0, 1].
@@ -206,13 +268,15 @@ pub fn run(args: &ScoreArgs) -> Result<()> {
     let render = &args.render;
     let methods = if args.methods.is_empty() { ScoreMethod::ALL.to_vec() } else { args.methods.clone() };
     let session = Session::open(render)?;
-    let report = score(&session, render, &methods)?;
+    let report = score(&session, render, &methods, args.bundle_distance)?;
     let truth = &report.truth;
     if args.json {
         println!("{}", serde_json::to_string_pretty(&to_json(&session, render, &report))?);
     } else {
+        let bundle = &report.bundle;
         println!(
-            "{}: {} x {}, {} geometry pixels, {} rays to {} ({} falloff), truth mean {:.3}, {:.1} % buried",
+            "{}: {} x {}, {} geometry pixels, {} rays; local truth to {} ({} falloff), mean {:.3}, {:.1} % buried; \
+             bundle truth to {} = {:.1} ({} falloff), mean {:.3}",
             session.lines.name,
             render.width,
             render.height,
@@ -220,8 +284,12 @@ pub fn run(args: &ScoreArgs) -> Result<()> {
             render.rays,
             render.ao_distance,
             truth_settings_falloff(render),
-            report.rows.first().map_or(0.0, |r| r.scores.mean_truth),
-            100.0 * truth.buried_share()
+            mean_over(&report.ao, &report.mask),
+            100.0 * truth.buried_share(),
+            bundle.distance,
+            bundle.settings.distance_world,
+            bundle.settings.falloff.name(),
+            mean_over(&bundle.truth.ao, &report.mask),
         );
         println!(
             "{:<17} {:>8} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} | {:>6} {:>7} {:>7} {:>7} | {:>9}",
@@ -258,6 +326,8 @@ pub fn run(args: &ScoreArgs) -> Result<()> {
                 row.image_ssim
             );
         }
+        println!();
+        print!("{}", legibility_table(&report));
     }
     if let Some(path) = &render.output {
         let image = grid(&report);
@@ -267,14 +337,76 @@ pub fn run(args: &ScoreArgs) -> Result<()> {
     Ok(())
 }
 
+/// The mean of `ao` over `mask`.
+fn mean_over(ao: &Image<f32>, mask: &[bool]) -> f64 {
+    let (sum, n) =
+        ao.data.iter().zip(mask).filter(|(_, m)| **m).fold((0.0, 0usize), |(s, n), (a, _)| (s + *a as f64, n + 1));
+    if n == 0 { 0.0 } else { sum / n as f64 }
+}
+
+/// Per picture: L at the three scales and their mean, the mean darkening, the near-black share,
+/// and for each method its correlation and RMSE against the bundle-scale truth.
+pub fn legibility_table(report: &Report) -> String {
+    use std::fmt::Write;
+    let mut out = String::new();
+    let scales: Vec<String> = legibility::SCALES.iter().map(|s| format!("L {:.0} %", s * 100.0)).collect();
+    let _ = writeln!(
+        out,
+        "{:<17} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} | {:>7} {:>7}",
+        "legibility", scales[0], scales[1], scales[2], "L mean", "dark", "black", "corr₂", "RMSE₂"
+    );
+    let line = |out: &mut String, name: &str, l: &Result<Legibility, Absent>, bundle: Option<&Scores>| {
+        let tail = bundle.map_or(String::new(), |b| format!(" | {:>7.3} {:>7.3}", b.correlation, b.raw.rmse));
+        let _ = match l {
+            Ok(l) => writeln!(
+                out,
+                "{:<17} {:>+7.3} {:>+7.3} {:>+7.3} {:>+7.3} {:>7.3} {:>6.1}%{tail}",
+                name,
+                l.scales[0],
+                l.scales[1],
+                l.scales[2],
+                l.mean(),
+                l.mean_darkening,
+                100.0 * l.near_black
+            ),
+            Err(why) => writeln!(out, "{name:<17} absent: {why}{tail}"),
+        };
+    };
+    for (name, l) in &report.pictures {
+        line(&mut out, name, l, None);
+    }
+    for row in &report.rows {
+        line(&mut out, row.method.name(), &row.legibility, Some(&row.bundle));
+    }
+    out
+}
+
+/// A legibility as JSON: its three scales, mean, mean darkening and near-black share, or why it
+/// is absent.
+fn legibility_json(l: &Result<Legibility, Absent>) -> serde_json::Value {
+    match l {
+        Ok(l) => json!({
+            "l_local": l.scales[0],
+            "l_bundle": l.scales[1],
+            "l_global": l.scales[2],
+            "l_mean": l.mean(),
+            "mean_darkening": l.mean_darkening,
+            "near_black": l.near_black,
+            "pixels": l.pixels,
+        }),
+        Err(why) => json!({"absent": why.to_string()}),
+    }
+}
+
 fn truth_settings_falloff(args: &crate::cli::RenderArgs) -> &'static str {
-    crate::truth::settings(args).falloff.name()
+    args.ao_falloff.name()
 }
 
 /// CONTRACT.md's `lineao score --json` object.
 pub fn to_json(session: &Session, args: &crate::cli::RenderArgs, report: &Report) -> serde_json::Value {
     let errors = |e: &metrics::Errors| json!({"bias": e.bias, "mean_abs": e.mean_abs, "rmse": e.rmse, "ssim": e.ssim});
-    let settings = crate::truth::settings(args);
+    let settings = crate::truth::settings(args, session.longest_side);
+    let bundle = &report.bundle;
     json!({
         "scene": session.lines.name,
         "width": args.width,
@@ -287,6 +419,18 @@ pub fn to_json(session: &Session, args: &crate::cli::RenderArgs, report: &Report
         "compared_pixels": report.mask.iter().filter(|m| **m).count(),
         "buried_share": report.truth.buried_share(),
         "truth_seconds": report.truth_seconds,
+        "truth_mean": mean_over(&report.ao, &report.mask),
+        "bundle_truth": {
+            "ao_distance": bundle.distance.to_string(),
+            "ao_distance_world": bundle.settings.distance_world,
+            "ao_falloff": bundle.settings.falloff.name(),
+            "mean": mean_over(&bundle.truth.ao, &report.mask),
+            "buried_share": bundle.truth.buried_share(),
+            "seconds": bundle.seconds,
+        },
+        "legibility_scales": legibility::SCALES,
+        "legibility_seconds": report.legibility_seconds,
+        "pictures": report.pictures.iter().map(|(name, l)| json!({"picture": name, "legibility": legibility_json(l)})).collect::<Vec<_>>(),
         "methods": report.rows.iter().map(|row| {
             let s = &row.scores;
             let mut value = errors(&s.raw);
@@ -301,6 +445,16 @@ pub fn to_json(session: &Session, args: &crate::cli::RenderArgs, report: &Report
                     ("scale".to_string(), json!(s.scale)),
                     ("scaled".to_string(), errors(&s.scaled)),
                     ("image_ssim".to_string(), json!(row.image_ssim)),
+                    ("bundle".to_string(), {
+                        let b = &row.bundle;
+                        let mut value = errors(&b.raw);
+                        if let Some(object) = value.as_object_mut() {
+                            object.insert("correlation".to_string(), json!(b.correlation));
+                            object.insert("truth_mean".to_string(), json!(b.mean_truth));
+                        }
+                        value
+                    }),
+                    ("legibility".to_string(), legibility_json(&row.legibility)),
                 ]);
             }
             value

@@ -22,11 +22,12 @@ pub struct Scene<'a> {
     pub radii: Option<&'a [f32]>,
 }
 
-/// The truth's settings from the command line.
-pub fn settings(args: &RenderArgs) -> TruthSettings {
+/// The truth's settings from the command line, in a scene whose bounds' longest side is
+/// `longest_side` world units (what `--ao-distance 20%` is a share of).
+pub fn settings(args: &RenderArgs, longest_side: f32) -> TruthSettings {
     TruthSettings {
         rays: args.rays,
-        distance_world: args.ao_distance,
+        distance_world: args.ao_distance.world(longest_side),
         falloff: args.ao_falloff,
         seed: args.ray_seed,
         vo: None,
@@ -35,12 +36,13 @@ pub fn settings(args: &RenderArgs) -> TruthSettings {
 }
 
 /// The GPU ray tracer's settings from the command line: `--rays` rays per pixel in all, at most
-/// [`RAYS_PER_FRAME`] per submitted frame.
-pub fn gpu_settings(args: &RenderArgs) -> lineao::RayTracedSettings {
+/// [`RAYS_PER_FRAME`] per submitted frame, in a scene whose bounds' longest side is
+/// `longest_side`.
+pub fn gpu_settings(args: &RenderArgs, longest_side: f32) -> lineao::RayTracedSettings {
     lineao::RayTracedSettings {
         rays_per_frame: args.rays.min(RAYS_PER_FRAME),
         max_rays: args.rays,
-        distance_world: args.ao_distance,
+        distance_world: args.ao_distance.world(longest_side),
         falloff: args.ao_falloff,
         seed: args.ray_seed,
         denoise: args.denoise.then(lineao::RayDenoiseSettings::default),

@@ -33,6 +33,18 @@ fn exit_codes() {
         let out = lineao(bad);
         assert_eq!(out.status.code(), Some(2), "{bad:?}: {}", stderr(&out));
     }
+    // A reach as a share of the scene: in (0 %, 100 %], a number.
+    for (bad, reason) in [
+        (&["score", "--ao-distance", "0%"][..], "(0 %, 100 %]"),
+        (&["score", "--ao-distance", "120%"], "(0 %, 100 %]"),
+        (&["render", "--ao-distance", "x%"], "a share such as 20%"),
+        (&["score", "--bundle-distance=-5%"], "(0 %, 100 %]"),
+        (&["score", "--ao-distance=-2"], "positive"),
+    ] {
+        let out = lineao(bad);
+        assert_eq!(out.status.code(), Some(2), "{bad:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains(reason), "{bad:?}: {}", stderr(&out));
+    }
     let dir = scratch("exit_codes");
     let png = dir.join("x.png");
     let png = png.to_str().unwrap();
@@ -767,10 +779,59 @@ fn score_ranks_the_truth_first() {
         );
     }
     assert!(report["buried_share"].as_f64().unwrap() < 0.2);
+    // Legibility of every method, `none` and both truths' pictures; the bundle-scale truth.
+    for m in methods {
+        let l = &m["legibility"];
+        for key in ["l_local", "l_bundle", "l_global", "l_mean", "mean_darkening", "near_black"] {
+            assert!(l[key].is_number(), "legibility {key} of {}", m["method"]);
+        }
+        assert!(m["bundle"]["correlation"].is_number());
+    }
+    let pictures = report["pictures"].as_array().unwrap();
+    let picture = |name: &str| &pictures.iter().find(|p| p["picture"] == name).unwrap()["legibility"];
+    assert_eq!(picture("none")["l_mean"].as_f64(), Some(0.0), "no AO, nothing legible");
+    assert_eq!(picture("none")["mean_darkening"].as_f64(), Some(0.0));
+    // Darker is deeper in the truth's own picture, at every scale.
+    for key in ["l_local", "l_bundle", "l_global"] {
+        assert!(
+            picture("bundle-truth")[key].as_f64().unwrap() > 0.05,
+            "bundle truth {key}: {}",
+            picture("bundle-truth")
+        );
+    }
+    let bundle = &report["bundle_truth"];
+    assert_eq!((bundle["ao_distance"].as_str(), bundle["ao_falloff"].as_str()), (Some("20%"), Some("linear")));
+    // 20 % of the bundles scene's longest side (its bounds, tens of mm).
+    let reach = bundle["ao_distance_world"].as_f64().unwrap();
+    assert!(reach > 10.0 && reach < 100.0, "{reach}");
+    assert!(bundle["mean"].as_f64().unwrap() > report["truth_mean"].as_f64().unwrap(), "the bundle reach sees more");
     assert_eq!(common::read_png(&grid).0, (3 * 200, 6 * 160));
     let again = lineao(&args);
     let again: Value = serde_json::from_slice(&again.stdout).unwrap();
     assert_eq!(report["methods"][0]["truth_mean"], again["methods"][0]["truth_mean"]);
+}
+
+/// A frame with fewer than 100 geometry pixels has no legibility, said with the reason, not 0.
+#[test]
+fn legibility_of_a_tiny_frame_is_absent_with_the_reason() {
+    let out = lineao(&[
+        "score",
+        "--vertices",
+        "2000",
+        "--width",
+        "12",
+        "--height",
+        "8",
+        "--rays",
+        "4",
+        "--methods",
+        "lineao",
+        "--json",
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let report: Value = serde_json::from_slice(&out.stdout).unwrap();
+    let absent = report["methods"][0]["legibility"]["absent"].as_str().unwrap_or_else(|| panic!("{report}"));
+    assert!(absent.contains("fewer than the 100"), "{absent}");
 }
 
 #[test]

@@ -70,13 +70,15 @@ pub enum ColorMode {
     Constant([u8; 3]),
 }
 
-/// The two parameter sets the presets choose between.
+/// The parameter sets the presets choose between.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Preset {
-    /// lineao's calibrated values (`lineao::Preset::Calibrated`): each method's strength and
-    /// reach fitted to the ray-traced truth. The strength slider then holds LineAO's, and the
-    /// other methods keep their calibrated strength relative to it.
-    Calibrated,
+    /// lineao's default (`lineao::Preset::Legible`): each method's strength and reach chosen
+    /// so that visibly darker lines lie deeper. The strength slider then holds LineAO's, and the
+    /// other methods keep their own strength relative to it.
+    Legible,
+    /// `lineao::Preset::Physical`: fitted to binary AO within 2 mm (faint on whole brains).
+    Physical,
     /// Whole-brain tractography, hundreds of thousands of streamlines packed millimetres apart:
     /// the paper's values (thin lines, three hemispheres, SSAO and VO spheres of 2 mm).
     Dense,
@@ -84,6 +86,17 @@ pub enum Preset {
     /// reach grown so that neighbours, not just a line's own body, occlude (four hemispheres, so
     /// the outermost reaches twice as far; spheres of 6 units; a softer strength).
     Sparse,
+}
+
+impl Preset {
+    /// The library's preset this one is, if any.
+    pub fn library(self) -> Option<lineao::Preset> {
+        match self {
+            Preset::Legible => Some(lineao::Preset::Legible),
+            Preset::Physical => Some(lineao::Preset::Physical),
+            Preset::Dense | Preset::Sparse => None,
+        }
+    }
 }
 
 /// The methods' parameters. World-space lengths are in the data's units (mm for tractograms).
@@ -115,8 +128,8 @@ impl Params {
         volume.density.occupancy_radius = 0.5 * zoom_unit;
         let mut params =
             Params { chain, tube_radius: 0.5 * zoom_unit, volume, cloudy: false, volume_combine: VoCombine::Product };
-        if preset == Preset::Calibrated {
-            params.chain = params.chain.with_preset(lineao::Preset::Calibrated);
+        if let Some(library) = preset.library() {
+            params.chain = params.chain.with_preset(library);
         }
         if preset == Preset::Sparse {
             let c = &mut params.chain;
@@ -200,13 +213,11 @@ impl Controls {
         let sky = if p.cloudy { Sky::above_nearest_axis(up.to_array()) } else { Sky::Uniform };
         let mut settings = p.chain.clone();
         settings.method = method.screen;
-        if self.preset == Preset::Calibrated {
-            // The slider holds LineAO's calibrated strength; another method keeps its own
-            // calibrated strength relative to it.
-            let calibrated = |method| {
-                ChainSettings { method, ..ChainSettings::default() }.with_preset(lineao::Preset::Calibrated).strength
-            };
-            settings.strength *= calibrated(method.screen) / calibrated(AoMethod::LineAo);
+        if let Some(library) = self.preset.library() {
+            // The slider holds LineAO's strength of the preset; another method keeps its own
+            // strength of the preset relative to it.
+            let preset = |method| ChainSettings { method, ..ChainSettings::default() }.with_preset(library).strength;
+            settings.strength *= preset(method.screen) / preset(AoMethod::LineAo);
         }
         settings.volume = method.volume.map(|_| VolumeAoSettings {
             // The view-independent forms hold the sky already.
@@ -275,7 +286,8 @@ impl Controls {
         ui.heading("Parameters");
         ui.horizontal(|ui| {
             for (preset, label, hint) in [
-                (Preset::Calibrated, "Calibrated", "Strength and reach fitted to the ray-traced truth"),
+                (Preset::Legible, "Legible", "Darker lines lie deeper: chosen by legibility (lineao score --fit)"),
+                (Preset::Physical, "Physical", "Fitted to binary AO within 2 mm: faint on whole brains"),
                 (Preset::Dense, "Dense tractography", "The paper's values"),
                 (Preset::Sparse, "Sparse streamlines", "Wider lines, wider reach"),
             ] {
@@ -552,7 +564,7 @@ mod tests {
 
     #[test]
     fn a_ray_traced_panel_shows_the_chosen_method_while_the_camera_moves() {
-        let mut controls = Controls::new([RAY_TRACED, METHODS[4]], true, Preset::Calibrated);
+        let mut controls = Controls::new([RAY_TRACED, METHODS[4]], true, Preset::Legible);
         let method = |panels: Vec<Panel>| panels.iter().map(|p| p.settings.method).collect::<Vec<_>>();
         assert_eq!(method(controls.panels(Vec3::Z, None, false)), [AoMethod::RayTraced, AoMethod::Ssao]);
         assert_eq!(method(controls.panels(Vec3::Z, None, true)), [AoMethod::LineAo, AoMethod::Ssao]);

@@ -30,7 +30,8 @@ fn options(args: &ViewArgs) -> app::Options {
         }
     };
     let preset = match args.preset {
-        PresetArg::Calibrated => Preset::Calibrated,
+        PresetArg::Legible => Preset::Legible,
+        PresetArg::Physical => Preset::Physical,
         PresetArg::Dense => Preset::Dense,
         PresetArg::Sparse => Preset::Sparse,
     };

@@ -488,7 +488,7 @@ impl Renderer {
         };
         let session = &self.session;
         py.detach(|| {
-            let report = lineao_cli::score::score(session, &args, &methods)?;
+            let report = lineao_cli::score::score(session, &args, &methods, lineao_cli::score::BUNDLE_DISTANCE)?;
             anyhow::Ok(lineao_cli::score::to_json(session, &args, &report).to_string())
         })
         .map_err(render_error)

@@ -205,7 +205,7 @@ fn prepare_encode_and_upload_do_not_wait_for_the_device() {
     let uploaded = LineGeometry::new(d, q, &positions, &offsets).unwrap();
     // The constructor as a future, as a host on an async runtime (or the web) awaits it.
     let mut chain = pollster::block_on(AoChain::new_async(d, common::OUTPUT_FORMAT, ChainSettings::default())).unwrap();
-    let calibrated = ChainSettings::default().with_preset(lineao::Preset::Calibrated);
+    let calibrated = ChainSettings::default().with_preset(lineao::Preset::Physical);
     pollster::block_on(chain.set_settings_async(d, calibrated)).unwrap();
     chain.set_timing(d, q, true);
     chain.resize(256, 192).unwrap();

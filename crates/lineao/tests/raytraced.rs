@@ -436,3 +436,46 @@ fn the_denoiser_brings_few_rays_closer_to_the_truth_and_fades_out() {
     assert!(d.spatial(4, false) > 0.0 && d.spatial(64, false) > 0.0);
     assert_eq!(d.spatial(145, false), 0.0);
 }
+
+/// The bundle-scale truth's identity (CONTRACT.md): obscurance with the linear falloff over
+/// [0, R] is binary AO averaged over radii R' uniform in [0, R] — a hit at t counts 1 − t/R,
+/// the share of those radii beyond t. Checked numerically with the same rays: the mean of
+/// binary truths at the midpoints of K bins of [0, R] against the linear truth at R.
+#[test]
+fn linear_falloff_is_binary_ao_averaged_over_uniform_radii() {
+    let scene = Scene::lines(60);
+    let mut tracer = Tracer::new(&scene, settings(8), None);
+    let (nd, _) = tracer.frame(&camera());
+    let view = tracer.chain.frame_view().unwrap();
+    let cones = truth::line_cones(&scene.positions, &scene.offsets, view, tracer.chain.settings().line_width_px);
+    let bvh = Bvh::build(cones, Vec::new());
+    let frame = truth::Frame { nd: &nd, view, lines: true };
+    let cancel = std::sync::atomic::AtomicBool::new(false);
+    let reach = 6.0;
+    let at = |distance_world: f32, falloff: Falloff| {
+        let settings = truth::TruthSettings { rays: 32, distance_world, falloff, ..Default::default() };
+        truth::compute(&bvh, &frame, &settings, &|_, _| {}, &cancel).unwrap()
+    };
+    let linear = at(reach, Falloff::Linear);
+    const K: usize = 48;
+    let binary: Vec<_> = (0..K).map(|k| at(reach * (k as f32 + 0.5) / K as f32, Falloff::None).ao).collect();
+    let (mut sum_abs, mut worst, mut geometry) = (0.0f64, 0.0f32, 0usize);
+    for (i, texel) in nd.data.iter().enumerate() {
+        // Buried origins are AO 1 under both; the rest must agree.
+        if !common::is_geometry(*texel) || linear.ao.data[i] >= 1.0 {
+            continue;
+        }
+        let mean = binary.iter().map(|b| b.data[i]).sum::<f32>() / K as f32;
+        let d = (mean - linear.ao.data[i]).abs();
+        sum_abs += d as f64;
+        worst = worst.max(d);
+        geometry += 1;
+    }
+    let mean_abs = sum_abs / geometry as f64;
+    eprintln!("linear vs mean of {K} binary: {geometry} pixels, mean |Δ| {mean_abs:.5}, worst {worst:.4}");
+    assert!(geometry > 1000 && linear.ao.data.iter().any(|&a| a > 0.1), "occlusion to compare");
+    // The midpoint rule moves each hit by at most 1/(2K); the origins' offset ε = 1e-3 R' moves
+    // with R', so a ray grazing a line may hit at one radius and not another.
+    assert!(mean_abs < 0.005, "mean |Δ| {mean_abs}");
+    assert!(worst <= 1.0 / K as f32 + 0.05, "worst {worst}");
+}

@@ -46,6 +46,21 @@ pub struct Scores {
     pub scaled: Errors,
 }
 
+/// Pearson's correlation of `a` and `b` over the pixels where `mask` holds (0 when either is
+/// constant there): [`score`]'s `correlation` alone, without the SSIM windows.
+pub fn correlation(a: &[f32], b: &[f32], mask: &[bool]) -> f64 {
+    let pairs = || a.iter().zip(b).zip(mask).filter(|(_, m)| **m).map(|((&a, &b), _)| (a as f64, b as f64));
+    let (n, sa, sb) = pairs().fold((0usize, 0.0, 0.0), |(n, sa, sb), (a, b)| (n + 1, sa + a, sb + b));
+    if n == 0 {
+        return 0.0;
+    }
+    let (ma, mb) = (sa / n as f64, sb / n as f64);
+    let (saa, sbb, sab) = pairs().fold((0.0, 0.0, 0.0), |(saa, sbb, sab), (a, b)| {
+        (saa + (a - ma) * (a - ma), sbb + (b - mb) * (b - mb), sab + (a - ma) * (b - mb))
+    });
+    if saa > 0.0 && sbb > 0.0 { sab / (saa * sbb).sqrt() } else { 0.0 }
+}
+
 /// Scores `method` against `truth` (same size) over the pixels where `mask` holds.
 pub fn score(method: &Image<f32>, truth: &Image<f32>, mask: &[bool]) -> Scores {
     assert_eq!((method.width, method.height), (truth.width, truth.height), "maps of different sizes");

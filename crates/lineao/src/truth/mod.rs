@@ -46,6 +46,7 @@
 //! flag stops it between rows.
 
 pub mod bvh;
+pub mod legibility;
 pub mod metrics;
 pub mod primitive;
 pub mod sequence;
