@@ -202,3 +202,16 @@ crate::settings::named!(LineShading {
     Specular => "Zöckler's maximum-principle specular added to the AO-darkened color (the paper's §3.3)",
     CylinderAveraged => "Mallo et al.'s cylinder-averaged diffuse and specular",
 });
+
+#[cfg(test)]
+mod layout {
+    #[test]
+    fn uniform_matches_its_wgsl_struct() {
+        crate::shader::assert_wgsl_layout!(
+            super::LightingUniform,
+            "shared/lighting.wgsl",
+            "Lighting",
+            [lights, count, kd, ks, shininess, line_shading]
+        );
+    }
+}

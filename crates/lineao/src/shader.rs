@@ -86,3 +86,63 @@ pub fn module_with(device: &wgpu::Device, path: &str, replacements: &[(&str, &st
         source: wgpu::ShaderSource::Wgsl(Cow::Owned(source)),
     })
 }
+
+/// In a test: asserts that the `#[repr(C)]` Rust struct `$rust` has the memory layout of the
+/// WGSL struct `$wgsl` of the composed shader `$file`, as naga lays it out: the same size and,
+/// member by member, the same names and byte offsets (padding members, whose names start with
+/// `_`, left out on both sides). List every field of `$rust` but its padding: a field added on
+/// one side only, renamed or reordered fails it.
+#[cfg(test)]
+macro_rules! assert_wgsl_layout {
+    ($rust:ty, $file:literal, $wgsl:literal, [$($field:ident),+ $(,)?]) => {
+        $crate::shader::check_layout(
+            $file,
+            $wgsl,
+            std::mem::size_of::<$rust>(),
+            &[$((stringify!($field), std::mem::offset_of!($rust, $field))),+],
+        )
+    };
+}
+#[cfg(test)]
+pub(crate) use assert_wgsl_layout;
+
+/// [`assert_wgsl_layout`]'s check: `fields` (name, offset) and `size` against naga's layout of
+/// `wgsl` in the composed `file`.
+#[cfg(test)]
+pub(crate) fn check_layout(file: &str, wgsl: &str, size: usize, fields: &[(&str, usize)]) {
+    let source = compose(file);
+    let module =
+        naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| panic!("{file}: {}", e.emit_to_string(&source)));
+    let (members, span) = module
+        .types
+        .iter()
+        .find_map(|(_, ty)| match (&ty.name, &ty.inner) {
+            (Some(name), naga::TypeInner::Struct { members, span }) if name == wgsl => Some((members, *span)),
+            _ => None,
+        })
+        .unwrap_or_else(|| panic!("no struct {wgsl} in {file}"));
+    let wgsl_fields: Vec<(&str, usize)> = members
+        .iter()
+        .filter_map(|m| m.name.as_deref().map(|n| (n, m.offset as usize)))
+        .filter(|(n, _)| !n.starts_with('_'))
+        .collect();
+    let rust_fields: Vec<(&str, usize)> = fields.iter().copied().filter(|(n, _)| !n.starts_with('_')).collect();
+    assert_eq!(rust_fields, wgsl_fields, "{wgsl} in {file}: fields (name, offset), Rust then WGSL");
+    assert_eq!(size, span as usize, "{wgsl} in {file}: size, Rust then WGSL");
+}
+
+#[cfg(test)]
+mod tests {
+    /// The check fails on a reordered field: a Rust struct whose first two fields are swapped
+    /// against `Levels` (shared/nd.wgsl: scale, then size).
+    #[test]
+    #[should_panic(expected = "fields (name, offset)")]
+    fn a_reordered_field_fails_the_layout_check() {
+        #[repr(C)]
+        struct Swapped {
+            size: [[u32; 4]; 5],
+            scale: [[f32; 4]; 5],
+        }
+        assert_wgsl_layout!(Swapped, "shared/nd.wgsl", "Levels", [size, scale]);
+    }
+}

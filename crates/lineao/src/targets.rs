@@ -309,3 +309,11 @@ impl FrameTargets {
         (1..crate::MAX_LEVELS as usize).map(|j| self.outer.get(j - 1).map_or(pad, |t| &t.view)).collect()
     }
 }
+
+#[cfg(test)]
+mod layout {
+    #[test]
+    fn uniform_matches_its_wgsl_struct() {
+        crate::shader::assert_wgsl_layout!(super::LevelsUniform, "shared/nd.wgsl", "Levels", [scale, size]);
+    }
+}

@@ -123,3 +123,16 @@ impl Bilateral {
         }
     }
 }
+
+#[cfg(test)]
+mod layout {
+    #[test]
+    fn uniform_matches_its_wgsl_struct() {
+        crate::shader::assert_wgsl_layout!(
+            super::BilateralUniform,
+            "bilateral.wgsl",
+            "BilateralUniform",
+            [view, radius, spatial, depth]
+        );
+    }
+}

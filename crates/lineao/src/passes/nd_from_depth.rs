@@ -317,3 +317,16 @@ impl NdFromDepth {
         self.outside_readback.copy(encoder, &self.outside);
     }
 }
+
+#[cfg(test)]
+mod layout {
+    #[test]
+    fn uniform_matches_its_wgsl_struct() {
+        crate::shader::assert_wgsl_layout!(
+            super::HostUniform,
+            "nd_from_depth.wgsl",
+            "HostUniform",
+            [inv_proj, view_rotation, size, near, far, f_px, zoom_unit, orthographic, far_depth]
+        );
+    }
+}

@@ -174,3 +174,16 @@ impl crate::stage::Stage for SsaoStage {
         self.blur.encode(encoder, targets, span("ssao-blur"));
     }
 }
+
+#[cfg(test)]
+mod layout {
+    #[test]
+    fn uniform_matches_its_wgsl_struct() {
+        crate::shader::assert_wgsl_layout!(
+            super::SsaoUniform,
+            "ssao.wgsl",
+            "SsaoUniform",
+            [view, noise_origin, radius, range]
+        );
+    }
+}

@@ -128,3 +128,16 @@ impl VolumeAo {
         dispatch_full_screen(encoder, "lineao::VolumeAo", &self.pipeline, group, targets.size, span);
     }
 }
+
+#[cfg(test)]
+mod layout {
+    #[test]
+    fn uniform_matches_its_wgsl_struct() {
+        crate::shader::assert_wgsl_layout!(
+            super::VolumeAoUniform,
+            "volume_ao.wgsl",
+            "VolumeAoUniform",
+            [view_to_world, weights, table_size]
+        );
+    }
+}
