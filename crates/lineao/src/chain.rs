@@ -640,7 +640,8 @@ impl AoChain {
         match (config, depth) {
             (None, Some(_)) => {
                 return Err(Error::Usage(
-                    "a depth was passed but the overlay was enabled without one: call enable_overlay with                      Some(OverlayDepth { format, proj })"
+                    "a depth was passed but the overlay was enabled without one: call enable_overlay with \
+                     Some(OverlayDepth { format, proj })"
                         .into(),
                 ));
             }

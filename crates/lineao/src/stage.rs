@@ -32,7 +32,7 @@ pub enum Reach {
 }
 
 /// What a method does in the chain. The timing span names are CONTRACT.md's.
-pub trait Stage: Send + Sync {
+pub trait Stage: wgpu::WasmNotSendSync {
     /// Whether this stage, as built, computes `settings`' method (else the chain builds another).
     fn matches(&self, settings: &ChainSettings) -> bool;
     /// How far it reads for a frame seen as `unguarded` (the frame's size, no guard band).

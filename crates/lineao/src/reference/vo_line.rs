@@ -50,7 +50,7 @@ pub fn vo_plane(n: [f32; 3]) -> [f32; 2] {
 /// with the normal clamp the part above the tangent plane n_x x + n_y y − n_z z_d ≥ 0, at depth
 /// s · g (`g` from [`vo_plane`]). Empty when hi ≤ lo. This is the paper's form, exact where
 /// rays are parallel (orthographic); the passes cut each chord along the sample's own view ray
-/// ([`tangent_plane_depth`]), which perspective needs.
+/// (`tangent_plane_depth` in this module), which perspective needs.
 pub fn vo_chord(s: [f32; 2], z_s: f32, n: [f32; 3], g: [f32; 2], clamp: bool) -> (f32, f32) {
     let (mut lo, mut hi) = (-z_s, z_s);
     if clamp {
