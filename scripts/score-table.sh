@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # Reproduces the README's table "How far each method is from the truth": `lineao score --json`
 # on the built-in scenes and the real tractograms of ../shared/data, at R = 2 mm (the default)
-# and R = 5 mm, 640 × 512, 256 rays, each method at the preset's values (calibrated by default;
-# PRESET=paper for the papers'). Prints a Markdown table (python3 formats the JSON).
+# and R = 5 mm, 640 × 512, 256 rays, each method at the preset's values (`physical`, the
+# calibration against the local truth these tables were made with, by default; PRESET=legible
+# for the default preset, PRESET=paper for the papers'). Prints a Markdown table (python3 formats the JSON).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 data=../shared/data
-preset=${PRESET:-calibrated}
+preset=${PRESET:-physical}
 sources=(--scene=bundles --scene=spiral --scene=vortex
   "$data/niivue+niivue/packages/niivue/demos/images/stroke.trk.gz"
   "$data/niivue+niivue/packages/niivue/demos/images/sub-01_ses-01_dwi_space-RASMM_model-probCSD_algo-AFQ_tractography.trx"

@@ -102,6 +102,24 @@ pub fn parse_score_method(s: &str) -> Result<ScoreMethod, String> {
     })
 }
 
+/// A positive, finite number (a radius, a range).
+fn parse_positive(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        Ok(v) => Err(format!("must be positive and finite, got {v}")),
+        Err(e) => Err(format!("'{s}': {e}")),
+    }
+}
+
+/// LineAO's δ scale, in (0, 1].
+fn parse_delta_scale(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(v) if v > 0.0 && v <= 1.0 => Ok(v),
+        Ok(v) => Err(format!("the δ scale must be in (0, 1], got {v}")),
+        Err(e) => Err(format!("'{s}': {e}")),
+    }
+}
+
 /// How far a truth's rays look: world units, or a share of the scene's longest side (`20%`,
 /// LineVis's default reach), resolved against the scene's bounds.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -253,6 +271,10 @@ pub struct BenchArgs {
     /// Disable LineAO's light attenuation (g_light = 1).
     #[arg(long)]
     pub no_light_attenuation: bool,
+    /// LineAO's parameters: the preset of `render` (`legible` by default, as every front end;
+    /// `paper` for the papers' values). The other methods keep the papers' values.
+    #[arg(long, default_value = "legible", value_parser = parse_preset)]
+    pub preset: lineao::Preset,
     /// Print CONTRACT.md's JSON instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -446,10 +468,9 @@ pub struct RenderArgs {
     #[arg(long, value_parser = named::<LineAoVariant>(), default_value = "paper")]
     pub variant: LineAoVariant,
     /// LineAO (variant paper): hemispheres j ≥ 1 at every pixel (`full`) or at their pyramid
-    /// level's resolution, upsampled depth-aware (`level`: faster) [default: the preset's;
-    /// paper full].
-    #[arg(long, value_parser = named::<LineAoOuter>())]
-    pub outer: Option<LineAoOuter>,
+    /// level's resolution, upsampled depth-aware (`level`: faster).
+    #[arg(long, value_parser = named::<LineAoOuter>(), default_value = "full")]
+    pub outer: LineAoOuter,
     /// Output PNG [default: lineao.png; `score`: no grid].
     #[arg(short, long)]
     pub output: Option<PathBuf>,
@@ -503,8 +524,8 @@ pub struct RenderArgs {
     /// LineAO s_r: hemispheres and pyramid levels (1..=5) [default: the preset's; paper 3].
     #[arg(long)]
     pub s_r: Option<u32>,
-    /// LineAO s_h: samples on the first hemisphere.
-    #[arg(long, default_value_t = 32)]
+    /// LineAO s_h: samples on the first hemisphere (1..=256).
+    #[arg(long, default_value_t = 32, value_parser = clap::value_parser!(u32).range(1..=256))]
     pub s_h: u32,
     /// LineAO r0 in pixels [default: 1.5 × line width].
     #[arg(long)]
@@ -518,7 +539,7 @@ pub struct RenderArgs {
     #[arg(long)]
     pub samples: Option<u32>,
     /// VO: a second sphere radius in world units, combined with --radius (VO paper, Fig. 8).
-    #[arg(long)]
+    #[arg(long, value_parser = parse_positive)]
     pub radius2: Option<f32>,
     /// VO with two radii: how they combine.
     #[arg(long, value_parser = named::<VoCombine>(), default_value = "product", requires = "radius2")]
@@ -540,10 +561,10 @@ pub struct RenderArgs {
     pub thickness: f32,
     /// SSAO and VO: sphere radius in world units (mm for tractograms) [default: the preset's;
     /// paper 2].
-    #[arg(long)]
+    #[arg(long, value_parser = parse_positive)]
     pub radius: Option<f32>,
     /// SSAO: range check in world units [default: the radius].
-    #[arg(long)]
+    #[arg(long, value_parser = parse_positive)]
     pub ssao_range: Option<f32>,
     /// SSAO: the kernel's points.
     #[arg(long, value_parser = named::<SsaoKernel>(), default_value = "crytek")]
@@ -553,7 +574,7 @@ pub struct RenderArgs {
     pub delta0: f32,
     /// LineAO: scale of the falloff δ(j) = scale · (1 − j/s_r)², in (0, 1]; below 1 occluders
     /// far in front (in normalized depth) stop counting [default: the preset's; paper 1].
-    #[arg(long)]
+    #[arg(long, value_parser = parse_delta_scale)]
     pub delta_scale: Option<f32>,
     /// LineAO ε: occluded iff Δd > ε.
     #[arg(long, default_value_t = 1e-6)]

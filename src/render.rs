@@ -103,7 +103,7 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky, lon
             noise_seed: args.noise_seed,
             variant: args.variant,
             reference_radius_px: LineAoSettings::default().reference_radius_px,
-            outer: LineAoSettings::default().outer,
+            outer: args.outer,
         },
         raytraced: crate::truth::gpu_settings(args, longest_side),
         line_width_px: args.line_width,
@@ -139,9 +139,6 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky, lon
     }
     if let Some(scale) = args.delta_scale {
         settings.line_ao.delta_scale = scale;
-    }
-    if let Some(outer) = args.outer {
-        settings.line_ao.outer = outer;
     }
     if let Some(radius) = args.reference_radius {
         settings.line_ao.reference_radius_px = radius;
@@ -499,38 +496,26 @@ impl Session {
 
     /// The truth on `chain`'s last frame, with a line on stderr saying what it cost.
     pub fn trace(&self, chain: &AoChain, settings: &lineao::truth::TruthSettings) -> Result<lineao::truth::Truth> {
-        Ok(self.trace_all(chain, &[settings])?.remove(0).0)
-    }
-
-    /// The truth of `chain`'s frame for each of `settings`, over one BVH, with the seconds each
-    /// took to trace.
-    pub fn trace_all(
-        &self,
-        chain: &AoChain,
-        settings: &[&lineao::truth::TruthSettings],
-    ) -> Result<Vec<(lineao::truth::Truth, f64)>> {
         let start = std::time::Instant::now();
         let bvh = crate::truth::bvh(chain, &self.truth_scene())?;
         let built = start.elapsed().as_secs_f64();
-        let mut truths = Vec::new();
-        for settings in settings {
-            let start = std::time::Instant::now();
-            let truth = crate::truth::trace(&self.gpu, chain, &bvh, settings)?;
-            let seconds = start.elapsed().as_secs_f64();
-            eprintln!(
-                "lineao: ray traced {} rays to {} ({} falloff) over {} geometry pixels in {seconds:.1} s ({:.0} k rays/s; \
-                 BVH {built:.2} s, {} MB); {:.1} % of the pixels buried in another line",
-                truth.rays,
-                settings.distance_world,
-                settings.falloff.name(),
-                truth.geometry_pixels,
-                truth.rays as f64 / seconds.max(1e-9) / 1e3,
-                bvh.bytes() >> 20,
-                100.0 * truth.buried_share()
-            );
-            truths.push((truth, seconds));
-        }
-        Ok(truths)
+        let truth = crate::truth::trace(&self.gpu, chain, &bvh, settings)?;
+        let seconds = start.elapsed().as_secs_f64() - built;
+        let second = settings.second.map_or(String::new(), |r| {
+            format!(" and to {} ({} falloff) from the same rays", r.distance_world, r.falloff.name())
+        });
+        eprintln!(
+            "lineao: ray traced {} rays to {} ({} falloff){second} over {} geometry pixels in {seconds:.1} s ({:.0} k \
+             rays/s; BVH {built:.2} s, {} MB); {:.1} % of the pixels buried in another line",
+            truth.rays,
+            settings.distance_world,
+            settings.falloff.name(),
+            truth.geometry_pixels,
+            truth.rays as f64 / seconds.max(1e-9) / 1e3,
+            bvh.bytes() >> 20,
+            100.0 * truth.buried_share()
+        );
+        Ok(truth)
     }
 }
 

@@ -12,7 +12,7 @@ use anyhow::{Context, Result};
 use lineao::reference::Image;
 use lineao::truth::legibility::{self, Absent, Legibility};
 use lineao::truth::metrics::{self, Scores};
-use lineao::truth::{Falloff, Truth, TruthSettings, VoBall};
+use lineao::truth::{Falloff, Reach, Truth, TruthSettings, VoBall};
 use lineao::{AoMethod, ChainSettings};
 use serde_json::json;
 
@@ -29,7 +29,7 @@ pub struct Row {
     /// SSIM of the composited image's luminance against the composite with the truth's AO.
     pub image_ssim: f64,
     /// Its AO against the bundle-scale truth.
-    pub bundle: Scores,
+    pub bundle: metrics::Agreement,
     /// How legible its composite is (darker is deeper).
     pub legibility: Result<Legibility, Absent>,
     /// Its AO over the visible frame, for the grid.
@@ -42,11 +42,14 @@ pub const BUNDLE_DISTANCE: AoDistance = AoDistance::Share(0.2);
 
 /// The second truth: obscurance with the linear falloff at a bundle's reach (CONTRACT.md
 /// "Bundle-scale truth").
+///
+/// It comes from the local truth's rays, each traced once to the larger reach
+/// ([`TruthSettings::second`]): its ray origins are the local truth's (ε = 1e-3 of the local
+/// reach), its buried pixels the same.
 pub struct Bundle {
     pub truth: Truth,
     pub settings: TruthSettings,
     pub distance: AoDistance,
-    pub seconds: f64,
 }
 
 /// The truth of one view and every method's scores.
@@ -155,22 +158,31 @@ pub fn score(
     let vo_ball = if args.no_normal_clamp { VoBall::Whole } else { VoBall::Half };
     let wants_vo = methods.iter().any(|m| matches!(m.method, AoMethod::VoLine | AoMethod::VoArea));
     let local = crate::truth::settings(args, session.longest_side);
-    let truth_settings = TruthSettings { vo: wants_vo.then_some(vo_ball), ..local.clone() };
     let bundle_settings = TruthSettings {
         distance_world: bundle_distance.world(session.longest_side),
         falloff: Falloff::Linear,
         vo: None,
-        ..local
+        ..local.clone()
     };
+    // Both truths from the same rays, each traced once to the larger reach.
+    let second = Reach { distance_world: bundle_settings.distance_world, falloff: Falloff::Linear };
+    let truth_settings = TruthSettings { vo: wants_vo.then_some(vo_ball), second: Some(second), ..local };
 
     // The truth's G-buffer: a chain without a method (and so without a guard band).
     let quiet = crate::cli::RenderArgs { timings: false, dump: None, ..args.clone() };
     let plain = ScoreMethod { method: AoMethod::None, variant: Default::default() };
     let panel = Panel::new(Method { screen: AoMethod::None, volume: None }, method_settings(session, args, plain));
     let rendered = session.render(&quiet, &panel, None, None, None)?;
-    let mut truths = session.trace_all(&rendered.chain, &[&truth_settings, &bundle_settings])?.into_iter();
-    let ((truth, truth_seconds), (bundle_truth, bundle_seconds)) =
-        (truths.next().context("the truth")?, truths.next().context("the bundle truth")?);
+    let start = std::time::Instant::now();
+    let truth = session.trace(&rendered.chain, &truth_settings)?;
+    let truth_seconds = start.elapsed().as_secs_f64();
+    let bundle_truth = Truth {
+        ao: truth.second.clone().context("the bundle-scale truth")?,
+        stderr: Image::filled(w, h, 0.0),
+        vo: None,
+        second: None,
+        ..truth.clone()
+    };
     let truth_targets = rendered.chain.targets().context("nothing was rendered")?;
     let nd = lineao::verify::read_rgba(&gpu.device, &gpu.queue, &truth_targets.nd[0])?;
     let color = lineao::readback::read_texture(&gpu.device, &gpu.queue, &truth_targets.color.texture)?.to_vec4();
@@ -245,7 +257,7 @@ pub fn score(
         .into_iter()
         .map(|(method, truth_name, target, ao)| {
             let scores = metrics::score(&ao, &target, &mask);
-            let bundle = metrics::score(&ao, &bundle_truth.ao, &mask);
+            let bundle = metrics::agreement(&ao.data, &bundle_truth.ao.data, &mask);
             let image_ssim = metrics::mean_ssim(&composite(&ao), &true_image, &all);
             let start = std::time::Instant::now();
             let legibility = legible(&ao);
@@ -253,8 +265,7 @@ pub fn score(
             Row { method, truth: truth_name, scores, image_ssim, bundle, legibility, ao }
         })
         .collect();
-    let bundle =
-        Bundle { truth: bundle_truth, settings: bundle_settings, distance: bundle_distance, seconds: bundle_seconds };
+    let bundle = Bundle { truth: bundle_truth, settings: bundle_settings, distance: bundle_distance };
     Ok(Report { truth, truth_seconds, ao: ao_truth, vo: vo_truth, bundle, mask, rows, pictures, legibility_seconds })
 }
 
@@ -355,8 +366,8 @@ pub fn legibility_table(report: &Report) -> String {
         "{:<17} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} | {:>7} {:>7}",
         "legibility", scales[0], scales[1], scales[2], "L mean", "dark", "black", "corr₂", "RMSE₂"
     );
-    let line = |out: &mut String, name: &str, l: &Result<Legibility, Absent>, bundle: Option<&Scores>| {
-        let tail = bundle.map_or(String::new(), |b| format!(" | {:>7.3} {:>7.3}", b.correlation, b.raw.rmse));
+    let line = |out: &mut String, name: &str, l: &Result<Legibility, Absent>, bundle: Option<&metrics::Agreement>| {
+        let tail = bundle.map_or(String::new(), |b| format!(" | {:>7.3} {:>7.3}", b.correlation, b.rmse));
         let _ = match l {
             Ok(l) => writeln!(
                 out,
@@ -426,7 +437,6 @@ pub fn to_json(session: &Session, args: &crate::cli::RenderArgs, report: &Report
             "ao_falloff": bundle.settings.falloff.name(),
             "mean": mean_over(&bundle.truth.ao, &report.mask),
             "buried_share": bundle.truth.buried_share(),
-            "seconds": bundle.seconds,
         },
         "legibility_scales": legibility::SCALES,
         "legibility_seconds": report.legibility_seconds,
@@ -447,12 +457,8 @@ pub fn to_json(session: &Session, args: &crate::cli::RenderArgs, report: &Report
                     ("image_ssim".to_string(), json!(row.image_ssim)),
                     ("bundle".to_string(), {
                         let b = &row.bundle;
-                        let mut value = errors(&b.raw);
-                        if let Some(object) = value.as_object_mut() {
-                            object.insert("correlation".to_string(), json!(b.correlation));
-                            object.insert("truth_mean".to_string(), json!(b.mean_truth));
-                        }
-                        value
+                        json!({"bias": b.bias, "mean_abs": b.mean_abs, "rmse": b.rmse,
+                               "correlation": b.correlation, "truth_mean": b.mean_truth})
                     }),
                     ("legibility".to_string(), legibility_json(&row.legibility)),
                 ]);

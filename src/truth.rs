@@ -31,6 +31,7 @@ pub fn settings(args: &RenderArgs, longest_side: f32) -> TruthSettings {
         falloff: args.ao_falloff,
         seed: args.ray_seed,
         vo: None,
+        second: None,
         threads: 0,
     }
 }
@@ -148,7 +149,7 @@ pub fn from_gpu(gpu: &Gpu, chain: &AoChain) -> Result<Truth> {
         stderr.data[i] = (variance / n).sqrt() as f32;
     }
     let rays = geometry_pixels as u64 * progress.rays_per_pixel as u64;
-    Ok(Truth { ao, stderr, vo: None, geometry_pixels, buried, rays })
+    Ok(Truth { ao, stderr, vo: None, second: None, geometry_pixels, buried, rays })
 }
 
 /// Set by Ctrl-C while a truth runs.

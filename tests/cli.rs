@@ -40,6 +40,10 @@ fn exit_codes() {
         (&["render", "--ao-distance", "x%"], "a share such as 20%"),
         (&["score", "--bundle-distance=-5%"], "(0 %, 100 %]"),
         (&["score", "--ao-distance=-2"], "positive"),
+        // Library ranges the command line knows: a bad command line, and the option named.
+        (&["render", "--s-h", "0"], "--s-h"),
+        (&["render", "--delta-scale", "0"], "(0, 1]"),
+        (&["render", "--method", "vo-line", "--radius", "0"], "--radius"),
     ] {
         let out = lineao(bad);
         assert_eq!(out.status.code(), Some(2), "{bad:?}: {}", stderr(&out));

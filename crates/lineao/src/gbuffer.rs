@@ -223,31 +223,29 @@ pub(crate) fn begin<'e>(
 }
 
 #[cfg(test)]
-mod layout {
-    #[test]
-    fn uniform_matches_its_wgsl_struct() {
-        crate::shader::assert_wgsl_layout!(
-            super::GeometryUniform,
-            "shared/geometry.wgsl",
-            "GeometryUniform",
-            [
-                view,
-                proj,
-                inv_proj,
-                constant_color,
-                viewport,
-                near,
-                far,
-                f_px,
-                zoom_unit,
-                line_width_px,
-                orthographic,
-                color_mode,
-                tube_radius,
-                ndc_per_px,
-                scalar_range,
-                colormap
-            ]
-        );
-    }
+#[test]
+fn uniform_matches_its_wgsl_struct() {
+    crate::shader::assert_wgsl_layout!(
+        GeometryUniform,
+        "shared/geometry.wgsl",
+        "GeometryUniform",
+        [
+            view,
+            proj,
+            inv_proj,
+            constant_color,
+            viewport,
+            near,
+            far,
+            f_px,
+            zoom_unit,
+            line_width_px,
+            orthographic,
+            color_mode,
+            tube_radius,
+            ndc_per_px,
+            scalar_range,
+            colormap
+        ]
+    );
 }

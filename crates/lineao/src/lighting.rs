@@ -204,14 +204,12 @@ crate::settings::named!(LineShading {
 });
 
 #[cfg(test)]
-mod layout {
-    #[test]
-    fn uniform_matches_its_wgsl_struct() {
-        crate::shader::assert_wgsl_layout!(
-            super::LightingUniform,
-            "shared/lighting.wgsl",
-            "Lighting",
-            [lights, count, kd, ks, shininess, line_shading]
-        );
-    }
+#[test]
+fn uniform_matches_its_wgsl_struct() {
+    crate::shader::assert_wgsl_layout!(
+        LightingUniform,
+        "shared/lighting.wgsl",
+        "Lighting",
+        [lights, count, kd, ks, shininess, line_shading]
+    );
 }

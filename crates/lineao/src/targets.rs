@@ -311,9 +311,7 @@ impl FrameTargets {
 }
 
 #[cfg(test)]
-mod layout {
-    #[test]
-    fn uniform_matches_its_wgsl_struct() {
-        crate::shader::assert_wgsl_layout!(super::LevelsUniform, "shared/nd.wgsl", "Levels", [scale, size]);
-    }
+#[test]
+fn uniform_matches_its_wgsl_struct() {
+    crate::shader::assert_wgsl_layout!(LevelsUniform, "shared/nd.wgsl", "Levels", [scale, size]);
 }

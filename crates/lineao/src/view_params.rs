@@ -80,14 +80,12 @@ impl From<ViewParams> for ViewUniform {
 }
 
 #[cfg(test)]
-mod layout {
-    #[test]
-    fn uniform_matches_its_wgsl_struct() {
-        crate::shader::assert_wgsl_layout!(
-            super::ViewUniform,
-            "shared/view.wgsl",
-            "ViewParams",
-            [near, far, f_px, orthographic, center]
-        );
-    }
+#[test]
+fn uniform_matches_its_wgsl_struct() {
+    crate::shader::assert_wgsl_layout!(
+        ViewUniform,
+        "shared/view.wgsl",
+        "ViewParams",
+        [near, far, f_px, orthographic, center]
+    );
 }

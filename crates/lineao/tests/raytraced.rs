@@ -443,18 +443,13 @@ fn the_denoiser_brings_few_rays_closer_to_the_truth_and_fades_out() {
 /// binary truths at the midpoints of K bins of [0, R] against the linear truth at R.
 #[test]
 fn linear_falloff_is_binary_ao_averaged_over_uniform_radii() {
-    let scene = Scene::lines(60);
-    let mut tracer = Tracer::new(&scene, settings(8), None);
-    let (nd, _) = tracer.frame(&camera());
-    let view = tracer.chain.frame_view().unwrap();
-    let cones = truth::line_cones(&scene.positions, &scene.offsets, view, tracer.chain.settings().line_width_px);
-    let bvh = Bvh::build(cones, Vec::new());
-    let frame = truth::Frame { nd: &nd, view, lines: true };
-    let cancel = std::sync::atomic::AtomicBool::new(false);
+    with_cpu_truths(check_linear_falloff);
+}
+
+fn check_linear_falloff(nd: &NdImage, trace: &dyn Fn(&truth::TruthSettings) -> truth::Truth) {
     let reach = 6.0;
     let at = |distance_world: f32, falloff: Falloff| {
-        let settings = truth::TruthSettings { rays: 32, distance_world, falloff, ..Default::default() };
-        truth::compute(&bvh, &frame, &settings, &|_, _| {}, &cancel).unwrap()
+        trace(&truth::TruthSettings { rays: 32, distance_world, falloff, ..Default::default() })
     };
     let linear = at(reach, Falloff::Linear);
     const K: usize = 48;
@@ -478,4 +473,48 @@ fn linear_falloff_is_binary_ao_averaged_over_uniform_radii() {
     // with R', so a ray grazing a line may hit at one radius and not another.
     assert!(mean_abs < 0.005, "mean |Δ| {mean_abs}");
     assert!(worst <= 1.0 / K as f32 + 0.05, "worst {worst}");
+}
+
+/// `TruthSettings::second`: one trace gives the local truth exactly as alone and the
+/// bundle-scale one as its own trace does (up to the rays' origins: ε is 1e-3 of the local
+/// reach for both, not of each).
+#[test]
+fn a_second_reach_from_the_same_rays_matches_its_own_trace() {
+    with_cpu_truths(check_second_reach);
+}
+
+fn check_second_reach(nd: &NdImage, trace: &dyn Fn(&truth::TruthSettings) -> truth::Truth) {
+    let local = truth::TruthSettings { rays: 32, distance_world: 2.0, ..Default::default() };
+    let bundle = truth::TruthSettings { distance_world: 12.0, falloff: Falloff::Linear, ..local.clone() };
+    let second = truth::Reach { distance_world: 12.0, falloff: Falloff::Linear };
+    let both = trace(&truth::TruthSettings { second: Some(second), ..local.clone() });
+    let (alone, bundle_alone) = (trace(&local), trace(&bundle));
+    let (mut same, mut sum_abs, mut geometry) = (0usize, 0.0f64, 0usize);
+    for (i, texel) in nd.data.iter().enumerate() {
+        if !common::is_geometry(*texel) {
+            continue;
+        }
+        geometry += 1;
+        same += (both.ao.data[i] == alone.ao.data[i]) as usize;
+        sum_abs += (both.second.as_ref().unwrap().data[i] - bundle_alone.ao.data[i]).abs() as f64;
+    }
+    let mean_abs = sum_abs / geometry as f64;
+    eprintln!("second reach: {geometry} pixels, {same} local values equal, bundle mean |Δ| {mean_abs:.5}");
+    assert!(same * 1000 >= geometry * 999, "{same} of {geometry}");
+    assert!(mean_abs < 0.005, "{mean_abs}");
+    assert!(bundle_alone.ao.data.iter().sum::<f32>() > alone.ao.data.iter().sum::<f32>(), "the longer reach sees more");
+}
+
+/// Renders 60 lines and hands `check` the frame's ND map and the CPU truth of that frame for
+/// any settings (one BVH).
+fn with_cpu_truths(check: impl FnOnce(&NdImage, &dyn Fn(&truth::TruthSettings) -> truth::Truth)) {
+    let scene = Scene::lines(60);
+    let mut tracer = Tracer::new(&scene, settings(8), None);
+    let (nd, _) = tracer.frame(&camera());
+    let view = tracer.chain.frame_view().unwrap();
+    let cones = truth::line_cones(&scene.positions, &scene.offsets, view, tracer.chain.settings().line_width_px);
+    let bvh = Bvh::build(cones, Vec::new());
+    let frame = truth::Frame { nd: &nd, view, lines: true };
+    let cancel = std::sync::atomic::AtomicBool::new(false);
+    check(&nd, &|s| truth::compute(&bvh, &frame, s, &|_, _| {}, &cancel).unwrap());
 }

@@ -125,14 +125,12 @@ impl Bilateral {
 }
 
 #[cfg(test)]
-mod layout {
-    #[test]
-    fn uniform_matches_its_wgsl_struct() {
-        crate::shader::assert_wgsl_layout!(
-            super::BilateralUniform,
-            "bilateral.wgsl",
-            "BilateralUniform",
-            [view, radius, spatial, depth]
-        );
-    }
+#[test]
+fn uniform_matches_its_wgsl_struct() {
+    crate::shader::assert_wgsl_layout!(
+        BilateralUniform,
+        "bilateral.wgsl",
+        "BilateralUniform",
+        [view, radius, spatial, depth]
+    );
 }

@@ -296,14 +296,12 @@ fn render_pipeline(
 }
 
 #[cfg(test)]
-mod layout {
-    #[test]
-    fn uniform_matches_its_wgsl_struct() {
-        crate::shader::assert_wgsl_layout!(
-            super::CompositeUniform,
-            "composite.wgsl",
-            "CompositeUniform",
-            [levels, guard, strength, debug_view, debug_level, zoom_max, combine, host_depth_rows, near, far]
-        );
-    }
+#[test]
+fn uniform_matches_its_wgsl_struct() {
+    crate::shader::assert_wgsl_layout!(
+        CompositeUniform,
+        "composite.wgsl",
+        "CompositeUniform",
+        [levels, guard, strength, debug_view, debug_level, zoom_max, combine, host_depth_rows, near, far]
+    );
 }

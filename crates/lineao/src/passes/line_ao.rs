@@ -377,14 +377,12 @@ impl crate::stage::Stage for LineAoStage {
 }
 
 #[cfg(test)]
-mod layout {
-    #[test]
-    fn uniform_matches_its_wgsl_struct() {
-        crate::shader::assert_wgsl_layout!(
-            super::LineAoUniform,
-            "line_ao.wgsl",
-            "LineAoUniform",
-            [levels, noise_origin, r0_px, delta0, reference_scale, epsilon, r0_zoom, delta_scale]
-        );
-    }
+#[test]
+fn uniform_matches_its_wgsl_struct() {
+    crate::shader::assert_wgsl_layout!(
+        LineAoUniform,
+        "line_ao.wgsl",
+        "LineAoUniform",
+        [levels, noise_origin, r0_px, delta0, reference_scale, epsilon, r0_zoom, delta_scale]
+    );
 }

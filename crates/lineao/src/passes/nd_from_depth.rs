@@ -319,14 +319,12 @@ impl NdFromDepth {
 }
 
 #[cfg(test)]
-mod layout {
-    #[test]
-    fn uniform_matches_its_wgsl_struct() {
-        crate::shader::assert_wgsl_layout!(
-            super::HostUniform,
-            "nd_from_depth.wgsl",
-            "HostUniform",
-            [inv_proj, view_rotation, size, near, far, f_px, zoom_unit, orthographic, far_depth]
-        );
-    }
+#[test]
+fn uniform_matches_its_wgsl_struct() {
+    crate::shader::assert_wgsl_layout!(
+        HostUniform,
+        "nd_from_depth.wgsl",
+        "HostUniform",
+        [inv_proj, view_rotation, size, near, far, f_px, zoom_unit, orthographic, far_depth]
+    );
 }

@@ -110,14 +110,12 @@ impl RayDenoise {
 }
 
 #[cfg(test)]
-mod layout {
-    #[test]
-    fn uniform_matches_its_wgsl_struct() {
-        crate::shader::assert_wgsl_layout!(
-            super::DenoiseUniform,
-            "ray_denoise.wgsl",
-            "Denoise",
-            [view, radius, spatial, normal_power, depth_tolerance, reach, width, height, rays]
-        );
-    }
+#[test]
+fn uniform_matches_its_wgsl_struct() {
+    crate::shader::assert_wgsl_layout!(
+        DenoiseUniform,
+        "ray_denoise.wgsl",
+        "Denoise",
+        [view, radius, spatial, normal_power, depth_tolerance, reach, width, height, rays]
+    );
 }

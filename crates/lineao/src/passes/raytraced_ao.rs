@@ -387,33 +387,31 @@ impl crate::stage::Stage for RayTracedAo {
 }
 
 #[cfg(test)]
-mod layout {
-    #[test]
-    fn uniform_matches_its_wgsl_struct() {
-        crate::shader::assert_wgsl_layout!(
-            super::TraceUniform,
-            "raytraced_ao.wgsl",
-            "Trace",
-            [
-                view,
-                inv_view,
-                view_z,
-                frame_rays,
-                first_ray,
-                seed,
-                distance,
-                epsilon,
-                line_half,
-                tube_radius,
-                max_radius,
-                guard,
-                node_count,
-                starts_at,
-                streamlines,
-                shifts,
-                width,
-                height
-            ]
-        );
-    }
+#[test]
+fn uniform_matches_its_wgsl_struct() {
+    crate::shader::assert_wgsl_layout!(
+        TraceUniform,
+        "raytraced_ao.wgsl",
+        "Trace",
+        [
+            view,
+            inv_view,
+            view_z,
+            frame_rays,
+            first_ray,
+            seed,
+            distance,
+            epsilon,
+            line_half,
+            tube_radius,
+            max_radius,
+            guard,
+            node_count,
+            starts_at,
+            streamlines,
+            shifts,
+            width,
+            height
+        ]
+    );
 }

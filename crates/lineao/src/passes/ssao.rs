@@ -176,14 +176,7 @@ impl crate::stage::Stage for SsaoStage {
 }
 
 #[cfg(test)]
-mod layout {
-    #[test]
-    fn uniform_matches_its_wgsl_struct() {
-        crate::shader::assert_wgsl_layout!(
-            super::SsaoUniform,
-            "ssao.wgsl",
-            "SsaoUniform",
-            [view, noise_origin, radius, range]
-        );
-    }
+#[test]
+fn uniform_matches_its_wgsl_struct() {
+    crate::shader::assert_wgsl_layout!(SsaoUniform, "ssao.wgsl", "SsaoUniform", [view, noise_origin, radius, range]);
 }

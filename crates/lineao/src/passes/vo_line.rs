@@ -225,14 +225,12 @@ impl crate::stage::Stage for VoLine {
 }
 
 #[cfg(test)]
-mod layout {
-    #[test]
-    fn uniform_matches_its_wgsl_struct() {
-        crate::shader::assert_wgsl_layout!(
-            super::VoUniform,
-            "shared/vo.wgsl",
-            "VoUniform",
-            [view, noise_origin, radius, zoom_unit, thickness, normal_clamp, combine, max_level, sigma_floor, samples]
-        );
-    }
+#[test]
+fn uniform_matches_its_wgsl_struct() {
+    crate::shader::assert_wgsl_layout!(
+        VoUniform,
+        "shared/vo.wgsl",
+        "VoUniform",
+        [view, noise_origin, radius, zoom_unit, thickness, normal_clamp, combine, max_level, sigma_floor, samples]
+    );
 }

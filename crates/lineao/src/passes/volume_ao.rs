@@ -130,14 +130,12 @@ impl VolumeAo {
 }
 
 #[cfg(test)]
-mod layout {
-    #[test]
-    fn uniform_matches_its_wgsl_struct() {
-        crate::shader::assert_wgsl_layout!(
-            super::VolumeAoUniform,
-            "volume_ao.wgsl",
-            "VolumeAoUniform",
-            [view_to_world, weights, table_size]
-        );
-    }
+#[test]
+fn uniform_matches_its_wgsl_struct() {
+    crate::shader::assert_wgsl_layout!(
+        VolumeAoUniform,
+        "volume_ao.wgsl",
+        "VolumeAoUniform",
+        [view_to_world, weights, table_size]
+    );
 }

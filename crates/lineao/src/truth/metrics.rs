@@ -46,6 +46,45 @@ pub struct Scores {
     pub scaled: Errors,
 }
 
+/// The cheap part of [`score`]: means, bias, mean |Δ|, RMSE and correlation, without SSIM's
+/// windows (what `lineao score` reports against its second truth).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Agreement {
+    pub pixels: usize,
+    pub mean_method: f64,
+    pub mean_truth: f64,
+    pub bias: f64,
+    pub mean_abs: f64,
+    pub rmse: f64,
+    pub correlation: f64,
+}
+
+/// [`Agreement`] of `method` with `truth` over the pixels where `mask` holds.
+pub fn agreement(method: &[f32], truth: &[f32], mask: &[bool]) -> Agreement {
+    let pairs = || method.iter().zip(truth).zip(mask).filter(|(_, m)| **m).map(|((&a, &t), _)| (a as f64, t as f64));
+    let (mut n, mut sa, mut st, mut abs, mut sq) = (0usize, 0.0, 0.0, 0.0, 0.0);
+    for (a, t) in pairs() {
+        n += 1;
+        sa += a;
+        st += t;
+        abs += (a - t).abs();
+        sq += (a - t) * (a - t);
+    }
+    if n == 0 {
+        return Agreement::default();
+    }
+    let count = n as f64;
+    Agreement {
+        pixels: n,
+        mean_method: sa / count,
+        mean_truth: st / count,
+        bias: (sa - st) / count,
+        mean_abs: abs / count,
+        rmse: (sq / count).sqrt(),
+        correlation: correlation(method, truth, mask),
+    }
+}
+
 /// Pearson's correlation of `a` and `b` over the pixels where `mask` holds (0 when either is
 /// constant there): [`score`]'s `correlation` alone, without the SSIM windows.
 pub fn correlation(a: &[f32], b: &[f32], mask: &[bool]) -> f64 {
@@ -129,35 +168,41 @@ pub fn ssim_map(a: &Image<f32>, b: &Image<f32>) -> Image<f32> {
             }
         }
     };
-    let blur = |f: &dyn Fn(usize) -> f64| -> Vec<f64> {
+    // The window's taps along one axis of length n, as (index, weight) lists per position: the
+    // interior's are contiguous, the border's reflected. Made once per axis.
+    let taps = |n: usize| -> Vec<[(usize, f64); 2 * SSIM_RADIUS + 1]> {
+        (0..n)
+            .map(|x| std::array::from_fn(|k| (reflect(x as i64 + k as i64 - SSIM_RADIUS as i64, n), weights[k])))
+            .collect()
+    };
+    let (along_x, along_y) = (taps(w), taps(h));
+    // Separable: along x into `rows`, then along y.
+    let blur = |f: &[f64]| -> Vec<f64> {
         let mut rows = vec![0.0; w * h];
         for y in 0..h {
-            for x in 0..w {
-                let mut s = 0.0;
-                for (k, wk) in weights.iter().enumerate() {
-                    s += wk * f(y * w + reflect(x as i64 + k as i64 - SSIM_RADIUS as i64, w));
-                }
-                rows[y * w + x] = s;
+            let line = &f[y * w..(y + 1) * w];
+            for (x, taps) in along_x.iter().enumerate() {
+                rows[y * w + x] = taps.iter().map(|&(i, wk)| wk * line[i]).sum();
             }
         }
         let mut out = vec![0.0; w * h];
-        for y in 0..h {
-            for x in 0..w {
-                let mut s = 0.0;
-                for (k, wk) in weights.iter().enumerate() {
-                    s += wk * rows[reflect(y as i64 + k as i64 - SSIM_RADIUS as i64, h) * w + x];
+        for (y, taps) in along_y.iter().enumerate() {
+            let row = &mut out[y * w..(y + 1) * w];
+            for &(j, wk) in taps {
+                for (o, r) in row.iter_mut().zip(&rows[j * w..(j + 1) * w]) {
+                    *o += wk * r;
                 }
-                out[y * w + x] = s;
             }
         }
         out
     };
-    let (av, bv) = (&a.data, &b.data);
-    let ua = blur(&|i| av[i] as f64);
-    let ub = blur(&|i| bv[i] as f64);
-    let uaa = blur(&|i| (av[i] as f64).powi(2));
-    let ubb = blur(&|i| (bv[i] as f64).powi(2));
-    let uab = blur(&|i| av[i] as f64 * bv[i] as f64);
+    let av: Vec<f64> = a.data.iter().map(|&v| v as f64).collect();
+    let bv: Vec<f64> = b.data.iter().map(|&v| v as f64).collect();
+    let product = |f: fn(f64, f64) -> f64| -> Vec<f64> { av.iter().zip(&bv).map(|(&a, &b)| f(a, b)).collect() };
+    let (ua, ub) = (blur(&av), blur(&bv));
+    let uaa = blur(&product(|a, _| a * a));
+    let ubb = blur(&product(|_, b| b * b));
+    let uab = blur(&product(|a, b| a * b));
     let data = (0..w * h)
         .map(|i| {
             let (va, vb, vab) = (uaa[i] - ua[i] * ua[i], ubb[i] - ub[i] * ub[i], uab[i] - ua[i] * ub[i]);

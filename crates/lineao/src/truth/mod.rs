@@ -118,6 +118,10 @@ pub struct TruthSettings {
     pub seed: u32,
     /// Also the VO truth over this ball (N points per pixel).
     pub vo: Option<VoBall>,
+    /// Also a second estimate from the same rays, to another reach with its own falloff
+    /// ([`Truth::second`]): each ray is traced to the larger reach once, and both values come
+    /// from its first hit. What `lineao score` traces its local and bundle-scale truths with.
+    pub second: Option<Reach>,
     /// Worker threads; 0 = one per core.
     pub threads: usize,
 }
@@ -127,7 +131,35 @@ impl Default for TruthSettings {
     /// default and that of LineAO's widest hemisphere on the built-in scenes (r0 + 2 z(P) px),
     /// so the truth measures what the methods claim to see.
     fn default() -> Self {
-        TruthSettings { rays: 256, distance_world: 2.0, falloff: Falloff::None, seed: 1, vo: None, threads: 0 }
+        TruthSettings {
+            rays: 256,
+            distance_world: 2.0,
+            falloff: Falloff::None,
+            seed: 1,
+            vo: None,
+            second: None,
+            threads: 0,
+        }
+    }
+}
+
+/// How far a ray looks and how its hit counts.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Reach {
+    /// R in world units (> 0, finite).
+    pub distance_world: f32,
+    pub falloff: Falloff,
+}
+
+impl Reach {
+    /// A ray's value for a first hit at `t` (none: no hit within any reach traced).
+    fn value(self, t: Option<f64>) -> f64 {
+        let distance = self.distance_world as f64;
+        match (t, self.falloff) {
+            (Some(t), Falloff::None) if t <= distance => 1.0,
+            (Some(t), Falloff::Linear) if t <= distance => 1.0 - t / distance,
+            _ => 0.0,
+        }
     }
 }
 
@@ -135,6 +167,14 @@ impl TruthSettings {
     pub fn validate(&self) -> Result<(), Error> {
         if self.rays == 0 {
             return Err(Error::InvalidSettings("rays must be at least 1".into()));
+        }
+        if let Some(second) = self.second
+            && !(second.distance_world.is_finite() && second.distance_world > 0.0)
+        {
+            return Err(Error::InvalidSettings(format!(
+                "the second AO distance must be positive and finite, got {}",
+                second.distance_world
+            )));
         }
         if !(self.distance_world.is_finite() && self.distance_world > 0.0) {
             return Err(Error::InvalidSettings(format!(
@@ -216,6 +256,8 @@ pub struct Truth {
     pub stderr: Image<f32>,
     /// The VO truth when asked for.
     pub vo: Option<Image<f32>>,
+    /// The second estimate ([`TruthSettings::second`]) when asked for; 1 on buried pixels too.
+    pub second: Option<Image<f32>>,
     /// Geometry pixels, and those whose origin was buried in another primitive.
     pub geometry_pixels: usize,
     pub buried: usize,
@@ -305,6 +347,7 @@ pub fn compute(
         ao: Image::filled(width, height, 0.0),
         stderr: Image::filled(width, height, 0.0),
         vo: settings.vo.map(|_| Image::filled(width, height, 0.0)),
+        second: settings.second.map(|_| Image::filled(width, height, 0.0)),
         geometry_pixels: 0,
         buried: 0,
         rays: 0,
@@ -315,7 +358,10 @@ pub fn compute(
         truth.ao.data[span.clone()].copy_from_slice(&row.ao);
         truth.stderr.data[span.clone()].copy_from_slice(&row.stderr);
         if let Some(vo) = &mut truth.vo {
-            vo.data[span].copy_from_slice(&row.vo);
+            vo.data[span.clone()].copy_from_slice(&row.vo);
+        }
+        if let Some(second) = &mut truth.second {
+            second.data[span].copy_from_slice(&row.second);
         }
         truth.geometry_pixels += row.geometry;
         truth.buried += row.buried;
@@ -329,6 +375,7 @@ struct Row {
     ao: Vec<f32>,
     stderr: Vec<f32>,
     vo: Vec<f32>,
+    second: Vec<f32>,
     geometry: usize,
     buried: usize,
     rays: u64,
@@ -363,6 +410,7 @@ impl<'a> Tracer<'a> {
             ao: vec![0.0; width],
             stderr: vec![0.0; width],
             vo: if vo { vec![0.0; width] } else { Vec::new() },
+            second: if self.settings.second.is_some() { vec![0.0; width] } else { Vec::new() },
             geometry: 0,
             buried: 0,
             rays: 0,
@@ -383,10 +431,22 @@ impl<'a> Tracer<'a> {
             let start = origin.surface + self.epsilon * origin.normal;
             if self.bvh.inside_cone(start, |p| origin.skips(self.bvh, p)) {
                 row.ao[x] = 1.0;
+                if let Some(second) = row.second.get_mut(x) {
+                    *second = 1.0;
+                }
                 row.buried += 1;
                 continue;
             }
             let skip = |p| origin.skips(self.bvh, p);
+            if let Some(reach) = self.settings.second {
+                let (mean, stderr, second) =
+                    two_reaches_at(self.bvh, start, origin.normal, self.settings, reach, seed, skip);
+                row.ao[x] = mean as f32;
+                row.stderr[x] = stderr as f32;
+                row.second[x] = second as f32;
+                row.rays += self.settings.rays as u64;
+                continue;
+            }
             let (mean, stderr) = ao_at(self.bvh, start, origin.normal, self.settings, seed, skip);
             row.ao[x] = mean as f32;
             row.stderr[x] = stderr as f32;
@@ -454,6 +514,34 @@ pub fn ao_at(
     let mean = sum / count;
     let variance = if count > 1.0 { ((sum2 - count * mean * mean) / (count - 1.0)).max(0.0) } else { 0.0 };
     (mean, (variance / count).sqrt())
+}
+
+/// [`ao_at`] and, from the same rays, the mean of the second estimate `second`: each ray traced
+/// once to the larger reach, both values from its first hit.
+fn two_reaches_at(
+    bvh: &Bvh,
+    start: DVec3,
+    n: DVec3,
+    settings: &TruthSettings,
+    second: Reach,
+    seed: u32,
+    skip: impl Fn(Prim) -> bool + Copy,
+) -> (f64, f64, f64) {
+    let first = Reach { distance_world: settings.distance_world, falloff: settings.falloff };
+    let reach = first.distance_world.max(second.distance_world) as f64;
+    let (mut sum, mut sum2, mut sum_second) = (0.0, 0.0, 0.0);
+    for i in 0..settings.rays {
+        let d = sequence::cosine_direction(sequence::sample_2d(i, seed), n);
+        let t = bvh.nearest_hit(start, d, reach, skip).map(|(t, _)| t);
+        let value = first.value(t);
+        sum += value;
+        sum2 += value * value;
+        sum_second += second.value(t);
+    }
+    let count = settings.rays as f64;
+    let mean = sum / count;
+    let variance = if count > 1.0 { ((sum2 - count * mean * mean) / (count - 1.0)).max(0.0) } else { 0.0 };
+    (mean, (variance / count).sqrt(), sum_second / count)
 }
 
 /// The occupied share of the ball (or half ball above the tangent plane of `n`) of radius R
