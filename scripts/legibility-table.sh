@@ -52,17 +52,19 @@ for name in files:
     for i, (what, x, corr) in enumerate(rows):
         print("| %s | %s | %s | %s | %s | %s |" % ((name if i == 0 else ""), what, *l(x), corr))
 print()
-print("| data | LineAO default L 1 / 4 / 15 % | paper | default − paper (≥ −0.02?) | default darkening, near-black |")
-print("|---|---|---|---|---|")
+print("| data | LineAO default L 1 / 4 / 15 % | paper | default − paper (≥ −0.02?) | default darkening, near-black | buried (truth) |")
+print("|---|---|---|---|---|---:|")
 for name in files:
-    d = json.load(open(os.path.join(out, f"{name}.legible.json")))["methods"][0]["legibility"]
+    report = json.load(open(os.path.join(out, f"{name}.legible.json")))
+    d = report["methods"][0]["legibility"]
     p = json.load(open(os.path.join(out, f"{name}.paper.json")))["methods"][0]["legibility"]
     if "absent" in d or "absent" in p:
-        print("| %s | absent | | | |" % name)
+        print("| %s | absent | | | | |" % name)
         continue
     keys = ("l_local", "l_bundle", "l_global")
     diff = [d[k] - p[k] for k in keys]
     ok = "yes" if min(diff) >= -0.02 else "no"
-    print("| %s | %s | %s | %s (%s) | %.2f, %.1f %% |" % (name, l(d)[0], l(p)[0],
-          " / ".join("%+.2f" % x for x in diff), ok, d["mean_darkening"], 100 * d["near_black"]))
+    print("| %s | %s | %s | %s (%s) | %.2f, %.1f %% | %.1f %% |" % (name, l(d)[0], l(p)[0],
+          " / ".join("%+.2f" % x for x in diff), ok, d["mean_darkening"], 100 * d["near_black"],
+          100 * report["buried_share"]))
 PY

@@ -749,3 +749,22 @@ pub const CPU_PASSES: [&str; 6] =
 pub fn is_pass(name: &str) -> bool {
     GPU_PASSES.contains(&name) || CPU_PASSES.contains(&name)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_ao_distance_is_world_units_or_a_share_of_the_longest_side() {
+        assert_eq!(parse_ao_distance("2"), Ok(AoDistance::World(2.0)));
+        assert_eq!(parse_ao_distance("20%"), Ok(AoDistance::Share(0.2)));
+        assert_eq!(parse_ao_distance(" 100 % "), Ok(AoDistance::Share(1.0)));
+        // 20 % of a 150 mm brain is 30 mm; a world distance ignores the scene.
+        assert!((AoDistance::Share(0.2).world(150.0) - 30.0).abs() < 1e-5);
+        assert_eq!(AoDistance::World(2.0).world(150.0), 2.0);
+        assert_eq!(AoDistance::Share(0.2).to_string(), "20%");
+        for bad in ["0%", "100.5%", "-1%", "x%", "0", "-2", "inf", ""] {
+            assert!(parse_ao_distance(bad).is_err(), "{bad}");
+        }
+    }
+}

@@ -570,3 +570,14 @@ pub(crate) fn validate_camera(camera: &Camera) -> Result<()> {
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn the_longest_side_is_the_boxs_over_finite_points() {
+        let points = [[0.0, 0.0, 0.0], [10.0, -5.0, 2.0], [f32::NAN, 1e9, 0.0], [3.0, 25.0, 1.0]];
+        // x spans 10, y 30 (the NaN point left out), z 2.
+        assert_eq!(super::longest_side(points.iter()), 30.0);
+        assert_eq!(super::longest_side([].iter()), 0.0);
+    }
+}
