@@ -129,7 +129,14 @@ impl Params {
         let mut params =
             Params { chain, tube_radius: 0.5 * zoom_unit, volume, cloudy: false, volume_combine: VoCombine::Product };
         if let Some(library) = preset.library() {
+            // Each method's own reach (the panels share one chain's settings): SSAO's and VO's
+            // from their presets (VO area shares VO line's sphere), LineAO's and the strength
+            // from LineAO's; `panel` scales the strength per method.
+            let of = |method| ChainSettings { method, ..params.chain.clone() }.with_preset(library);
+            let (ssao, vo) = (of(AoMethod::Ssao).ssao, of(AoMethod::VoLine).vo);
             params.chain = params.chain.with_preset(library);
+            params.chain.ssao = ssao;
+            params.chain.vo = vo;
         }
         if preset == Preset::Sparse {
             let c = &mut params.chain;
@@ -558,6 +565,37 @@ mod tests {
                         }
                     }
                 }
+            }
+        }
+    }
+
+    /// The viewer's library presets give each method what `render` gives it: LineAO's and
+    /// SSAO's reach and strength of the preset (SSAO's 8 mm under `legible`).
+    #[test]
+    fn library_presets_give_each_method_its_own_values() {
+        for (preset, library) in
+            [(Preset::Legible, lineao::Preset::Legible), (Preset::Physical, lineao::Preset::Physical)]
+        {
+            let controls = Controls::new([METHODS[1], METHODS[4]], true, preset);
+            let panels = controls.panels(Vec3::Z, None, false);
+            for panel in &panels {
+                let method = panel.settings.method;
+                let expected = ChainSettings { method, ..ChainSettings::default() }.with_preset(library);
+                let s = &panel.settings;
+                assert!(
+                    (s.strength - expected.strength).abs() < 1e-6,
+                    "{preset:?} {method:?}: strength {}",
+                    s.strength
+                );
+                match method {
+                    AoMethod::LineAo => assert_eq!(
+                        (s.line_ao.s_r, s.line_ao.r0_px, s.line_ao.delta_scale),
+                        (expected.line_ao.s_r, expected.line_ao.r0_px, expected.line_ao.delta_scale)
+                    ),
+                    AoMethod::Ssao => assert_eq!(s.ssao.radius_world, expected.ssao.radius_world, "{preset:?}"),
+                    other => panic!("unexpected {other:?}"),
+                }
+                s.validate().unwrap();
             }
         }
     }
