@@ -96,6 +96,7 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky, lon
             s_r: LineAoSettings::default().s_r,
             s_h: args.s_h,
             r0_px: args.r0,
+            r0_per_width: LineAoSettings::default().r0_per_width,
             delta0: args.delta0,
             delta_scale: LineAoSettings::default().delta_scale,
             epsilon: args.epsilon,
@@ -573,6 +574,31 @@ pub(crate) fn validate_camera(camera: &Camera) -> Result<()> {
 
 #[cfg(test)]
 mod tests {
+    /// CONTRACT.md: the library's default settings are the front ends' default — what
+    /// `lineao render` with no option gives each method is `ChainSettings::default()`'s preset.
+    #[test]
+    fn the_librarys_default_is_the_command_lines() {
+        use clap::Parser;
+        let cli = crate::cli::Cli::parse_from(["lineao", "render"]);
+        let crate::cli::Command::Render(args) = cli.command else { panic!("render") };
+        for screen in [lineao::AoMethod::LineAo, lineao::AoMethod::Ssao, lineao::AoMethod::VoLine] {
+            let method = crate::cli::Method { screen, volume: None };
+            let cli = super::settings(&args, method, 1.0, lineao::volume::Sky::Uniform, 100.0);
+            let library = lineao::ChainSettings { method: screen, ..lineao::ChainSettings::default() }
+                .with_preset(lineao::Preset::default());
+            assert_eq!(cli.line_ao, library.line_ao, "{screen:?}");
+            assert_eq!(
+                (cli.strength, &cli.ssao, &cli.vo),
+                (library.strength, &library.ssao, &library.vo),
+                "{screen:?}"
+            );
+        }
+        // And the library's default itself is LineAO at the default preset.
+        let default = lineao::ChainSettings::default();
+        assert_eq!(default, lineao::ChainSettings::papers().with_preset(lineao::Preset::Legible));
+        assert_eq!((default.line_ao.s_r, default.r0_px(), default.strength), (2, 9.0, 0.6));
+    }
+
     #[test]
     fn the_longest_side_is_the_boxs_over_finite_points() {
         let points = [[0.0, 0.0, 0.0], [10.0, -5.0, 2.0], [f32::NAN, 1e9, 0.0], [3.0, 25.0, 1.0]];

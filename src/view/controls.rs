@@ -434,7 +434,7 @@ fn line_ao_ui(ui: &mut Ui, chain: &mut ChainSettings) {
     });
     ui.add(egui::Slider::new(&mut ao.s_r, 1..=lineao::MAX_LEVELS).text("s_r hemispheres"));
     ui.add(egui::Slider::new(&mut ao.s_h, 4..=128).logarithmic(true).text("s_h samples"));
-    let mut r0 = ao.r0_px.unwrap_or(1.5 * chain.line_width_px);
+    let mut r0 = ao.r0_px.unwrap_or(ao.r0_per_width * chain.line_width_px);
     if ui.add(egui::Slider::new(&mut r0, 0.5..=16.0).text("r0 (px)")).changed() {
         ao.r0_px = Some(r0);
     }
@@ -589,8 +589,8 @@ mod tests {
                 );
                 match method {
                     AoMethod::LineAo => assert_eq!(
-                        (s.line_ao.s_r, s.line_ao.r0_px, s.line_ao.delta_scale),
-                        (expected.line_ao.s_r, expected.line_ao.r0_px, expected.line_ao.delta_scale)
+                        (s.line_ao.s_r, s.r0_px(), s.line_ao.delta_scale),
+                        (expected.line_ao.s_r, expected.r0_px(), expected.line_ao.delta_scale)
                     ),
                     AoMethod::Ssao => assert_eq!(s.ssao.radius_world, expected.ssao.radius_world, "{preset:?}"),
                     other => panic!("unexpected {other:?}"),

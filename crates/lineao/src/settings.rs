@@ -1,4 +1,6 @@
-//! User-facing settings of the LineAO pass chain, with the paper's values as defaults.
+//! User-facing settings of the LineAO pass chain. Each method's settings default to its paper's
+//! values; [`ChainSettings::default()`] is the default preset ([`Preset::Legible`]), which changes
+//! LineAO's reach and every method's strength, as every front end does.
 
 use crate::lighting::Lighting;
 
@@ -131,8 +133,11 @@ pub struct LineAoSettings {
     pub s_r: u32,
     /// s_h: samples on the first hemisphere, 1..=256; hemisphere j takes ⌈s_h/(j+1)⌉. Default 32.
     pub s_h: u32,
-    /// r0 in pixels for lines; `None` = 1.5 × the line width (paper §3.2.3).
+    /// r0 in pixels for lines; `None` = `r0_per_width` × the line width.
     pub r0_px: Option<f32>,
+    /// r0 for lines as a multiple of the line width where `r0_px` is `None`, ≥ 0: 1.5 in the
+    /// paper (§3.2.3), 4.5 in the default preset (`legible`).
+    pub r0_per_width: f32,
     /// δ0, the depth difference below which an occluder counts fully. Default 1e-4.
     pub delta0: f32,
     /// Scale of the falloff δ(j) = delta_scale · (1 − j/s_r)² (Eq. 11), in (0, 1]: the depth
@@ -181,6 +186,7 @@ impl Default for LineAoSettings {
             s_r: 3,
             s_h: 32,
             r0_px: None,
+            r0_per_width: 1.5,
             delta0: 1e-4,
             delta_scale: 1.0,
             epsilon: 1e-6,
@@ -202,6 +208,9 @@ impl LineAoSettings {
         }
         if !(1..=256).contains(&self.s_h) {
             return bad(format!("s_h must be in 1..=256, got {}", self.s_h));
+        }
+        if !(self.r0_per_width.is_finite() && self.r0_per_width >= 0.0) {
+            return bad(format!("r0 per line width must be finite and >= 0, got {}", self.r0_per_width));
         }
         if !(self.delta_scale.is_finite() && self.delta_scale > 0.0 && self.delta_scale <= 1.0) {
             return bad(format!("the δ scale must be in (0, 1], got {}", self.delta_scale));
@@ -746,7 +755,18 @@ pub struct ChainSettings {
 }
 
 impl Default for ChainSettings {
+    /// The default preset's settings ([`Preset::Legible`], what every front end starts from):
+    /// the papers' values ([`ChainSettings::papers`]) with the preset's for LineAO.
     fn default() -> Self {
+        ChainSettings::papers().with_preset(Preset::default())
+    }
+}
+
+impl ChainSettings {
+    /// The papers' values for every setting (LineAO s_r 3, r0 1.5 × the line width, δ scale 1,
+    /// strength 1; VO and SSAO spheres of 2 world units): `ChainSettings::default()` before the
+    /// default preset is applied, and what [`Preset::Paper`] restores.
+    pub fn papers() -> Self {
         ChainSettings {
             method: AoMethod::LineAo,
             line_ao: LineAoSettings::default(),
@@ -772,7 +792,7 @@ impl Default for ChainSettings {
 /// A named set of parameters.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Preset {
-    /// The papers' values (what `ChainSettings::default()` holds).
+    /// The papers' values ([`ChainSettings::papers`]).
     Paper,
     /// Each method's strength and reach fitted for *legibility* — visibly darker pixels lie
     /// deeper ([`crate::truth::legibility`]) — with the picture kept readable (near-black ≤ 2 %,
@@ -826,7 +846,7 @@ struct Calibrated {
 impl ChainSettings {
     /// `self` with `preset`'s values for its method (and LineAO variant): the strength, LineAO's
     /// s_r, δ scale and r0 (lines; tubes keep Eq. 16's r0), VO's and SSAO's radius in zoom units.
-    /// [`Preset::Paper`] restores the defaults of those.
+    /// [`Preset::Paper`] restores the papers' values of those ([`ChainSettings::papers`]).
     pub fn with_preset(mut self, preset: Preset) -> ChainSettings {
         let paper = Calibrated {
             strength: 1.0,
@@ -872,7 +892,9 @@ impl ChainSettings {
         self.strength = c.strength;
         self.line_ao.s_r = c.s_r;
         self.line_ao.delta_scale = c.delta_scale;
-        self.line_ao.r0_px = if self.tubes.is_none() { Some(c.r0_per_width * self.line_width_px) } else { None };
+        // r0 follows the line width (tubes keep Eq. 16's r0, which ignores it).
+        self.line_ao.r0_px = None;
+        self.line_ao.r0_per_width = c.r0_per_width;
         self.line_ao.reference_radius_px = c.reference_radius_px;
         self.vo.radius_world = c.radius * self.zoom_unit;
         self.ssao.radius_world = c.radius * self.zoom_unit;
@@ -906,9 +928,10 @@ impl ChainSettings {
         settings
     }
 
-    /// r0's constant part in pixels: the explicit value, or 1.5 × the line width (tubes: 0).
+    /// r0's constant part in pixels: the explicit value, or `r0_per_width` × the line width
+    /// (tubes: 0).
     pub fn r0_px(&self) -> f32 {
-        let default = if self.tubes.is_some() { 0.0 } else { 1.5 * self.line_width_px };
+        let default = if self.tubes.is_some() { 0.0 } else { self.line_ao.r0_per_width * self.line_width_px };
         self.line_ao.r0_px.unwrap_or(default)
     }
 
