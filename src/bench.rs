@@ -285,17 +285,14 @@ fn summary(name: &str, on: &str, mut ms: Vec<f64>) -> serde_json::Value {
 pub fn run(args: &BenchArgs) -> Result<()> {
     let source = crate::source::Source::Scene { kind: args.scene, vertices: args.vertices, seed: args.seed };
     let scene = source.load(None)?;
-    let settings = ChainSettings {
+    // LineAO as the preset sets it; SSAO, VO and the rest keep the papers' values (their
+    // presets' reach and strength do not change what a pass costs; their sample counts do).
+    let papers = ChainSettings {
         line_ao: LineAoSettings { light_attenuation: !args.no_light_attenuation, ..LineAoSettings::default() },
         zoom_unit: scene.hint.zoom_unit,
-        ..ChainSettings::default()
+        ..ChainSettings::papers()
     };
-    // LineAO as the preset sets it; SSAO, VO and the rest keep the papers' values (the preset's
-    // reach and strength for them do not change what a pass costs, but its sample counts do).
-    let settings = {
-        let preset = settings.clone().with_preset(args.preset);
-        ChainSettings { line_ao: preset.line_ao, ..settings }
-    };
+    let settings = ChainSettings { line_ao: papers.clone().with_preset(args.preset).line_ao, ..papers };
     let mut camera = crate::render::camera_from_hint(&scene.hint);
     if let Some(fov_y_deg) = args.fov {
         camera.projection = Projection::Perspective { fov_y_deg };

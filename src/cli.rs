@@ -155,11 +155,9 @@ fn parse_ao_distance(s: &str) -> Result<AoDistance, String> {
             Ok(p) => Err(format!("a share of the scene's longest side must be in (0 %, 100 %], got {p} %")),
             Err(e) => Err(format!("'{s}': {e} (a distance in world units, or a share such as 20%)")),
         },
-        None => match s.trim().parse::<f32>() {
-            Ok(v) if v.is_finite() && v > 0.0 => Ok(AoDistance::World(v)),
-            Ok(v) => Err(format!("must be positive and finite, got {v}")),
-            Err(e) => Err(format!("'{s}': {e} (a distance in world units, or a share such as 20%)")),
-        },
+        None => parse_positive(s)
+            .map(AoDistance::World)
+            .map_err(|e| format!("{e} (a distance in world units, or a share such as 20%)")),
     }
 }
 

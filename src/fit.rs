@@ -25,7 +25,7 @@ use std::path::{Path, PathBuf};
 use anyhow::Result;
 use glam::Quat;
 use lineao::reference::Image;
-use lineao::truth::legibility::{self, Pairs};
+use lineao::truth::legibility::{self, Pairs, Shading};
 use lineao::truth::{Falloff, TruthSettings};
 use lineao::{AoMethod, ChainSettings, LineAoOuter, LineAoVariant};
 
@@ -171,22 +171,17 @@ fn real_files(dir: &Path) -> Vec<PathBuf> {
     found
 }
 
-/// What a view's pictures are measured with: the pairs, the lit luminance and the unlit part.
+/// What a view's pictures are measured with: the pairs, what AO darkens, the bundle-scale truth.
 struct Frame {
     pairs: Pairs,
     mask: Vec<bool>,
-    /// Luminance of the colour (what AO darkens) and of colour plus specular (Y_none).
-    luminance: Vec<f32>,
-    lit: Vec<f32>,
+    shading: Shading,
     bundle: Image<f32>,
 }
 
 impl Frame {
     fn measure(&self, ao: &[f32], strength: f32) -> Measure {
-        let y: Vec<f32> =
-            (0..ao.len()).map(|i| self.lit[i] - self.luminance[i] * (strength * ao[i]).clamp(0.0, 1.0)).collect();
-        let d = legibility::darkening(&y, &self.lit);
-        let l = self.pairs.measure(&d, &self.mask);
+        let l = self.pairs.measure(&self.shading.darkening(ao, strength), &self.mask);
         let shown: Vec<f32> = ao.iter().map(|a| (strength * a).clamp(0.0, 1.0)).collect();
         let correlation = lineao::truth::metrics::correlation(&shown, &self.bundle.data, &self.mask);
         Measure {
@@ -251,22 +246,16 @@ pub fn run(args: &ScoreArgs) -> Result<()> {
 
 /// The view's G-buffer, pairs and bundle-scale truth; none when it has too little geometry.
 fn frame(session: &Session, source: &RenderArgs, bundle: &TruthSettings) -> Result<Option<(Frame, Measure)>> {
-    let gpu = &session.gpu;
     let plain = session.settings(source, Method { screen: AoMethod::None, volume: None });
     let mut chain = None;
     let gbuffer = raw_ao(session, &mut chain, plain, source.width, source.height)?;
     let chain = chain.expect("rendered");
     let truth = session.trace(&chain, bundle)?;
-    let targets = chain.targets().expect("rendered");
-    let nd = lineao::verify::read_rgba(&gpu.device, &gpu.queue, &targets.nd[0])?;
-    let color = lineao::readback::read_texture(&gpu.device, &gpu.queue, &targets.color.texture)?.to_vec4();
-    let specular = lineao::verify::read_f32(&gpu.device, &gpu.queue, &targets.specular)?;
-    let luminance: Vec<f32> = color.iter().map(|c| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]).collect();
-    let lit: Vec<f32> = luminance.iter().zip(&specular.data).map(|(l, s)| l + s).collect();
+    let (nd, shading) = crate::score::read_frame(session, &chain)?;
     let depth = Image { data: nd.data.iter().map(|t| t[3]).collect(), width: nd.width, height: nd.height };
     let Ok(pairs) = Pairs::sample_n(&depth, &gbuffer.geometry, FIT_PAIRS, legibility::SEED) else { return Ok(None) };
-    let frame = Frame { pairs, mask: gbuffer.geometry, luminance, lit, bundle: truth.ao };
-    let own = frame.measure(&frame.bundle.data.clone(), 1.0);
+    let frame = Frame { pairs, mask: gbuffer.geometry, shading, bundle: truth.ao };
+    let own = frame.measure(&frame.bundle.data, 1.0);
     Ok(Some((frame, own)))
 }
 

@@ -522,11 +522,7 @@ impl Session {
 
 /// The longest side of the axis-aligned box around the finite `points` (0 without any).
 fn longest_side<'a>(points: impl Iterator<Item = &'a [f32; 3]>) -> f32 {
-    let (lo, hi) = points
-        .map(|p| Vec3::from_array(*p))
-        .filter(|p| p.is_finite())
-        .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(p), hi.max(p)));
-    if lo.is_finite() { (hi - lo).max_element() } else { 0.0 }
+    lineao::camera::axis_aligned_box(points).map_or(0.0, |(lo, hi)| (hi - lo).max_element())
 }
 
 /// The camera of the command line (--eye, --target, --up, --fov, --ortho), the rest from `hint`.

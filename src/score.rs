@@ -10,7 +10,8 @@
 
 use anyhow::{Context, Result};
 use lineao::reference::Image;
-use lineao::truth::legibility::{self, Absent, Legibility};
+use lineao::reference::NdImage;
+use lineao::truth::legibility::{self, Absent, Legibility, Shading};
 use lineao::truth::metrics::{self, Scores};
 use lineao::truth::{Falloff, Reach, Truth, TruthSettings, VoBall};
 use lineao::{AoMethod, ChainSettings};
@@ -45,9 +46,9 @@ pub const BUNDLE_DISTANCE: AoDistance = AoDistance::Share(0.2);
 ///
 /// It comes from the local truth's rays, each traced once to the larger reach
 /// ([`TruthSettings::second`]): its ray origins are the local truth's (ε = 1e-3 of the local
-/// reach), its buried pixels the same.
+/// reach), its buried pixels the same ([`Report::truth`]'s).
 pub struct Bundle {
-    pub truth: Truth,
+    pub ao: Image<f32>,
     pub settings: TruthSettings,
     pub distance: AoDistance,
 }
@@ -153,7 +154,6 @@ pub fn score(
     methods: &[ScoreMethod],
     bundle_distance: AoDistance,
 ) -> Result<Report> {
-    let gpu = &session.gpu;
     let (w, h) = (args.width as usize, args.height as usize);
     let vo_ball = if args.no_normal_clamp { VoBall::Whole } else { VoBall::Half };
     let wants_vo = methods.iter().any(|m| matches!(m.method, AoMethod::VoLine | AoMethod::VoArea));
@@ -174,19 +174,10 @@ pub fn score(
     let panel = Panel::new(Method { screen: AoMethod::None, volume: None }, method_settings(session, args, plain));
     let rendered = session.render(&quiet, &panel, None, None, None)?;
     let start = std::time::Instant::now();
-    let truth = session.trace(&rendered.chain, &truth_settings)?;
+    let mut truth = session.trace(&rendered.chain, &truth_settings)?;
     let truth_seconds = start.elapsed().as_secs_f64();
-    let bundle_truth = Truth {
-        ao: truth.second.clone().context("the bundle-scale truth")?,
-        stderr: Image::filled(w, h, 0.0),
-        vo: None,
-        second: None,
-        ..truth.clone()
-    };
-    let truth_targets = rendered.chain.targets().context("nothing was rendered")?;
-    let nd = lineao::verify::read_rgba(&gpu.device, &gpu.queue, &truth_targets.nd[0])?;
-    let color = lineao::readback::read_texture(&gpu.device, &gpu.queue, &truth_targets.color.texture)?.to_vec4();
-    let specular = lineao::verify::read_f32(&gpu.device, &gpu.queue, &truth_targets.specular)?;
+    let bundle_ao = truth.second.take().context("the bundle-scale truth")?;
+    let (nd, shading) = read_frame(session, &rendered.chain)?;
     let geometry = |image: &lineao::reference::NdImage, x: usize, y: usize| {
         let t = image.get(x, y);
         t[0] != 0.0 || t[1] != 0.0 || t[2] != 0.0
@@ -195,20 +186,8 @@ pub fn score(
     let ao_truth = truth.ao.clone();
     let vo_truth = truth.vo.clone();
     let strength_of = |m: ScoreMethod| method_settings(session, args, m).strength;
-    let luminance: Vec<f32> = color.iter().map(|c| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]).collect();
     let composite = |ao: &Image<f32>| -> Image<f32> {
-        Image::from_fn(w, h, |x, y| {
-            let a = ao.get(x, y).clamp(0.0, 1.0);
-            srgb(luminance[y * w + x] * (1.0 - a) + specular.get(x, y))
-        })
-    };
-    // D = 1 − Y/Y_none of the composite with occlusion `ao` (clamped as the composite does):
-    // Y = lum (1 − a) + specular, Y_none = lum + specular.
-    let darkening = |ao: &Image<f32>| -> Vec<f32> {
-        let lit: Vec<f32> = (0..w * h).map(|i| luminance[i] + specular.data[i]).collect();
-        let y: Vec<f32> =
-            (0..w * h).map(|i| luminance[i] * (1.0 - ao.data[i].clamp(0.0, 1.0)) + specular.data[i]).collect();
-        legibility::darkening(&y, &lit)
+        Image::from_fn(w, h, |x, y| srgb(shading.composite(y * w + x, ao.get(x, y))))
     };
 
     let mut rows = Vec::new();
@@ -246,18 +225,20 @@ pub fn score(
     let start = std::time::Instant::now();
     let depth = Image { data: nd.data.iter().map(|t| t[3]).collect(), width: w, height: h };
     let pairs = legibility::Pairs::sample(&depth, &mask);
-    let legible = |ao: &Image<f32>| pairs.as_ref().map(|p| p.measure(&darkening(ao), &mask)).map_err(Clone::clone);
+    let legible = |ao: &Image<f32>| {
+        pairs.as_ref().map(|p| p.measure(&shading.darkening(&ao.data, 1.0), &mask)).map_err(Clone::clone)
+    };
     let pictures = vec![
         ("none", legible(&Image::filled(w, h, 0.0))),
         ("truth", legible(&ao_truth)),
-        ("bundle-truth", legible(&bundle_truth.ao)),
+        ("bundle-truth", legible(&bundle_ao)),
     ];
     let mut legibility_seconds = start.elapsed().as_secs_f64();
     let rows = rows
         .into_iter()
         .map(|(method, truth_name, target, ao)| {
             let scores = metrics::score(&ao, &target, &mask);
-            let bundle = metrics::agreement(&ao.data, &bundle_truth.ao.data, &mask);
+            let bundle = metrics::agreement(&ao.data, &bundle_ao.data, &mask);
             let image_ssim = metrics::mean_ssim(&composite(&ao), &true_image, &all);
             let start = std::time::Instant::now();
             let legibility = legible(&ao);
@@ -265,8 +246,18 @@ pub fn score(
             Row { method, truth: truth_name, scores, image_ssim, bundle, legibility, ao }
         })
         .collect();
-    let bundle = Bundle { truth: bundle_truth, settings: bundle_settings, distance: bundle_distance };
+    let bundle = Bundle { ao: bundle_ao, settings: bundle_settings, distance: bundle_distance };
     Ok(Report { truth, truth_seconds, ao: ao_truth, vo: vo_truth, bundle, mask, rows, pictures, legibility_seconds })
+}
+
+/// The ND map (level 0) of `chain`'s last frame and what AO darkens in it.
+pub fn read_frame(session: &Session, chain: &lineao::AoChain) -> Result<(NdImage, Shading)> {
+    let (device, queue) = (&session.gpu.device, &session.gpu.queue);
+    let targets = chain.targets().context("nothing was rendered")?;
+    let nd = lineao::verify::read_rgba(device, queue, &targets.nd[0])?;
+    let color = lineao::readback::read_texture(device, queue, &targets.color.texture)?.to_vec4();
+    let specular = lineao::verify::read_f32(device, queue, &targets.specular)?;
+    Ok((nd, Shading::new(&color, &specular.data)))
 }
 
 /// sRGB encoding of a linear value in [0, 1].
@@ -300,7 +291,7 @@ pub fn run(args: &ScoreArgs) -> Result<()> {
             bundle.distance,
             bundle.settings.distance_world,
             bundle.settings.falloff.name(),
-            mean_over(&bundle.truth.ao, &report.mask),
+            mean_over(&bundle.ao, &report.mask),
         );
         println!(
             "{:<17} {:>8} {:>7} {:>7} {:>7} {:>7} {:>7} {:>7} | {:>6} {:>7} {:>7} {:>7} | {:>9}",
@@ -435,8 +426,8 @@ pub fn to_json(session: &Session, args: &crate::cli::RenderArgs, report: &Report
             "ao_distance": bundle.distance.to_string(),
             "ao_distance_world": bundle.settings.distance_world,
             "ao_falloff": bundle.settings.falloff.name(),
-            "mean": mean_over(&bundle.truth.ao, &report.mask),
-            "buried_share": bundle.truth.buried_share(),
+            "mean": mean_over(&bundle.ao, &report.mask),
+            "buried_share": report.truth.buried_share(),
         },
         "legibility_scales": legibility::SCALES,
         "legibility_seconds": report.legibility_seconds,

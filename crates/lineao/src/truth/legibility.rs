@@ -76,10 +76,37 @@ pub enum Absent {
     NoPairs { radius_px: f64 },
 }
 
-/// D = 1 − Y/Y_none per pixel from linear-light luminances (0 where Y_none is 0: nothing to
-/// darken).
-pub fn darkening(y: &[f32], y_none: &[f32]) -> Vec<f32> {
-    y.iter().zip(y_none).map(|(&y, &n)| if n > 0.0 { 1.0 - y / n } else { 0.0 }).collect()
+/// What AO darkens in a frame, per pixel in linear light: the luminance of the lines' colour,
+/// which the composite multiplies by 1 − clamp(strength · ao, 0, 1), and the frame's luminance
+/// without AO (that colour plus the lines' specular, which AO leaves).
+#[derive(Clone, Debug)]
+pub struct Shading {
+    luminance: Vec<f32>,
+    specular: Vec<f32>,
+}
+
+impl Shading {
+    /// From the frame's linear RGB colours and specular luminances (Rec. 709 luminance).
+    pub fn new(color: &[[f32; 4]], specular: &[f32]) -> Shading {
+        let luminance = color.iter().map(|c| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]).collect();
+        Shading { luminance, specular: specular.to_vec() }
+    }
+
+    /// The composite's linear-light luminance at pixel `i` with occlusion `a` (clamped as the
+    /// composite clamps it): lum (1 − a) + specular.
+    pub fn composite(&self, i: usize, a: f32) -> f32 {
+        self.luminance[i] * (1.0 - a.clamp(0.0, 1.0)) + self.specular[i]
+    }
+
+    /// D = 1 − Y/Y_none of the composite with occlusion clamp(strength · ao, 0, 1), which is
+    /// lum · a / (lum + specular); 0 where Y_none is 0 (nothing to darken).
+    pub fn darkening(&self, ao: &[f32], strength: f32) -> Vec<f32> {
+        ao.iter()
+            .zip(&self.luminance)
+            .zip(&self.specular)
+            .map(|((&a, &l), &s)| if l + s > 0.0 { l * (strength * a).clamp(0.0, 1.0) / (l + s) } else { 0.0 })
+            .collect()
+    }
 }
 
 /// The pairs of one frame at each scale, each stored deeper pixel first.
@@ -337,8 +364,12 @@ mod tests {
     }
 
     #[test]
-    fn darkening_of_luminances() {
-        assert_eq!(darkening(&[0.5, 0.0, 1.0], &[1.0, 0.0, 1.0]), vec![0.5, 0.0, 0.0]);
+    fn darkening_of_a_composite() {
+        // White lines without specular, with as much specular as colour, and black.
+        let shading = Shading::new(&[[1.0; 4], [1.0; 4], [0.0; 4]], &[0.0, 1.0, 0.0]);
+        assert_eq!(shading.darkening(&[0.5, 0.5, 0.5], 1.0), vec![0.5, 0.25, 0.0]);
+        // The composite's clamp(strength · ao, 0, 1).
+        assert_eq!(shading.darkening(&[0.8, 0.8, 0.8], 2.0), vec![1.0, 0.5, 0.0]);
     }
 
     /// The exact L of a fixed pair of 48 × 40 images, computed independently by numpy 2.4

@@ -438,16 +438,15 @@ impl<'a> Tracer<'a> {
                 continue;
             }
             let skip = |p| origin.skips(self.bvh, p);
-            if let Some(reach) = self.settings.second {
-                let (mean, stderr, second) =
-                    two_reaches_at(self.bvh, start, origin.normal, self.settings, reach, seed, skip);
-                row.ao[x] = mean as f32;
-                row.stderr[x] = stderr as f32;
-                row.second[x] = second as f32;
-                row.rays += self.settings.rays as u64;
-                continue;
-            }
-            let (mean, stderr) = ao_at(self.bvh, start, origin.normal, self.settings, seed, skip);
+            let (mean, stderr) = match self.settings.second {
+                Some(reach) => {
+                    let (mean, stderr, second) =
+                        two_reaches_at(self.bvh, start, origin.normal, self.settings, reach, seed, skip);
+                    row.second[x] = second as f32;
+                    (mean, stderr)
+                }
+                None => ao_at(self.bvh, start, origin.normal, self.settings, seed, skip),
+            };
             row.ao[x] = mean as f32;
             row.stderr[x] = stderr as f32;
             row.rays += self.settings.rays as u64;
@@ -510,7 +509,13 @@ pub fn ao_at(
         sum += value;
         sum2 += value * value;
     }
-    let count = settings.rays as f64;
+    mean_and_stderr(sum, sum2, settings.rays)
+}
+
+/// The mean of `count` values and its standard error s/√N (s the sample standard deviation),
+/// from their sum and the sum of their squares.
+fn mean_and_stderr(sum: f64, sum2: f64, count: u32) -> (f64, f64) {
+    let count = count as f64;
     let mean = sum / count;
     let variance = if count > 1.0 { ((sum2 - count * mean * mean) / (count - 1.0)).max(0.0) } else { 0.0 };
     (mean, (variance / count).sqrt())
@@ -538,10 +543,8 @@ fn two_reaches_at(
         sum2 += value * value;
         sum_second += second.value(t);
     }
-    let count = settings.rays as f64;
-    let mean = sum / count;
-    let variance = if count > 1.0 { ((sum2 - count * mean * mean) / (count - 1.0)).max(0.0) } else { 0.0 };
-    (mean, (variance / count).sqrt(), sum_second / count)
+    let (mean, stderr) = mean_and_stderr(sum, sum2, settings.rays);
+    (mean, stderr, sum_second / settings.rays as f64)
 }
 
 /// The occupied share of the ball (or half ball above the tangent plane of `n`) of radius R
