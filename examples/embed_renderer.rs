@@ -471,7 +471,7 @@ mod tests {
             &nd,
             &zoom,
             &lineao::noise::noise_tile(s.line_ao.noise_seed),
-            &lineao::passes::line_ao::sample_table(&s.line_ao),
+            &lineao::method::line_ao::sample_table(&s.line_ao),
             &LineAoParams::new(s, &view),
         );
         let stats = check_policy(&gpu, &cpu, &nd[0], line_ao_flip_bound(s.line_ao.s_r, s.line_ao.s_h)).unwrap();

@@ -74,14 +74,18 @@ pub struct ScoreMethod {
 }
 
 impl ScoreMethod {
-    pub const ALL: [ScoreMethod; 6] = [
-        ScoreMethod::paper(lineao::AoMethod::LineAo),
-        ScoreMethod { method: lineao::AoMethod::LineAo, variant: lineao::LineAoVariant::Reference },
-        ScoreMethod::paper(lineao::AoMethod::VoLine),
-        ScoreMethod::paper(lineao::AoMethod::VoArea),
-        ScoreMethod::paper(lineao::AoMethod::Ssao),
-        ScoreMethod::paper(lineao::AoMethod::RayTraced),
-    ];
+    /// What `score` compares, in the registry's order: every method with a picture of its own
+    /// (not `none`), LineAO's authors' variant after LineAO.
+    pub fn all() -> Vec<ScoreMethod> {
+        let mut all = Vec::new();
+        for &method in lineao::AoMethod::REGISTRY.iter().filter(|&&m| m != lineao::AoMethod::None) {
+            all.push(ScoreMethod::paper(method));
+            if method == lineao::AoMethod::LineAo {
+                all.push(ScoreMethod { method, variant: lineao::LineAoVariant::Reference });
+            }
+        }
+        all
+    }
 
     const fn paper(method: lineao::AoMethod) -> ScoreMethod {
         ScoreMethod { method, variant: lineao::LineAoVariant::Paper }
@@ -96,8 +100,8 @@ impl ScoreMethod {
 }
 
 pub fn parse_score_method(s: &str) -> Result<ScoreMethod, String> {
-    ScoreMethod::ALL.into_iter().find(|m| m.name() == s).ok_or_else(|| {
-        let names: Vec<_> = ScoreMethod::ALL.iter().map(|m| m.name()).collect();
+    ScoreMethod::all().into_iter().find(|m| m.name() == s).ok_or_else(|| {
+        let names: Vec<_> = ScoreMethod::all().iter().map(|m| m.name()).collect();
         format!("unknown method '{s}' (one of {})", names.join(", "))
     })
 }
@@ -303,24 +307,15 @@ pub struct Method {
 
 impl Method {
     /// Every method the viewer lists and `--grid` shows (the grid all but the last, with
-    /// LineAO's other variant inserted third), in that order: the screen-space ones, the
-    /// object-space ones, and LineAO with each object-space one.
-    pub const ALL: [Method; 9] = {
-        const fn m(screen: lineao::AoMethod, volume: Option<lineao::volume::VolumeMethod>) -> Method {
-            Method { screen, volume }
-        }
-        [
-            m(lineao::AoMethod::None, None),
-            m(lineao::AoMethod::LineAo, None),
-            m(lineao::AoMethod::VoLine, None),
-            m(lineao::AoMethod::VoArea, None),
-            m(lineao::AoMethod::Ssao, None),
-            m(lineao::AoMethod::None, Some(lineao::volume::VolumeMethod::Sweep)),
-            m(lineao::AoMethod::None, Some(lineao::volume::VolumeMethod::VarianceVolume)),
-            m(lineao::AoMethod::LineAo, Some(lineao::volume::VolumeMethod::Sweep)),
-            m(lineao::AoMethod::LineAo, Some(lineao::volume::VolumeMethod::VarianceVolume)),
-        ]
-    };
+    /// LineAO's other variant inserted third), in that order: the registry's screen-space ones,
+    /// the object-space ones, and LineAO with each object-space one.
+    pub fn all() -> Vec<Method> {
+        use lineao::volume::VolumeMethod;
+        let screen = lineao::AoMethod::screen_space().map(|screen| Method { screen, volume: None });
+        let volume = VolumeMethod::ALL.map(|v| Method { screen: lineao::AoMethod::None, volume: Some(v) });
+        let both = VolumeMethod::ALL.map(|v| Method { screen: lineao::AoMethod::LineAo, volume: Some(v) });
+        screen.chain(volume).chain(both).collect()
+    }
 
     pub fn name(&self) -> String {
         match (self.screen, self.volume) {
@@ -335,7 +330,7 @@ pub fn parse_method(s: &str) -> Result<Method, String> {
     use lineao::volume::VolumeMethod;
     let screen = |name: &str| lineao::AoMethod::from_name(name);
     let unknown = || {
-        let screen: Vec<_> = lineao::AoMethod::ALL.iter().map(|m| m.name()).collect();
+        let screen: Vec<_> = lineao::AoMethod::screen_space().map(|m| m.name()).collect();
         let volume: Vec<_> = VolumeMethod::ALL.iter().map(|m| m.name()).collect();
         format!(
             "unknown method '{s}' (one of {}, {}, or SCREEN+VOLUME such as lineao+sweep)",
@@ -532,10 +527,19 @@ pub struct RenderArgs {
     /// [default: the preset's; paper 2]
     #[arg(long)]
     pub reference_radius: Option<f32>,
-    /// SSAO: point samples in the sphere (8..=32) [default: 16]; vo-line: line samples (5, 7,
-    /// 9, 12, 13 or 16) [default: 9]; vo-area: area samples (1 or a line count) [default: 1].
+    /// The shown method's samples (each panel's with --grid or --compare): --ssao-samples,
+    /// --vo-samples or --vo-area-samples, whichever method it shows.
     #[arg(long)]
     pub samples: Option<u32>,
+    /// SSAO: point samples in the sphere (8..=32) [default: 16].
+    #[arg(long)]
+    pub ssao_samples: Option<u32>,
+    /// VO line sampling: line samples (5, 7, 9, 12, 13 or 16) [default: 9].
+    #[arg(long)]
+    pub vo_samples: Option<u32>,
+    /// VO area sampling: area samples (1 or a line count) [default: 1].
+    #[arg(long)]
+    pub vo_area_samples: Option<u32>,
     /// VO: a second sphere radius in world units, combined with --radius (VO paper, Fig. 8).
     #[arg(long, value_parser = parse_positive)]
     pub radius2: Option<f32>,
@@ -557,10 +561,16 @@ pub struct RenderArgs {
     /// VO: thickness model, world units (0 = off).
     #[arg(long, default_value_t = 0.0)]
     pub thickness: f32,
-    /// SSAO and VO: sphere radius in world units (mm for tractograms) [default: the preset's;
-    /// paper 2].
+    /// The shown method's sphere radius: --ssao-radius or --vo-radius, whichever --method names
+    /// (with --grid or --compare, both).
     #[arg(long, value_parser = parse_positive)]
     pub radius: Option<f32>,
+    /// SSAO: sphere radius in world units (mm for tractograms) [default: the preset's; paper 2].
+    #[arg(long, value_parser = parse_positive)]
+    pub ssao_radius: Option<f32>,
+    /// VO (line and area sampling): sphere radius in world units [default: the preset's; paper 2].
+    #[arg(long, value_parser = parse_positive)]
+    pub vo_radius: Option<f32>,
     /// SSAO: range check in world units [default: the radius].
     #[arg(long, value_parser = parse_positive)]
     pub ssao_range: Option<f32>,
@@ -648,7 +658,7 @@ pub struct RenderArgs {
     #[arg(long, conflicts_with_all = ["bilateral", "denoise"])]
     pub cpu: bool,
     /// Ray-traced AO on the GPU: the edge-aware denoiser after the rays (same line or surface,
-    /// a window narrowing as 1/√rays; `lineao::passes::ray_denoise`), for low `--rays`.
+    /// a window narrowing as 1/√rays; `lineao::method::raytraced::denoise`), for low `--rays`.
     #[arg(long)]
     pub denoise: bool,
     /// Write the method's inputs and output as .npy files and params.json into this folder.

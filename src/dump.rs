@@ -152,7 +152,7 @@ pub fn write(
         merge(&mut extra, variant_keys);
         merge(&mut params, extra);
         write_npy(dir, "noise.npy", &[64, 64, 3], &flat3(&noise::noise_tile(ao.noise_seed)))?;
-        let samples = lineao::passes::line_ao::sample_table(ao);
+        let samples = lineao::method::line_ao::sample_table(ao);
         write_npy(dir, "samples.npy", &[ao.s_r as u64, ao.s_h as u64, 3], &flat3(&samples))?;
     }
     if s.method == AoMethod::Ssao {

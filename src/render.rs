@@ -66,15 +66,16 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky, lon
         combine: args.volume_combine,
     });
     let method = method.screen;
-    // --samples counts the chosen method's samples; the others keep their defaults.
-    let samples = |m: AoMethod, default: u32| args.samples.filter(|_| method == m).unwrap_or(default);
+    // Each method's own flag, else --samples where it is the method shown, else its default.
+    let samples =
+        |m: AoMethod, own: Option<u32>, default: u32| own.or(args.samples.filter(|_| method == m)).unwrap_or(default);
     let vo_default = VoSettings::default();
     let mut settings = ChainSettings {
         method,
         volume,
         vo: VoSettings {
-            samples: samples(AoMethod::VoLine, vo_default.samples),
-            area_samples: samples(AoMethod::VoArea, vo_default.area_samples),
+            samples: samples(AoMethod::VoLine, args.vo_samples, vo_default.samples),
+            area_samples: samples(AoMethod::VoArea, args.vo_area_samples, vo_default.area_samples),
             radius_world: vo_default.radius_world,
             radius2_world: args.radius2,
             combine: args.combine,
@@ -83,7 +84,7 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky, lon
             noise_seed: args.noise_seed,
         },
         ssao: SsaoSettings {
-            samples: samples(AoMethod::Ssao, SsaoSettings::default().samples),
+            samples: samples(AoMethod::Ssao, args.ssao_samples, SsaoSettings::default().samples),
             radius_world: SsaoSettings::default().radius_world,
             range_world: SsaoSettings::default().range_world,
             noise_seed: args.noise_seed,
@@ -144,8 +145,10 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky, lon
     if let Some(radius) = args.reference_radius {
         settings.line_ao.reference_radius_px = radius;
     }
-    if let Some(radius) = args.radius {
+    if let Some(radius) = args.vo_radius.or(args.radius) {
         settings.vo.radius_world = radius;
+    }
+    if let Some(radius) = args.ssao_radius.or(args.radius) {
         settings.ssao.radius_world = radius;
         settings.ssao.range_world = radius;
     }
@@ -178,7 +181,9 @@ impl Panel {
 
 /// The methods of `--grid`, in order (LineAO's other variant is inserted third).
 fn grid_methods() -> Vec<Method> {
-    Method::ALL[..8].to_vec()
+    let mut methods = Method::all();
+    methods.pop();
+    methods
 }
 
 /// The panels the command line asks for: one method, two (--compare) or all (--grid).
@@ -593,6 +598,30 @@ mod tests {
         let default = lineao::ChainSettings::default();
         assert_eq!(default, lineao::ChainSettings::papers().with_preset(lineao::Preset::Legible));
         assert_eq!((default.line_ao.s_r, default.r0_px(), default.strength), (2, 9.0, 0.6));
+    }
+
+    /// Each method's samples and radius have flags of their own, so a grid sets them all; the
+    /// shorthand `--samples` counts the shown method's only (each panel's).
+    #[test]
+    fn each_method_takes_its_own_samples_and_radius() {
+        use clap::Parser;
+        use lineao::AoMethod;
+        let parse = |extra: &[&str]| {
+            let cli = crate::cli::Cli::parse_from(["lineao", "render"].iter().chain(extra));
+            let crate::cli::Command::Render(args) = cli.command else { panic!("render") };
+            move |screen| {
+                let method = crate::cli::Method { screen, volume: None };
+                super::settings(&args, method, 1.0, lineao::volume::Sky::Uniform, 100.0)
+            }
+        };
+        let grid = parse(&["--grid", "--ssao-samples", "12", "--vo-samples", "5", "--vo-area-samples", "7"]);
+        let (ssao, vo_line, vo_area) = (grid(AoMethod::Ssao), grid(AoMethod::VoLine), grid(AoMethod::VoArea));
+        assert_eq!((ssao.ssao.samples, vo_line.vo.samples, vo_area.vo.area_samples), (12, 5, 7));
+        let radii = parse(&["--grid", "--ssao-radius", "3", "--vo-radius", "1.5"]);
+        assert_eq!((radii(AoMethod::Ssao).ssao.radius_world, radii(AoMethod::VoLine).vo.radius_world), (3.0, 1.5));
+        // --samples: the panel's own method's, the others' untouched.
+        let shown = parse(&["--method", "vo-line", "--samples", "13"])(AoMethod::VoLine);
+        assert_eq!((shown.vo.samples, shown.vo.area_samples, shown.ssao.samples), (13, 1, 16));
     }
 
     #[test]

@@ -44,6 +44,8 @@ fn exit_codes() {
         (&["render", "--s-h", "0"], "--s-h"),
         (&["render", "--delta-scale", "0"], "(0, 1]"),
         (&["render", "--method", "vo-line", "--radius", "0"], "--radius"),
+        (&["render", "--method", "vo-line", "--vo-radius", "0"], "--vo-radius"),
+        (&["render", "--ssao-radius=-1"], "--ssao-radius"),
     ] {
         let out = lineao(bad);
         assert_eq!(out.status.code(), Some(2), "{bad:?}: {}", stderr(&out));
@@ -59,6 +61,9 @@ fn exit_codes() {
         (&["render", "--eye", "0,0,0", "--target", "0,0,0", "-o", png], "coincide"),
         (&["render", "--method", "ssao", "--ssao-kernel", "sphere", "--samples", "10", "-o", png], "sphere kernel"),
         (&["render", "--variant", "reference", "--outer", "level", "-o", png], "outer = level"),
+        // Each method's samples have a flag of their own, whichever method is shown.
+        (&["render", "--method", "ssao", "--vo-samples", "6", "-o", png], "VO samples must be one of"),
+        (&["render", "--method", "vo-line", "--ssao-samples", "40", "-o", png], "SSAO samples must be in 8..=32"),
         (&["render", "--surface", "/nonexistent/hull.obj", "-o", png], "/nonexistent/hull.obj"),
         (&["render", "--geometry", "tubes", "--tube-radius=-1", "-o", png], "tube radius"),
         (

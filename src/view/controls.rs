@@ -17,38 +17,29 @@ use lineao::{
 use super::worker::Panel;
 use crate::cli::Method;
 
-/// The methods the selector offers: `render --grid`'s ([`Method::ALL`], in its order), then
+/// The methods the selector offers: `render --grid`'s ([`Method::all`], in its order), then
 /// the ray-traced truth converging while the view rests.
-pub const METHODS: [Method; 10] = {
-    let mut methods = [RAY_TRACED; 10];
-    let mut i = 0;
-    while i < Method::ALL.len() {
-        methods[i] = Method::ALL[i];
-        i += 1;
-    }
-    methods
-};
+pub fn methods() -> Vec<Method> {
+    Method::all().into_iter().chain([RAY_TRACED]).collect()
+}
 
-/// The GPU ray tracer ([`lineao::passes::raytraced_ao`]), progressive.
+/// The GPU ray tracer ([`lineao::method::raytraced`]), progressive.
 pub const RAY_TRACED: Method = Method { screen: AoMethod::RayTraced, volume: None };
 
 /// What a ray-traced panel shows while the camera moves, by default: LineAO.
-pub const MOVING_DEFAULT: Method = Method::ALL[1];
+pub const MOVING_DEFAULT: Method = Method { screen: AoMethod::LineAo, volume: None };
 
-/// What the method selector calls a method.
+/// What the method selector calls a method: the registry's label, and the object-space AO's.
 pub fn method_label(method: Method) -> String {
+    let volume = |v| match v {
+        VolumeMethod::Sweep => "sweep",
+        VolumeMethod::VarianceVolume => "variance",
+    };
     match (method.screen, method.volume) {
-        (AoMethod::None, None) => "none".into(),
-        (AoMethod::LineAo, None) => "LineAO".into(),
-        (AoMethod::VoLine, None) => "VO line".into(),
-        (AoMethod::VoArea, None) => "VO area".into(),
-        (AoMethod::Ssao, None) => "Crytek SSAO".into(),
-        (AoMethod::RayTraced, None) => "ray traced (progressive)".into(),
+        (screen, None) => screen.info().label.into(),
         (AoMethod::None, Some(VolumeMethod::Sweep)) => "occlusion sweep".into(),
         (AoMethod::None, Some(VolumeMethod::VarianceVolume)) => "variance volume".into(),
-        (AoMethod::LineAo, Some(VolumeMethod::Sweep)) => "LineAO + sweep".into(),
-        (AoMethod::LineAo, Some(VolumeMethod::VarianceVolume)) => "LineAO + variance".into(),
-        _ => method.name(),
+        (screen, Some(v)) => format!("{} + {}", screen.info().label, volume(v)),
     }
 }
 
@@ -409,7 +400,7 @@ fn srgb_to_linear(c: f32) -> f32 {
 
 fn method_combo(ui: &mut Ui, id: &str, method: &mut Method) {
     egui::ComboBox::from_id_salt(id).selected_text(method_label(*method)).width(180.0).show_ui(ui, |ui| {
-        for m in METHODS {
+        for m in methods() {
             ui.selectable_value(method, m, method_label(m));
         }
     });
@@ -509,7 +500,7 @@ fn ray_ui(ui: &mut Ui, chain: &mut ChainSettings, moving: &mut Method) {
         r.denoise = denoise.then(lineao::RayDenoiseSettings::default);
     }
     egui::ComboBox::from_label("while moving").selected_text(method_label(*moving)).show_ui(ui, |ui| {
-        for m in METHODS.into_iter().filter(|m| m.volume.is_none() && *m != RAY_TRACED) {
+        for m in methods().into_iter().filter(|m| m.volume.is_none() && *m != RAY_TRACED) {
             ui.selectable_value(moving, m, method_label(m));
         }
     });
@@ -553,9 +544,9 @@ mod tests {
     fn every_preset_and_method_gives_valid_settings() {
         for preset in [Preset::Dense, Preset::Sparse] {
             for zoom_unit in [1.0, 0.01] {
-                let mut controls = Controls::new([METHODS[1], METHODS[4]], true, preset);
+                let mut controls = Controls::new([methods()[1], methods()[4]], true, preset);
                 controls.set_zoom_unit(zoom_unit);
-                for method in METHODS {
+                for method in methods() {
                     controls.methods[1] = method;
                     for geometry in [Geometry::Lines, Geometry::Tubes] {
                         controls.geometry = geometry;
@@ -576,7 +567,7 @@ mod tests {
         for (preset, library) in
             [(Preset::Legible, lineao::Preset::Legible), (Preset::Physical, lineao::Preset::Physical)]
         {
-            let controls = Controls::new([METHODS[1], METHODS[4]], true, preset);
+            let controls = Controls::new([methods()[1], methods()[4]], true, preset);
             let panels = controls.panels(Vec3::Z, None, false);
             for panel in &panels {
                 let method = panel.settings.method;
@@ -602,17 +593,17 @@ mod tests {
 
     #[test]
     fn a_ray_traced_panel_shows_the_chosen_method_while_the_camera_moves() {
-        let mut controls = Controls::new([RAY_TRACED, METHODS[4]], true, Preset::Legible);
+        let mut controls = Controls::new([RAY_TRACED, methods()[4]], true, Preset::Legible);
         let method = |panels: Vec<Panel>| panels.iter().map(|p| p.settings.method).collect::<Vec<_>>();
         assert_eq!(method(controls.panels(Vec3::Z, None, false)), [AoMethod::RayTraced, AoMethod::Ssao]);
         assert_eq!(method(controls.panels(Vec3::Z, None, true)), [AoMethod::LineAo, AoMethod::Ssao]);
-        controls.moving_method = METHODS[2];
+        controls.moving_method = methods()[2];
         assert_eq!(method(controls.panels(Vec3::Z, None, true)), [AoMethod::VoLine, AoMethod::Ssao]);
     }
 
     #[test]
     fn the_default_light_is_the_contracts() {
-        let controls = Controls::new([METHODS[1]; 2], false, Preset::Dense);
+        let controls = Controls::new([methods()[1]; 2], false, Preset::Dense);
         let panel = &controls.panels(Vec3::Z, None, false)[0];
         let expected = lineao::lighting::Lighting::default().lights[0].dir.normalize();
         assert!(panel.settings.lighting.lights[0].dir.distance(expected) < 1e-5);

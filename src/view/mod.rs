@@ -37,7 +37,7 @@ fn options(args: &ViewArgs) -> app::Options {
     };
     let (methods, compare) = match args.compare {
         Some(pair) => (pair, true),
-        None => ([args.method, controls::METHODS[4]], false),
+        None => ([args.method, crate::cli::Method { screen: lineao::AoMethod::Ssao, volume: None }], false),
     };
     let mut controls = Controls::new(methods, compare, preset);
     controls.geometry = match args.geometry {

@@ -13,7 +13,7 @@ use lineao::AoMethod;
 use lineao_tracts::SceneKind;
 
 use super::app::{App, Options};
-use super::controls::{Controls, METHODS, Preset, RAY_TRACED};
+use super::controls::{Controls, Preset, RAY_TRACED, methods};
 use super::worker::{PREVIEW_VERTICES, Source};
 
 const SIZE: [f32; 2] = [1000.0, 640.0];
@@ -91,7 +91,7 @@ fn non_background(image: &[u8]) -> f64 {
 
 #[test]
 fn a_built_in_scene_is_on_screen_with_the_panel() {
-    let mut harness = harness(options(scene(SceneKind::Bundles, 60_000), [METHODS[1], METHODS[4]], false));
+    let mut harness = harness(options(scene(SceneKind::Bundles, 60_000), [methods()[1], methods()[4]], false));
     settle(&mut harness);
     let app = harness.state();
     assert!(app.error.is_none(), "{:?}", app.error);
@@ -117,7 +117,7 @@ fn a_built_in_scene_is_on_screen_with_the_panel() {
 #[test]
 fn the_viewer_renders_what_the_library_renders() {
     // The render thread's frame against an AoChain driven directly, same settings and camera.
-    let mut harness = harness(options(scene(SceneKind::Spiral, 30_000), [METHODS[1], METHODS[4]], false));
+    let mut harness = harness(options(scene(SceneKind::Spiral, 30_000), [methods()[1], methods()[4]], false));
     settle(&mut harness);
     let frame = harness.state().shown.as_ref().expect("a frame");
     let gpu = lineao::Gpu::headless().unwrap();
@@ -139,7 +139,7 @@ fn the_viewer_renders_what_the_library_renders() {
 
 #[test]
 fn compare_shows_two_methods_split_at_the_divider_which_drags() {
-    let mut harness = harness(options(scene(SceneKind::Bundles, 60_000), [METHODS[1], METHODS[4]], true));
+    let mut harness = harness(options(scene(SceneKind::Bundles, 60_000), [methods()[1], methods()[4]], true));
     settle(&mut harness);
     let app = harness.state();
     let frame = app.shown.as_ref().expect("a frame");
@@ -178,7 +178,7 @@ fn compare_shows_two_methods_split_at_the_divider_which_drags() {
 
 #[test]
 fn the_method_selector_switches_the_method() {
-    let mut harness = harness(options(scene(SceneKind::Bundles, 60_000), [METHODS[1], METHODS[4]], false));
+    let mut harness = harness(options(scene(SceneKind::Bundles, 60_000), [methods()[1], methods()[4]], false));
     settle(&mut harness);
     let lineao = harness.state().shown.as_ref().unwrap().images[0].clone();
     // Open the combo box showing "LineAO" and pick "none".
@@ -203,7 +203,7 @@ fn the_method_selector_switches_the_method() {
 #[test]
 fn a_real_file_opens_and_a_bad_one_says_why() {
     let path = data("niivue+niivue/packages/niivue/demos/images/stroke.trk.gz");
-    let mut harness = harness(options(Source::File(path.clone()), [METHODS[1], METHODS[4]], false));
+    let mut harness = harness(options(Source::File(path.clone()), [methods()[1], methods()[4]], false));
     settle(&mut harness);
     let app = harness.state();
     assert!(app.error.is_none(), "{:?}", app.error);
@@ -249,7 +249,7 @@ fn a_real_file_opens_and_a_bad_one_says_why() {
 #[test]
 fn big_data_previews_while_the_camera_moves_without_blocking_input() {
     let vertices = 2 * PREVIEW_VERTICES + 50_000;
-    let mut harness = harness(options(scene(SceneKind::Bundles, vertices), [METHODS[1], METHODS[4]], false));
+    let mut harness = harness(options(scene(SceneKind::Bundles, vertices), [methods()[1], methods()[4]], false));
     settle(&mut harness);
     let full = harness.state().shown.as_ref().unwrap().size;
     let rect = harness.state().image_rect.unwrap();
@@ -287,7 +287,7 @@ fn big_data_previews_while_the_camera_moves_without_blocking_input() {
 
 #[test]
 fn keys_orbit_zoom_reset_and_switch_to_orthographic() {
-    let mut harness = harness(options(scene(SceneKind::Vortex, 20_000), [METHODS[0], METHODS[4]], false));
+    let mut harness = harness(options(scene(SceneKind::Vortex, 20_000), [methods()[0], methods()[4]], false));
     settle(&mut harness);
     let home = harness.state().camera.unwrap();
     harness.key_press(egui::Key::ArrowLeft);
@@ -308,7 +308,7 @@ fn keys_orbit_zoom_reset_and_switch_to_orthographic() {
 
 #[test]
 fn the_ray_traced_method_accumulates_while_the_camera_rests_and_shows_lineao_while_it_moves() {
-    let mut options = options(scene(SceneKind::Spiral, 30_000), [RAY_TRACED, METHODS[4]], false);
+    let mut options = options(scene(SceneKind::Spiral, 30_000), [RAY_TRACED, methods()[4]], false);
     options.controls.params.chain.raytraced.max_rays = 12;
     let mut harness = harness(options);
     // Frame after frame, 4 more rays per pixel until 12, each on screen as it comes.

@@ -19,8 +19,8 @@ use std::sync::Arc;
 use std::sync::mpsc::{Receiver, Sender, TryRecvError};
 
 use lineao::camera::Camera;
+use lineao::method::raytraced::RayProgress;
 use lineao::passes::lines::{LineGeometry, VertexAttributes};
-use lineao::passes::raytraced_ao::RayProgress;
 use lineao::timing::PassTime;
 use lineao::volume::VolumeAoOptions;
 use lineao::{AoChain, AoMethod, ChainSettings, Gpu, LineColor, RayScene};

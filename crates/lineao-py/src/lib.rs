@@ -376,13 +376,12 @@ fn settings() -> Vec<(String, String, Option<String>)> {
         .collect()
 }
 
-/// The method names `render` accepts (`method=`, `compare=`): the screen-space ones (the
-/// ray-traced truth among them), then the object-space ones and their sums with LineAO.
+/// The method names `render` accepts (`method=`, `compare=`): the registry's (the ray-traced
+/// truth among them), then the object-space ones and their sums with LineAO.
 #[pyfunction]
 fn methods() -> Vec<String> {
-    let screen = lineao::AoMethod::ALL.into_iter().chain([lineao::AoMethod::RayTraced]);
-    let mut names: Vec<String> = screen.map(|m| m.name().to_string()).collect();
-    for method in lineao_cli::cli::Method::ALL {
+    let mut names: Vec<String> = lineao::AoMethod::REGISTRY.iter().map(|m| m.name().to_string()).collect();
+    for method in lineao_cli::cli::Method::all() {
         if !names.contains(&method.name()) {
             names.push(method.name());
         }
@@ -478,7 +477,7 @@ impl Renderer {
     ) -> PyResult<String> {
         let args = self.frame_args(settings)?;
         let methods = match methods {
-            None => lineao_cli::cli::ScoreMethod::ALL.to_vec(),
+            None => lineao_cli::cli::ScoreMethod::all(),
             Some(names) => names
                 .iter()
                 .map(|n| {

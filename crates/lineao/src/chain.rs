@@ -23,7 +23,7 @@
 //! pixel's normal (`volume_ao`), and the composite shows it alone (method `None`) or combined
 //! with the method's occlusion.
 //!
-//! Each method is a [`crate::stage::Stage`]: the chain builds only the active method's stage
+//! Each method is a [`crate::method::Stage`]: the chain builds only the active method's stage
 //! (keeping a few built ones for settings it may switch back to), asks it how far it reads for
 //! the guard band and which timing spans it records, and binds, prepares and records it without
 //! branching on the method.
@@ -38,37 +38,21 @@ use std::sync::Arc;
 use crate::Error;
 use crate::camera::{self, Bounds, Camera, FrameView};
 use crate::gbuffer::Load;
+use crate::method::raytraced::RayProgress;
+use crate::method::{self, Reach};
 use crate::passes::bilateral::Bilateral;
 use crate::passes::composite::{Composite, OverlayDepth, Shown};
 use crate::passes::lines::LineStyle;
 use crate::passes::lines::{LineGeometry, LineRenderer};
 use crate::passes::meshes::{MeshGeometry, MeshRenderer};
 use crate::passes::nd_from_depth::{HostConfig, HostInputs, NdFromDepth};
-use crate::passes::raytraced_ao::RayProgress;
 use crate::passes::tubes::TubeRenderer;
 use crate::passes::volume_ao::VolumeAo;
 use crate::ray_scene::RayScene;
 use crate::settings::{AoMethod, ChainSettings};
-use crate::stage::{self, Reach, Stages};
+use crate::stage::Stages;
 use crate::targets::{FrameTargets, Moments};
 use crate::timing::{PassTime, PassTimer, Span};
-
-/// The spans of a timed frame, in chain order.
-pub const PASS_NAMES: [&str; 13] = [
-    "lines",
-    "nd-pyramid",
-    "lineao",
-    "raytraced",
-    "ray-denoise",
-    "ssao",
-    "ssao-blur",
-    "vo-line",
-    "moments",
-    "vo-area",
-    "blur",
-    "volume-ao",
-    "composite",
-];
 
 pub struct AoChain {
     settings: ChainSettings,
@@ -122,7 +106,7 @@ impl AoChain {
         crate::gpu::validated_async(device, "creating the pass chain's pipelines", || AoChain {
             stages: {
                 let mut stages = Stages::default();
-                stages.select(&settings, None, device, || stage::build(device, &settings));
+                stages.select(&settings, None, device, || method::build(device, &settings));
                 stages
             },
             lines: LineRenderer::with_outputs(device, LineStyle::Quads, settings.volume.is_some()),
@@ -162,7 +146,7 @@ impl AoChain {
         // new stage (the targets stay; a new stage binds them).
         let (stages, targets) = (&mut self.stages, self.targets.as_ref());
         crate::gpu::validated_async(device, "creating the method's pipelines", || {
-            stages.select(&settings, targets, device, || stage::build(device, &settings))
+            stages.select(&settings, targets, device, || method::build(device, &settings))
         })
         .await?;
         let octants = settings.volume.is_some();
@@ -189,7 +173,7 @@ impl AoChain {
         }
         // The pyramid's depth, the method's own targets, the blur's and object-space AO's, and
         // what the composite shows are bound at allocation.
-        let layout = |s: &ChainSettings| (s.levels(), stage::needs(s), s.blur.is_some(), s.volume.is_some());
+        let layout = |s: &ChainSettings| (s.levels(), method::needs(s), s.blur.is_some(), s.volume.is_some());
         if layout(&settings) != layout(&self.settings) {
             self.targets = None;
         }
@@ -207,21 +191,21 @@ impl AoChain {
     /// How far the ray-traced method's picture has come (rays per pixel so far, the cap), or
     /// `None` for the other methods.
     pub fn ray_progress(&self) -> Option<RayProgress> {
-        self.stages.active().and_then(|stage| stage.progress())
+        self.stages.ray_tracer().map(|tracer| tracer.progress())
     }
 
     /// The ray-traced method's accumulation per pixel of the guard-banded frame
-    /// ([`crate::passes::raytraced_ao::ACCUMULATION_BYTES`] each: the sums of the rays' values
+    /// ([`crate::method::raytraced::ACCUMULATION_BYTES`] each: the sums of the rays' values
     /// and of their squares, the own segment, the buried flag), for reading back its standard
     /// error; `None` for the other methods.
     pub fn ray_accumulation(&self) -> Option<&wgpu::Buffer> {
-        self.stages.active().and_then(|stage| stage.accumulation())
+        self.stages.ray_tracer().and_then(|tracer| tracer.accumulation())
     }
 
     /// Turns per-pass GPU timing on or off. Returns whether timing is on: it stays off on
     /// adapters without timestamp queries.
     pub fn set_timing(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, enabled: bool) -> bool {
-        self.timer = if enabled { PassTimer::new(device, queue, &PASS_NAMES) } else { None };
+        self.timer = if enabled { PassTimer::new(device, queue, &method::pass_names()) } else { None };
         self.timer.is_some()
     }
 
@@ -277,7 +261,7 @@ impl AoChain {
             )));
         }
         let banded = (width + 2 * guard, height + 2 * guard);
-        let accumulation = banded.0 as u64 * banded.1 as u64 * crate::passes::raytraced_ao::ACCUMULATION_BYTES;
+        let accumulation = banded.0 as u64 * banded.1 as u64 * crate::method::raytraced::ACCUMULATION_BYTES;
         if settings.method == AoMethod::RayTraced && accumulation > self.max_storage {
             return Err(Error::TooLarge(format!(
                 "the ray tracer's accumulation for {width} x {height} px needs {accumulation} bytes, more than the \
@@ -285,7 +269,7 @@ impl AoChain {
                 self.max_storage
             )));
         }
-        if stage::needs(settings).moments && Moments::bytes(banded) > self.max_storage {
+        if method::needs(settings).moments && Moments::bytes(banded) > self.max_storage {
             return Err(Error::TooLarge(format!(
                 "VO area's moments pyramid for {width} x {height} px needs {} bytes, more than the adapter's {} \
                  byte storage buffers",
@@ -368,7 +352,7 @@ impl AoChain {
         let stale = self.targets.as_ref().is_none_or(|t| t.guard != guard || t.nd.len() != levels as usize);
         if stale {
             let mut targets = FrameTargets::new(device, width, height, guard, levels);
-            let needs = stage::needs(s);
+            let needs = method::needs(s);
             if needs.moments {
                 targets = targets.with_moments(device);
             }

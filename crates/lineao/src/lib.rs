@@ -9,13 +9,15 @@
 //!
 //! - [`AoChain`] wires the passes for a method and owns every size-dependent texture:
 //!   `resize`, `prepare`, `encode` into your `CommandEncoder` and target view.
-//! - [`passes`]: [`LineRenderer`] (fixed-width lines writing the
-//!   G-buffer), [`NdPyramid`](passes::nd_pyramid::NdPyramid), [`LineAo`](passes::line_ao::LineAo),
-//!   the alternatives LineAO is measured against — [`Ssao`](passes::ssao::Ssao) (Crytek),
-//!   [`VoLine`](passes::vo_line::VoLine) and [`VoArea`](passes::vo_area::VoArea) (Volumetric
-//!   Obscurance) — the [`Bilateral`](passes::bilateral::Bilateral) blur and the
-//!   [`Composite`](passes::composite::Composite), each usable alone; each method is a
-//!   [`stage::Stage`] of the chain.
+//! - [`method`]: one folder per method — [`LineAo`](method::line_ao::LineAo) and the
+//!   alternatives LineAO is measured against, [`Ssao`](method::ssao::Ssao) (Crytek),
+//!   [`VoLine`](method::vo_line::VoLine) and [`VoArea`](method::vo_area::VoArea) (Volumetric
+//!   Obscurance), and the GPU ray tracer — each a [`method::Stage`] of the chain, listed by
+//!   one registry that names, times and presets them.
+//! - [`passes`]: what every method shares — [`LineRenderer`] (fixed-width lines writing the
+//!   G-buffer), [`NdPyramid`](passes::nd_pyramid::NdPyramid), the
+//!   [`Bilateral`](passes::bilateral::Bilateral) blur and the
+//!   [`Composite`](passes::composite::Composite), each usable alone.
 //! - [`mod@reference`]: the CPU reference of each pass.
 //! - [`truth`]: the ground truth — ambient occlusion ray traced on the geometry the frame shows
 //!   (a BVH over rounded cones and triangles), and the [`truth::metrics`] that score a method
@@ -46,10 +48,12 @@
 pub(crate) mod binding;
 pub mod camera;
 pub mod chain;
+pub mod colormap;
 pub mod gbuffer;
 pub mod gpu;
 pub mod lighting;
 pub mod line_geometry;
+pub mod method;
 pub mod noise;
 pub mod passes;
 pub mod ray_scene;

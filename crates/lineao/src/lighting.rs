@@ -35,6 +35,8 @@ pub const MAX_LIGHTS: usize = 4;
 
 /// A directional light in view space.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Light {
     /// Direction toward the light, view space (normalized when uploaded).
     pub dir: Vec3,
@@ -44,6 +46,9 @@ pub struct Light {
 
 /// Lights and the Blinn-Phong material of Eq. 14 (and of the illuminated-lines specular).
 #[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Lighting {
     /// Up to [`MAX_LIGHTS`] lights; more are an error when the chain is prepared.
     pub lights: Vec<Light>,

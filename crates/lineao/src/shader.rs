@@ -6,8 +6,9 @@
 
 use std::borrow::Cow;
 
-/// Every WGSL file under `shaders/`, by path relative to that folder.
-pub const FILES: &[(&str, &str)] = &[
+/// The WGSL files of the shared passes (under `shaders/`), by path relative to that folder;
+/// each method's are in its folder and its registry entry ([`crate::method::MethodInfo::shaders`]).
+const SHARED: &[(&str, &str)] = &[
     ("shared/cone.wgsl", include_str!("../shaders/shared/cone.wgsl")),
     ("shared/fullscreen.wgsl", include_str!("../shaders/shared/fullscreen.wgsl")),
     ("shared/gbuffer.wgsl", include_str!("../shaders/shared/gbuffer.wgsl")),
@@ -19,19 +20,11 @@ pub const FILES: &[(&str, &str)] = &[
     ("shared/vo.wgsl", include_str!("../shaders/shared/vo.wgsl")),
     ("bilateral.wgsl", include_str!("../shaders/bilateral.wgsl")),
     ("composite.wgsl", include_str!("../shaders/composite.wgsl")),
-    ("line_ao.wgsl", include_str!("../shaders/line_ao.wgsl")),
     ("lines.wgsl", include_str!("../shaders/lines.wgsl")),
     ("meshes.wgsl", include_str!("../shaders/meshes.wgsl")),
-    ("moments.wgsl", include_str!("../shaders/moments.wgsl")),
     ("nd_from_depth.wgsl", include_str!("../shaders/nd_from_depth.wgsl")),
     ("nd_pyramid.wgsl", include_str!("../shaders/nd_pyramid.wgsl")),
-    ("ray_denoise.wgsl", include_str!("../shaders/ray_denoise.wgsl")),
-    ("raytraced_ao.wgsl", include_str!("../shaders/raytraced_ao.wgsl")),
-    ("ssao.wgsl", include_str!("../shaders/ssao.wgsl")),
-    ("ssao_blur.wgsl", include_str!("../shaders/ssao_blur.wgsl")),
     ("tubes.wgsl", include_str!("../shaders/tubes.wgsl")),
-    ("vo_area.wgsl", include_str!("../shaders/vo_area.wgsl")),
-    ("vo_line.wgsl", include_str!("../shaders/vo_line.wgsl")),
     ("volume_ao.wgsl", include_str!("../shaders/volume_ao.wgsl")),
 ];
 
@@ -41,9 +34,16 @@ pub const FILES: &[(&str, &str)] = &[
 /// no imports).
 pub const GBUFFER_WGSL: &str = include_str!("../shaders/shared/gbuffer.wgsl");
 
-/// The embedded source of `path` (relative to `shaders/`), without imports resolved.
+/// Every embedded WGSL file, (name, source): the shared ones, then each method's.
+pub fn files() -> impl Iterator<Item = (&'static str, &'static str)> {
+    let methods = crate::AoMethod::REGISTRY.iter().flat_map(|m| m.info().shaders.iter());
+    SHARED.iter().chain(methods).copied()
+}
+
+/// The embedded source of `path` (relative to `shaders/`, or a method's file name), without
+/// imports resolved.
 pub fn raw(path: &str) -> Option<&'static str> {
-    FILES.iter().find(|(p, _)| *p == path).map(|(_, s)| *s)
+    files().find(|(p, _)| *p == path).map(|(_, s)| s)
 }
 
 /// `path` with every `#import` resolved. Panics only on a missing import, which the naga test

@@ -352,7 +352,7 @@ fn a_host_renderers_depth_traces_like_the_cpu_truth_through_the_embedding_api() 
 /// The denoiser's inputs and output after `frames` frames of a standalone ray-traced pass over
 /// the G-buffer of a chain with no method: the accumulation, `nd[0]`, the denoised `ao`.
 fn denoised_frames(scene: &Scene, s: &ChainSettings, frames: u32) -> (Image<[u32; 4]>, NdImage, Image<f32>, FrameView) {
-    use lineao::passes::raytraced_ao::RayTracedAo;
+    use lineao::method::raytraced::RayTracedAo;
     let drawing = ChainSettings { method: AoMethod::None, ..s.clone() };
     let mut tracer = Tracer::new(scene, drawing, None);
     tracer.frame(&camera());

@@ -4,8 +4,8 @@
 mod common;
 
 use common::{cameras_for_polylines, flat_view, gpu, is_geometry, polylines, render};
-use lineao::passes::ssao::Ssao;
-use lineao::passes::ssao_blur::SsaoBlur;
+use lineao::method::ssao::Ssao;
+use lineao::method::ssao::blur::SsaoBlur;
 use lineao::reference::{self, Image, NdImage, SsaoParams, ViewParams};
 use lineao::targets::FrameTargets;
 use lineao::verify::{check_policy, compare, read_f32, write_target};

@@ -126,7 +126,7 @@ fn lineao_sees_surfaces_and_matches_its_cpu_reference() {
         &f.nd,
         &f.zoom,
         &lineao::noise::noise_tile(1),
-        &lineao::passes::line_ao::sample_table(&s.line_ao),
+        &lineao::method::line_ao::sample_table(&s.line_ao),
         &reference::LineAoParams::new(&s, &f.view),
     );
     let stats = check_policy(&f.ao, &cpu, &f.nd[0], line_ao_flip_bound(3, 32)).unwrap();

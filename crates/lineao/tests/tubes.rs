@@ -321,7 +321,7 @@ fn lineao_on_tubes_takes_r0_from_the_zoom_and_matches_its_cpu_reference() {
             &frame.nd,
             &frame.zoom,
             &lineao::noise::noise_tile(1),
-            &lineao::passes::line_ao::sample_table(&s.line_ao),
+            &lineao::method::line_ao::sample_table(&s.line_ao),
             &reference::LineAoParams::new(&s, &frame.view),
         );
         let stats = check_policy(&frame.ao, &cpu, &frame.nd[0], line_ao_flip_bound(3, 32))

@@ -8,9 +8,9 @@ mod common;
 
 use common::{cameras_for_polylines, flat_view, gpu, polylines, render};
 use lineao::camera::{Bounds, Camera, FrameView, Projection};
-use lineao::passes::moments::MomentsPyramid;
-use lineao::passes::vo_area::VoArea;
-use lineao::passes::vo_line::VoLine;
+use lineao::method::vo_area::VoArea;
+use lineao::method::vo_area::moments::MomentsPyramid;
+use lineao::method::vo_line::VoLine;
 use lineao::reference::{self, Image, NdImage, ViewParams, VoParams, vo_line_sample, vo_sample, vo_visible};
 use lineao::sample_sets::{
     VO_AREA_SAMPLE_COUNTS, VO_SAMPLE_COUNTS, vo_area_lod_offsets, vo_area_samples, vo_disk_samples,

@@ -13,31 +13,43 @@ fn validate(path: &str) -> Result<(), String> {
 
 #[test]
 fn every_wgsl_file_validates() {
-    let failures: Vec<String> = lineao::shader::FILES
-        .iter()
-        .filter_map(|(path, _)| validate(path).err().map(|e| format!("{path}:\n{e}")))
-        .collect();
+    let failures: Vec<String> =
+        lineao::shader::files().filter_map(|(path, _)| validate(path).err().map(|e| format!("{path}:\n{e}"))).collect();
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
+/// The shared passes' files under `shaders/` (by path relative to it) and each method's in its
+/// folder `src/method/<name>/` (by file name).
 #[test]
 fn every_wgsl_file_on_disk_is_embedded() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("shaders");
+    let crate_root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let shaders = crate_root.join("shaders");
+    let mut folders = vec![(shaders.clone(), shaders.clone()), (shaders.join("shared"), shaders.clone())];
+    for entry in std::fs::read_dir(crate_root.join("src/method")).unwrap() {
+        let dir = entry.unwrap().path();
+        // The toy method is registered in the library's own tests only (`method/toy/`).
+        if dir.is_dir() && !dir.ends_with("toy") {
+            folders.push((dir.clone(), dir));
+        }
+    }
     let mut on_disk = Vec::new();
-    for dir in [root.clone(), root.join("shared")] {
+    for (dir, root) in folders {
         for entry in std::fs::read_dir(&dir).unwrap() {
             let path = entry.unwrap().path();
             if path.extension().is_some_and(|e| e == "wgsl") {
-                on_disk.push(path.strip_prefix(&root).unwrap().to_string_lossy().replace('\\', "/"));
+                let name = path.strip_prefix(&root).unwrap().to_string_lossy().replace('\\', "/");
+                on_disk.push((name, std::fs::read_to_string(&path).unwrap()));
             }
         }
     }
     on_disk.sort();
-    let mut embedded: Vec<String> = lineao::shader::FILES.iter().map(|(p, _)| p.to_string()).collect();
+    let mut embedded: Vec<(String, String)> =
+        lineao::shader::files().map(|(p, s)| (p.to_string(), s.to_string())).collect();
     embedded.sort();
-    assert_eq!(on_disk, embedded);
-    for (path, source) in lineao::shader::FILES {
-        assert_eq!(std::fs::read_to_string(root.join(path)).unwrap(), *source, "{path} is stale");
+    let names = |files: &[(String, String)]| files.iter().map(|(p, _)| p.clone()).collect::<Vec<_>>();
+    assert_eq!(names(&on_disk), names(&embedded));
+    for ((path, on_disk), (_, embedded)) in on_disk.iter().zip(&embedded) {
+        assert_eq!(on_disk, embedded, "{path} is stale");
     }
 }
 

@@ -1,22 +1,16 @@
-//! The passes, one module (and one WGSL file) each. Every pass owns its long-lived pipeline and
+//! The passes every method shares — the geometry (lines, tubes, meshes, a host's depth), the ND
+//! pyramid, the bilateral blur, object-space AO and the composite — one module (and one WGSL
+//! file) each; the methods' own passes are in [`crate::method`]. Every pass owns its long-lived pipeline and
 //! layouts, rebuilds its bind groups on `resize`, writes its uniforms in `prepare` and records
 //! itself in `encode`, so a host with its own render graph can use any of them alone.
 
 pub mod bilateral;
 pub mod composite;
-pub mod line_ao;
 pub mod lines;
 pub mod meshes;
-pub mod moments;
 pub mod nd_from_depth;
 pub mod nd_pyramid;
-pub mod ray_denoise;
-pub mod raytraced_ao;
-pub mod ssao;
-pub mod ssao_blur;
 pub mod tubes;
-pub mod vo_area;
-pub mod vo_line;
 pub mod volume_ao;
 
 /// Workgroup size of the compute passes (8 × 8, as in the WGSL files).

@@ -1,8 +1,8 @@
 //! CPU reference of the separable bilateral blur (`shaders/bilateral.wgsl`).
 
-use super::ssao::ViewParams;
 use super::{Image, NdImage};
 use crate::settings::BilateralSettings;
+use crate::view_params::ViewParams;
 
 /// x then y, each neighbour k pixels away weighing exp(−k² · 1/(2σ_s²) − Δz² · 1/(2σ_z²)) over
 /// geometry pixels; background stays 0.

@@ -1,31 +1,29 @@
 //! The CPU reference: every screen-space pass in plain Rust over f32 images.
 //!
-//! It exists to prove the shaders. Tests read the GPU's inputs back, run these functions on
+//! Each method's reference lives in its folder (`method/<name>/reference.rs`) and is
+//! re-exported here, beside the shared passes'. It exists to prove the shaders. Tests read the GPU's inputs back, run these functions on
 //! exactly those inputs (same noise) and compare pixel by pixel (CONTRACT.md "GPU vs CPU
 //! agreement"). The arithmetic follows the WGSL line by line, in f32 and in the same order, so
 //! the two differ only by rounding inside the GPU (fused multiply-adds, `pow`, `sqrt`).
 
 mod bilateral;
-mod line_ao;
-mod ray_denoise;
-mod ssao;
 pub mod tubes;
-mod vo_area;
-mod vo_line;
 mod volume_ao;
 
-pub use bilateral::bilateral;
-pub use line_ao::{
+pub use crate::method::line_ao::reference::{
     LineAoParams, OUTER_DEPTH_TOLERANCE, delta, depth_weight, hermite, light_weight, line_ao, line_ao_pixel,
     representative_pixel, upsample_outer, whole_exponent, whole_pow,
 };
-pub use ray_denoise::ray_denoise;
-pub use ssao::{SSAO_EPSILON, SsaoParams, ViewParams, ssao, ssao_blur, ssao_pixel};
-pub use vo_area::{MomentsImage, moments_pyramid, moments_trilinear, vo_area, vo_sigma_floor};
-pub use vo_line::{
+pub use crate::method::raytraced::reference::ray_denoise;
+pub use crate::method::ssao::reference::{SSAO_EPSILON, SsaoParams, ViewParams, ssao, ssao_blur, ssao_pixel};
+pub use crate::method::vo_area::reference::{
+    MomentsImage, moments_pyramid, moments_trilinear, vo_area, vo_sigma_floor,
+};
+pub use crate::method::vo_line::reference::{
     VoParams, vo_chord, vo_chord_half, vo_combine, vo_line, vo_line_pixel, vo_line_sample, vo_plane, vo_reflect,
     vo_sample, vo_visible,
 };
+pub use bilateral::bilateral;
 pub use volume_ao::{unpack_octants, volume_ao};
 
 /// A row-major image, `data[y * width + x]`.

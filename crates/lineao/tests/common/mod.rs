@@ -3,7 +3,7 @@
 #![allow(dead_code)]
 
 use lineao::camera::{Bounds, Camera, FrameView};
-use lineao::passes::line_ao::LineAo;
+use lineao::method::line_ao::LineAo;
 use lineao::passes::lines::LineGeometry;
 use lineao::passes::meshes::MeshGeometry;
 use lineao::passes::nd_pyramid::NdPyramid;

@@ -15,7 +15,7 @@
 //!
 //! ω_i = reflect(R1(P), `R2[j][i]`) flipped into the hemisphere of n_j(P) (§3.4, [`crate::noise`]).
 //! Where we depart from the paper (the ε test, the third case of Eq. 12) is in CONTRACT.md.
-//! The CPU reference is [`crate::reference::line_ao`]; `shaders/line_ao.wgsl` is the shader.
+//! The CPU reference is [`crate::reference::line_ao`]; `line_ao.wgsl` is the shader.
 //!
 //! # Variant `reference`: what the authors' code does
 //!
@@ -60,11 +60,34 @@ use crate::camera::FrameView;
 use crate::lighting::{Lighting, LightingUniform};
 use crate::noise;
 use crate::passes::dispatch_full_screen;
-use crate::settings::{LineAoOuter, LineAoSettings, LineAoVariant};
+use crate::settings::ChainSettings;
+
+pub(crate) mod reference;
+mod settings;
+pub use settings::{LineAoOuter, LineAoSettings, LineAoVariant, R0};
+
+/// LineAO in the registry ([`crate::method`]).
+pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
+    name: "lineao",
+    label: "LineAO",
+    help: "LineAO (Eichelbaum et al. 2013): hemispheres of growing radius on a Gaussian pyramid of normals and depth",
+    screen_space: true,
+    spans: &["nd-pyramid", "lineao"],
+    shaders: &[("line_ao.wgsl", include_str!("line_ao.wgsl"))],
+    build: Some(|device, settings| Box::new(LineAoStage::new(device, settings))),
+    needs: |settings| {
+        let ao = &settings.line_ao;
+        super::Needs {
+            outer: ao.variant == LineAoVariant::Paper && ao.outer == LineAoOuter::Level && ao.s_r > 1,
+            ..super::Needs::default()
+        }
+    },
+    preset: settings::preset,
+};
 use crate::targets::{AO_FORMAT, FrameTargets, LevelsUniform, OUTER_FORMAT};
 use crate::timing::Span;
 
-/// Keep in sync with `LineAoUniform` in `shaders/line_ao.wgsl`.
+/// Keep in sync with `LineAoUniform` in `line_ao.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct LineAoUniform {
@@ -156,7 +179,7 @@ pub struct LineAo {
     group: Option<wgpu::BindGroup>,
 }
 
-/// Entries of the uniform sample table (`samples` in `shaders/line_ao.wgsl`): s_r ≤ 5, s_h ≤ 256.
+/// Entries of the uniform sample table (`samples` in `line_ao.wgsl`): s_r ≤ 5, s_h ≤ 256.
 const SAMPLE_TABLE_LEN: usize = crate::MAX_LEVELS as usize * 256;
 
 impl LineAo {
@@ -311,7 +334,7 @@ impl LineAo {
     }
 }
 
-/// LineAO's [`crate::stage::Stage`]: the Gaussian ND pyramid (when s_r > 1), then the
+/// LineAO's [`crate::method::Stage`]: the Gaussian ND pyramid (when s_r > 1), then the
 /// hemispheres (or the authors' variant on level 0).
 pub struct LineAoStage {
     pyramid: crate::passes::nd_pyramid::NdPyramid,
@@ -319,7 +342,7 @@ pub struct LineAoStage {
 }
 
 impl LineAoStage {
-    pub fn new(device: &wgpu::Device, settings: &crate::ChainSettings) -> LineAoStage {
+    pub fn new(device: &wgpu::Device, settings: &ChainSettings) -> LineAoStage {
         LineAoStage {
             pyramid: crate::passes::nd_pyramid::NdPyramid::new(device),
             line_ao: LineAo::new(device, &settings.line_ao, &settings.lighting),
@@ -327,16 +350,16 @@ impl LineAoStage {
     }
 }
 
-impl crate::stage::Stage for LineAoStage {
-    fn matches(&self, settings: &crate::ChainSettings) -> bool {
+impl crate::method::Stage for LineAoStage {
+    fn matches(&self, settings: &ChainSettings) -> bool {
         settings.method == crate::AoMethod::LineAo && self.line_ao.matches(&settings.line_ao, &settings.lighting)
     }
 
-    fn reach(&self, settings: &crate::ChainSettings, unguarded: &FrameView) -> crate::stage::Reach {
+    fn reach(&self, settings: &ChainSettings, unguarded: &FrameView) -> crate::method::Reach {
         let ao = &settings.line_ao;
         match ao.variant {
             // Its radius grows as 1/(1 − d), without bound toward the far plane.
-            LineAoVariant::Reference => crate::stage::Reach::Unbounded,
+            LineAoVariant::Reference => crate::method::Reach::Unbounded,
             // The widest hemisphere reads the deepest level, whose texels near the band's edge
             // are filtered with clamp-to-edge: the band covers that reach too.
             LineAoVariant::Paper => {
@@ -345,12 +368,12 @@ impl crate::stage::Stage for LineAoStage {
                 let radius_px = r0.px
                     + (r0.per_zoom + deepest as f32) * unguarded.zoom_max()
                     + crate::camera::pyramid_reach(deepest);
-                crate::stage::Reach::Pixels { radius_px, levels: ao.s_r }
+                crate::method::Reach::Pixels { radius_px, levels: ao.s_r }
             }
         }
     }
 
-    fn spans(&self, settings: &crate::ChainSettings) -> &'static [&'static str] {
+    fn spans(&self, settings: &ChainSettings) -> &'static [&'static str] {
         if settings.levels() > 1 { &["nd-pyramid", "lineao"] } else { &["lineao"] }
     }
 
@@ -359,7 +382,7 @@ impl crate::stage::Stage for LineAoStage {
         self.line_ao.resize(device, targets);
     }
 
-    fn prepare(&self, queue: &wgpu::Queue, targets: &FrameTargets, view: &FrameView, settings: &crate::ChainSettings) {
+    fn prepare(&self, queue: &wgpu::Queue, targets: &FrameTargets, view: &FrameView, settings: &ChainSettings) {
         self.line_ao.prepare(queue, targets, view, &settings.line_ao, settings.r0(), &settings.lighting);
     }
 

@@ -19,7 +19,7 @@
 //! fades out (below a quarter pixel it copies the mean) as the picture converges.
 //!
 //! It reads the ray tracer's accumulation and `nd[0]`, and writes `ao` in place of the plain
-//! mean; [`crate::passes::raytraced_ao::RayTracedAo`] runs it after each frame's rays. The CPU
+//! mean; [`crate::method::raytraced::RayTracedAo`] runs it after each frame's rays. The CPU
 //! reference is [`crate::reference::ray_denoise`].
 
 use crate::binding::{self, Slot};
@@ -30,7 +30,7 @@ use crate::targets::{AO_FORMAT, FrameTargets};
 use crate::timing::Span;
 use crate::view_params::{ViewParams, ViewUniform};
 
-/// Keep in sync with `Denoise` in `shaders/ray_denoise.wgsl`.
+/// Keep in sync with `Denoise` in `ray_denoise.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 struct DenoiseUniform {

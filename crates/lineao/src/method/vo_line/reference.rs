@@ -1,11 +1,11 @@
-//! CPU reference of Volumetric Obscurance with line samples (`shaders/vo_line.wgsl`) and of
+//! CPU reference of Volumetric Obscurance with line samples (`vo_line.wgsl`) and of
 //! what VO's line and area sampling share (`shaders/shared/vo.wgsl`), in the shaders' f32
 //! operation order.
 
-use super::ssao::ViewParams;
-use super::{Image, NdImage};
 use crate::camera::FrameView;
+use crate::reference::{Image, NdImage};
 use crate::settings::{VoCombine, VoSettings};
+use crate::view_params::ViewParams;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct VoParams {
@@ -135,7 +135,7 @@ pub fn vo_reflect(sample: [f32; 2], u: [f32; 2]) -> [f32; 2] {
 
 /// What a VO pixel shares between line and area sampling: 0 on background; otherwise
 /// `obscurance(depth, zoom, u, radius)` at the first radius, combined with the second.
-pub(super) fn vo_pixel(
+pub(crate) fn vo_pixel(
     nd: &NdImage,
     zoom: &Image<f32>,
     noise: &[[f32; 2]],
@@ -159,7 +159,7 @@ pub(super) fn vo_pixel(
 }
 
 /// ao = 1 − Σ A_i free_i / Σ A_i allowed_i; 0 when nothing is allowed.
-pub(super) fn vo_ao(free: f32, allowed: f32) -> f32 {
+pub(crate) fn vo_ao(free: f32, allowed: f32) -> f32 {
     if allowed > 0.0 { 1.0 - free / allowed } else { 0.0 }
 }
 

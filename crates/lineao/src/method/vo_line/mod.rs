@@ -26,14 +26,32 @@
 //!
 //! The sphere's radius is in world units, mapped to pixels by the zoom map. The CPU reference
 //! is [`crate::reference::vo_line`]. `VoCore` is what line and area sampling
-//! ([`crate::passes::vo_area`]) share: the uniform, the tables, the pipeline and its bindings.
+//! ([`crate::method::vo_area`]) share: the uniform, the tables, the pipeline and its bindings.
 
 use crate::binding::{self, Slot};
 use crate::camera::FrameView;
 use crate::noise;
 use crate::passes::dispatch_full_screen;
 use crate::sample_sets;
-use crate::settings::{VoCombine, VoSettings};
+use crate::settings::ChainSettings;
+
+pub(crate) mod reference;
+mod settings;
+pub(crate) use settings::preset;
+pub use settings::{VoCombine, VoSettings};
+
+/// VO with line samples in the registry ([`crate::method`]).
+pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
+    name: "vo-line",
+    label: "VO line",
+    help: "Volumetric Obscurance with line samples (Loos & Sloan 2010, §4.1)",
+    screen_space: true,
+    spans: &["vo-line"],
+    shaders: &[("vo_line.wgsl", include_str!("vo_line.wgsl"))],
+    build: Some(|device, settings| Box::new(VoLine::new(device, &settings.vo))),
+    needs: |_| super::Needs::default(),
+    preset: |preset, settings| settings::preset(preset, settings, 1.5),
+};
 use crate::targets::{AO_FORMAT, FrameTargets, Moments};
 use crate::timing::Span;
 use crate::view_params::ViewParams;
@@ -191,18 +209,18 @@ impl VoLine {
     }
 }
 
-impl crate::stage::Stage for VoLine {
-    fn matches(&self, settings: &crate::ChainSettings) -> bool {
+impl crate::method::Stage for VoLine {
+    fn matches(&self, settings: &ChainSettings) -> bool {
         settings.method == crate::AoMethod::VoLine && VoLine::matches(self, &settings.vo)
     }
 
     /// The sphere's radius in pixels where it is largest (at the near plane).
-    fn reach(&self, settings: &crate::ChainSettings, unguarded: &FrameView) -> crate::stage::Reach {
+    fn reach(&self, settings: &ChainSettings, unguarded: &FrameView) -> crate::method::Reach {
         let radius_px = settings.vo.max_radius_world() * unguarded.zoom_max() / settings.zoom_unit;
-        crate::stage::Reach::Pixels { radius_px, levels: 1 }
+        crate::method::Reach::Pixels { radius_px, levels: 1 }
     }
 
-    fn spans(&self, _: &crate::ChainSettings) -> &'static [&'static str] {
+    fn spans(&self, _: &ChainSettings) -> &'static [&'static str] {
         &["vo-line"]
     }
 
@@ -210,7 +228,7 @@ impl crate::stage::Stage for VoLine {
         VoLine::resize(self, device, targets);
     }
 
-    fn prepare(&self, queue: &wgpu::Queue, targets: &FrameTargets, view: &FrameView, settings: &crate::ChainSettings) {
+    fn prepare(&self, queue: &wgpu::Queue, targets: &FrameTargets, view: &FrameView, settings: &ChainSettings) {
         VoLine::prepare(self, queue, targets, view, &settings.vo);
     }
 

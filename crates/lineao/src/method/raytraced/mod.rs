@@ -17,7 +17,7 @@
 //! [`RayTracedAo::progress`] says how far it is.
 //!
 //! **Denoiser.** With `RayTracedSettings::denoise` each frame ends with the edge-aware
-//! denoiser ([`crate::passes::ray_denoise`]) writing `ao` from the accumulation.
+//! denoiser ([`crate::method::raytraced::denoise`]) writing `ao` from the accumulation.
 //!
 //! **Scene.** The rays need the geometry itself, not only the G-buffer: a [`RayScene`] uploaded
 //! once per geometry ([`crate::AoChain::set_ray_scene`]). Without one there is nothing to hit
@@ -29,15 +29,36 @@ use std::sync::{Arc, Mutex};
 use crate::binding::{self, Slot};
 use crate::camera::FrameView;
 use crate::passes::dispatch_full_screen;
-use crate::passes::ray_denoise::RayDenoise;
 use crate::ray_scene::RayScene;
 use crate::settings::{AoMethod, ChainSettings};
+use denoise::RayDenoise;
+
+pub mod denoise;
+pub(crate) mod reference;
+mod settings;
+pub use settings::{RayDenoiseSettings, RayTracedSettings};
+
+/// The GPU ray tracer in the registry ([`crate::method`]).
+pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
+    name: "raytraced",
+    label: "ray traced (progressive)",
+    help: "Ray-traced AO on the GPU, accumulated while the view rests: the ground truth",
+    screen_space: false,
+    spans: &["raytraced", "ray-denoise"],
+    shaders: &[
+        ("raytraced_ao.wgsl", include_str!("raytraced_ao.wgsl")),
+        ("ray_denoise.wgsl", include_str!("ray_denoise.wgsl")),
+    ],
+    build: Some(|device, _| Box::new(RayTracedAo::new(device))),
+    needs: |_| super::Needs::default(),
+    preset: |_, settings| settings.strength = 1.0,
+};
 use crate::targets::{AO_FORMAT, FrameTargets};
 use crate::timing::Span;
 use crate::truth::{EPSILON_PER_DISTANCE, Falloff};
 use crate::view_params::{ViewParams, ViewUniform};
 
-/// Keep in sync with `Trace` in `shaders/raytraced_ao.wgsl`.
+/// Keep in sync with `Trace` in `raytraced_ao.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 struct TraceUniform {
@@ -339,14 +360,14 @@ impl RayTracedAo {
     }
 }
 
-impl crate::stage::Stage for RayTracedAo {
+impl crate::method::Stage for RayTracedAo {
     fn matches(&self, settings: &ChainSettings) -> bool {
         settings.method == AoMethod::RayTraced
     }
 
     /// Rays go through the scene, not the screen: no guard band.
-    fn reach(&self, _: &ChainSettings, _: &FrameView) -> crate::stage::Reach {
-        crate::stage::Reach::Pixels { radius_px: 0.0, levels: 1 }
+    fn reach(&self, _: &ChainSettings, _: &FrameView) -> crate::method::Reach {
+        crate::method::Reach::Pixels { radius_px: 0.0, levels: 1 }
     }
 
     fn spans(&self, settings: &ChainSettings) -> &'static [&'static str] {
@@ -355,21 +376,6 @@ impl crate::stage::Stage for RayTracedAo {
 
     fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets) {
         RayTracedAo::resize(self, device, targets);
-    }
-
-    fn set_scene(&mut self, device: &wgpu::Device, scene: Option<&Arc<RayScene>>, targets: Option<&FrameTargets>) {
-        RayTracedAo::set_scene(self, scene.cloned());
-        if let Some(targets) = targets {
-            RayTracedAo::resize(self, device, targets);
-        }
-    }
-
-    fn progress(&self) -> Option<RayProgress> {
-        Some(RayTracedAo::progress(self))
-    }
-
-    fn accumulation(&self) -> Option<&wgpu::Buffer> {
-        RayTracedAo::accumulation(self)
     }
 
     fn prepare(&self, queue: &wgpu::Queue, targets: &FrameTargets, view: &FrameView, settings: &ChainSettings) {

@@ -1,8 +1,8 @@
-//! CPU reference of the ray tracer's edge-aware denoiser (`shaders/ray_denoise.wgsl`).
+//! CPU reference of the ray tracer's edge-aware denoiser (`ray_denoise.wgsl`).
 
-use super::ssao::ViewParams;
-use super::{Image, NdImage};
+use crate::reference::{Image, NdImage};
 use crate::settings::RayDenoiseSettings;
+use crate::view_params::ViewParams;
 
 /// The own segment of a pixel without one (surfaces, tubes).
 const NONE: u32 = u32::MAX;

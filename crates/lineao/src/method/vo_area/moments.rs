@@ -6,7 +6,7 @@
 //! read gives the mean μ = M₁ and the variance σ² = M₂ − M₁² of any footprint. Level 0 is the
 //! linear depth z = −z_view (world units) of each pixel and its square, the background at the
 //! far plane; each further level is the binomial 5 × 5 of the one below at half resolution
-//! (`shaders/moments.wgsl`) — a Gaussian, as the paper recommends for its mip-map, so that
+//! (`moments.wgsl`) — a Gaussian, as the paper recommends for its mip-map, so that
 //! large footprints read smoothly. Everything in f32 (M₂ − M₁² cancels in f16). The levels
 //! have mip-chain sizes, ⌊W/2^l⌋ down to 1, in one storage buffer ([`Moments`]). The CPU
 //! reference is [`crate::reference::moments_pyramid`].

@@ -12,7 +12,7 @@
 //! ```
 //!
 //! r(P) comes from a 4 × 4 tile of unit vectors, so 16 neighbouring pixels see 16 rotations of
-//! the kernel, and [`crate::passes::ssao_blur`] averages exactly that 4 × 4 window. Nothing here
+//! the kernel, and [`crate::method::ssao::blur`] averages exactly that 4 × 4 window. Nothing here
 //! knows about lines: a surface facing the camera is half occluded by itself (the samples behind
 //! it), the grey look that LineAO's hemispheres avoid. The radius is in world units, so thin
 //! lines far away get a sphere of a pixel or two — the paper's point about screen-space AO on
@@ -22,12 +22,30 @@ use crate::binding::{self, Slot};
 use crate::camera::FrameView;
 use crate::noise;
 use crate::passes::dispatch_full_screen;
-use crate::settings::{SsaoKernel, SsaoSettings};
+use crate::settings::ChainSettings;
+
+pub mod blur;
+pub(crate) mod reference;
+mod settings;
+pub use settings::{SsaoKernel, SsaoSettings};
+
+/// Crytek SSAO in the registry ([`crate::method`]).
+pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
+    name: "ssao",
+    label: "Crytek SSAO",
+    help: "Crytek SSAO (Mittring 2007), the LineAO paper's baseline, with its 4 × 4 blur",
+    screen_space: true,
+    spans: &["ssao", "ssao-blur"],
+    shaders: &[("ssao.wgsl", include_str!("ssao.wgsl")), ("ssao_blur.wgsl", include_str!("ssao_blur.wgsl"))],
+    build: Some(|device, settings| Box::new(SsaoStage::new(device, settings))),
+    needs: |_| super::Needs { ao_raw: true, ..super::Needs::default() },
+    preset: settings::preset,
+};
 use crate::targets::{AO_FORMAT, FrameTargets};
 use crate::timing::Span;
 use crate::view_params::{ViewParams, ViewUniform};
 
-/// Keep in sync with `SsaoUniform` in `shaders/ssao.wgsl`.
+/// Keep in sync with `SsaoUniform` in `ssao.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct SsaoUniform {
@@ -126,32 +144,32 @@ impl Ssao {
     }
 }
 
-/// Crytek SSAO's [`crate::stage::Stage`]: the samples (`nd[0]` → `ao_raw`), then the 4 × 4 blur
+/// Crytek SSAO's [`crate::method::Stage`]: the samples (`nd[0]` → `ao_raw`), then the 4 × 4 blur
 /// matched to the rotation tile (`ao_raw` → `ao`).
 pub struct SsaoStage {
     ssao: Ssao,
-    blur: crate::passes::ssao_blur::SsaoBlur,
+    blur: blur::SsaoBlur,
 }
 
 impl SsaoStage {
-    pub fn new(device: &wgpu::Device, settings: &crate::ChainSettings) -> SsaoStage {
-        SsaoStage { ssao: Ssao::new(device, &settings.ssao), blur: crate::passes::ssao_blur::SsaoBlur::new(device) }
+    pub fn new(device: &wgpu::Device, settings: &ChainSettings) -> SsaoStage {
+        SsaoStage { ssao: Ssao::new(device, &settings.ssao), blur: blur::SsaoBlur::new(device) }
     }
 }
 
-impl crate::stage::Stage for SsaoStage {
-    fn matches(&self, settings: &crate::ChainSettings) -> bool {
+impl crate::method::Stage for SsaoStage {
+    fn matches(&self, settings: &ChainSettings) -> bool {
         settings.method == crate::AoMethod::Ssao && self.ssao.matches(&settings.ssao)
     }
 
     /// The sphere's radius in pixels where it is largest (at the near plane), plus the blur's
     /// 2 px.
-    fn reach(&self, settings: &crate::ChainSettings, unguarded: &FrameView) -> crate::stage::Reach {
+    fn reach(&self, settings: &ChainSettings, unguarded: &FrameView) -> crate::method::Reach {
         let radius_px = settings.ssao.radius_world * unguarded.zoom_max() / settings.zoom_unit + 2.0;
-        crate::stage::Reach::Pixels { radius_px, levels: 1 }
+        crate::method::Reach::Pixels { radius_px, levels: 1 }
     }
 
-    fn spans(&self, _: &crate::ChainSettings) -> &'static [&'static str] {
+    fn spans(&self, _: &ChainSettings) -> &'static [&'static str] {
         &["ssao", "ssao-blur"]
     }
 
@@ -160,7 +178,7 @@ impl crate::stage::Stage for SsaoStage {
         self.blur.resize(device, targets);
     }
 
-    fn prepare(&self, queue: &wgpu::Queue, targets: &FrameTargets, view: &FrameView, settings: &crate::ChainSettings) {
+    fn prepare(&self, queue: &wgpu::Queue, targets: &FrameTargets, view: &FrameView, settings: &ChainSettings) {
         self.ssao.prepare(queue, targets, view, &settings.ssao);
     }
 

@@ -14,7 +14,7 @@
 //!
 //! with everything in the unit sphere's coordinates, as for lines (σ = 0 *is* a line sample).
 //! The normal clamp, the thickness model, the per-pixel reflection and two radii work as in
-//! [`crate::passes::vo_line`]. The footprint of sample i covers π r² A_i/ΣA pixels for a sphere
+//! [`crate::method::vo_line`]. The footprint of sample i covers π r² A_i/ΣA pixels for a sphere
 //! of r pixels: one log2 per pixel plus a precomputed per-sample offset gives its level of
 //! detail ([`crate::sample_sets::vo_area_lod_offsets`]); reads are trilinear. One sample — the
 //! whole sphere — already darkens creases and contacts without any noise; more samples keep
@@ -22,10 +22,28 @@
 //! (CONTRACT.md). The CPU reference is [`crate::reference::vo_area`].
 
 use crate::camera::FrameView;
-use crate::passes::moments::MomentsPyramid;
-use crate::passes::vo_line::{VoCore, VoUniform};
+use crate::method::vo_line::VoSettings;
+use crate::method::vo_line::{VoCore, VoUniform};
 use crate::sample_sets;
-use crate::settings::VoSettings;
+use crate::settings::ChainSettings;
+use moments::MomentsPyramid;
+
+pub mod moments;
+pub(crate) mod reference;
+
+/// VO with area samples in the registry ([`crate::method`]); its settings are VO's
+/// ([`VoSettings`], `ChainSettings::vo`).
+pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
+    name: "vo-area",
+    label: "VO area",
+    help: "Volumetric Obscurance with area samples over a pyramid of depth moments (Loos & Sloan 2010, §4.2)",
+    screen_space: true,
+    spans: &["moments", "vo-area"],
+    shaders: &[("vo_area.wgsl", include_str!("vo_area.wgsl")), ("moments.wgsl", include_str!("moments.wgsl"))],
+    build: Some(|device, settings| Box::new(VoArea::new(device, &settings.vo))),
+    needs: |_| super::Needs { moments: true, ..super::Needs::default() },
+    preset: |preset, settings| crate::method::vo_line::preset(preset, settings, 1.0),
+};
 use crate::targets::FrameTargets;
 use crate::timing::Span;
 
@@ -84,20 +102,20 @@ impl VoArea {
     }
 }
 
-impl crate::stage::Stage for VoArea {
-    fn matches(&self, settings: &crate::ChainSettings) -> bool {
+impl crate::method::Stage for VoArea {
+    fn matches(&self, settings: &ChainSettings) -> bool {
         settings.method == crate::AoMethod::VoArea && VoArea::matches(self, &settings.vo)
     }
 
     /// Area samples read moments over a footprint around each sample point: half its side is at
     /// most ½ √π r < r, and the Gaussian levels' tails reach about as far again, so 2 r covers
     /// what they read.
-    fn reach(&self, settings: &crate::ChainSettings, unguarded: &FrameView) -> crate::stage::Reach {
+    fn reach(&self, settings: &ChainSettings, unguarded: &FrameView) -> crate::method::Reach {
         let radius_px = 2.0 * settings.vo.max_radius_world() * unguarded.zoom_max() / settings.zoom_unit;
-        crate::stage::Reach::Pixels { radius_px, levels: 1 }
+        crate::method::Reach::Pixels { radius_px, levels: 1 }
     }
 
-    fn spans(&self, _: &crate::ChainSettings) -> &'static [&'static str] {
+    fn spans(&self, _: &ChainSettings) -> &'static [&'static str] {
         &["moments", "vo-area"]
     }
 
@@ -105,7 +123,7 @@ impl crate::stage::Stage for VoArea {
         VoArea::resize(self, device, targets);
     }
 
-    fn prepare(&self, queue: &wgpu::Queue, targets: &FrameTargets, view: &FrameView, settings: &crate::ChainSettings) {
+    fn prepare(&self, queue: &wgpu::Queue, targets: &FrameTargets, view: &FrameView, settings: &ChainSettings) {
         VoArea::prepare(self, queue, targets, view, &settings.vo);
     }
 

@@ -1,7 +1,7 @@
-//! CPU reference of Crytek SSAO and its 4 × 4 blur (`shaders/ssao.wgsl`, `shaders/ssao_blur.wgsl`),
+//! CPU reference of Crytek SSAO and its 4 × 4 blur (`ssao.wgsl`, `ssao_blur.wgsl`),
 //! in the shaders' f32 operation order.
 
-use super::{Image, NdImage};
+use crate::reference::{Image, NdImage};
 pub use crate::view_params::ViewParams;
 
 /// A sample counts as occluded only when the surface is in front of it by more than this

@@ -1,12 +1,12 @@
 //! CPU reference of LineAO, variants `paper` (CONTRACT.md "LineAO") and `reference` (the
-//! authors' shader, [`crate::passes::line_ao`]), written plainly from the equations: the shader
-//! `shaders/line_ao.wgsl` is optimized differently and the tests compare the two.
+//! authors' shader, [`crate::method::line_ao`]), written plainly from the equations: the shader
+//! `line_ao.wgsl` is optimized differently and the tests compare the two.
 
 use glam::Vec3;
 
-use super::{Image, NdImage, level_texel};
 use crate::camera::FrameView;
 use crate::lighting::Light;
+use crate::reference::{Image, NdImage, level_texel};
 use crate::settings::{ChainSettings, LineAoOuter, LineAoVariant};
 
 /// Every number LineAO reads besides the images and the noise.
@@ -33,7 +33,7 @@ pub struct LineAoParams {
     /// Pixel coordinate of the visible viewport's top-left corner (the guard band).
     pub noise_origin: [i32; 2],
     /// Variant `reference`: base radius per axis in pixels per unit of zoom at d = 0
-    /// ([`crate::passes::line_ao::reference_scale`]).
+    /// ([`crate::method::line_ao::reference_scale`]).
     pub reference_scale: [f32; 2],
 }
 
@@ -44,7 +44,7 @@ impl LineAoParams {
         LineAoParams {
             variant: ao.variant,
             outer: ao.outer,
-            reference_scale: crate::passes::line_ao::reference_scale(view, ao.reference_radius_px),
+            reference_scale: crate::method::line_ao::reference_scale(view, ao.reference_radius_px),
             s_r: ao.s_r,
             s_h: ao.s_h,
             r0_px: settings.r0().px,

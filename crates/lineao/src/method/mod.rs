@@ -1,0 +1,275 @@
+//! The ambient occlusion methods: one folder each, and one registry line.
+//!
+//! A method's folder holds everything that is the method's own: its passes and their WGSL, the
+//! [`Stage`] that puts them in the chain, its settings (units, ranges, defaults, validation and
+//! its values in each [`Preset`]), and its CPU reference (re-exported by
+//! [`crate::reference`]). The folder ends in one [`MethodInfo`], and the [`registry!`] below
+//! lists every method by that value. Everything that names methods derives from the registry:
+//! [`AoMethod`] itself, its names and help, the chain's timing spans ([`pass_names`]), the
+//! shaders the naga test validates, the presets, and — in the front ends — the command line's
+//! values, the bench's passes, `score`'s rows, the viewer's labels and Python's `methods()`.
+//!
+//! ```text
+//!   method/<name>/mod.rs        the passes, the Stage, `pub(crate) const METHOD: MethodInfo`
+//!   method/<name>/settings.rs   the settings and their validation
+//!   method/<name>/reference.rs  the CPU reference, line by line the WGSL's arithmetic
+//!   method/<name>/*.wgsl        the shaders
+//! ```
+//!
+//! Adding a method: its folder, its line in `registry!`, and — when it has settings of its
+//! own — their field in [`ChainSettings`] (the compiler asks for its default in
+//! [`ChainSettings::papers`]).
+
+use crate::camera::FrameView;
+use crate::settings::{ChainSettings, Preset};
+use crate::targets::FrameTargets;
+use crate::timing::Span;
+
+pub mod line_ao;
+pub mod raytraced;
+pub mod ssao;
+#[cfg(test)]
+mod toy;
+pub mod vo_area;
+pub mod vo_line;
+
+/// How a method builds its stage for a device and settings.
+pub(crate) type BuildStage = fn(&wgpu::Device, &ChainSettings) -> Box<dyn Stage>;
+
+/// Everything the library and the front ends know of a method besides its settings.
+pub struct MethodInfo {
+    /// The name on the command line, in `params.json`, in Python and in CONTRACT.md.
+    pub name: &'static str,
+    /// What a method list in a user interface shows.
+    pub label: &'static str,
+    /// One line of help: what the method is and where it comes from.
+    pub help: &'static str,
+    /// Whether the method is screen-space AO in the chain, shown by `--grid` and the viewer's
+    /// list among the others (the ray-traced truth, progressive and scene-bound, is not).
+    pub screen_space: bool,
+    /// The timing spans its stage can record, in chain order (CONTRACT.md's names).
+    pub spans: &'static [&'static str],
+    /// Its WGSL files, by the name its passes compose them under.
+    pub shaders: &'static [(&'static str, &'static str)],
+    /// Its stage; `None` for a method that runs no pass (`none`).
+    pub(crate) build: Option<BuildStage>,
+    /// The shared targets it needs allocated besides the G-buffer and `ao`.
+    pub(crate) needs: fn(&ChainSettings) -> Needs,
+    /// Sets `preset`'s values of its own settings and the strength it is shown with.
+    pub(crate) preset: fn(Preset, &mut ChainSettings),
+}
+
+/// The registry: the methods, in the order front ends list them. A method is its folder and
+/// one line here.
+macro_rules! registry {
+    ($( $(#[doc = $doc:literal])* $(#[cfg($cfg:meta)])? $variant:ident => $info:path ),+ $(,)?) => {
+        /// Which ambient occlusion the chain computes: one variant per method of the registry
+        /// ([`crate::method`]), each described by [`AoMethod::info`].
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        pub enum AoMethod {
+            $( $(#[doc = $doc])* $(#[cfg($cfg)])? $variant, )+
+        }
+
+        impl AoMethod {
+            /// Every method, in the registry's order.
+            pub const REGISTRY: &'static [AoMethod] = &[$( $(#[cfg($cfg)])? AoMethod::$variant, )+];
+
+            /// What the registry holds for the method.
+            pub fn info(self) -> &'static MethodInfo {
+                match self {
+                    $( $(#[cfg($cfg)])? AoMethod::$variant => &$info, )+
+                }
+            }
+        }
+    };
+}
+
+registry! {
+    /// Plain lines (with the illuminated-lines specular), no occlusion.
+    None => NONE,
+    /// LineAO (Eichelbaum et al. 2013).
+    LineAo => line_ao::METHOD,
+    /// Volumetric Obscurance with line samples (Loos & Sloan 2010, §4.1).
+    VoLine => vo_line::METHOD,
+    /// Volumetric Obscurance with area samples over a pyramid of depth moments (§4.2).
+    VoArea => vo_area::METHOD,
+    /// Crytek SSAO (Mittring 2007), the LineAO paper's baseline, with its 4 × 4 blur.
+    Ssao => ssao::METHOD,
+    /// Ray-traced AO on the GPU, progressive: the ground truth ([`crate::truth`]) where the view
+    /// rests. Rays go through the scene, not the screen, so it needs no guard band.
+    RayTraced => raytraced::METHOD,
+    /// A method made by the registry alone, which the tests find everywhere methods are listed.
+    #[cfg(test)]
+    Toy => toy::METHOD,
+}
+
+impl Default for AoMethod {
+    /// LineAO.
+    fn default() -> AoMethod {
+        AoMethod::LineAo
+    }
+}
+
+/// Plain lines: no pass, no settings.
+const NONE: MethodInfo = MethodInfo {
+    name: "none",
+    label: "none",
+    help: "Plain lines (with the illuminated-lines specular), no occlusion",
+    screen_space: true,
+    spans: &[],
+    shaders: &[],
+    build: None,
+    needs: |_| Needs::default(),
+    preset: |_, settings| settings.strength = 1.0,
+};
+
+impl AoMethod {
+    /// The name used on the command line and in `params.json`.
+    pub fn name(self) -> &'static str {
+        self.info().name
+    }
+
+    /// The screen-space methods, in the order `--grid` shows them (not the ray-traced truth,
+    /// which is progressive and needs the scene).
+    pub fn screen_space() -> impl Iterator<Item = AoMethod> {
+        AoMethod::REGISTRY.iter().copied().filter(|m| m.info().screen_space)
+    }
+
+    /// The method called `name`.
+    pub fn from_name(name: &str) -> Option<AoMethod> {
+        AoMethod::REGISTRY.iter().copied().find(|m| m.name() == name)
+    }
+
+    /// Every method's name, comma-separated: what an error about an unknown one lists.
+    pub fn names() -> String {
+        AoMethod::REGISTRY.iter().map(|m| m.name()).collect::<Vec<_>>().join(", ")
+    }
+}
+
+crate::settings::serde_by_name!(AoMethod);
+
+/// The registry's names and help, as every other setting with a fixed set of values.
+impl crate::settings::Named for AoMethod {
+    const VALUES: &'static [AoMethod] = AoMethod::REGISTRY;
+
+    fn name(self) -> &'static str {
+        self.info().name
+    }
+
+    fn help(self) -> &'static str {
+        self.info().help
+    }
+}
+
+impl std::fmt::Display for AoMethod {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for AoMethod {
+    type Err = String;
+
+    fn from_str(name: &str) -> Result<AoMethod, String> {
+        AoMethod::from_name(name).ok_or_else(|| format!("unknown method '{name}' (one of {})", AoMethod::names()))
+    }
+}
+
+/// The spans of a timed frame, in chain order (CONTRACT.md): the geometry, every method's, the
+/// blur, object-space AO and the composite.
+pub fn pass_names() -> Vec<&'static str> {
+    let methods = AoMethod::REGISTRY.iter().flat_map(|m| m.info().spans.iter().copied());
+    let mut names: Vec<&'static str> = std::iter::once("lines").chain(methods).collect();
+    names.dedup();
+    names.extend(["blur", "volume-ao", "composite"]);
+    names
+}
+
+/// How far from a pixel a stage reads, for the guard band (CONTRACT.md).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Reach {
+    /// At most `radius_px` pixels (before any blur), on a pyramid of `levels` levels (the band
+    /// is rounded to the deepest level's texel).
+    Pixels { radius_px: f32, levels: u32 },
+    /// Without bound (it grows toward the far plane): the largest band allowed.
+    Unbounded,
+}
+
+/// The shared targets a method's stage writes besides the G-buffer, its pyramid and `ao`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Needs {
+    /// `ao_raw`: an occlusion before the stage's own blur (SSAO).
+    pub ao_raw: bool,
+    /// The moments pyramid of VO area sampling.
+    pub moments: bool,
+    /// LineAO's `outer = level` targets.
+    pub outer: bool,
+}
+
+/// What a method does in the chain: it reads the G-buffer in [`FrameTargets`] and writes `ao`,
+/// between the geometry and the composite. The timing span names are CONTRACT.md's.
+///
+/// Why a trait object and not an enum of stage types: a stage is called a handful of times per
+/// frame (not per pixel), so dynamic dispatch costs nothing measurable, and the chain, the
+/// guard band and the timings follow from the trait without naming a method.
+pub trait Stage: wgpu::WasmNotSendSync + std::any::Any {
+    /// Whether this stage, as built, computes `settings`' method (else the chain builds another).
+    fn matches(&self, settings: &ChainSettings) -> bool;
+    /// How far it reads for a frame seen as `unguarded` (the frame's size, no guard band).
+    fn reach(&self, settings: &ChainSettings, unguarded: &FrameView) -> Reach;
+    /// The spans it records, in order, under `settings` (of its method's [`MethodInfo::spans`]).
+    fn spans(&self, settings: &ChainSettings) -> &'static [&'static str];
+    /// Binds newly allocated targets.
+    fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets);
+    /// Writes the frame's uniforms.
+    fn prepare(&self, queue: &wgpu::Queue, targets: &FrameTargets, view: &FrameView, settings: &ChainSettings);
+    /// Records the stage; `span(name)` times one of [`Stage::spans`].
+    fn encode<'t>(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &FrameTargets,
+        span: &dyn Fn(&'static str) -> Option<Span<'t>>,
+    );
+}
+
+/// What `settings`' method needs allocated.
+pub fn needs(settings: &ChainSettings) -> Needs {
+    (settings.method.info().needs)(settings)
+}
+
+/// The stage of `settings`' method; `None` for a method without passes.
+pub fn build(device: &wgpu::Device, settings: &ChainSettings) -> Option<Box<dyn Stage>> {
+    settings.method.info().build.map(|build| build(device, settings))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn names_are_unique_and_round_trip() {
+        for &method in AoMethod::REGISTRY {
+            assert_eq!(AoMethod::from_name(method.name()), Some(method));
+            assert_eq!(method.name().parse::<AoMethod>(), Ok(method));
+            let same = AoMethod::REGISTRY.iter().filter(|m| m.name() == method.name()).count();
+            assert_eq!(same, 1, "{method}");
+        }
+        assert!("gtao".parse::<AoMethod>().unwrap_err().contains("lineao, vo-line"));
+    }
+
+    #[test]
+    fn every_span_is_timed_once_in_chain_order() {
+        let names = pass_names();
+        let mut unique = names.clone();
+        unique.sort();
+        unique.dedup();
+        assert_eq!(unique.len(), names.len(), "{names:?}");
+        for &method in AoMethod::REGISTRY {
+            for span in method.info().spans {
+                assert!(names.contains(span), "{method}: {span}");
+            }
+        }
+        assert_eq!(names.first(), Some(&"lines"));
+        assert_eq!(names.last(), Some(&"composite"));
+    }
+}

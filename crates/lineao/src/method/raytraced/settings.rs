@@ -1,0 +1,121 @@
+//! The GPU ray tracer's settings: rays per frame, the cap, the reach, and the denoiser.
+
+/// The ray-traced method on the GPU ([`crate::method::raytraced`]): rays per frame while the
+/// view rests, accumulated up to a cap, as the CPU truth traces them.
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct RayTracedSettings {
+    /// Rays per geometry pixel each frame, ≥ 1. Default 4 (LineVis's).
+    pub rays_per_frame: u32,
+    /// Rays per pixel after which the frame is converged and nothing more is traced, ≥ 1.
+    /// Default 1024.
+    pub max_rays: u32,
+    /// The rays' reach R in world units, > 0. Default 2 (the truth's).
+    pub distance_world: f32,
+    pub falloff: crate::truth::Falloff,
+    /// Seed of the per-pixel scramble (the CPU truth's `seed`).
+    pub seed: u32,
+    /// The edge-aware denoiser ([`crate::method::raytraced::denoise`]), or none. Default none: the
+    /// picture as traced (what `lineao score` scores).
+    pub denoise: Option<RayDenoiseSettings>,
+}
+
+/// The ray tracer's edge-aware denoiser: each pixel's mean averaged with its neighbours' on the
+/// same surface, in a window whose Gaussian narrows as 1/√rays, so it smooths the first frames
+/// and fades out as the picture converges.
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct RayDenoiseSettings {
+    /// Pixels on each side of the window, 1..=8. Default 3.
+    pub radius_px: u32,
+    /// σ of the spatial Gaussian at 4 rays per pixel, in pixels, > 0 (σ = sigma_px · √(4/rays);
+    /// below a quarter pixel the window is the pixel alone). Default 1.5.
+    pub sigma_px: f32,
+    /// Neighbours count with max(n·n', 0)^normal_power, ≥ 0. Default 32.
+    pub normal_power: f32,
+    /// Lines and tubes: neighbours whose own segments are at most this many vertices apart along
+    /// the polyline, ≥ 0. Default 2.
+    pub reach_vertices: u32,
+    /// Meshes: neighbours whose depth differs by at most this share of the pixel's, in (0, 1].
+    /// Default 0.02.
+    pub depth_tolerance: f32,
+}
+
+impl Default for RayDenoiseSettings {
+    fn default() -> Self {
+        RayDenoiseSettings { radius_px: 3, sigma_px: 1.5, normal_power: 32.0, reach_vertices: 2, depth_tolerance: 0.02 }
+    }
+}
+
+impl RayDenoiseSettings {
+    /// 1/(2σ²) of the spatial Gaussian after `rays` rays per pixel, or 0 where σ is below a
+    /// quarter pixel (the pixel alone). Tubes take half the σ: several pixels wide, their
+    /// occlusion changes across their width, which lines a pixel or two wide do not show
+    /// (measured against the truth in docs/ground-truth.md).
+    pub fn spatial(&self, rays: u32, tubes: bool) -> f32 {
+        let sigma = self.sigma_px * (4.0 / rays.max(1) as f32).sqrt() * if tubes { 0.5 } else { 1.0 };
+        if sigma < 0.25 { 0.0 } else { 1.0 / (2.0 * sigma * sigma) }
+    }
+
+    pub fn validate(&self) -> Result<(), crate::Error> {
+        let ok = (1..=8).contains(&self.radius_px)
+            && self.sigma_px.is_finite()
+            && self.sigma_px > 0.0
+            && self.normal_power.is_finite()
+            && self.normal_power >= 0.0
+            && self.depth_tolerance > 0.0
+            && self.depth_tolerance <= 1.0;
+        if ok {
+            return Ok(());
+        }
+        Err(crate::Error::InvalidSettings(format!(
+            "ray denoiser: radius 1..=8 px, σ > 0, normal power ≥ 0 and depth tolerance in (0, 1], got {self:?}"
+        )))
+    }
+}
+
+impl Default for RayTracedSettings {
+    fn default() -> Self {
+        let truth = crate::truth::TruthSettings::default();
+        RayTracedSettings {
+            rays_per_frame: 4,
+            max_rays: 1024,
+            distance_world: truth.distance_world,
+            falloff: truth.falloff,
+            seed: truth.seed,
+            denoise: None,
+        }
+    }
+}
+
+impl RayTracedSettings {
+    /// The CPU truth's settings tracing the same rays as `rays` rays per pixel of these.
+    pub fn truth(&self, rays: u32) -> crate::truth::TruthSettings {
+        crate::truth::TruthSettings {
+            rays,
+            distance_world: self.distance_world,
+            falloff: self.falloff,
+            seed: self.seed,
+            vo: None,
+            second: None,
+            threads: 0,
+        }
+    }
+
+    pub fn validate(&self) -> Result<(), crate::Error> {
+        if self.rays_per_frame == 0 || self.max_rays == 0 {
+            return Err(crate::Error::InvalidSettings(format!(
+                "rays per frame and the ray cap must be at least 1, got {} and {}",
+                self.rays_per_frame, self.max_rays
+            )));
+        }
+        if let Some(denoise) = &self.denoise {
+            denoise.validate()?;
+        }
+        self.truth(1).validate()
+    }
+}

@@ -1,0 +1,100 @@
+//! Crytek SSAO's settings: the kernel, its radius and range check in world units.
+
+use crate::settings::{ChainSettings, Named, Preset, named};
+
+named!(SsaoKernel {
+    Crytek => "Mittring's random kernel, denser near the centre",
+    Sphere => "The VO paper's generated point set (8, 12, 16, 24 or 32 samples)",
+});
+
+/// Crytek SSAO (`lineao::method::ssao`).
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct SsaoSettings {
+    /// Point samples in the sphere (8..=32).
+    pub samples: u32,
+    /// Radius of the sampling sphere in world units.
+    pub radius_world: f32,
+    /// Range check: a sample counts as occluded only when the visible surface is in front of it
+    /// by less than this (world units), so far-away foreground does not darken the background.
+    pub range_world: f32,
+    /// Seed of the kernel and the 4 × 4 rotation tile.
+    pub noise_seed: u32,
+    /// Where the kernel's points come from.
+    pub kernel: SsaoKernel,
+}
+
+impl Default for SsaoSettings {
+    fn default() -> Self {
+        SsaoSettings { samples: 16, radius_world: 2.0, range_world: 2.0, noise_seed: 1, kernel: SsaoKernel::Crytek }
+    }
+}
+
+impl SsaoSettings {
+    /// Checks every range documented above.
+    pub fn validate(&self) -> Result<(), crate::Error> {
+        let bad = |what: String| Err(crate::Error::InvalidSettings(what));
+        if !(8..=32).contains(&self.samples) {
+            return bad(format!("SSAO samples must be in 8..=32, got {}", self.samples));
+        }
+        if self.kernel == SsaoKernel::Sphere && !crate::sample_sets::VO_SPHERE_SAMPLE_COUNTS.contains(&self.samples) {
+            return bad(format!(
+                "the sphere kernel has {:?} samples, got {}",
+                crate::sample_sets::VO_SPHERE_SAMPLE_COUNTS,
+                self.samples
+            ));
+        }
+        if !(self.radius_world.is_finite() && self.radius_world > 0.0) {
+            return bad(format!("the SSAO radius must be > 0 world units, got {}", self.radius_world));
+        }
+        if !(self.range_world.is_finite() && self.range_world > 0.0) {
+            return bad(format!("the SSAO range must be > 0 world units, got {}", self.range_world));
+        }
+        Ok(())
+    }
+}
+
+impl SsaoSettings {
+    /// The kernel's points in the unit ball (scaled by the radius in the pass).
+    pub fn kernel_points(&self) -> Vec<[f32; 3]> {
+        match self.kernel {
+            SsaoKernel::Crytek => crate::noise::ssao_kernel(self.noise_seed, self.samples),
+            SsaoKernel::Sphere => crate::sample_sets::vo_sphere_samples(self.samples).unwrap_or_default().to_vec(),
+        }
+    }
+}
+
+/// The SSAO kernel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum SsaoKernel {
+    /// Mittring's: random directions, lengths growing quadratically (denser near the centre).
+    #[default]
+    Crytek,
+    /// The VO paper's point-sample set (§4.5): every point an equal share of the ball
+    /// (`lineao::sample_sets::VO_SPHERE_SAMPLE_COUNTS` sizes only).
+    Sphere,
+}
+
+impl SsaoKernel {
+    /// The CLI and `params.json` name: `crytek` or `sphere`.
+    pub fn name(self) -> &'static str {
+        match self {
+            SsaoKernel::Crytek => "crytek",
+            SsaoKernel::Sphere => "sphere",
+        }
+    }
+}
+
+/// SSAO's sphere (radius and range, zoom units) and strength in `preset` (docs/ground-truth.md).
+pub(crate) fn preset(preset: Preset, settings: &mut ChainSettings) {
+    let (strength, radius) = match preset {
+        Preset::Paper => (1.0, 2.0),
+        Preset::Legible => (1.0, 8.0),
+        Preset::Physical => (0.68, 3.0),
+    };
+    settings.strength = strength;
+    settings.ssao.radius_world = radius * settings.zoom_unit;
+    settings.ssao.range_world = radius * settings.zoom_unit;
+}

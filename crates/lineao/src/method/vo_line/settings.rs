@@ -1,0 +1,121 @@
+//! Volumetric Obscurance's settings, shared by line and area sampling (`vo_area` builds on
+//! `vo_line`): the sample sets, the radii, the normal clamp and the thickness.
+
+use crate::settings::{ChainSettings, Named, Preset, named};
+
+named!(VoCombine {
+    Product => "Brightness multiplies: 1 − (1 − ao_a)(1 − ao_b)",
+    Min => "The darker of the two",
+});
+
+/// How two occlusions combine: VO at two radii (VO paper, Fig. 8), or object-space AO with the
+/// screen-space method's ([`VolumeAoSettings`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum VoCombine {
+    /// Brightness multiplies: ao = 1 − (1 − ao_small)(1 − ao_large).
+    #[default]
+    Product,
+    /// The darker one: ao = max(ao_small, ao_large).
+    Min,
+}
+
+impl VoCombine {
+    /// The name used on the command line and in `params.json`.
+    pub fn name(self) -> &'static str {
+        match self {
+            VoCombine::Product => "product",
+            VoCombine::Min => "min",
+        }
+    }
+}
+
+/// Volumetric Obscurance (`lineao::method::vo_line`, `lineao::method::vo_area`).
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct VoSettings {
+    /// Line samples: one of `lineao::sample_sets::VO_SAMPLE_COUNTS` (5, 7, 9, 12, 13, 16).
+    pub samples: u32,
+    /// Area samples: one of `lineao::sample_sets::VO_AREA_SAMPLE_COUNTS` (1 or a line count).
+    /// Default 1.
+    pub area_samples: u32,
+    /// Radius of the sphere in world units.
+    pub radius_world: f32,
+    /// A second radius: VO is evaluated at both and combined by `combine`, so fine features
+    /// (the small one) and wide contact shadows (the large one) both show.
+    pub radius2_world: Option<f32>,
+    pub combine: VoCombine,
+    /// Restrict the sphere to the half above the surface's tangent plane (§4.4).
+    pub normal_clamp: bool,
+    /// Thickness model (§4.3): occupied only this far behind the visible surface, world units;
+    /// 0 = off (occupied all the way back).
+    pub thickness_world: f32,
+    /// Seed of the 4 × 4 tile of 2D reflection directions.
+    pub noise_seed: u32,
+}
+
+impl VoSettings {
+    /// The larger of the radii: what the guard band must cover.
+    pub fn max_radius_world(&self) -> f32 {
+        self.radius2_world.map_or(self.radius_world, |r| r.max(self.radius_world))
+    }
+}
+
+impl Default for VoSettings {
+    fn default() -> Self {
+        VoSettings {
+            samples: 9,
+            area_samples: 1,
+            radius_world: 2.0,
+            radius2_world: None,
+            combine: VoCombine::Product,
+            normal_clamp: true,
+            thickness_world: 0.0,
+            noise_seed: 1,
+        }
+    }
+}
+
+impl VoSettings {
+    /// Checks every range documented above.
+    pub fn validate(&self) -> Result<(), crate::Error> {
+        let bad = |what: String| Err(crate::Error::InvalidSettings(what));
+        if !crate::sample_sets::VO_SAMPLE_COUNTS.contains(&self.samples) {
+            return bad(format!(
+                "VO samples must be one of {:?}, got {}",
+                crate::sample_sets::VO_SAMPLE_COUNTS,
+                self.samples
+            ));
+        }
+        if !crate::sample_sets::VO_AREA_SAMPLE_COUNTS.contains(&self.area_samples) {
+            return bad(format!(
+                "VO area samples must be one of {:?}, got {}",
+                crate::sample_sets::VO_AREA_SAMPLE_COUNTS,
+                self.area_samples
+            ));
+        }
+        for radius in std::iter::once(self.radius_world).chain(self.radius2_world) {
+            if !(radius.is_finite() && radius > 0.0) {
+                return bad(format!("a VO radius must be > 0 world units, got {radius}"));
+            }
+        }
+        if !(self.thickness_world.is_finite() && self.thickness_world >= 0.0) {
+            return bad(format!("the VO thickness must be >= 0 world units, got {}", self.thickness_world));
+        }
+        Ok(())
+    }
+}
+
+/// VO's radius (zoom units) and strength in `preset` (docs/ground-truth.md); `physical_radius`
+/// is the sampling's own (line 1.5, area 1). Legible: line samples keep the paper's radius,
+/// area samples reach 1.
+pub(crate) fn preset(preset: Preset, settings: &mut ChainSettings, physical_radius: f32) {
+    let (strength, radius) = match preset {
+        Preset::Paper => (1.0, 2.0),
+        Preset::Legible => (0.8, if physical_radius < 1.5 { 1.0 } else { 2.0 }),
+        Preset::Physical => (0.22, physical_radius),
+    };
+    settings.strength = strength;
+    settings.vo.radius_world = radius * settings.zoom_unit;
+}
