@@ -595,6 +595,12 @@ pub struct RenderArgs {
     /// `calibrated`: faint) or `paper` (the papers' values). Explicit options win.
     #[arg(long, default_value = "legible", value_parser = parse_preset)]
     pub preset: lineao::Preset,
+    /// Settings over the preset and every other option: `lineao::ChainSettings` as JSON, a file
+    /// or the text itself (starting with `{`). Only the keys it names change, e.g.
+    /// `{"ssao": {"samples": 12}, "strength": 0.8}` (docs/render.md); not `method`, which
+    /// --method, --compare and --grid choose.
+    #[arg(long, value_name = "FILE|JSON", value_parser = parse_settings)]
+    pub settings: Option<SettingsPatch>,
     /// Disable LineAO's light attenuation (g_light = 1).
     #[arg(long)]
     pub no_light_attenuation: bool,
@@ -675,6 +681,51 @@ pub enum ColorArg {
     Constant([f32; 3]),
     /// A per-vertex field of the file through --colormap.
     Field(String),
+}
+
+/// Keys of `lineao::ChainSettings` in JSON that replace what the options give, checked against
+/// the settings' types when parsed (a typo is a bad command line, naming the key).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SettingsPatch(serde_json::Map<String, serde_json::Value>);
+
+impl SettingsPatch {
+    /// `settings` with the patch's keys: objects merge key by key, anything else replaces.
+    pub fn apply(&self, settings: &lineao::ChainSettings) -> Result<lineao::ChainSettings, String> {
+        fn merge(into: &mut serde_json::Value, patch: &serde_json::Value) {
+            match (into, patch) {
+                (serde_json::Value::Object(into), serde_json::Value::Object(patch)) => {
+                    for (key, value) in patch {
+                        merge(into.entry(key.clone()).or_insert(serde_json::Value::Null), value);
+                    }
+                }
+                (into, patch) => *into = patch.clone(),
+            }
+        }
+        let mut value = serde_json::to_value(settings).map_err(|e| e.to_string())?;
+        merge(&mut value, &serde_json::Value::Object(self.0.clone()));
+        serde_path_to_error::deserialize(value).map_err(|e| match e.path().to_string().as_str() {
+            "." => e.inner().to_string(),
+            path => format!("{path}: {}", e.inner()),
+        })
+    }
+}
+
+fn parse_settings(s: &str) -> Result<SettingsPatch, String> {
+    let (text, source) = if s.trim_start().starts_with('{') {
+        (s.to_string(), "the settings".to_string())
+    } else {
+        (std::fs::read_to_string(s).map_err(|e| format!("{s}: {e}"))?, s.to_string())
+    };
+    let patch = match serde_json::from_str(&text) {
+        Ok(serde_json::Value::Object(map)) => SettingsPatch(map),
+        Ok(_) => return Err(format!("{source}: expected a JSON object of settings")),
+        Err(e) => return Err(format!("{source}: {e}")),
+    };
+    if patch.0.contains_key("method") {
+        return Err(format!("{source}: `method` is chosen by --method, --compare or --grid"));
+    }
+    patch.apply(&lineao::ChainSettings::default()).map_err(|e| format!("{source}: {e}"))?;
+    Ok(patch)
 }
 
 fn parse_preset(s: &str) -> Result<lineao::Preset, String> {

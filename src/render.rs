@@ -155,7 +155,11 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky, lon
     if let Some(range) = args.ssao_range {
         settings.ssao.range_world = range;
     }
-    settings
+    match &args.settings {
+        // Checked against the same types when parsed: it applies to any settings.
+        Some(patch) => patch.apply(&settings).expect("--settings was checked when parsed"),
+        None => settings,
+    }
 }
 
 /// What one image of the output shows: a label, the chain's settings and the object-space
@@ -622,6 +626,28 @@ mod tests {
         // --samples: the panel's own method's, the others' untouched.
         let shown = parse(&["--method", "vo-line", "--samples", "13"])(AoMethod::VoLine);
         assert_eq!((shown.vo.samples, shown.vo.area_samples, shown.ssao.samples), (13, 1, 16));
+    }
+
+    /// `--settings` changes the keys it names, over the preset and the options, and nothing else.
+    #[test]
+    fn settings_as_json_change_only_their_keys() {
+        use clap::Parser;
+        let settings = |extra: &[&str]| {
+            let cli = crate::cli::Cli::parse_from(["lineao", "render", "--ssao-samples", "24"].iter().chain(extra));
+            let crate::cli::Command::Render(args) = cli.command else { panic!("render") };
+            let method = crate::cli::Method { screen: lineao::AoMethod::Ssao, volume: None };
+            super::settings(&args, method, 1.0, lineao::volume::Sky::Uniform, 100.0)
+        };
+        let plain = settings(&[]);
+        assert_eq!(settings(&["--settings", "{}"]), plain);
+        let patched = settings(&["--settings", r#"{"ssao": {"samples": 12}, "strength": 0.25, "blur": {}}"#]);
+        let expected = lineao::ChainSettings {
+            ssao: lineao::SsaoSettings { samples: 12, ..plain.ssao.clone() },
+            strength: 0.25,
+            blur: Some(lineao::BilateralSettings::default()),
+            ..plain
+        };
+        assert_eq!(patched, expected);
     }
 
     #[test]

@@ -46,6 +46,14 @@ fn exit_codes() {
         (&["render", "--method", "vo-line", "--radius", "0"], "--radius"),
         (&["render", "--method", "vo-line", "--vo-radius", "0"], "--vo-radius"),
         (&["render", "--ssao-radius=-1"], "--ssao-radius"),
+        // Settings as JSON are checked against their types, the key named.
+        (
+            &["render", "--settings", r#"{"ssao": {"sample": 12}}"#],
+            "ssao.sample: unknown field `sample`, expected one of `samples`",
+        ),
+        (&["render", "--settings", r#"{"line_ao": {"s_r": "two"}}"#], "line_ao.s_r: invalid type"),
+        (&["render", "--settings", r#"{"method": "ssao"}"#], "--method"),
+        (&["render", "--settings", "/nonexistent/settings.json"], "/nonexistent/settings.json"),
     ] {
         let out = lineao(bad);
         assert_eq!(out.status.code(), Some(2), "{bad:?}: {}", stderr(&out));

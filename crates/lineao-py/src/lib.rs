@@ -273,7 +273,8 @@ fn save(
 }
 
 /// `render`'s command line from keyword arguments: `line_width=2.0` → `--line-width 2.0`,
-/// `grid=True` → `--grid`, `compare=("lineao", "ssao")` → `--compare lineao,ssao`, `None` and
+/// `grid=True` → `--grid`, `compare=("lineao", "ssao")` → `--compare lineao,ssao`, a dict → JSON
+/// (`settings={"ssao": {"samples": 12}}`), `None` and
 /// `False` → left out. Unknown names are a `TypeError` that lists the known ones.
 fn argv(settings: &Bound<'_, PyDict>) -> PyResult<Vec<String>> {
     let command = RenderArgs::augment_args(clap::Command::new("render"));
@@ -299,6 +300,12 @@ fn argv(settings: &Bound<'_, PyDict>) -> PyResult<Vec<String>> {
             if on {
                 argv.push(flag);
             }
+            continue;
+        }
+        // Typed settings as a dict (`settings={"ssao": {"samples": 12}}`) → `--settings` JSON.
+        if value.is_instance_of::<PyDict>() {
+            let json = value.py().import("json")?.call_method1("dumps", (value,))?;
+            argv.extend([flag, json.str()?.to_string()]);
             continue;
         }
         let items: Option<Vec<String>> = if value.is_instance_of::<PyString>() {

@@ -50,6 +50,12 @@ def test_settings_compare_and_grid_are_the_command_lines(lineao_bin, tmp_path):
         lineao_bin, tmp_path, TRK, "--color", "0.8,0.2,0.1", "--background", "0,0,0", "--method", "vo-line", "--width", 320, "--height", 256
     )
     assert (coloured != expected).sum() == 0
+    # Typed settings as a dict are the command line's --settings JSON.
+    typed = lineao.render(t, method="ssao", settings={"ssao": {"samples": 12}, "strength": 0.5}, **SMALL)
+    expected = cli_render(
+        lineao_bin, tmp_path, TRK, "--method", "ssao", "--ssao-samples", 12, "--strength", 0.5, "--width", 320, "--height", 256
+    )
+    assert (typed != expected).sum() == 0
 
 
 def test_names_and_defaults_come_from_the_library():
@@ -132,6 +138,8 @@ def test_bad_input_names_the_argument(tmp_path):
         lineao.render(lineao.load(TRK), width=0)
     with pytest.raises(ValueError, match="unknown method 'bogus'"):
         lineao.render(lineao.load(TRK), method="bogus")
+    with pytest.raises(ValueError, match="ssao.sample: unknown field `sample`"):
+        lineao.render(lineao.load(TRK), settings={"ssao": {"sample": 12}})
     with pytest.raises(ValueError, match="no finite points"):
         lineao.render([])
     with pytest.raises(ValueError, match="outside the"):
