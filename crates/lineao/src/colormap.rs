@@ -9,7 +9,7 @@ named!(Colormap {
     CoolWarm => "Moreland's diverging blue–white–red",
 });
 
-/// Colormaps for [`LineColor::Scalar`], perceptually ordered where it matters.
+/// Colormaps for [`LineColor::Scalar`](crate::LineColor::Scalar), perceptually ordered where it matters.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Colormap {
     /// Matplotlib's viridis: perceptually uniform, readable in grayscale and by most color-blind

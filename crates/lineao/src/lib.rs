@@ -78,7 +78,13 @@ pub use wgpu;
 // What an embedding needs first, at the root.
 pub use camera::{Bounds, Camera, FrameView, Projection};
 pub use chain::AoChain;
+pub use colormap::Colormap;
 pub use gpu::Gpu;
+pub use method::AoMethod;
+pub use method::line_ao::{LineAoOuter, LineAoSettings, LineAoVariant, R0};
+pub use method::raytraced::{RayDenoiseSettings, RayTracedSettings};
+pub use method::ssao::{SsaoKernel, SsaoSettings};
+pub use method::vo_line::{VoCombine, VoSettings};
 pub use passes::composite::OverlayDepth;
 pub use passes::lines::{LineGeometry, LineRenderer, LineStyle};
 pub use passes::meshes::{MeshGeometry, MeshRenderer};
@@ -86,9 +92,8 @@ pub use passes::nd_from_depth::{HostConfig, HostInputs};
 pub use passes::tubes::TubeRenderer;
 pub use ray_scene::{RayGeometry, RayScene};
 pub use settings::{
-    AoMethod, BilateralSettings, ChainSettings, Colormap, DebugView, LineAoOuter, LineAoSettings, LineAoVariant,
-    LineColor, Named, Preset, R0, RayDenoiseSettings, RayTracedSettings, SsaoKernel, SsaoSettings, SurfaceSettings,
-    TubeSettings, VoCombine, VoSettings, VolumeAoSettings,
+    BilateralSettings, ChainSettings, DebugView, LineColor, Named, Preset, SurfaceSettings, TubeSettings,
+    VolumeAoSettings,
 };
 
 // docs/embedding.md's code compiles as it stands: `cargo test --doc` checks it.

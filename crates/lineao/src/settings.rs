@@ -4,12 +4,13 @@
 
 use crate::lighting::Lighting;
 
-pub use crate::colormap::{COLORMAP_ENTRIES, Colormap};
-pub use crate::method::AoMethod;
-pub use crate::method::line_ao::{LineAoOuter, LineAoSettings, LineAoVariant, R0};
-pub use crate::method::raytraced::{RayDenoiseSettings, RayTracedSettings};
-pub use crate::method::ssao::{SsaoKernel, SsaoSettings};
-pub use crate::method::vo_line::{VoCombine, VoSettings};
+// Each method's settings are its folder's (and the crate root's); named here for the crate.
+pub(crate) use crate::colormap::{COLORMAP_ENTRIES, Colormap};
+pub(crate) use crate::method::AoMethod;
+pub(crate) use crate::method::line_ao::{LineAoOuter, LineAoSettings, LineAoVariant, R0};
+pub(crate) use crate::method::raytraced::{RayDenoiseSettings, RayTracedSettings};
+pub(crate) use crate::method::ssao::SsaoSettings;
+pub(crate) use crate::method::vo_line::{VoCombine, VoSettings};
 
 /// A setting with a fixed set of values, each with the name the command line, `params.json` and
 /// CONTRACT.md use and a line of help: what a CLI or a binding (Python, a host's UI) parses and
@@ -428,6 +429,58 @@ impl ChainSettings {
             return bad(format!("debug level {k} does not exist: the pyramid has {} levels", self.levels()));
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod preset_tests {
+    use super::*;
+
+    /// The fitted table (docs/ground-truth.md), written out here apart from the methods' own
+    /// `preset` functions: (strength, s_r, r0 per width, δ scale, reference radius, the method's
+    /// sphere radius in zoom units) for each preset and method, at a zoom unit of 2.
+    #[test]
+    fn each_method_takes_its_presets_values_and_the_others_keep_the_papers() {
+        use AoMethod::*;
+        use LineAoVariant::{Paper as P, Reference as R};
+        let paper = (1.0, 3, 1.5, 1.0, 2.0, 2.0);
+        let table = [
+            (Preset::Legible, LineAo, P, (0.6, 2, 4.5, 1.0, 2.0, 2.0)),
+            (Preset::Legible, LineAo, R, (0.6, 3, 1.5, 1.0, 2.0, 2.0)),
+            (Preset::Legible, VoLine, P, (0.8, 3, 1.5, 1.0, 2.0, 2.0)),
+            (Preset::Legible, VoArea, P, (0.8, 3, 1.5, 1.0, 2.0, 1.0)),
+            (Preset::Legible, Ssao, P, (1.0, 3, 1.5, 1.0, 2.0, 8.0)),
+            (Preset::Physical, LineAo, P, (0.58, 2, 1.5, 0.1, 2.0, 2.0)),
+            (Preset::Physical, LineAo, R, (0.46, 3, 1.5, 1.0, 1.0, 2.0)),
+            (Preset::Physical, VoLine, P, (0.22, 3, 1.5, 1.0, 2.0, 1.5)),
+            (Preset::Physical, VoArea, P, (0.22, 3, 1.5, 1.0, 2.0, 1.0)),
+            (Preset::Physical, Ssao, P, (0.68, 3, 1.5, 1.0, 2.0, 3.0)),
+            (Preset::Legible, None, P, paper),
+            (Preset::Physical, RayTraced, P, paper),
+        ];
+        let cases = table.into_iter().chain([LineAo, VoLine, VoArea, Ssao].map(|m| (Preset::Paper, m, P, paper)));
+        for (preset, method, variant, expected) in cases {
+            let mut start = ChainSettings { method, zoom_unit: 2.0, ..ChainSettings::papers() };
+            start.line_ao.variant = variant;
+            // Whatever an earlier preset left is replaced.
+            let s = start.with_preset(Preset::Physical).with_preset(Preset::Legible).with_preset(preset);
+            let ao = &s.line_ao;
+            let (strength, s_r, r0_per_width, delta_scale, reference_radius, radius) = expected;
+            let sphere = match method {
+                VoLine | VoArea => s.vo.radius_world,
+                _ => s.ssao.radius_world,
+            };
+            let got = (s.strength, ao.s_r, ao.r0_per_width, ao.delta_scale, ao.reference_radius_px, sphere / 2.0);
+            assert_eq!(
+                got,
+                (strength, s_r, r0_per_width, delta_scale, reference_radius, radius),
+                "{preset:?} {method}"
+            );
+            assert_eq!((ao.r0_px, s.ssao.range_world), (Option::None, s.ssao.radius_world), "{preset:?} {method}");
+            // The other methods' spheres are the papers'.
+            let other = if matches!(method, VoLine | VoArea) { s.ssao.radius_world } else { s.vo.radius_world };
+            assert_eq!(other, 4.0, "{preset:?} {method}");
+        }
     }
 }
 

@@ -3,7 +3,7 @@
 //! A method's folder holds everything that is the method's own: its passes and their WGSL, the
 //! [`Stage`] that puts them in the chain, its settings (units, ranges, defaults, validation and
 //! its values in each [`Preset`]), and its CPU reference (re-exported by
-//! [`crate::reference`]). The folder ends in one [`MethodInfo`], and the [`registry!`] below
+//! [`crate::reference`]). The folder ends in one [`MethodInfo`], and the `registry!` below
 //! lists every method by that value. Everything that names methods derives from the registry:
 //! [`AoMethod`] itself, its names and help, the chain's timing spans ([`pass_names`]), the
 //! shaders the naga test validates, the presets, and — in the front ends — the command line's

@@ -7,7 +7,7 @@
 //! agreement (CONTRACT.md "Legibility"):
 //!
 //! - **Darkening** D = 1 − Y/Y_none per geometry pixel, Y the linear-light luminance of the
-//!   composite and Y_none that of the same frame without AO ([`darkening`]).
+//!   composite and Y_none that of the same frame without AO ([`Shading::darkening`]).
 //! - **Pairs** (p, q): p uniform over the geometry pixels, q = p + o with o uniform over the
 //!   integer offsets of the disc of radius r (the centre left out), both geometry, their
 //!   normalized depths apart by more than [`DEPTH_SEPARATION`]. Pairs that fail are drawn again,

@@ -42,7 +42,7 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     shaders: &[("vo_area.wgsl", include_str!("vo_area.wgsl")), ("moments.wgsl", include_str!("moments.wgsl"))],
     build: Some(|device, settings| Box::new(VoArea::new(device, &settings.vo))),
     needs: |_| super::Needs { moments: true, ..super::Needs::default() },
-    preset: |preset, settings| crate::method::vo_line::preset(preset, settings, 1.0),
+    preset: |preset, settings| crate::method::vo_line::preset(preset, settings, 1.0, 1.0),
 };
 use crate::targets::FrameTargets;
 use crate::timing::Span;

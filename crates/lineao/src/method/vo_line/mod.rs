@@ -50,7 +50,7 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     shaders: &[("vo_line.wgsl", include_str!("vo_line.wgsl"))],
     build: Some(|device, settings| Box::new(VoLine::new(device, &settings.vo))),
     needs: |_| super::Needs::default(),
-    preset: |preset, settings| settings::preset(preset, settings, 1.5),
+    preset: |preset, settings| settings::preset(preset, settings, 2.0, 1.5),
 };
 use crate::targets::{AO_FORMAT, FrameTargets, Moments};
 use crate::timing::Span;

@@ -9,7 +9,7 @@ named!(VoCombine {
 });
 
 /// How two occlusions combine: VO at two radii (VO paper, Fig. 8), or object-space AO with the
-/// screen-space method's ([`VolumeAoSettings`]).
+/// screen-space method's ([`VolumeAoSettings`](crate::VolumeAoSettings)).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum VoCombine {
     /// Brightness multiplies: ao = 1 − (1 − ao_small)(1 − ao_large).
@@ -107,13 +107,12 @@ impl VoSettings {
     }
 }
 
-/// VO's radius (zoom units) and strength in `preset` (docs/ground-truth.md); `physical_radius`
-/// is the sampling's own (line 1.5, area 1). Legible: line samples keep the paper's radius,
-/// area samples reach 1.
-pub(crate) fn preset(preset: Preset, settings: &mut ChainSettings, physical_radius: f32) {
+/// VO's radius (zoom units) and strength in `preset` (docs/ground-truth.md), the radii being the
+/// sampling's own: line samples legible 2 and physical 1.5, area samples 1 and 1.
+pub(crate) fn preset(preset: Preset, settings: &mut ChainSettings, legible_radius: f32, physical_radius: f32) {
     let (strength, radius) = match preset {
         Preset::Paper => (1.0, 2.0),
-        Preset::Legible => (0.8, if physical_radius < 1.5 { 1.0 } else { 2.0 }),
+        Preset::Legible => (0.8, legible_radius),
         Preset::Physical => (0.22, physical_radius),
     };
     settings.strength = strength;
