@@ -4,9 +4,9 @@
 //! integration into an existing renderer looks like:
 //!
 //! 1. `AoChain::new` with the host's output format, `resize` with its size;
-//! 2. `enable_host` with what its buffers are (depth samples, reversed-Z, normals);
-//! 3. per frame `prepare_view` with its own view and projection matrices and the scene's bounds;
-//! 4. `encode_host` with its depth, normal and color views into its encoder: the ND and zoom
+//! 2. `HostAo::new` over the chain with what its buffers are (depth samples, reversed-Z, normals);
+//! 3. per frame `HostAo::prepare` with its own view and projection matrices and the scene's bounds;
+//! 4. `HostAo::encode` with its depth, normal and color views into its encoder: the ND and zoom
 //!    maps are derived there, LineAO runs, the composite writes the output.
 //!
 //! ```sh
@@ -16,7 +16,7 @@
 use glam::Vec3;
 use lineao::camera::{Bounds, FrameView};
 use lineao::passes::nd_from_depth::{HostConfig, HostInputs, HostNormals};
-use lineao::{AoChain, ChainSettings};
+use lineao::{AoChain, ChainSettings, HostAo};
 use wgpu::util::DeviceExt;
 
 /// The host's shaders: one vertex stage for both passes (bit-identical depth), Lambert shading.
@@ -98,12 +98,12 @@ fn scene() -> (Vec<Vertex>, Vec<u32>) {
     (vertices, indices)
 }
 
-/// What one frame produced: the image, and the chain with its device (the test reads its
+/// What one frame produced: the image, and the host chain with its device (the test reads its
 /// targets back).
 #[cfg_attr(not(test), allow(dead_code))]
 struct Rendered {
     rgba: Vec<u8>,
-    chain: AoChain,
+    host: HostAo,
     device: wgpu::Device,
     queue: wgpu::Queue,
     settings: ChainSettings,
@@ -252,15 +252,16 @@ fn render(width: u32, height: u32, settings: ChainSettings) -> Result<Rendered, 
     // The occlusion through the public API: the chain writes into the host's output format.
     let mut chain = AoChain::new(&device, wgpu::TextureFormat::Rgba8UnormSrgb, settings.clone())?;
     chain.resize(width, height)?;
-    chain.enable_host(
+    let mut host = HostAo::new(
         &device,
+        chain,
         HostConfig {
             depth_samples: 1,
             reversed_z: true,
             normals: Some(HostNormals { world_space: false, unorm: false }),
         },
     )?;
-    chain.prepare_view(&device, &queue, FrameView::from_matrices(view, proj, width, height, &BOUNDS))?;
+    host.prepare(&device, &queue, FrameView::from_matrices(view, proj, width, height, &BOUNDS))?;
 
     let mut encoder = device.create_command_encoder(&Default::default());
     let clear = |r, g, b| wgpu::Operations {
@@ -308,7 +309,7 @@ fn render(width: u32, height: u32, settings: ChainSettings) -> Result<Rendered, 
         pass.draw_indexed(0..indices.len() as u32, 0, 0..1);
     }
     let inputs = HostInputs { depth: &depth_view, normals: Some(&normal_view), color: Some(&color_view) };
-    chain.encode_host(&device, &mut encoder, &inputs, Some(&output_view))?;
+    host.encode(&device, &mut encoder, &inputs, Some(&output_view))?;
     queue.submit([encoder.finish()]);
 
     let rgba = lineao::readback::read_texture(&device, &queue, &output)?.bytes;
@@ -318,7 +319,7 @@ fn render(width: u32, height: u32, settings: ChainSettings) -> Result<Rendered, 
         up: Vec3::Y,
         projection: lineao::Projection::Perspective { fov_y_deg: FOV_Y_DEG },
     };
-    Ok(Rendered { rgba, chain, device, queue, settings, vertices, indices, camera, bounds: BOUNDS })
+    Ok(Rendered { rgba, host, device, queue, settings, vertices, indices, camera, bounds: BOUNDS })
 }
 
 /// How a method's occlusion compares with the truth ray traced on the host's own triangles
@@ -338,7 +339,7 @@ struct MeshScore {
 fn measure(r: &Rendered, reach: f32, rays: u32) -> Result<MeshScore, Box<dyn std::error::Error>> {
     use lineao::truth::{Bvh, Frame, TruthSettings};
     let (d, q) = (&r.device, &r.queue);
-    let targets = r.chain.targets().ok_or("no frame")?;
+    let targets = r.host.chain().targets().ok_or("no frame")?;
     let nd = lineao::verify::read_rgba(d, q, &targets.nd[0])?;
     let ao = lineao::verify::read_f32(d, q, targets.shown())?;
     let positions: Vec<[f32; 3]> = r.vertices.iter().map(|v| v.position).collect();
@@ -461,8 +462,8 @@ mod tests {
         };
         let r = super::render(200, 150, settings).unwrap();
         let (d, q) = (&r.device, &r.queue);
-        let t = r.chain.targets().unwrap();
-        let view = *r.chain.frame_view().unwrap();
+        let t = r.host.chain().targets().unwrap();
+        let view = *r.host.chain().frame_view().unwrap();
         let nd: Vec<_> = t.nd.iter().map(|level| read_rgba(d, q, level).unwrap()).collect();
         let zoom = read_f32(d, q, &t.zoom).unwrap();
         let gpu = read_f32(d, q, &t.ao).unwrap();

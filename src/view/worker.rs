@@ -338,9 +338,7 @@ fn render_frame(
         }
         let panel = &mut chains[i];
         let chain = &mut panel.chain;
-        if chain.timing() != view.timings {
-            chain.set_timing(d, q, view.timings);
-        }
+        chain.set_timing(d, q, view.timings);
         chain.resize(size.0, size.1).map_err(|e| e.to_string())?;
         submit_frame(gpu, chain, (geometry, &[]), (&view.camera, &bounds), &target.view);
         times.push(if view.timings { chain.pass_times(d).map_err(|e| e.to_string())? } else { None });

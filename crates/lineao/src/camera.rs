@@ -150,7 +150,7 @@ impl FrameView {
     /// [`FrameView::new`]; f_px = `proj[1][1]` · H / 2; the projection is orthographic when
     /// its last row is (0, 0, 0, 1). The frustum must be symmetric.
     ///
-    /// The zoom unit is the chain's ([`crate::ChainSettings::zoom_unit`]): [`crate::AoChain::prepare_view`]
+    /// The zoom unit is the chain's ([`crate::ChainSettings::zoom_unit`]): [`crate::HostAo::prepare`]
     /// sets it, so it is said in one place; this view holds 1 until then.
     pub fn from_matrices(view: Mat4, proj: Mat4, width: u32, height: u32, bounds: &Bounds) -> Self {
         let c_z = view.transform_point3(bounds.center).z;

@@ -77,7 +77,7 @@ pub use wgpu;
 
 // What an embedding needs first, at the root.
 pub use camera::{Bounds, Camera, FrameView, Projection};
-pub use chain::AoChain;
+pub use chain::{AoChain, HostAo, OverlayAo};
 pub use colormap::Colormap;
 pub use gpu::Gpu;
 pub use method::AoMethod;

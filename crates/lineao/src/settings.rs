@@ -338,7 +338,7 @@ impl ChainSettings {
         self
     }
 
-    /// Settings for a host's triangle meshes (`AoChain::encode_host`) in a scene of bounding
+    /// Settings for a host's triangle meshes ([`crate::HostAo`]) in a scene of bounding
     /// radius `scene_radius` (world units), chosen against the ray-traced truth: Volumetric
     /// Obscurance with line samples, the normal clamp and a thickness of one radius, reaching
     /// a tenth of the scene's radius, strength 1.75, then the bilateral blur.

@@ -13,7 +13,7 @@ use lineao::passes::nd_from_depth::{HostConfig, HostInputs, HostNormals};
 use lineao::reference::tubes::pixel_ray;
 use lineao::reference::{Image, NdImage};
 use lineao::verify::{read_f32, read_rgba};
-use lineao::{AoChain, AoMethod, ChainSettings, TubeSettings};
+use lineao::{AoChain, AoMethod, ChainSettings, HostAo, OverlayAo, TubeSettings};
 
 /// What the host path leaves in the chain's targets.
 struct HostFrame {
@@ -34,12 +34,12 @@ fn run_host(
     let (d, q) = (&gpu.device, &gpu.queue);
     let mut chain = AoChain::new(d, common::OUTPUT_FORMAT, settings).unwrap();
     chain.resize(view.width, view.height).unwrap();
-    chain.enable_host(d, config).unwrap();
-    chain.prepare_view(d, q, view).unwrap();
+    let mut host = HostAo::new(d, chain, config).unwrap();
+    host.prepare(d, q, view).unwrap();
     let mut encoder = d.create_command_encoder(&Default::default());
-    chain.encode_host(d, &mut encoder, &HostInputs { depth, normals, color: None }, None).unwrap();
+    host.encode(d, &mut encoder, &HostInputs { depth, normals, color: None }, None).unwrap();
     q.submit([encoder.finish()]);
-    let t = chain.targets().unwrap();
+    let t = host.chain().targets().unwrap();
     HostFrame {
         nd: read_rgba(d, q, &t.nd[0]).unwrap(),
         zoom: read_f32(d, q, &t.zoom).unwrap(),
@@ -351,11 +351,14 @@ fn host_api_misuse_is_an_error_that_says_what_to_change() {
     let mut chain = AoChain::new(d, common::OUTPUT_FORMAT, ChainSettings::default()).unwrap();
     chain.resize(size.0, size.1).unwrap();
     let mut encoder = d.create_command_encoder(&Default::default());
-    expect(chain.encode_host(d, &mut encoder, &inputs, None), "enable_host");
-    pollster::block_on(chain.enable_host_async(d, HostConfig::default())).unwrap();
-    expect(chain.encode_host(d, &mut encoder, &inputs, None), "prepare_view");
-    expect(chain.prepare_view(d, q, view((32, 32))).map(|_| ()), "resize");
-    chain.prepare_view(d, q, view(size)).unwrap().expect("a view at the chain's size");
+    // A sample count no texture has (an encode before making a HostAo cannot be written).
+    let no_samples = HostConfig { depth_samples: 0, ..HostConfig::default() };
+    let refused = HostAo::new(d, AoChain::new(d, common::OUTPUT_FORMAT, ChainSettings::default()).unwrap(), no_samples);
+    assert!(matches!(&refused, Err(lineao::Error::InvalidSettings(t)) if t.contains("1..=32")), "{:?}", refused.err());
+    let mut host = pollster::block_on(HostAo::new_async(d, chain, HostConfig::default())).unwrap();
+    expect(host.encode(d, &mut encoder, &inputs, None), "HostAo::prepare");
+    expect(host.prepare(d, q, view((32, 32))).map(|_| ()), "resize");
+    host.prepare(d, q, view(size)).unwrap().expect("a view at the chain's size");
 
     let unsampled = texture(&gpu, size, F::Depth32Float, U::RENDER_ATTACHMENT, 1);
     let multisampled = texture(&gpu, size, F::Depth32Float, depth_usage, 4);
@@ -373,37 +376,37 @@ fn host_api_misuse_is_an_error_that_says_what_to_change() {
         (with(&depth, None, Some(&uint_color)), "float or unorm"),
         (with(&depth, None, Some(&small_color)), "32×32"),
     ] {
-        expect(chain.encode_host(d, &mut encoder, &inputs, None), says);
+        expect(host.encode(d, &mut encoder, &inputs, None), says);
     }
     // Normals promised but not passed.
     let normals =
         HostConfig { normals: Some(HostNormals { world_space: false, unorm: true }), ..HostConfig::default() };
-    chain.enable_host(d, normals).unwrap();
-    expect(chain.encode_host(d, &mut encoder, &with(&depth, None, None), None), "HostInputs::normals is None");
-    chain.enable_host(d, HostConfig::default()).unwrap();
+    host.set_config(d, normals).unwrap();
+    expect(host.encode(d, &mut encoder, &with(&depth, None, None), None), "HostInputs::normals is None");
+    host.set_config(d, HostConfig::default()).unwrap();
 
     // The composite's target: its format, its size, its usage.
     let wrong_format = texture(&gpu, size, F::Rgba16Float, U::RENDER_ATTACHMENT, 1);
     let wrong_size = texture(&gpu, (32, 32), common::OUTPUT_FORMAT, U::RENDER_ATTACHMENT, 1);
     let not_attachment = texture(&gpu, size, common::OUTPUT_FORMAT, U::TEXTURE_BINDING, 1);
-    expect(chain.encode_host(d, &mut encoder, &inputs, Some(&wrong_format)), "the chain was made for");
-    expect(chain.encode_host(d, &mut encoder, &inputs, Some(&wrong_size)), "32×32");
-    expect(chain.encode_host(d, &mut encoder, &inputs, Some(&not_attachment)), "RENDER_ATTACHMENT");
+    expect(host.encode(d, &mut encoder, &inputs, Some(&wrong_format)), "the chain was made for");
+    expect(host.encode(d, &mut encoder, &inputs, Some(&wrong_size)), "32×32");
+    expect(host.encode(d, &mut encoder, &inputs, Some(&not_attachment)), "RENDER_ATTACHMENT");
 
     // What is right records, and the frame runs without a validation error.
     let scope = d.push_error_scope(wgpu::ErrorFilter::Validation);
-    chain.encode_host(d, &mut encoder, &inputs, Some(&output)).unwrap();
+    host.encode(d, &mut encoder, &inputs, Some(&output)).unwrap();
     q.submit([encoder.finish()]);
     assert!(pollster::block_on(scope.pop()).is_none(), "a checked frame must be valid");
 
     // 0 × 0: nothing to record, no error.
-    chain.resize(0, 0).unwrap();
-    assert!(chain.prepare_view(d, q, view((0, 0))).unwrap().is_none());
+    host.chain_mut().resize(0, 0).unwrap();
+    assert!(host.prepare(d, q, view((0, 0))).unwrap().is_none());
     let mut encoder = d.create_command_encoder(&Default::default());
-    chain.encode_host(d, &mut encoder, &inputs, None).unwrap();
+    host.encode(d, &mut encoder, &inputs, None).unwrap();
 }
 
-/// `encode_overlay` draws the lines into a host's frame: the host's colour stays on the
+/// `OverlayAo` draws the lines into a host's frame: the host's colour stays on the
 /// background and where its depth is nearer; the lines' pixels equal `encode`'s, and the depth
 /// they leave is the host projection's depth of their view-space z (reversed-Z with an infinite
 /// far plane, and standard depth), tested against what the host drew before.
@@ -435,6 +438,7 @@ fn the_overlay_keeps_the_hosts_frame_and_writes_its_depth() {
     let g = view.guard as usize;
     let nd_at = |x: usize, y: usize| nd.data[(y + g) * nd.width + x + g];
     let z_of = |x, y| -(view.near + nd_at(x, y)[3] * (view.far - view.near));
+    let mut overlay = OverlayAo::new(d, chain, None).unwrap();
 
     for (name, proj) in [("reversed-Z, infinite far", reversed_infinite), ("standard", standard)] {
         let depth_at = |z: f32| proj.project_point3(Vec3::new(0.0, 0.0, z)).z;
@@ -475,11 +479,9 @@ fn the_overlay_keeps_the_hosts_frame_and_writes_its_depth() {
             occlusion_query_set: None,
             multiview_mask: None,
         });
-        chain
-            .enable_overlay(d, Some(lineao::OverlayDepth { format: wgpu::TextureFormat::Depth32Float, proj }))
-            .unwrap();
-        chain.prepare(d, q, &camera, &bounds).unwrap();
-        chain.encode_overlay(&mut encoder, &geometry, &[], &color.view, Some(&depth_view)).unwrap();
+        overlay.set_depth(d, Some(lineao::OverlayDepth { format: wgpu::TextureFormat::Depth32Float, proj })).unwrap();
+        overlay.chain_mut().prepare(d, q, &camera, &bounds).unwrap();
+        overlay.encode(&mut encoder, &geometry, &[], &color.view, Some(&depth_view)).unwrap();
         q.submit([encoder.finish()]);
         let shown = read_texture_vec4(&gpu, &color.texture);
         let depths: Vec<f32> =
@@ -509,22 +511,22 @@ fn the_overlay_keeps_the_hosts_frame_and_writes_its_depth() {
         assert!(worst < 1e-5, "{name}: depth {worst}");
     }
 
-    // Misuse: a depth the overlay was not enabled for, or none where it was.
+    // Misuse: a depth the overlay was not made for, or none where it was (an overlay encode
+    // before the overlay is made cannot be written).
     let other = texture(&gpu, size, wgpu::TextureFormat::Depth24Plus, wgpu::TextureUsages::RENDER_ATTACHMENT, 1);
     let output = lineao::targets::Target::output(d, "test::output", size, common::OUTPUT_FORMAT);
     let mut encoder = d.create_command_encoder(&Default::default());
-    let result = chain.encode_overlay(&mut encoder, &geometry, &[], &output.view, Some(&other));
+    let result = overlay.encode(&mut encoder, &geometry, &[], &output.view, Some(&other));
     assert!(matches!(&result, Err(lineao::Error::Usage(t)) if t.contains("Depth24Plus")), "{result:?}");
-    let result = chain.encode_overlay(&mut encoder, &geometry, &[], &output.view, None);
+    let result = overlay.encode(&mut encoder, &geometry, &[], &output.view, None);
     assert!(matches!(&result, Err(lineao::Error::Usage(t)) if t.contains("got none")), "{result:?}");
-    chain.enable_overlay(d, None).unwrap();
-    let result = chain.encode_overlay(&mut encoder, &geometry, &[], &output.view, Some(&other));
+    overlay.set_depth(d, None).unwrap();
+    let result = overlay.encode(&mut encoder, &geometry, &[], &output.view, Some(&other));
     assert!(matches!(&result, Err(lineao::Error::Usage(t)) if t.contains("without one")), "{result:?}");
-    let fresh = AoChain::new(d, common::OUTPUT_FORMAT, ChainSettings::default()).unwrap();
-    let result = fresh.encode_overlay(&mut encoder, &geometry, &[], &output.view, None);
-    assert!(matches!(&result, Err(lineao::Error::Usage(t)) if t.contains("enable_overlay")), "{result:?}");
     let bad = lineao::OverlayDepth { format: wgpu::TextureFormat::Rgba8Unorm, proj: standard };
-    assert!(matches!(chain.enable_overlay(d, Some(bad)), Err(lineao::Error::Usage(_))));
+    assert!(matches!(overlay.set_depth(d, Some(bad)), Err(lineao::Error::Usage(_))));
+    let fresh = AoChain::new(d, common::OUTPUT_FORMAT, ChainSettings::default()).unwrap();
+    assert!(matches!(OverlayAo::new(d, fresh, Some(bad)), Err(lineao::Error::Usage(_))));
 }
 
 fn read_texture_vec4(gpu: &lineao::Gpu, texture: &wgpu::Texture) -> Vec<[f32; 4]> {
@@ -546,17 +548,17 @@ fn geometry_outside_the_bounds_is_counted() {
     let depth = depth.create_view(&Default::default());
     let mut chain = AoChain::new(d, common::OUTPUT_FORMAT, ChainSettings::default()).unwrap();
     chain.resize(size.0, size.1).unwrap();
-    assert_eq!(chain.pixels_outside_bounds(d).unwrap(), None, "no host frame yet");
-    chain.enable_host(d, HostConfig::default()).unwrap();
+    let mut host = HostAo::new(d, chain, HostConfig::default()).unwrap();
+    assert_eq!(host.pixels_outside_bounds(d).unwrap(), None, "no host frame yet");
     for (scale, name) in [(1.0, "the sphere's bounds"), (0.5, "half its radius")] {
         let bounds = Bounds { center: centre, radius: radius * scale };
         let view = FrameView::from_matrices(view_matrix, proj, size.0, size.1, &bounds);
-        chain.prepare_view(d, q, view).unwrap();
+        host.prepare(d, q, view).unwrap();
         let mut encoder = d.create_command_encoder(&Default::default());
-        chain.encode_host(d, &mut encoder, &HostInputs { depth: &depth, normals: None, color: None }, None).unwrap();
+        host.encode(d, &mut encoder, &HostInputs { depth: &depth, normals: None, color: None }, None).unwrap();
         q.submit([encoder.finish()]);
         d.poll(wgpu::PollType::wait_indefinitely()).unwrap();
-        let counted = chain.pixels_outside_bounds(d).unwrap().expect("the frame has run");
+        let counted = host.pixels_outside_bounds(d).unwrap().expect("the frame has run");
         // The analytic count: pixels whose sphere hit lies outside [near, far].
         let inv_proj = proj.inverse();
         let sphere_view = (view_matrix * centre.extend(1.0)).xyz();

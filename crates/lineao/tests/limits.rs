@@ -120,6 +120,8 @@ fn what_the_device_cannot_do_is_a_clear_error() {
 fn a_chain_can_move_between_threads_and_be_shared() {
     fn send_and_sync<T: Send + Sync>() {}
     send_and_sync::<AoChain>();
+    send_and_sync::<lineao::HostAo>();
+    send_and_sync::<lineao::OverlayAo>();
     send_and_sync::<LineGeometry>();
 }
 

@@ -325,18 +325,19 @@ fn a_host_renderers_depth_traces_like_the_cpu_truth_through_the_embedding_api() 
     s.raytraced.distance_world = 3.0;
     let mut chain = AoChain::new(d, OUTPUT_FORMAT, s.clone()).unwrap();
     chain.resize(SIZE.0, SIZE.1).unwrap();
-    chain.enable_host(d, HostConfig::default()).unwrap();
     let meshes = [(&triangles[..], &indices[..])];
     let geometry = RayGeometry { meshes: &meshes, ..Default::default() };
     chain.set_ray_scene(d, Some(Arc::new(RayScene::new(d, q, &geometry).unwrap())));
+    let mut host = lineao::HostAo::new(d, chain, HostConfig::default()).unwrap();
     let view = lineao::FrameView::from_matrices(view_matrix, proj, SIZE.0, SIZE.1, &bounds);
     let inputs = HostInputs { depth: &depth, normals: None, color: None };
     for _ in 0..2 {
-        chain.prepare_view(d, q, view).unwrap();
+        host.prepare(d, q, view).unwrap();
         let mut encoder = d.create_command_encoder(&Default::default());
-        chain.encode_host(d, &mut encoder, &inputs, None).unwrap();
+        host.encode(d, &mut encoder, &inputs, None).unwrap();
         q.submit([encoder.finish()]);
     }
+    let chain = host.chain();
     assert_eq!(chain.ray_progress().unwrap().rays_per_pixel, 16);
     let t = chain.targets().unwrap();
     let (nd, ao) = (read_rgba(d, q, &t.nd[0]).unwrap(), read_f32(d, q, &t.ao).unwrap());

@@ -477,7 +477,7 @@ fn area_sampling_guards_twice_the_sphere_for_its_footprints() {
         )
         .unwrap();
         chain.resize(240, 180).unwrap();
-        chain.guard_for(&perspective, &bounds)
+        chain.prepare(&gpu.device, &gpu.queue, &perspective, &bounds).unwrap().guard
     };
     let (line, area) = (guard(AoMethod::VoLine), guard(AoMethod::VoArea));
     assert!(line > 2 && area + 1 >= 2 * line && area <= 2 * line + 1, "line {line}, area {area}");

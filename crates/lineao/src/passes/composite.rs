@@ -14,7 +14,7 @@
 //! Debug views show the AO alone, the normals, the depth, the zoom map or one pyramid level.
 //! The CPU reference is [`crate::reference::composite`].
 //!
-//! As an overlay ([`Composite::set_overlay`], [`crate::AoChain::encode_overlay`]) it draws only
+//! As an overlay ([`Composite::set_overlay`], [`crate::OverlayAo`]) it draws only
 //! the geometry's pixels into a host's frame: the background is discarded, so the host's colour
 //! stays, and with the host's depth attachment each pixel writes the geometry's depth as the
 //! host's projection puts it, tested against what the host drew before (so lines hide behind

@@ -20,7 +20,7 @@
 //! The scene's bounds ([`FrameView::from_matrices`]) set the normalized depth range: geometry
 //! nearer than their near end or beyond their far end is clamped to it and gets wrong
 //! occlusion. Each frame counts such pixels ([`NdFromDepth::try_outside`], through
-//! `AoChain::pixels_outside_bounds`), so a host whose bounds miss part of its scene hears of it.
+//! `HostAo::pixels_outside_bounds`), so a host whose bounds miss part of its scene hears of it.
 //!
 //! Background is where the depth equals the host's clear depth (1, or 0 for reversed-Z). The
 //! projection must be symmetric (the optical axis at the image centre), as the VO and SSAO passes
@@ -98,7 +98,7 @@ pub fn check_inputs(config: &HostConfig, inputs: &HostInputs, size: (u32, u32)) 
     if depth.sample_count() != config.depth_samples {
         return Err(Error::Usage(format!(
             "the host depth has {} samples per pixel but HostConfig::depth_samples is {}: \
-             call enable_host with the depth's sample count",
+             make the HostAo with the depth's sample count",
             depth.sample_count(),
             config.depth_samples
         )));
@@ -107,7 +107,7 @@ pub fn check_inputs(config: &HostConfig, inputs: &HostInputs, size: (u32, u32)) 
         (Some(_), None) => {
             return Err(Error::Usage(
                 "normals were passed but HostConfig::normals is None: say how they are stored in \
-                 enable_host, or pass none (normals then come from the depth)"
+                 HostConfig, or pass none (normals then come from the depth)"
                     .into(),
             ));
         }

@@ -23,6 +23,10 @@
 //! pixel's normal (`volume_ao`), and the composite shows it alone (method `None`) or combined
 //! with the method's occlusion.
 //!
+//! Two wrappers embed the chain in a host renderer: [`HostAo`] runs it over the host's own depth
+//! (and normals, color) instead of lineao's lines, and [`OverlayAo`] draws lineao's lines with
+//! their occlusion into the host's frame.
+//!
 //! Each method is a [`crate::method::Stage`]: the chain builds only the active method's stage
 //! (keeping a few built ones for settings it may switch back to), asks it how far it reads for
 //! the guard band and which timing spans it records, and binds, prepares and records it without
@@ -33,6 +37,9 @@
 //! the names `lineao bench` uses (CONTRACT.md): `lines`, `nd-pyramid`, `lineao`, `raytraced`,
 //! `ray-denoise`, `ssao`, `ssao-blur`, `vo-line`, `moments`, `vo-area`, `blur`, `volume-ao`, `composite`.
 
+mod host;
+mod overlay;
+
 use std::sync::Arc;
 
 use crate::Error;
@@ -41,11 +48,10 @@ use crate::gbuffer::Load;
 use crate::method::raytraced::RayProgress;
 use crate::method::{self, Reach};
 use crate::passes::bilateral::Bilateral;
-use crate::passes::composite::{Composite, OverlayDepth, Shown};
+use crate::passes::composite::{Composite, Shown};
 use crate::passes::lines::LineStyle;
 use crate::passes::lines::{LineGeometry, LineRenderer};
 use crate::passes::meshes::{MeshGeometry, MeshRenderer};
-use crate::passes::nd_from_depth::{HostConfig, HostInputs, NdFromDepth};
 use crate::passes::tubes::TubeRenderer;
 use crate::passes::volume_ao::VolumeAo;
 use crate::ray_scene::RayScene;
@@ -54,6 +60,9 @@ use crate::stage::Stages;
 use crate::targets::{FrameTargets, Moments};
 use crate::timing::{PassTime, PassTimer, Span};
 
+pub use host::HostAo;
+pub use overlay::OverlayAo;
+
 pub struct AoChain {
     settings: ChainSettings,
     lines: LineRenderer,
@@ -61,8 +70,6 @@ pub struct AoChain {
     tubes: Option<TubeRenderer>,
     /// Made when the settings ask for context surfaces.
     meshes: Option<MeshRenderer>,
-    /// Made by [`AoChain::enable_host`].
-    host: Option<NdFromDepth>,
     /// The method's stage (built for the active method only; [`crate::stage`]).
     stages: Stages,
     bilateral: Bilateral,
@@ -112,7 +119,6 @@ impl AoChain {
             lines: LineRenderer::with_outputs(device, LineStyle::Quads, settings.volume.is_some()),
             tubes: settings.tubes.as_ref().map(|_| TubeRenderer::new(device, settings.volume.is_some())),
             meshes: settings.surfaces.as_ref().map(|_| MeshRenderer::new(device, settings.volume.is_some())),
-            host: None,
             bilateral: Bilateral::new(device),
             volume_ao: settings.volume.as_ref().map(|_| VolumeAo::new(device)),
             composite: Composite::new(device, format),
@@ -202,15 +208,13 @@ impl AoChain {
         self.stages.ray_tracer().and_then(|tracer| tracer.accumulation())
     }
 
-    /// Turns per-pass GPU timing on or off. Returns whether timing is on: it stays off on
-    /// adapters without timestamp queries.
+    /// Turns per-pass GPU timing on or off (a timer that is on stays as it is, so a host may
+    /// call it every frame). Returns whether timing is on: it stays off on adapters without
+    /// timestamp queries.
     pub fn set_timing(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, enabled: bool) -> bool {
-        self.timer = if enabled { PassTimer::new(device, queue, &method::pass_names()) } else { None };
-        self.timer.is_some()
-    }
-
-    /// Whether per-pass GPU timing is on.
-    pub fn timing(&self) -> bool {
+        if enabled != self.timer.is_some() {
+            self.timer = if enabled { PassTimer::new(device, queue, &method::pass_names()) } else { None };
+        }
         self.timer.is_some()
     }
 
@@ -281,7 +285,7 @@ impl AoChain {
     }
 
     /// The guard band for this view: the largest sampling radius over the image (CONTRACT.md).
-    pub fn guard_for(&self, camera: &Camera, bounds: &Bounds) -> u32 {
+    fn guard_for(&self, camera: &Camera, bounds: &Bounds) -> u32 {
         let s = &self.settings;
         // Plain lines read no neighbours on screen.
         let Some(stage) = self.stages.active() else { return 0 };
@@ -316,12 +320,9 @@ impl AoChain {
         self.prepare_frame(device, queue, view)
     }
 
-    /// [`AoChain::prepare`] for a view made elsewhere: a host's own matrices
-    /// ([`FrameView::from_matrices`], no guard band) for [`AoChain::encode_host`]. `Ok(None)`
-    /// while the chain is 0 × 0 (nothing is recorded then); a view of another size than the
-    /// chain's is an [`Error::Usage`]. The view's zoom unit is replaced by
-    /// [`ChainSettings::zoom_unit`], the one place it is set.
-    pub fn prepare_view(
+    /// [`AoChain::prepare`] for a view made elsewhere (a host's own matrices); the view's zoom
+    /// unit is replaced by [`ChainSettings::zoom_unit`], the one place it is set.
+    fn prepare_view(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -331,7 +332,7 @@ impl AoChain {
         if (view.width, view.height) != (width, height) {
             self.view = None;
             return Err(Error::Usage(format!(
-                "prepare_view with a {}×{} view but the chain is {width}×{height}: call AoChain::resize first",
+                "a {}×{} view but the chain is {width}×{height}: resize the chain first",
                 view.width, view.height
             )));
         }
@@ -378,9 +379,6 @@ impl AoChain {
             self.targets = Some(targets);
         }
         let targets = self.targets.as_ref()?;
-        if let Some(host) = &self.host {
-            host.prepare(queue, &view);
-        }
         match (&self.tubes, &s.tubes) {
             (Some(tubes), Some(t)) => tubes.prepare(queue, &view, t.radius_world, s.line_color, &s.lighting),
             _ => self.lines.prepare(queue, &view, s.line_width_px, s.line_color, &s.lighting),
@@ -406,114 +404,6 @@ impl AoChain {
         self.composite.prepare(queue, targets, &view, strength, s.debug_view, shown);
         self.view = Some(view);
         Some(view)
-    }
-
-    /// Makes the chain ready for a host renderer's own buffers ([`AoChain::encode_host`]): its
-    /// depth's samples and convention and whether it has normals. Host frames use
-    /// [`AoChain::prepare_view`] with the host's matrices.
-    pub fn enable_host(&mut self, device: &wgpu::Device, config: HostConfig) -> Result<(), Error> {
-        pollster::block_on(self.enable_host_async(device, config))
-    }
-
-    /// [`AoChain::enable_host`] as a future.
-    pub async fn enable_host_async(&mut self, device: &wgpu::Device, config: HostConfig) -> Result<(), Error> {
-        if config.depth_samples == 0 || config.depth_samples > 32 {
-            return Err(Error::InvalidSettings(format!(
-                "depth samples must be in 1..=32, got {}",
-                config.depth_samples
-            )));
-        }
-        if self.host.as_ref().is_none_or(|h| h.config() != config) {
-            let host =
-                crate::gpu::validated_async(device, "creating the host pass", || NdFromDepth::new(device, config));
-            self.host = Some(host.await?);
-        }
-        Ok(())
-    }
-
-    /// Records a frame over a host renderer's own buffers (after [`AoChain::enable_host`] and
-    /// [`AoChain::prepare_view`]): the G-buffer derived from its depth, normals and color
-    /// ([`crate::passes::nd_from_depth`]), the method, and the composite into `target`; or only
-    /// the AO (`target` `None`), which the host then reads from [`AoChain::ao_view`].
-    ///
-    /// Writes nothing to the queue. Every texture is checked first
-    /// ([`crate::passes::nd_from_depth::check_inputs`] has the table): a missing call or a
-    /// texture of the wrong size, format, usage or sample count is an [`Error::Usage`] saying
-    /// what to change, with nothing recorded. At 0 × 0 it records nothing and returns `Ok`.
-    ///
-    /// ```no_run
-    /// use lineao::glam::{Mat4, Vec3};
-    /// use lineao::{AoChain, Bounds, ChainSettings, FrameView, HostConfig, HostInputs, wgpu};
-    ///
-    /// /// One frame of a host that has drawn its scene into `depth` (Depth32Float, usage
-    /// /// RENDER_ATTACHMENT | TEXTURE_BINDING, stored) and `color`, seen through `view`, `proj`.
-    /// fn frame(
-    ///     device: &wgpu::Device,
-    ///     queue: &wgpu::Queue,
-    ///     (depth, color, output): (&wgpu::TextureView, &wgpu::TextureView, &wgpu::TextureView),
-    ///     (view, proj): (Mat4, Mat4),
-    /// ) -> Result<(), lineao::Error> {
-    ///     let (width, height) = (1280, 1024);
-    ///     // Once: the composite's format, the size, what the host's depth is like.
-    ///     let mut chain = AoChain::new(device, wgpu::TextureFormat::Rgba8UnormSrgb, ChainSettings::default())?;
-    ///     chain.resize(width, height)?;
-    ///     chain.enable_host(device, HostConfig { depth_samples: 1, reversed_z: false, normals: None })?;
-    ///     // Per frame: the host's matrices, and the sphere that holds the scene (its depth range).
-    ///     let bounds = Bounds { center: Vec3::ZERO, radius: 100.0 };
-    ///     chain.prepare_view(device, queue, FrameView::from_matrices(view, proj, width, height, &bounds))?;
-    ///     let mut encoder = device.create_command_encoder(&Default::default());
-    ///     let inputs = HostInputs { depth, normals: None, color: Some(color) };
-    ///     chain.encode_host(device, &mut encoder, &inputs, Some(output))?;
-    ///     queue.submit([encoder.finish()]);
-    ///     Ok(())
-    /// }
-    /// ```
-    pub fn encode_host(
-        &self,
-        device: &wgpu::Device,
-        encoder: &mut wgpu::CommandEncoder,
-        inputs: &HostInputs,
-        target: Option<&wgpu::TextureView>,
-    ) -> Result<(), Error> {
-        let Some(host) = &self.host else {
-            return Err(Error::Usage("encode_host before enable_host: call AoChain::enable_host once first".into()));
-        };
-        if self.size.0 == 0 || self.size.1 == 0 {
-            return Ok(());
-        }
-        let (Some(targets), Some(_)) = (&self.targets, &self.view) else {
-            return Err(Error::Usage(
-                "encode_host before prepare_view: call AoChain::prepare_view with the frame's matrices first".into(),
-            ));
-        };
-        crate::passes::nd_from_depth::check_inputs(&host.config(), inputs, self.size)?;
-        if let Some(target) = target {
-            self.check_target(target)?;
-        }
-        let span = |name| self.timer.as_ref().and_then(|t| t.span(name));
-        encoder.push_debug_group("lineao");
-        host.encode(device, encoder, targets, inputs, span("lines"));
-        self.encode_method(encoder, targets, &span);
-        if let Some(target) = target {
-            self.composite.encode(encoder, target, span("composite"));
-        }
-        if let Some(timer) = &self.timer {
-            timer.resolve(encoder);
-        }
-        encoder.pop_debug_group();
-        Ok(())
-    }
-
-    /// Never waits: how many pixels of an earlier [`AoChain::encode_host`] frame showed geometry
-    /// outside the bounds given to [`FrameView::from_matrices`] (nearer than their near end or
-    /// beyond their far end: clamped there, so their occlusion is wrong), once the GPU has
-    /// finished that frame; `None` while it has not, or without [`AoChain::enable_host`]. A host
-    /// asks once per frame and, seeing a count above 0, grows its bounds.
-    pub fn pixels_outside_bounds(&self, device: &wgpu::Device) -> Result<Option<u32>, Error> {
-        match &self.host {
-            Some(host) => host.try_outside(device),
-            None => Ok(None),
-        }
     }
 
     /// The composite's target: a render attachment of the chain's format and visible size.
@@ -575,94 +465,49 @@ impl AoChain {
         meshes: &[&MeshGeometry],
         target: &wgpu::TextureView,
     ) {
-        self.encode_frame(encoder, geometry, meshes, |composite, encoder, span| {
-            composite.encode(encoder, target, span)
-        });
+        self.record(
+            encoder,
+            |encoder, targets, span| self.draw_geometry(encoder, targets, geometry, meshes, span),
+            |composite, encoder, span| composite.encode(encoder, target, span),
+        );
     }
 
-    /// Makes the chain ready to draw into a host's frame ([`AoChain::encode_overlay`]), keeping
-    /// the host's picture; with `depth`, the lines also write (and test against) the host's
-    /// depth as its projection `depth.proj` puts them, so the host can draw after lineao. Call
-    /// again when the host's projection changes (cheap: the pipeline is rebuilt only for a new
-    /// depth format or direction); it takes effect at the next `prepare`. A `depth.format`
-    /// without a depth aspect is an [`Error::Usage`].
-    pub fn enable_overlay(&mut self, device: &wgpu::Device, depth: Option<OverlayDepth>) -> Result<(), Error> {
-        if let Some(d) = depth
-            && !d.format.has_depth_aspect()
-        {
-            return Err(Error::Usage(format!("the overlay's depth format {:?} is not a depth format", d.format)));
-        }
-        self.composite.set_overlay(device, depth);
-        Ok(())
-    }
-
-    /// [`AoChain::encode_with_meshes`] drawn into a host's frame (after
-    /// [`AoChain::enable_overlay`] and `prepare`): `target`'s colour is loaded, not cleared, and
-    /// only the geometry's pixels are written (the background shows the host's picture);
-    /// `depth`, required when the overlay was enabled with depth and refused otherwise, gets the
-    /// lines' depth at the visible size. Both are the chain's visible size, one sample;
-    /// `target` of the chain's format with `RENDER_ATTACHMENT`, `depth` of the overlay's format
-    /// with `RENDER_ATTACHMENT` and its stored contents (`StoreOp::Store` where the host drew
-    /// it). A mismatch is an [`Error::Usage`] with nothing recorded.
-    pub fn encode_overlay(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        geometry: &LineGeometry,
-        meshes: &[&MeshGeometry],
-        target: &wgpu::TextureView,
-        depth: Option<&wgpu::TextureView>,
-    ) -> Result<(), Error> {
-        let Some(config) = self.composite.overlay_depth() else {
-            return Err(Error::Usage(
-                "encode_overlay before enable_overlay: call AoChain::enable_overlay once first".into(),
-            ));
-        };
-        if self.size.0 == 0 || self.size.1 == 0 {
-            return Ok(());
-        }
-        self.check_target(target)?;
-        match (config, depth) {
-            (None, Some(_)) => {
-                return Err(Error::Usage(
-                    "a depth was passed but the overlay was enabled without one: call enable_overlay with \
-                     Some(OverlayDepth { format, proj })"
-                        .into(),
-                ));
-            }
-            (Some(_), None) => {
-                return Err(Error::Usage("the overlay was enabled with depth but encode_overlay got none".into()));
-            }
-            (Some(config), Some(view)) => {
-                self.check_attachment("the overlay's depth", view.texture(), config.format, "enable_overlay said")?
-            }
-            (None, None) => {}
-        }
-        self.encode_frame(encoder, geometry, meshes, |composite, encoder, span| {
-            composite.encode_overlay(encoder, target, depth, span)
-        });
-        Ok(())
-    }
-
-    /// Records the geometry, the method and `composite` (the last step, which targets the
-    /// caller's views). Does nothing before the first `prepare` with a non-zero size.
-    fn encode_frame<'s>(
+    /// Records a frame: `gbuffer` writes the G-buffer, then the method, its blur and
+    /// object-space AO, then `composite` (the last step, which targets the caller's views), in a
+    /// `lineao` debug group with the timer's spans. Does nothing before the first `prepare` with
+    /// a non-zero size.
+    fn record<'s>(
         &'s self,
         encoder: &mut wgpu::CommandEncoder,
-        geometry: &LineGeometry,
-        meshes: &[&MeshGeometry],
+        gbuffer: impl FnOnce(&mut wgpu::CommandEncoder, &'s FrameTargets, Option<Span<'s>>),
         composite: impl FnOnce(&'s Composite, &mut wgpu::CommandEncoder, Option<Span<'s>>),
     ) {
-        let Some(targets) = &self.targets else { return };
-        if self.view.is_none() {
-            return;
-        }
+        let (Some(targets), Some(_)) = (&self.targets, &self.view) else { return };
         let span = |name| self.timer.as_ref().and_then(|t| t.span(name));
         encoder.push_debug_group("lineao");
+        gbuffer(encoder, targets, span("lines"));
+        self.encode_method(encoder, targets, &span);
+        composite(&self.composite, encoder, span("composite"));
+        if let Some(timer) = &self.timer {
+            timer.resolve(encoder);
+        }
+        encoder.pop_debug_group();
+    }
+
+    /// The lines (or tubes) and the context surfaces into the G-buffer, under one `span`.
+    fn draw_geometry(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &FrameTargets,
+        geometry: &LineGeometry,
+        meshes: &[&MeshGeometry],
+        span: Option<Span<'_>>,
+    ) {
         let load = Load::Clear(self.settings.background);
         // The lines' span covers the surfaces when there are any.
         let (lines_span, meshes_span) = match (&self.meshes, meshes.is_empty()) {
-            (Some(_), false) => (span("lines").map(Span::begin_only), span("lines").map(Span::end_only)),
-            _ => (span("lines"), None),
+            (Some(_), false) => Span::split(span),
+            _ => (span, None),
         };
         match &self.tubes {
             Some(tubes) => tubes.encode(encoder, targets, geometry, load, lines_span),
@@ -671,12 +516,6 @@ impl AoChain {
         if let (Some(renderer), false) = (&self.meshes, meshes.is_empty()) {
             renderer.encode(encoder, targets, meshes, Load::Keep, meshes_span);
         }
-        self.encode_method(encoder, targets, &span);
-        composite(&self.composite, encoder, span("composite"));
-        if let Some(timer) = &self.timer {
-            timer.resolve(encoder);
-        }
-        encoder.pop_debug_group();
     }
 
     /// Records only the composite of the last prepared frame over the targets as they are: for a
