@@ -93,9 +93,12 @@ struct Passes {
     ssao_12: Ssao,
     ssao_16: Ssao,
     ssao_blur: SsaoBlur,
+    /// SSAO's occlusion before its blur (the SSAO stage's own in the chain).
+    ssao_raw: Target,
     vo_line_5: VoLine,
     vo_area_1: VoArea,
-    /// The chain's G-buffer copied into targets with a moments pyramid, for `vo_area_1`.
+    /// The chain's G-buffer copied into one-level targets, for `vo_area_1` (which sizes its
+    /// moments pyramid by them).
     area_targets: FrameTargets,
     bilateral: Bilateral,
     tubes: TubeRenderer,
@@ -143,7 +146,8 @@ impl Passes {
             ssao_blur: SsaoBlur::new(device),
             vo_line_5: VoLine::new(device, &VoSettings { samples: 5, ..settings.vo.clone() }),
             vo_area_1: VoArea::new(device, &VoSettings { area_samples: 1, ..settings.vo.clone() }),
-            area_targets: FrameTargets::new(device, view.width, view.height, targets.guard, 1).with_moments(device),
+            area_targets: FrameTargets::new(device, view.width, view.height, targets.guard, 1),
+            ssao_raw: Target::ao(device, "lineao::bench::ssao_raw", targets.size),
             bilateral: Bilateral::new(device),
             tubes: TubeRenderer::new(device, false),
             nd_from_depth: NdFromDepth::new(device, HostConfig::default()),
@@ -175,10 +179,10 @@ impl Passes {
             pass.prepare(queue, targets, view, line_ao, settings.r0(), &settings.lighting);
         }
         for (pass, samples) in [(&mut passes.ssao_12, 12), (&mut passes.ssao_16, 16)] {
-            pass.resize(device, targets);
+            pass.resize(device, targets, &passes.ssao_raw);
             pass.prepare(queue, targets, view, &SsaoSettings { samples, ..settings.ssao.clone() });
         }
-        passes.ssao_blur.resize(device, targets);
+        passes.ssao_blur.resize(device, targets, &passes.ssao_raw);
         passes.vo_line_5.resize(device, targets);
         passes.vo_line_5.prepare(queue, targets, view, &VoSettings { samples: 5, ..settings.vo.clone() });
         passes.vo_area_1.resize(device, &passes.area_targets);
@@ -309,10 +313,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let mut chain = AoChain::new(device, wgpu::TextureFormat::Rgba8UnormSrgb, settings.clone())?;
     chain.resize(args.width, args.height)?;
     let view = chain.prepare(device, queue, &camera, &bounds).context("nothing to render at this size")?;
-    let targets = &FrameTargets::new(device, args.width, args.height, view.guard, settings.levels())
-        .with_outer(device)
-        .with_ao_raw(device)
-        .with_blur(device);
+    let targets = &FrameTargets::new(device, args.width, args.height, view.guard, settings.levels()).with_blur(device);
     let tractogram = &scene.tracts;
     let ray_geometry =
         lineao::RayGeometry { positions: &tractogram.positions, offsets: &tractogram.offsets, ..Default::default() };

@@ -24,6 +24,8 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 use lineao::camera::{Camera, Projection};
+use lineao::method::ssao::SsaoStage;
+use lineao::method::vo_area::VoArea;
 use lineao::readback::read_texture;
 use lineao::volume::{ScalarForm, VolumeAoOptions, VolumeMethod};
 use lineao::{AoChain, AoMethod, Gpu, LineAoVariant, noise};
@@ -76,7 +78,9 @@ pub fn write(
     }
     let (w, h) = (targets.size.0 as u64, targets.size.1 as u64);
     write_npy(dir, "zoom.npy", &[h, w], &read(&targets.zoom.texture)?.to_f32())?;
-    let raw = match (s.method, &targets.volume_ao, &targets.ao_raw) {
+    // SSAO's before its 4 × 4 blur.
+    let ssao_raw = chain.stage::<SsaoStage>().and_then(SsaoStage::raw);
+    let raw = match (s.method, &targets.volume_ao, ssao_raw) {
         (AoMethod::None, Some(volume_ao), _) => volume_ao,
         (AoMethod::Ssao, _, Some(raw)) => raw,
         _ => &targets.ao,
@@ -191,7 +195,7 @@ pub fn write(
         write_npy(dir, "vo_samples.npy", &[count as u64, 3], &flat3(&samples))?;
         let tile: Vec<f32> = noise::vo_noise(vo.noise_seed).into_iter().flatten().collect();
         write_npy(dir, "vo_noise.npy", &[4, 4, 2], &tile)?;
-        if let Some(moments) = &targets.moments {
+        if let Some(moments) = chain.stage::<VoArea>().and_then(VoArea::moments) {
             for (l, level) in lineao::verify::read_moments(&gpu.device, &gpu.queue, moments)?.iter().enumerate() {
                 let shape = [level.height as u64, level.width as u64, 2];
                 write_npy(dir, &format!("moments_{l}.npy"), &shape, &level.data.concat())?;

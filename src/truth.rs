@@ -7,6 +7,7 @@ use std::sync::OnceLock;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use anyhow::{Context, Result};
+use lineao::method::raytraced::RayTracedAo;
 use lineao::reference::Image;
 use lineao::truth::{Bvh, LineShape, Truth, TruthSettings};
 use lineao::{AoChain, Gpu};
@@ -129,7 +130,8 @@ pub fn accumulate(gpu: &Gpu, chain: &mut AoChain, mut frame: impl FnMut(&mut AoC
 pub fn from_gpu(gpu: &Gpu, chain: &AoChain) -> Result<Truth> {
     let (d, q) = (&gpu.device, &gpu.queue);
     let progress = chain.ray_progress().context("the ray-traced method is not active")?;
-    let accumulation = chain.ray_accumulation().context("nothing was traced")?;
+    let accumulation =
+        chain.stage::<RayTracedAo>().and_then(RayTracedAo::accumulation).context("nothing was traced")?;
     let targets = chain.targets().context("nothing was rendered")?;
     let nd = lineao::verify::read_rgba(d, q, &targets.nd[0])?;
     let words: Vec<[u32; 4]> = bytemuck::cast_slice(&lineao::readback::read_buffer(d, q, accumulation)?).to_vec();

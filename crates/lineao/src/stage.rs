@@ -77,11 +77,16 @@ impl Stages {
         }
     }
 
-    /// The active stage if it is the ray tracer: the one stage whose progress and accumulation
-    /// the chain reports, and that takes the scene.
-    pub fn ray_tracer(&self) -> Option<&RayTracedAo> {
+    /// The active stage if it is a `T`.
+    pub fn active_as<T: Stage>(&self) -> Option<&T> {
         let stage: &dyn std::any::Any = self.active.as_deref()?;
         stage.downcast_ref()
+    }
+
+    /// The active stage if it is the ray tracer: the one stage whose progress the chain reports,
+    /// and that takes the scene.
+    pub fn ray_tracer(&self) -> Option<&RayTracedAo> {
+        self.active_as()
     }
 
     fn ray_tracer_mut(&mut self) -> Option<&mut RayTracedAo> {

@@ -10,15 +10,15 @@
 //! | specular  | R32Float      | illuminated-lines specular, added in the composite         |
 //! | depth     | Depth32Float  | hardware depth                                             |
 //! | ao        | R32Float      | occlusion of the chosen method, 0 = none                   |
-//! | ao_raw    | R32Float      | SSAO's occlusion before its 4 × 4 blur (SSAO only)         |
 //! | ao_blurred| R32Float      | `ao` after the bilateral blur (via `ao_blur_tmp`; blur only)|
 //! | octants   | Rg32Uint      | object-space AO: the lines' octant visibilities, unorm8 × 8 |
 //! | volume_ao | R32Float      | object-space AO with the pixel's normal (`volume_ao` pass) |
 //!
-//! All at the guard-banded size; level j is ⌈W_{j−1}/2⌉ × ⌈H_{j−1}/2⌉ (CONTRACT.md). VO area
-//! sampling adds [`Moments`], a buffer of (E\[z\], E\[z²\]) pyramids, only when a chain needs it
-//! ([`FrameTargets::with_moments`]); object-space AO adds `octants` and `volume_ao`
-//! ([`FrameTargets::with_volume`]).
+//! All at the guard-banded size; level j is ⌈W_{j−1}/2⌉ × ⌈H_{j−1}/2⌉ (CONTRACT.md).
+//! Object-space AO adds `octants` and `volume_ao` ([`FrameTargets::with_volume`]). What one
+//! method alone reads and writes on the way to `ao` is that method's own (SSAO's occlusion
+//! before its blur, VO area's moments pyramid, LineAO's `outer = level` targets: see
+//! [`crate::method`]), allocated by its stage at the targets' size.
 
 /// Half floats: plenty for a color, and with it the G-buffer a geometry pass writes is 32 bytes
 /// per pixel, WebGPU's default `max_color_attachment_bytes_per_sample`, so the chain runs on a
@@ -32,11 +32,6 @@ pub const AO_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 /// The eight octant visibilities of object-space AO per pixel, `pack4x8unorm` of octants 0–3
 /// and 4–7.
 pub const OCTANTS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Uint;
-/// LineAO `outer = level`: (AO_j, d_j) per texel of level j.
-pub const OUTER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
-
-/// Levels the moments pyramid can have (`shared/moments.wgsl`): enough for 32768² pixels.
-pub const MAX_MOMENT_LEVELS: usize = 16;
 
 /// A texture with its default view.
 pub struct Target {
@@ -69,6 +64,12 @@ impl Target {
     /// An offscreen texture to composite into and read back (PNG output, tests, examples).
     pub fn output(device: &wgpu::Device, label: &str, size: (u32, u32), format: wgpu::TextureFormat) -> Target {
         Target::new(device, label, size, format, wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC)
+    }
+
+    /// An occlusion (R32Float) that compute passes write and later ones read, copied for
+    /// readback and written by hosts and tests.
+    pub fn ao(device: &wgpu::Device, label: &str, size: (u32, u32)) -> Target {
+        Target::new(device, label, size, AO_FORMAT, AO_USAGE)
     }
 
     pub fn size(&self) -> (u32, u32) {
@@ -112,81 +113,13 @@ pub struct FrameTargets {
     pub depth: Target,
     /// What the composite shows: the method's occlusion, after its blur if it has one.
     pub ao: Target,
-    /// A method's occlusion before its blur (SSAO); the blur writes `ao`.
-    pub ao_raw: Option<Target>,
     /// The bilateral blur's horizontal half, and its result.
     pub ao_blur_tmp: Option<Target>,
     pub ao_blurred: Option<Target>,
-    /// LineAO `outer = level`: hemisphere j's (AO_j, d_j) at level j's size, for j = 1..levels
-    /// (`outer[j − 1]`).
-    pub outer: Vec<Target>,
-    /// VO area's pyramid of depth moments.
-    pub moments: Option<Moments>,
     /// Object-space AO: the geometry's octant visibilities per pixel, and the occlusion the
     /// `volume_ao` pass makes of them.
     pub octants: Option<Target>,
     pub volume_ao: Option<Target>,
-}
-
-/// One level of [`Moments`]: `width` × `height` texels from element `offset`, row-major.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct MomentsLevel {
-    pub offset: u32,
-    pub width: u32,
-    pub height: u32,
-}
-
-/// VO area sampling's pyramid of depth moments (`lineao::passes::moments`): every level in one
-/// storage buffer of `vec2<f32>` (E\[z\], E\[z²\]), and the layout as a uniform
-/// (`array<vec4<u32>, 16>` of (offset, width, height, 0)).
-pub struct Moments {
-    pub buffer: wgpu::Buffer,
-    pub levels: Vec<MomentsLevel>,
-    pub layout: wgpu::Buffer,
-}
-
-impl Moments {
-    /// Level l is ⌊W_{l−1}/2⌋ × ⌊H_{l−1}/2⌋ (at least 1) down to 1 × 1, as a mip chain.
-    pub fn levels((width, height): (u32, u32)) -> Vec<MomentsLevel> {
-        let mut levels = vec![MomentsLevel { offset: 0, width, height }];
-        while let Some(&last) = levels.last().filter(|l| l.width > 1 || l.height > 1) {
-            levels.push(MomentsLevel {
-                offset: last.offset + last.width * last.height,
-                width: (last.width / 2).max(1),
-                height: (last.height / 2).max(1),
-            });
-        }
-        levels
-    }
-
-    /// Bytes of the buffer for a `size` pyramid.
-    pub fn bytes(size: (u32, u32)) -> u64 {
-        let last = *Moments::levels(size).last().expect("level 0 exists");
-        (last.offset as u64 + (last.width * last.height) as u64) * 8
-    }
-
-    fn new(device: &wgpu::Device, size: (u32, u32)) -> Moments {
-        use wgpu::util::DeviceExt;
-        let levels = Moments::levels(size);
-        let mut rects = [[0u32; 4]; MAX_MOMENT_LEVELS];
-        for (rect, l) in rects.iter_mut().zip(&levels) {
-            *rect = [l.offset, l.width, l.height, 0];
-        }
-        Moments {
-            buffer: device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("lineao::Moments"),
-                size: Moments::bytes(size),
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            }),
-            layout: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("lineao::Moments::layout"),
-                contents: bytemuck::cast_slice(&rects),
-                usage: wgpu::BufferUsages::UNIFORM,
-            }),
-            levels,
-        }
-    }
 }
 
 impl FrameTargets {
@@ -217,12 +150,9 @@ impl FrameTargets {
             zoom: Target::new(device, "lineao::FrameTargets::zoom", size, ZOOM_FORMAT, gbuffer),
             specular: Target::new(device, "lineao::FrameTargets::specular", size, SPECULAR_FORMAT, gbuffer),
             depth: Target::new(device, "lineao::FrameTargets::depth", size, DEPTH_FORMAT, attachment),
-            ao: Target::new(device, "lineao::FrameTargets::ao", size, AO_FORMAT, AO_USAGE),
-            ao_raw: None,
+            ao: Target::ao(device, "lineao::FrameTargets::ao", size),
             ao_blur_tmp: None,
             ao_blurred: None,
-            outer: Vec::new(),
-            moments: None,
             octants: None,
             volume_ao: None,
         }
@@ -239,43 +169,16 @@ impl FrameTargets {
         self
     }
 
-    /// These targets with `ao_raw`, where SSAO writes its occlusion before its 4 × 4 blur.
-    pub fn with_ao_raw(mut self, device: &wgpu::Device) -> FrameTargets {
-        self.ao_raw = Some(Target::new(device, "lineao::FrameTargets::ao_raw", self.size, AO_FORMAT, AO_USAGE));
-        self
-    }
-
     /// These targets with the bilateral blur's two (`ao_blur_tmp`, `ao_blurred`).
     pub fn with_blur(mut self, device: &wgpu::Device) -> FrameTargets {
-        let target = |label| Target::new(device, label, self.size, AO_FORMAT, AO_USAGE);
-        self.ao_blur_tmp = Some(target("lineao::FrameTargets::ao_blur_tmp"));
-        self.ao_blurred = Some(target("lineao::FrameTargets::ao_blurred"));
+        self.ao_blur_tmp = Some(Target::ao(device, "lineao::FrameTargets::ao_blur_tmp", self.size));
+        self.ao_blurred = Some(Target::ao(device, "lineao::FrameTargets::ao_blurred", self.size));
         self
     }
 
     /// What the composite shows: `ao_blurred` when the blur's targets exist, else `ao`.
     pub fn shown(&self) -> &Target {
         self.ao_blurred.as_ref().unwrap_or(&self.ao)
-    }
-
-    /// These targets with LineAO's `outer = level` targets (`outer`: one per pyramid level
-    /// j ≥ 1, at its size).
-    pub fn with_outer(mut self, device: &wgpu::Device) -> FrameTargets {
-        let usage =
-            wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
-        self.outer = (self.nd.iter().enumerate().skip(1))
-            .map(|(j, level)| {
-                Target::new(device, &format!("lineao::FrameTargets::outer[{j}]"), level.size(), OUTER_FORMAT, usage)
-            })
-            .collect();
-        self
-    }
-
-    /// These targets with the moments pyramid of VO area sampling. The caller checks the
-    /// size against the device's storage-buffer limits ([`Moments::bytes`]).
-    pub fn with_moments(mut self, device: &wgpu::Device) -> FrameTargets {
-        self.moments = Some(Moments::new(device, self.size));
-        self
     }
 
     /// Visible size (without the guard band).
@@ -301,12 +204,6 @@ impl FrameTargets {
     /// shaders' fixed bindings.
     pub fn level_views(&self) -> Vec<&wgpu::TextureView> {
         (0..crate::MAX_LEVELS as usize).map(|k| &self.nd[k.min(self.nd.len() - 1)].view).collect()
-    }
-
-    /// Views of `outer` for j = 1..MAX_LEVELS, padded with the last pyramid level (never read).
-    pub fn outer_views(&self) -> Vec<&wgpu::TextureView> {
-        let pad = &self.nd[self.nd.len() - 1].view;
-        (1..crate::MAX_LEVELS as usize).map(|j| self.outer.get(j - 1).map_or(pad, |t| &t.view)).collect()
     }
 }
 

@@ -39,7 +39,7 @@ pub fn read_image<T: bytemuck::Pod>(
 pub fn read_moments(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
-    moments: &crate::targets::Moments,
+    moments: &crate::method::vo_area::moments::Moments,
 ) -> Result<Vec<crate::reference::MomentsImage>, Error> {
     let all: Vec<[f32; 2]> =
         bytemuck::pod_collect_to_vec(&crate::readback::read_buffer(device, queue, &moments.buffer)?);

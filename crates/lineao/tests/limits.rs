@@ -245,7 +245,13 @@ fn the_chain_allocates_only_the_targets_its_method_uses() {
         chain.resize(64, 48).unwrap();
         chain.prepare(d, q, &camera, &bounds).unwrap();
         let t = chain.targets().unwrap();
-        let has = (t.ao_raw.is_some(), t.ao_blurred.is_some(), !t.outer.is_empty(), t.moments.is_some());
+        // The method's own (its stage's), and the blur's (shared).
+        let has = (
+            chain.stage::<lineao::method::ssao::SsaoStage>().and_then(|s| s.raw()).is_some(),
+            t.ao_blurred.is_some(),
+            chain.stage::<lineao::method::line_ao::LineAoStage>().is_some_and(|s| !s.outer().is_empty()),
+            chain.stage::<lineao::method::vo_area::VoArea>().and_then(|s| s.moments()).is_some(),
+        );
         assert_eq!(has, (raw, blurred, outer, moments), "{:?}", settings.method);
     }
 }

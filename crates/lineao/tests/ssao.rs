@@ -7,7 +7,7 @@ use common::{cameras_for_polylines, flat_view, gpu, is_geometry, polylines, rend
 use lineao::method::ssao::Ssao;
 use lineao::method::ssao::blur::SsaoBlur;
 use lineao::reference::{self, Image, NdImage, SsaoParams, ViewParams};
-use lineao::targets::FrameTargets;
+use lineao::targets::{FrameTargets, Target};
 use lineao::verify::{check_policy, compare, read_f32, write_target};
 use lineao::{AoMethod, ChainSettings, Gpu, SsaoKernel, SsaoSettings, noise};
 
@@ -15,14 +15,15 @@ use lineao::{AoMethod, ChainSettings, Gpu, SsaoKernel, SsaoSettings, noise};
 fn ssao_on(gpu: &Gpu, nd0: &NdImage, settings: &SsaoSettings, guard: u32) -> (Image<f32>, Image<f32>, SsaoParams) {
     let (d, q) = (&gpu.device, &gpu.queue);
     let (w, h) = (nd0.width as u32 - 2 * guard, nd0.height as u32 - 2 * guard);
-    let targets = FrameTargets::new(d, w, h, guard, 1).with_ao_raw(d);
+    let targets = FrameTargets::new(d, w, h, guard, 1);
+    let raw = Target::ao(d, "test::ssao_raw", targets.size);
     write_target(q, &targets.nd[0], nd0);
     let view = flat_view(w, h, guard);
     let mut ssao = Ssao::new(d, settings);
-    ssao.resize(d, &targets);
+    ssao.resize(d, &targets, &raw);
     ssao.prepare(q, &targets, &view, settings);
     let mut blur = SsaoBlur::new(d);
-    blur.resize(d, &targets);
+    blur.resize(d, &targets, &raw);
     let mut encoder = d.create_command_encoder(&Default::default());
     ssao.encode(&mut encoder, &targets, None);
     blur.encode(&mut encoder, &targets, None);
@@ -33,7 +34,7 @@ fn ssao_on(gpu: &Gpu, nd0: &NdImage, settings: &SsaoSettings, guard: u32) -> (Im
         range: settings.range_world,
         noise_origin: [guard as i32; 2],
     };
-    (read_f32(d, q, targets.ao_raw.as_ref().unwrap()).unwrap(), read_f32(d, q, &targets.ao).unwrap(), params)
+    (read_f32(d, q, &raw).unwrap(), read_f32(d, q, &targets.ao).unwrap(), params)
 }
 
 fn reflect(k: [f32; 3], r: [f32; 3]) -> [f32; 3] {
@@ -92,20 +93,17 @@ fn a_plane_facing_the_camera(gpu: &Gpu, settings: &SsaoSettings, kernel: &[[f32;
 fn blur_skips_the_background_and_keeps_a_constant() {
     let gpu = gpu();
     let (w, h) = (24usize, 20usize);
-    // A background hole in the middle; SSAO of a plane is not constant, so write ao_raw directly.
+    // A background hole in the middle; SSAO of a plane is not constant, so write the raw occlusion directly.
     let nd0 = Image::from_fn(w, h, |x, y| {
         if (10..14).contains(&x) && (8..12).contains(&y) { [0.0; 4] } else { [0.0, 0.0, 1.0, 0.5] }
     });
     let (d, q) = (&gpu.device, &gpu.queue);
-    let targets = FrameTargets::new(d, w as u32, h as u32, 0, 1).with_ao_raw(d);
+    let targets = FrameTargets::new(d, w as u32, h as u32, 0, 1);
+    let raw = Target::ao(d, "test::ssao_raw", targets.size);
     write_target(q, &targets.nd[0], &nd0);
-    write_target(
-        q,
-        targets.ao_raw.as_ref().unwrap(),
-        &Image::from_fn(w, h, |x, y| if is_geometry(nd0.get(x, y)) { 0.25f32 } else { 0.9 }),
-    );
+    write_target(q, &raw, &Image::from_fn(w, h, |x, y| if is_geometry(nd0.get(x, y)) { 0.25f32 } else { 0.9 }));
     let mut blur = SsaoBlur::new(d);
-    blur.resize(d, &targets);
+    blur.resize(d, &targets, &raw);
     let mut encoder = d.create_command_encoder(&Default::default());
     blur.encode(&mut encoder, &targets, None);
     q.submit([encoder.finish()]);

@@ -49,20 +49,18 @@ fn vo_on(
 ) -> (Image<f32>, Image<f32>) {
     let (d, q) = (&gpu.device, &gpu.queue);
     let guard = view.guard;
-    let mut targets = FrameTargets::new(d, view.width, view.height, guard, 1);
-    if sampling == Sampling::Area {
-        targets = targets.with_moments(d);
-    }
+    let targets = FrameTargets::new(d, view.width, view.height, guard, 1);
     write_target(q, &targets.nd[0], nd0);
     write_target(q, &targets.zoom, zoom);
     let mut encoder = d.create_command_encoder(&Default::default());
+    let mut area = None;
     if sampling == Sampling::Line {
         let mut vo = VoLine::new(d, settings);
         vo.resize(d, &targets);
         vo.prepare(q, &targets, view, settings);
         vo.encode(&mut encoder, &targets, None);
     } else {
-        let mut vo = VoArea::new(d, settings);
+        let vo = area.insert(VoArea::new(d, settings));
         vo.resize(d, &targets);
         vo.prepare(q, &targets, view, settings);
         vo.encode(&mut encoder, &targets, None, None);
@@ -73,7 +71,7 @@ fn vo_on(
     let cpu = if sampling == Sampling::Line {
         reference::vo_line(nd0, zoom, vo_disk_samples(settings.samples).unwrap(), &noise, &params)
     } else {
-        let moments = read_moments(d, q, targets.moments.as_ref().unwrap()).unwrap();
+        let moments = read_moments(d, q, area.as_ref().and_then(VoArea::moments).unwrap()).unwrap();
         let samples = vo_area_samples(settings.area_samples).unwrap();
         reference::vo_area(nd0, zoom, &moments, &samples, &vo_area_lod_offsets(&samples), &noise, &params)
     };
@@ -243,7 +241,7 @@ fn the_moments_pyramid_is_the_cpu_reference() {
         let depth = 0.5 + 0.3 * ((x as f32 * 0.37).sin() * (y as f32 * 0.21).cos());
         if (20..30).contains(&x) && (10..15).contains(&y) { [0.0, 0.0, 0.0, 1.0] } else { [0.0, 0.0, 1.0, depth] }
     });
-    let targets = FrameTargets::new(d, view.width, view.height, 5, 1).with_moments(d);
+    let targets = FrameTargets::new(d, view.width, view.height, 5, 1);
     write_target(q, &targets.nd[0], &nd0);
     let mut moments = MomentsPyramid::new(d);
     moments.resize(d, &targets);
@@ -251,7 +249,7 @@ fn the_moments_pyramid_is_the_cpu_reference() {
     let mut encoder = d.create_command_encoder(&Default::default());
     moments.encode(&mut encoder, None);
     q.submit([encoder.finish()]);
-    let gpu_levels = read_moments(d, q, targets.moments.as_ref().unwrap()).unwrap();
+    let gpu_levels = read_moments(d, q, moments.moments().unwrap()).unwrap();
     let cpu_levels = reference::moments_pyramid(&nd0, &ViewParams::of(&view));
     assert_eq!(gpu_levels.len(), cpu_levels.len());
     assert_eq!(gpu_levels.len(), 6, "63 x 47 has mips down to 1 x 1");

@@ -13,8 +13,8 @@
 //!   target view ◀─ Composite ◀──────────┘ color · (1 − strength · ao) + specular
 //! ```
 //!
-//! With [`AoMethod::Ssao`] the pyramid and LineAO give way to Crytek SSAO (`nd[0]` → `ao_raw`)
-//! and its 4 × 4 blur (`ao_raw` → `ao`); with [`AoMethod::VoLine`] to Volumetric Obscurance
+//! With [`AoMethod::Ssao`] the pyramid and LineAO give way to Crytek SSAO (`nd[0]` → its raw occlusion)
+//! and its 4 × 4 blur (→ `ao`); with [`AoMethod::VoLine`] to Volumetric Obscurance
 //! with line samples (`nd[0]`, `zoom` → `ao`); with [`AoMethod::VoArea`] to the moments pyramid
 //! (`nd[0]` → `moments`) and VO with area samples (→ `ao`). With `ChainSettings::blur` the
 //! bilateral blur follows any method (`ao` → `ao_blurred`, which the composite then shows).
@@ -57,7 +57,7 @@ use crate::passes::volume_ao::VolumeAo;
 use crate::ray_scene::RayScene;
 use crate::settings::{AoMethod, ChainSettings};
 use crate::stage::Stages;
-use crate::targets::{FrameTargets, Moments};
+use crate::targets::FrameTargets;
 use crate::timing::{PassTime, PassTimer, Span};
 
 pub use host::HostAo;
@@ -79,9 +79,8 @@ pub struct AoChain {
     /// The composite's target format.
     format: wgpu::TextureFormat,
     size: (u32, u32),
-    max_texture: u32,
-    /// Bytes a storage buffer binding may hold (VO area's moments pyramid).
-    max_storage: u64,
+    /// The device's limits, which the sizes are checked against.
+    limits: wgpu::Limits,
     targets: Option<FrameTargets>,
     view: Option<FrameView>,
     timer: Option<PassTimer>,
@@ -125,8 +124,7 @@ impl AoChain {
             format,
             settings,
             size: (0, 0),
-            max_texture: device.limits().max_texture_dimension_2d,
-            max_storage: device.limits().max_storage_buffer_binding_size.min(device.limits().max_buffer_size),
+            limits: device.limits(),
             targets: None,
             view: None,
             timer: None,
@@ -179,7 +177,7 @@ impl AoChain {
         }
         // The pyramid's depth, the method's own targets, the blur's and object-space AO's, and
         // what the composite shows are bound at allocation.
-        let layout = |s: &ChainSettings| (s.levels(), method::needs(s), s.blur.is_some(), s.volume.is_some());
+        let layout = |s: &ChainSettings| (s.levels(), s.blur.is_some(), s.volume.is_some());
         if layout(&settings) != layout(&self.settings) {
             self.targets = None;
         }
@@ -200,12 +198,12 @@ impl AoChain {
         self.stages.ray_tracer().map(|tracer| tracer.progress())
     }
 
-    /// The ray-traced method's accumulation per pixel of the guard-banded frame
-    /// ([`crate::method::raytraced::ACCUMULATION_BYTES`] each: the sums of the rays' values
-    /// and of their squares, the own segment, the buried flag), for reading back its standard
-    /// error; `None` for the other methods.
-    pub fn ray_accumulation(&self) -> Option<&wgpu::Buffer> {
-        self.stages.ray_tracer().and_then(|tracer| tracer.accumulation())
+    /// The active method's stage if it is a `T` (its own targets, for readback: SSAO's
+    /// occlusion before its blur, [`crate::method::ssao::SsaoStage::raw`]; VO area's moments,
+    /// [`crate::method::vo_area::VoArea::moments`]; the ray tracer's accumulation,
+    /// [`crate::method::raytraced::RayTracedAo::accumulation`]).
+    pub fn stage<T: method::Stage>(&self) -> Option<&T> {
+        self.stages.active_as()
     }
 
     /// Turns per-pass GPU timing on or off (a timer that is on stays as it is, so a host may
@@ -257,30 +255,15 @@ impl AoChain {
     /// Whether `settings` fit the adapter at `width` × `height` with the largest guard band.
     fn check_size(&self, settings: &ChainSettings, width: u32, height: u32) -> Result<(), Error> {
         let guard = settings.guard_max_px;
-        let limit = self.max_texture.saturating_sub(2 * guard);
+        let limit = self.limits.max_texture_dimension_2d.saturating_sub(2 * guard);
         if width > limit || height > limit {
             return Err(Error::TooLarge(format!(
                 "{width} x {height} px exceeds the adapter's {} px textures less the guard band",
-                self.max_texture
+                self.limits.max_texture_dimension_2d
             )));
         }
         let banded = (width + 2 * guard, height + 2 * guard);
-        let accumulation = banded.0 as u64 * banded.1 as u64 * crate::method::raytraced::ACCUMULATION_BYTES;
-        if settings.method == AoMethod::RayTraced && accumulation > self.max_storage {
-            return Err(Error::TooLarge(format!(
-                "the ray tracer's accumulation for {width} x {height} px needs {accumulation} bytes, more than the \
-                 adapter's {} byte storage buffers",
-                self.max_storage
-            )));
-        }
-        if method::needs(settings).moments && Moments::bytes(banded) > self.max_storage {
-            return Err(Error::TooLarge(format!(
-                "VO area's moments pyramid for {width} x {height} px needs {} bytes, more than the adapter's {} \
-                 byte storage buffers",
-                Moments::bytes(banded),
-                self.max_storage
-            )));
-        }
+        (settings.method.info().fits)(banded, &self.limits)?;
         Ok(())
     }
 
@@ -353,16 +336,6 @@ impl AoChain {
         let stale = self.targets.as_ref().is_none_or(|t| t.guard != guard || t.nd.len() != levels as usize);
         if stale {
             let mut targets = FrameTargets::new(device, width, height, guard, levels);
-            let needs = method::needs(s);
-            if needs.moments {
-                targets = targets.with_moments(device);
-            }
-            if needs.outer {
-                targets = targets.with_outer(device);
-            }
-            if needs.ao_raw {
-                targets = targets.with_ao_raw(device);
-            }
             if s.blur.is_some() {
                 targets = targets.with_blur(device);
             }

@@ -53,8 +53,11 @@ pub struct MethodInfo {
     pub shaders: &'static [(&'static str, &'static str)],
     /// Its stage; `None` for a method that runs no pass (`none`).
     pub(crate) build: Option<BuildStage>,
-    /// The shared targets it needs allocated besides the G-buffer and `ao`.
-    pub(crate) needs: fn(&ChainSettings) -> Needs,
+    /// Whether what its stage allocates for a guard-banded frame of this size fits the device's
+    /// limits (an [`crate::Error::TooLarge`] saying what does not), checked before a frame of
+    /// that size is made. The targets a method alone reads and writes are its stage's own,
+    /// allocated in [`Stage::resize`].
+    pub(crate) fits: fn((u32, u32), &wgpu::Limits) -> Result<(), crate::Error>,
     /// Sets `preset`'s values of its own settings and the strength it is shown with.
     pub(crate) preset: fn(Preset, &mut ChainSettings),
 }
@@ -119,7 +122,7 @@ const NONE: MethodInfo = MethodInfo {
     spans: &[],
     shaders: &[],
     build: None,
-    needs: |_| Needs::default(),
+    fits: fits_always,
     preset: |_, settings| settings.strength = 1.0,
 };
 
@@ -195,15 +198,9 @@ pub enum Reach {
     Unbounded,
 }
 
-/// The shared targets a method's stage writes besides the G-buffer, its pyramid and `ao`.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct Needs {
-    /// `ao_raw`: an occlusion before the stage's own blur (SSAO).
-    pub ao_raw: bool,
-    /// The moments pyramid of VO area sampling.
-    pub moments: bool,
-    /// LineAO's `outer = level` targets.
-    pub outer: bool,
+/// [`MethodInfo::fits`] of a method that allocates nothing the device could refuse.
+pub(crate) fn fits_always(_: (u32, u32), _: &wgpu::Limits) -> Result<(), crate::Error> {
+    Ok(())
 }
 
 /// What a method does in the chain: it reads the G-buffer in [`FrameTargets`] and writes `ao`,
@@ -219,7 +216,8 @@ pub trait Stage: wgpu::WasmNotSendSync + std::any::Any {
     fn reach(&self, settings: &ChainSettings, unguarded: &FrameView) -> Reach;
     /// The spans it records, in order, under `settings` (of its method's [`MethodInfo::spans`]).
     fn spans(&self, settings: &ChainSettings) -> &'static [&'static str];
-    /// Binds newly allocated targets.
+    /// Binds newly allocated targets, and allocates at their size what the stage alone reads
+    /// and writes (checked by its method's size check in the registry).
     fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets);
     /// Writes the frame's uniforms.
     fn prepare(&self, queue: &wgpu::Queue, targets: &FrameTargets, view: &FrameView, settings: &ChainSettings);
@@ -230,11 +228,6 @@ pub trait Stage: wgpu::WasmNotSendSync + std::any::Any {
         targets: &FrameTargets,
         span: &dyn Fn(&'static str) -> Option<Span<'t>>,
     );
-}
-
-/// What `settings`' method needs allocated.
-pub fn needs(settings: &ChainSettings) -> Needs {
-    (settings.method.info().needs)(settings)
 }
 
 /// The stage of `settings`' method; `None` for a method without passes.

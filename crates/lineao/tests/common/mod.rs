@@ -99,9 +99,7 @@ pub fn render_scene(
         specular: read_f32(d, q, &t.specular).unwrap(),
         depth: read_f32(d, q, &t.depth).unwrap(),
         ao: read_f32(d, q, &t.ao).unwrap(),
-        ao_raw: t
-            .ao_raw
-            .as_ref()
+        ao_raw: (chain.stage::<lineao::method::ssao::SsaoStage>().and_then(|s| s.raw()))
             .map(|raw| read_f32(d, q, raw).unwrap())
             .unwrap_or_else(|| Image::from_fn(0, 0, |_, _| 0.0)),
         ao_blurred: t
@@ -109,7 +107,9 @@ pub fn render_scene(
             .as_ref()
             .map(|b| read_f32(d, q, b).unwrap())
             .unwrap_or_else(|| Image::from_fn(0, 0, |_, _| 0.0)),
-        moments: t.moments.as_ref().map(|m| lineao::verify::read_moments(d, q, m).unwrap()).unwrap_or_default(),
+        moments: (chain.stage::<lineao::method::vo_area::VoArea>().and_then(|s| s.moments()))
+            .map(|m| lineao::verify::read_moments(d, q, m).unwrap())
+            .unwrap_or_default(),
         output: read_rgba(d, q, &output).unwrap(),
         octants: t.octants.as_ref().map(|o| lineao::verify::read_image(d, q, o).unwrap()),
         volume_ao: t.volume_ao.as_ref().map(|v| read_f32(d, q, v).unwrap()),
@@ -139,10 +139,7 @@ pub fn line_ao_on(
 ) -> (Vec<NdImage>, Image<f32>) {
     let (d, q) = (&gpu.device, &gpu.queue);
     let (w, h) = (nd0.width as u32 - 2 * guard, nd0.height as u32 - 2 * guard);
-    let mut targets = FrameTargets::new(d, w, h, guard, settings.levels());
-    if settings.line_ao.outer == lineao::LineAoOuter::Level {
-        targets = targets.with_outer(d);
-    }
+    let targets = FrameTargets::new(d, w, h, guard, settings.levels());
     write_target(q, &targets.nd[0], nd0);
     write_target(q, &targets.zoom, zoom);
     let mut pyramid = NdPyramid::new(d);

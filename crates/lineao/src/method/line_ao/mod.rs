@@ -75,16 +75,10 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     spans: &["nd-pyramid", "lineao"],
     shaders: &[("line_ao.wgsl", include_str!("line_ao.wgsl"))],
     build: Some(|device, settings| Box::new(LineAoStage::new(device, settings))),
-    needs: |settings| {
-        let ao = &settings.line_ao;
-        super::Needs {
-            outer: ao.variant == LineAoVariant::Paper && ao.outer == LineAoOuter::Level && ao.s_r > 1,
-            ..super::Needs::default()
-        }
-    },
+    fits: super::fits_always,
     preset: settings::preset,
 };
-use crate::targets::{AO_FORMAT, FrameTargets, LevelsUniform, OUTER_FORMAT};
+use crate::targets::{AO_FORMAT, FrameTargets, LevelsUniform, Target};
 use crate::timing::Span;
 
 /// Keep in sync with `LineAoUniform` in `line_ao.wgsl`.
@@ -168,16 +162,21 @@ pub struct LineAo {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
     /// `outer = level`: one pipeline per hemisphere j ≥ 1 (`line_ao_outer`), their layout (the
-    /// main one plus the output) and groups.
+    /// main one plus the output) and groups, and the targets they write: hemisphere j's
+    /// (AO_j, d_j) at level j's size (`outer[j − 1]`), which the main pass reads.
     outer_pipelines: Vec<wgpu::ComputePipeline>,
     outer_layout: wgpu::BindGroupLayout,
     outer_groups: Vec<wgpu::BindGroup>,
+    outer: Vec<Target>,
     uniform: wgpu::Buffer,
     lighting: wgpu::Buffer,
     noise: wgpu::Buffer,
     samples: wgpu::Buffer,
     group: Option<wgpu::BindGroup>,
 }
+
+/// `outer = level`: (AO_j, d_j) per texel of level j.
+pub const OUTER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
 
 /// Entries of the uniform sample table (`samples` in `line_ao.wgsl`): s_r ≤ 5, s_h ≤ 256.
 const SAMPLE_TABLE_LEN: usize = crate::MAX_LEVELS as usize * 256;
@@ -259,6 +258,7 @@ impl LineAo {
             outer_pipelines,
             outer_layout,
             outer_groups: Vec::new(),
+            outer: Vec::new(),
         }
     }
 
@@ -268,7 +268,15 @@ impl LineAo {
         self.shape == Shape::of(settings, lighting)
     }
 
+    /// Binds `targets` and allocates the `outer = level` targets at their levels' sizes.
     pub fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets) {
+        let usage =
+            wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_SRC;
+        self.outer = (targets.nd.iter().enumerate().skip(1).take(self.outer_pipelines.len()))
+            .map(|(j, level)| {
+                Target::new(device, &format!("lineao::LineAo::outer[{j}]"), level.size(), OUTER_FORMAT, usage)
+            })
+            .collect();
         let mut resources = vec![
             self.uniform.as_entire_binding(),
             self.lighting.as_entire_binding(),
@@ -280,13 +288,16 @@ impl LineAo {
         let levels = targets.level_views();
         resources.extend(levels.iter().map(|v| wgpu::BindingResource::TextureView(v)));
         let common = resources.len();
-        resources.extend(targets.outer_views().into_iter().map(wgpu::BindingResource::TextureView));
+        // outer1..outer4, padded with the last pyramid level (never read).
+        let pad = &targets.nd[targets.nd.len() - 1].view;
+        let outer = (1..crate::MAX_LEVELS as usize).map(|j| self.outer.get(j - 1).map_or(pad, |t| &t.view));
+        resources.extend(outer.map(wgpu::BindingResource::TextureView));
         self.group = Some(binding::group(device, "lineao::LineAo::group", &self.layout, &resources));
         // Each outer pass writes its level, so it must not also bind it for reading: the
         // pyramid's levels stand in for outer1..outer4 there (line_ao_outer reads none of them).
         resources.truncate(common);
         resources.extend(levels[1..].iter().map(|v| wgpu::BindingResource::TextureView(v)));
-        self.outer_groups = (targets.outer.iter().take(self.outer_pipelines.len()))
+        self.outer_groups = (self.outer.iter())
             .map(|target| {
                 let mut resources = resources.clone();
                 resources.push(wgpu::BindingResource::TextureView(&target.view));
@@ -320,12 +331,18 @@ impl LineAo {
         queue.write_buffer(&self.lighting, 0, bytemuck::bytes_of(&lighting.uniform()));
     }
 
+    /// `outer = level`: hemisphere j's (AO_j, d_j) at level j's size (`outer[j − 1]`), empty
+    /// for `outer = full`.
+    pub fn outer(&self) -> &[Target] {
+        &self.outer
+    }
+
     /// Records the pass (with `outer = level` first one pass per outer hemisphere at its level's
     /// size), timed into `span` when given.
     pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, targets: &FrameTargets, span: Option<Span>) {
         let Some(group) = &self.group else { return };
         let (first, last) = if self.outer_pipelines.is_empty() { (None, span) } else { Span::split(span) };
-        let outer = self.outer_pipelines.iter().zip(&self.outer_groups).zip(&targets.outer);
+        let outer = self.outer_pipelines.iter().zip(&self.outer_groups).zip(&self.outer);
         for (k, ((pipeline, group), target)) in outer.enumerate() {
             let span = first.filter(|_| k == 0);
             dispatch_full_screen(encoder, "lineao::LineAo::outer", pipeline, group, target.size(), span);
@@ -347,6 +364,11 @@ impl LineAoStage {
             pyramid: crate::passes::nd_pyramid::NdPyramid::new(device),
             line_ao: LineAo::new(device, &settings.line_ao, &settings.lighting),
         }
+    }
+
+    /// The `outer = level` targets of the last frame ([`LineAo::outer`]).
+    pub fn outer(&self) -> &[Target] {
+        self.line_ao.outer()
     }
 }
 

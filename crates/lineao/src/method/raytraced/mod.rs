@@ -50,7 +50,7 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
         ("ray_denoise.wgsl", include_str!("ray_denoise.wgsl")),
     ],
     build: Some(|device, _| Box::new(RayTracedAo::new(device))),
-    needs: |_| super::Needs::default(),
+    fits,
     preset: |_, settings| settings.strength = 1.0,
 };
 use crate::targets::{AO_FORMAT, FrameTargets};
@@ -200,6 +200,21 @@ const LABEL: &str = "lineao::RayTracedAo";
 /// √((squares − rays · mean²) / (rays − 1) / rays).
 pub const ACCUMULATION_BYTES: u64 = 16;
 
+/// Whether the accumulation for a guard-banded `size` fits the device's storage buffers (the
+/// method's entry in the registry's size check).
+fn fits(size: (u32, u32), limits: &wgpu::Limits) -> Result<(), crate::Error> {
+    let max_storage = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+    let bytes = size.0 as u64 * size.1 as u64 * ACCUMULATION_BYTES;
+    if bytes > max_storage {
+        return Err(crate::Error::TooLarge(format!(
+            "the ray tracer's accumulation for {} x {} px (with the guard band) needs {bytes} bytes, more than \
+             the adapter's {max_storage} byte storage buffers",
+            size.0, size.1
+        )));
+    }
+    Ok(())
+}
+
 impl RayTracedAo {
     pub fn new(device: &wgpu::Device) -> RayTracedAo {
         let mut slots = vec![Slot::Uniform, Slot::Texture, Slot::StorageTexture(AO_FORMAT), Slot::StorageReadWrite];
@@ -248,7 +263,7 @@ impl RayTracedAo {
         let accumulation = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("lineao::RayTracedAo::accumulation"),
             size: (w as u64 * h as u64 * ACCUMULATION_BYTES).max(ACCUMULATION_BYTES),
-            // Read back for the standard error (`AoChain::ray_accumulation`) and by the tests.
+            // Read back for the standard error (`AoChain::stage`) and by the tests.
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });

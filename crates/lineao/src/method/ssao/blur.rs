@@ -1,12 +1,12 @@
-//! The 4 × 4 blur that belongs to Crytek SSAO: the mean of `ao_raw` over the window
+//! The 4 × 4 blur that belongs to Crytek SSAO: the mean of its raw occlusion over the window
 //! x−2..=x+1, y−2..=y+1, which holds each of the 16 kernel rotations of the 4 × 4 tile exactly
 //! once, so the rotation pattern cancels. Only geometry pixels are averaged (the background has
-//! no occlusion to spread into the lines' silhouettes). Reads `ao_raw`, writes `ao`. The CPU
+//! no occlusion to spread into the lines' silhouettes). Reads SSAO's raw occlusion, writes `ao`. The CPU
 //! reference is [`crate::reference::ssao_blur`].
 
 use crate::binding::{self, Slot};
 use crate::passes::dispatch_full_screen;
-use crate::targets::{AO_FORMAT, FrameTargets};
+use crate::targets::{AO_FORMAT, FrameTargets, Target};
 use crate::timing::Span;
 
 pub struct SsaoBlur {
@@ -28,12 +28,8 @@ impl SsaoBlur {
         SsaoBlur { pipeline, layout, group: None }
     }
 
-    /// Binds `ao_raw` → `ao` (without `ao_raw` the pass records nothing).
-    pub fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets) {
-        let Some(raw) = &targets.ao_raw else {
-            self.group = None;
-            return;
-        };
+    /// Binds `raw` (SSAO's occlusion, [`Target::ao`] at the targets' size) → `ao`.
+    pub fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets, raw: &Target) {
         self.group = Some(binding::group(
             device,
             "lineao::SsaoBlur::group",

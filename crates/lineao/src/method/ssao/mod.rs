@@ -38,10 +38,10 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     spans: &["ssao", "ssao-blur"],
     shaders: &[("ssao.wgsl", include_str!("ssao.wgsl")), ("ssao_blur.wgsl", include_str!("ssao_blur.wgsl"))],
     build: Some(|device, settings| Box::new(SsaoStage::new(device, settings))),
-    needs: |_| super::Needs { ao_raw: true, ..super::Needs::default() },
+    fits: super::fits_always,
     preset: settings::preset,
 };
-use crate::targets::{AO_FORMAT, FrameTargets};
+use crate::targets::{AO_FORMAT, FrameTargets, Target};
 use crate::timing::Span;
 use crate::view_params::{ViewParams, ViewUniform};
 
@@ -106,13 +106,9 @@ impl Ssao {
         (self.samples, self.noise_seed, self.kernel) == (settings.samples, settings.noise_seed, settings.kernel)
     }
 
-    /// Reads `nd[0]`, writes `ao_raw`.
-    /// Binds `nd[0]` and `ao_raw` (without `ao_raw` the pass records nothing).
-    pub fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets) {
-        let Some(raw) = &targets.ao_raw else {
-            self.group = None;
-            return;
-        };
+    /// Binds `nd[0]`, which it reads, and `raw` (an [`AO_FORMAT`] target of the targets' size,
+    /// [`Target::ao`]), where it writes the occlusion before the blur.
+    pub fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets, raw: &Target) {
         self.group = Some(binding::group(
             device,
             "lineao::Ssao::group",
@@ -144,16 +140,24 @@ impl Ssao {
     }
 }
 
-/// Crytek SSAO's [`crate::method::Stage`]: the samples (`nd[0]` → `ao_raw`), then the 4 × 4 blur
-/// matched to the rotation tile (`ao_raw` → `ao`).
+/// Crytek SSAO's [`crate::method::Stage`]: the samples (`nd[0]` → `raw`), then the 4 × 4 blur
+/// matched to the rotation tile (`raw` → `ao`).
 pub struct SsaoStage {
     ssao: Ssao,
     blur: blur::SsaoBlur,
+    /// The occlusion before the blur, at the targets' size.
+    raw: Option<Target>,
 }
 
 impl SsaoStage {
     pub fn new(device: &wgpu::Device, settings: &ChainSettings) -> SsaoStage {
-        SsaoStage { ssao: Ssao::new(device, &settings.ssao), blur: blur::SsaoBlur::new(device) }
+        SsaoStage { ssao: Ssao::new(device, &settings.ssao), blur: blur::SsaoBlur::new(device), raw: None }
+    }
+
+    /// The occlusion before the blur of the last frame (what CONTRACT.md's `ao.npy` holds for
+    /// SSAO).
+    pub fn raw(&self) -> Option<&Target> {
+        self.raw.as_ref()
     }
 }
 
@@ -174,8 +178,10 @@ impl crate::method::Stage for SsaoStage {
     }
 
     fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets) {
-        self.ssao.resize(device, targets);
-        self.blur.resize(device, targets);
+        let raw = Target::ao(device, "lineao::SsaoStage::raw", targets.size);
+        self.ssao.resize(device, targets, &raw);
+        self.blur.resize(device, targets, &raw);
+        self.raw = Some(raw);
     }
 
     fn prepare(&self, queue: &wgpu::Queue, targets: &FrameTargets, view: &FrameView, settings: &ChainSettings) {

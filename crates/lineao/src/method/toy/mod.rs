@@ -17,7 +17,7 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     spans: &["toy"],
     shaders: &[("toy.wgsl", include_str!("toy.wgsl"))],
     build: Some(|device, _| Box::new(Toy::new(device))),
-    needs: |_| super::Needs::default(),
+    fits: super::fits_always,
     preset: |_, settings| settings.strength = 1.0,
 };
 

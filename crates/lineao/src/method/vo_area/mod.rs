@@ -41,7 +41,7 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     spans: &["moments", "vo-area"],
     shaders: &[("vo_area.wgsl", include_str!("vo_area.wgsl")), ("moments.wgsl", include_str!("moments.wgsl"))],
     build: Some(|device, settings| Box::new(VoArea::new(device, &settings.vo))),
-    needs: |_| super::Needs { moments: true, ..super::Needs::default() },
+    fits: moments::fits,
     preset: |preset, settings| crate::method::vo_line::preset(preset, settings, 1.0, 1.0),
 };
 use crate::targets::FrameTargets;
@@ -71,14 +71,18 @@ impl VoArea {
         self.core.matches(settings.area_samples, settings)
     }
 
-    /// Reads `nd[0]`, `zoom` and `moments` (which it writes first), writes `ao`. Does nothing
-    /// without `targets.moments` ([`FrameTargets::with_moments`]).
+    /// Reads `nd[0]`, `zoom` and its moments pyramid (which it writes first, allocated here at
+    /// the targets' size), writes `ao`.
     pub fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets) {
         self.moments.resize(device, targets);
-        if let Some(moments) = &targets.moments {
-            self.core.resize(device, targets, Some(moments));
-            self.max_level = moments.levels.len() as u32 - 1;
-        }
+        let moments = self.moments.moments().expect("sized above");
+        self.core.resize(device, targets, Some(moments));
+        self.max_level = moments.levels.len() as u32 - 1;
+    }
+
+    /// The moments pyramid of the last frame (for readback: [`crate::verify::read_moments`]).
+    pub fn moments(&self) -> Option<&moments::Moments> {
+        self.moments.moments()
     }
 
     pub fn prepare(&self, queue: &wgpu::Queue, targets: &FrameTargets, view: &FrameView, settings: &VoSettings) {
@@ -94,7 +98,7 @@ impl VoArea {
         moments: Option<Span>,
         span: Option<Span>,
     ) {
-        if targets.moments.is_none() {
+        if self.moments.moments().is_none() {
             return;
         }
         self.moments.encode(encoder, moments);

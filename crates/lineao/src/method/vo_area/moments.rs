@@ -14,11 +14,91 @@
 use crate::binding::{self, Slot};
 use crate::camera::FrameView;
 use crate::passes::dispatch_size;
-use crate::targets::{FrameTargets, Moments};
+use crate::targets::FrameTargets;
 use crate::timing::{self, Span};
 use crate::view_params::ViewParams;
 use crate::view_params::ViewUniform;
 
+/// Levels the moments pyramid can have (`shared/moments.wgsl`): enough for 32768² pixels.
+pub const MAX_MOMENT_LEVELS: usize = 16;
+
+/// One level of [`Moments`]: `width` × `height` texels from element `offset`, row-major.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MomentsLevel {
+    pub offset: u32,
+    pub width: u32,
+    pub height: u32,
+}
+
+/// VO area sampling's pyramid of depth moments ([`MomentsPyramid`] writes it): every level in one
+/// storage buffer of `vec2<f32>` (E\[z\], E\[z²\]), and the layout as a uniform
+/// (`array<vec4<u32>, 16>` of (offset, width, height, 0)).
+pub struct Moments {
+    pub buffer: wgpu::Buffer,
+    pub levels: Vec<MomentsLevel>,
+    pub layout: wgpu::Buffer,
+}
+
+impl Moments {
+    /// Level l is ⌊W_{l−1}/2⌋ × ⌊H_{l−1}/2⌋ (at least 1) down to 1 × 1, as a mip chain.
+    pub fn levels((width, height): (u32, u32)) -> Vec<MomentsLevel> {
+        let mut levels = vec![MomentsLevel { offset: 0, width, height }];
+        while let Some(&last) = levels.last().filter(|l| l.width > 1 || l.height > 1) {
+            levels.push(MomentsLevel {
+                offset: last.offset + last.width * last.height,
+                width: (last.width / 2).max(1),
+                height: (last.height / 2).max(1),
+            });
+        }
+        levels
+    }
+
+    /// Bytes of the buffer for a `size` pyramid.
+    pub fn bytes(size: (u32, u32)) -> u64 {
+        let last = *Moments::levels(size).last().expect("level 0 exists");
+        (last.offset as u64 + (last.width * last.height) as u64) * 8
+    }
+
+    pub fn new(device: &wgpu::Device, size: (u32, u32)) -> Moments {
+        use wgpu::util::DeviceExt;
+        let levels = Moments::levels(size);
+        let mut rects = [[0u32; 4]; MAX_MOMENT_LEVELS];
+        for (rect, l) in rects.iter_mut().zip(&levels) {
+            *rect = [l.offset, l.width, l.height, 0];
+        }
+        Moments {
+            buffer: device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("lineao::Moments"),
+                size: Moments::bytes(size),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            }),
+            layout: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("lineao::Moments::layout"),
+                contents: bytemuck::cast_slice(&rects),
+                usage: wgpu::BufferUsages::UNIFORM,
+            }),
+            levels,
+        }
+    }
+}
+
+/// Whether VO area's moments pyramid for a guard-banded `size` fits the device's storage
+/// buffers (the method's entry in the registry's size check).
+pub(crate) fn fits(size: (u32, u32), limits: &wgpu::Limits) -> Result<(), crate::Error> {
+    let max_storage = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+    let bytes = Moments::bytes(size);
+    if bytes > max_storage {
+        return Err(crate::Error::TooLarge(format!(
+            "VO area's moments pyramid for {} x {} px (with the guard band) needs {bytes} bytes, more than the \
+             adapter's {max_storage} byte storage buffers",
+            size.0, size.1
+        )));
+    }
+    Ok(())
+}
+
+/// The pass that writes [`Moments`] from `nd[0]`; it owns the pyramid, sized by `resize`.
 pub struct MomentsPyramid {
     level0: wgpu::ComputePipeline,
     downsample: wgpu::ComputePipeline,
@@ -26,6 +106,7 @@ pub struct MomentsPyramid {
     uniform: wgpu::Buffer,
     /// Per level: the bind group that writes it (with its own level-index uniform), its size.
     groups: Vec<(wgpu::BindGroup, (u32, u32))>,
+    moments: Option<Moments>,
 }
 
 impl MomentsPyramid {
@@ -44,16 +125,22 @@ impl MomentsPyramid {
             uniform: binding::uniform_buffer::<ViewUniform>(device, label),
             layout,
             groups: Vec::new(),
+            moments: None,
         }
     }
 
-    /// Reads `nd[0]`, writes every level of `targets.moments` (nothing when there are none).
+    /// Allocates the pyramid for `targets`' size and binds it: reads `nd[0]`, writes every
+    /// level. The caller checks the size against the device's storage-buffer limits
+    /// ([`Moments::bytes`]; the chain does, through the registry).
     pub fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets) {
-        let Some(moments) = &targets.moments else {
-            self.groups.clear();
-            return;
-        };
-        self.groups = (0..moments.levels.len()).map(|l| self.level_group(device, targets, moments, l)).collect();
+        let moments = Moments::new(device, targets.size);
+        self.groups = (0..moments.levels.len()).map(|l| self.level_group(device, targets, &moments, l)).collect();
+        self.moments = Some(moments);
+    }
+
+    /// The pyramid, once sized.
+    pub fn moments(&self) -> Option<&Moments> {
+        self.moments.as_ref()
     }
 
     fn level_group(

@@ -49,10 +49,11 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     spans: &["vo-line"],
     shaders: &[("vo_line.wgsl", include_str!("vo_line.wgsl"))],
     build: Some(|device, settings| Box::new(VoLine::new(device, &settings.vo))),
-    needs: |_| super::Needs::default(),
+    fits: super::fits_always,
     preset: |preset, settings| settings::preset(preset, settings, 2.0, 1.5),
 };
-use crate::targets::{AO_FORMAT, FrameTargets, Moments};
+use crate::method::vo_area::moments::Moments;
+use crate::targets::{AO_FORMAT, FrameTargets};
 use crate::timing::Span;
 use crate::view_params::ViewParams;
 use crate::view_params::ViewUniform;
