@@ -185,10 +185,11 @@ pub struct ViewArgs {
     /// Streamlines as lines or tubes.
     #[arg(long, value_enum, default_value_t = GeometryArg::Lines)]
     pub geometry: GeometryArg,
-    /// Parameters: lineao's default (legible), fitted to the local truth (physical), for dense
-    /// tractography (the paper's) or for sparse streamlines.
-    #[arg(long, value_enum, default_value_t = PresetArg::Legible)]
-    pub preset: PresetArg,
+    /// Parameters: lineao's default (legible), fitted to the local truth (physical), the
+    /// papers' values for dense tractography (paper, or dense), or for sparse streamlines
+    /// (sparse; the viewer also draws them 3 px wide).
+    #[arg(long, default_value = "legible", value_parser = parse_preset)]
+    pub preset: lineao::Preset,
     /// How lines are lit (as `render --line-shading`).
     #[arg(long, value_parser = named::<LineShading>(), default_value = "specular")]
     pub line_shading: LineShading,
@@ -221,19 +222,6 @@ pub struct ViewArgs {
     /// With --screenshot: UI frames to run at least before saving.
     #[arg(long, default_value_t = 3, requires = "screenshot")]
     pub frames: u32,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum PresetArg {
-    /// Each method's strength and reach chosen so that darker lines lie deeper (`score --fit`).
-    Legible,
-    /// Fitted to binary AO within 2 mm (was `calibrated`; faint on whole brains).
-    #[value(alias = "calibrated")]
-    Physical,
-    /// Whole-brain tractography: the paper's values.
-    Dense,
-    /// Few streamlines far apart: wider lines, every method reaching farther.
-    Sparse,
 }
 
 fn parse_size(s: &str) -> Result<[u32; 2], String> {
@@ -729,7 +717,7 @@ fn parse_settings(s: &str) -> Result<SettingsPatch, String> {
 }
 
 fn parse_preset(s: &str) -> Result<lineao::Preset, String> {
-    lineao::Preset::from_name(s).ok_or_else(|| format!("unknown preset '{s}' (legible, physical, paper)"))
+    lineao::Preset::from_name(s).ok_or_else(|| format!("unknown preset '{s}' (legible, physical, paper, sparse)"))
 }
 
 fn parse_scene(s: &str) -> Result<SceneKind, String> {

@@ -10,8 +10,8 @@ use glam::Vec3;
 use lineao::lighting::LineShading;
 use lineao::volume::{ScalarForm, Sky, VolumeAoOptions, VolumeMethod};
 use lineao::{
-    AoMethod, BilateralSettings, ChainSettings, Colormap, DebugView, LineAoOuter, LineAoVariant, LineColor, SsaoKernel,
-    TubeSettings, VoCombine, VolumeAoSettings,
+    AoMethod, BilateralSettings, ChainSettings, Colormap, DebugView, LineAoOuter, LineAoVariant, LineColor, Preset,
+    SsaoKernel, TubeSettings, VoCombine, VolumeAoSettings,
 };
 
 use super::worker::Panel;
@@ -61,35 +61,6 @@ pub enum ColorMode {
     Constant([u8; 3]),
 }
 
-/// The parameter sets the presets choose between.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Preset {
-    /// lineao's default (`lineao::Preset::Legible`): each method's strength and reach chosen
-    /// so that visibly darker lines lie deeper. The strength slider then holds LineAO's, and the
-    /// other methods keep their own strength relative to it.
-    Legible,
-    /// `lineao::Preset::Physical`: fitted to binary AO within 2 mm (faint on whole brains).
-    Physical,
-    /// Whole-brain tractography, hundreds of thousands of streamlines packed millimetres apart:
-    /// the paper's values (thin lines, three hemispheres, SSAO and VO spheres of 2 mm).
-    Dense,
-    /// A few hundred streamlines of a flow field, far apart: wider lines, and every method's
-    /// reach grown so that neighbours, not just a line's own body, occlude (four hemispheres, so
-    /// the outermost reaches twice as far; spheres of 6 units; a softer strength).
-    Sparse,
-}
-
-impl Preset {
-    /// The library's preset this one is, if any.
-    pub fn library(self) -> Option<lineao::Preset> {
-        match self {
-            Preset::Legible => Some(lineao::Preset::Legible),
-            Preset::Physical => Some(lineao::Preset::Physical),
-            Preset::Dense | Preset::Sparse => None,
-        }
-    }
-}
-
 /// The methods' parameters. World-space lengths are in the data's units (mm for tractograms).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Params {
@@ -119,25 +90,19 @@ impl Params {
         volume.density.occupancy_radius = 0.5 * zoom_unit;
         let mut params =
             Params { chain, tube_radius: 0.5 * zoom_unit, volume, cloudy: false, volume_combine: VoCombine::Product };
-        if let Some(library) = preset.library() {
-            // Each method's own reach (the panels share one chain's settings): SSAO's and VO's
-            // from their presets (VO area shares VO line's sphere), LineAO's and the strength
-            // from LineAO's; `panel` scales the strength per method.
-            let of = |method| ChainSettings { method, ..params.chain.clone() }.with_preset(library);
-            let (ssao, vo) = (of(AoMethod::Ssao).ssao, of(AoMethod::VoLine).vo);
-            params.chain = params.chain.with_preset(library);
-            params.chain.ssao = ssao;
-            params.chain.vo = vo;
-        }
+        // Each method's own reach (the panels share one chain's settings): SSAO's and VO's from
+        // their presets (VO area shares VO line's sphere), LineAO's and the strength from
+        // LineAO's; `panel` scales the strength per method.
+        let of = |method| ChainSettings { method, ..params.chain.clone() }.with_preset(preset);
+        let (ssao, vo) = (of(AoMethod::Ssao).ssao, of(AoMethod::VoLine).vo);
+        params.chain = params.chain.with_preset(preset);
+        params.chain.ssao = ssao;
+        params.chain.vo = vo;
         if preset == Preset::Sparse {
-            let c = &mut params.chain;
-            c.line_width_px = 3.0;
-            c.line_ao.s_r = 4;
-            c.line_ao.s_h = 24;
-            c.strength = 0.8;
-            c.ssao.radius_world = 6.0 * zoom_unit;
-            c.ssao.range_world = 6.0 * zoom_unit;
-            c.vo.radius_world = 6.0 * zoom_unit;
+            // Lines far apart are drawn wider, with more samples on LineAO's wider hemispheres,
+            // and their density volume smoothed as far.
+            params.chain.line_width_px = 3.0;
+            params.chain.line_ao.s_h = 24;
             params.volume.density.occupancy_radius = zoom_unit;
         }
         params
@@ -211,12 +176,10 @@ impl Controls {
         let sky = if p.cloudy { Sky::above_nearest_axis(up.to_array()) } else { Sky::Uniform };
         let mut settings = p.chain.clone();
         settings.method = method.screen;
-        if let Some(library) = self.preset.library() {
-            // The slider holds LineAO's strength of the preset; another method keeps its own
-            // strength of the preset relative to it.
-            let preset = |method| ChainSettings { method, ..ChainSettings::default() }.with_preset(library).strength;
-            settings.strength *= preset(method.screen) / preset(AoMethod::LineAo);
-        }
+        // The slider holds LineAO's strength of the preset; another method keeps its own
+        // strength of the preset relative to it.
+        let preset = |method| ChainSettings { method, ..ChainSettings::default() }.with_preset(self.preset).strength;
+        settings.strength *= preset(method.screen) / preset(AoMethod::LineAo);
         settings.volume = method.volume.map(|_| VolumeAoSettings {
             // The view-independent forms hold the sky already.
             sky: if p.volume.form.is_none() { sky.weights() } else { [1.0; 8] },
@@ -286,8 +249,8 @@ impl Controls {
             for (preset, label, hint) in [
                 (Preset::Legible, "Legible", "Darker lines lie deeper: chosen by legibility (lineao score --fit)"),
                 (Preset::Physical, "Physical", "Fitted to binary AO within 2 mm: faint on whole brains"),
-                (Preset::Dense, "Dense tractography", "The paper's values"),
-                (Preset::Sparse, "Sparse streamlines", "Wider lines, wider reach"),
+                (Preset::Paper, "Paper (dense)", "The papers' values, made for whole-brain tractography"),
+                (Preset::Sparse, "Sparse streamlines", "Wider lines, every method reaching farther"),
             ] {
                 if ui.selectable_label(self.preset == preset, label).on_hover_text(hint).clicked() {
                     self.preset = preset;
@@ -542,7 +505,7 @@ mod tests {
 
     #[test]
     fn every_preset_and_method_gives_valid_settings() {
-        for preset in [Preset::Dense, Preset::Sparse] {
+        for preset in Preset::ALL {
             for zoom_unit in [1.0, 0.01] {
                 let mut controls = Controls::new([methods()[1], methods()[4]], true, preset);
                 controls.set_zoom_unit(zoom_unit);
@@ -564,14 +527,16 @@ mod tests {
     /// SSAO's reach and strength of the preset (SSAO's 8 mm under `legible`).
     #[test]
     fn library_presets_give_each_method_its_own_values() {
-        for (preset, library) in
-            [(Preset::Legible, lineao::Preset::Legible), (Preset::Physical, lineao::Preset::Physical)]
-        {
+        for preset in Preset::ALL {
+            let library = preset;
             let controls = Controls::new([methods()[1], methods()[4]], true, preset);
             let panels = controls.panels(Vec3::Z, None, false);
             for panel in &panels {
                 let method = panel.settings.method;
-                let expected = ChainSettings { method, ..ChainSettings::default() }.with_preset(library);
+                // The viewer's own line width (3 px under `sparse`) sets r0 in pixels.
+                let width = panel.settings.line_width_px;
+                let expected =
+                    ChainSettings { method, line_width_px: width, ..ChainSettings::default() }.with_preset(library);
                 let s = &panel.settings;
                 assert!(
                     (s.strength - expected.strength).abs() < 1e-6,
@@ -603,7 +568,7 @@ mod tests {
 
     #[test]
     fn the_default_light_is_the_contracts() {
-        let controls = Controls::new([methods()[1]; 2], false, Preset::Dense);
+        let controls = Controls::new([methods()[1]; 2], false, Preset::Paper);
         let panel = &controls.panels(Vec3::Z, None, false)[0];
         let expected = lineao::lighting::Lighting::default().lights[0].dir.normalize();
         assert!(panel.settings.lighting.lights[0].dir.distance(expected) < 1e-5);

@@ -16,8 +16,8 @@ mod worker;
 
 use anyhow::{Context, Result};
 
-use crate::cli::{ColorArg, GeometryArg, PresetArg, ViewArgs};
-use controls::{ColorMode, Controls, Geometry, Preset};
+use crate::cli::{ColorArg, GeometryArg, ViewArgs};
+use controls::{ColorMode, Controls, Geometry};
 use worker::Source;
 
 /// The viewer's opening state from the command line.
@@ -29,12 +29,7 @@ fn options(args: &ViewArgs) -> app::Options {
             Source::Scene { kind, vertices: args.vertices.unwrap_or(kind.default_vertices()), seed: 1 }
         }
     };
-    let preset = match args.preset {
-        PresetArg::Legible => Preset::Legible,
-        PresetArg::Physical => Preset::Physical,
-        PresetArg::Dense => Preset::Dense,
-        PresetArg::Sparse => Preset::Sparse,
-    };
+    let preset = args.preset;
     let (methods, compare) = match args.compare {
         Some(pair) => (pair, true),
         None => ([args.method, crate::cli::Method { screen: lineao::AoMethod::Ssao, volume: None }], false),

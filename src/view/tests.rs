@@ -13,13 +13,14 @@ use lineao::AoMethod;
 use lineao_tracts::SceneKind;
 
 use super::app::{App, Options};
-use super::controls::{Controls, Preset, RAY_TRACED, methods};
+use super::controls::{Controls, RAY_TRACED, methods};
 use super::worker::{PREVIEW_VERTICES, Source};
+use lineao::Preset;
 
 const SIZE: [f32; 2] = [1000.0, 640.0];
 
 fn options(source: Source, methods: [crate::cli::Method; 2], compare: bool) -> Options {
-    Options { source, controls: Controls::new(methods, compare, Preset::Dense), orthographic: false, screenshot: None }
+    Options { source, controls: Controls::new(methods, compare, Preset::Paper), orthographic: false, screenshot: None }
 }
 
 fn scene(kind: SceneKind, vertices: usize) -> Source {
@@ -103,8 +104,7 @@ fn a_built_in_scene_is_on_screen_with_the_panel() {
     let image = frame.images[0].clone();
     let size = frame.size;
     // The panel: the method, the compare switch, the presets, the parameters of LineAO.
-    for label in
-        ["Compare side by side", "Dense tractography", "Reset to defaults", "s_r hemispheres", "GPU time per pass"]
+    for label in ["Compare side by side", "Paper (dense)", "Reset to defaults", "s_r hemispheres", "GPU time per pass"]
     {
         assert!(harness.query_all_by_label(label).next().is_some(), "the panel shows '{label}'");
     }

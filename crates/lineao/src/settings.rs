@@ -296,30 +296,40 @@ pub enum Preset {
     /// 2 mm, least RMSE): physically close at that reach, but so faint on whole brains that it
     /// looks like no AO at all. Was called `calibrated`, a name still accepted.
     Physical,
+    /// For a few streamlines far apart (flow fields, a single bundle): the papers' values with
+    /// every method reaching farther, so that neighbours and not just a line's own body occlude
+    /// — LineAO's four hemispheres (the fourth reaches twice as far as the third), SSAO's and
+    /// VO's spheres of 6 zoom units — at a softer strength (0.8): the viewer's values for sparse
+    /// streamlines (`--scene vortex`), chosen by eye, not fitted.
+    Sparse,
 }
 
 named!(Preset {
     Legible => "Each method's strength and reach chosen so that darker lines lie deeper (the default)",
     Physical => "Fitted to binary AO within 2 mm (was `calibrated`; faint on whole brains)",
-    Paper => "The papers' values",
+    Paper => "The papers' values (`dense` too: whole-brain tractography)",
+    Sparse => "Few streamlines far apart: every method reaching farther, a softer strength",
 });
 
 impl Preset {
-    pub const ALL: [Preset; 3] = [Preset::Legible, Preset::Physical, Preset::Paper];
+    pub const ALL: [Preset; 4] = [Preset::Legible, Preset::Physical, Preset::Paper, Preset::Sparse];
 
-    /// The name on the command line (`legible`, `physical`, `paper`).
+    /// The name on the command line (`legible`, `physical`, `paper`, `sparse`).
     pub fn name(self) -> &'static str {
         match self {
             Preset::Paper => "paper",
             Preset::Legible => "legible",
             Preset::Physical => "physical",
+            Preset::Sparse => "sparse",
         }
     }
 
-    /// The preset called `name`; `calibrated`, the name `physical` had before, too.
+    /// The preset called `name`; `calibrated`, the name `physical` had before, and `dense`, the
+    /// viewer's name for the papers' values, too.
     pub fn from_name(name: &str) -> Option<Preset> {
         match name {
             "calibrated" => Some(Preset::Physical),
+            "dense" => Some(Preset::Paper),
             _ => Preset::ALL.into_iter().find(|p| p.name() == name),
         }
     }
@@ -455,8 +465,14 @@ mod preset_tests {
             (Preset::Physical, VoLine, P, (0.22, 3, 1.5, 1.0, 2.0, 1.5)),
             (Preset::Physical, VoArea, P, (0.22, 3, 1.5, 1.0, 2.0, 1.0)),
             (Preset::Physical, Ssao, P, (0.68, 3, 1.5, 1.0, 2.0, 3.0)),
+            (Preset::Sparse, LineAo, P, (0.8, 4, 1.5, 1.0, 2.0, 2.0)),
+            (Preset::Sparse, LineAo, R, (0.8, 3, 1.5, 1.0, 2.0, 2.0)),
+            (Preset::Sparse, VoLine, P, (0.8, 3, 1.5, 1.0, 2.0, 6.0)),
+            (Preset::Sparse, VoArea, P, (0.8, 3, 1.5, 1.0, 2.0, 6.0)),
+            (Preset::Sparse, Ssao, P, (0.8, 3, 1.5, 1.0, 2.0, 6.0)),
             (Preset::Legible, None, P, paper),
             (Preset::Physical, RayTraced, P, paper),
+            (Preset::Sparse, RayTraced, P, paper),
         ];
         let cases = table.into_iter().chain([LineAo, VoLine, VoArea, Ssao].map(|m| (Preset::Paper, m, P, paper)));
         for (preset, method, variant, expected) in cases {

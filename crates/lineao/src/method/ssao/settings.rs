@@ -93,6 +93,7 @@ pub(crate) fn preset(preset: Preset, settings: &mut ChainSettings) {
         Preset::Paper => (1.0, 2.0),
         Preset::Legible => (1.0, 8.0),
         Preset::Physical => (0.68, 3.0),
+        Preset::Sparse => (0.8, 6.0),
     };
     settings.strength = strength;
     settings.ssao.radius_world = radius * settings.zoom_unit;

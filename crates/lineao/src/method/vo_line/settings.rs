@@ -114,6 +114,7 @@ pub(crate) fn preset(preset: Preset, settings: &mut ChainSettings, legible_radiu
         Preset::Paper => (1.0, 2.0),
         Preset::Legible => (0.8, legible_radius),
         Preset::Physical => (0.22, physical_radius),
+        Preset::Sparse => (0.8, 6.0),
     };
     settings.strength = strength;
     settings.vo.radius_world = radius * settings.zoom_unit;
