@@ -202,13 +202,17 @@ def test_ctrl_c_interrupts_a_long_load(tmp_path):
     lineao.save([rng.normal(size=(1000, 3)).astype(np.float32) for _ in range(3000)], big)
     calls = []
 
-    def slow(done, total):  # keeps the load going long enough for the signal to arrive
+    def slow(done, total):  # keeps the load going until the signal has arrived
         calls.append(done)
         if len(calls) == 1:
             threading.Timer(0.05, os.kill, (os.getpid(), signal.SIGINT)).start()
             import time
 
-            time.sleep(0.5)
+            # Short sleeps in a loop, not one long one: the loop's jumps let Python run the
+            # handler wherever the kernel delivered the signal (the sending thread too), and a
+            # loaded machine gets seconds, not half of one, to deliver it (CI once missed 0.5 s).
+            for _ in range(200):
+                time.sleep(0.025)
 
     with pytest.raises(KeyboardInterrupt):
         lineao.load(big, progress=slow)

@@ -8,7 +8,9 @@
 //! passes a host renderer can embed, with a plain-Rust CPU reference that proves every shader.
 //!
 //! - [`AoChain`] wires the passes for a method and owns every size-dependent texture:
-//!   `resize`, `prepare`, `encode` into your `CommandEncoder` and target view.
+//!   `resize`, `prepare`, `encode` into your `CommandEncoder` and target view. [`HostAo`] runs
+//!   it over your renderer's own depth (and normals, colour); [`OverlayAo`] draws its lines
+//!   into your frame, keeping your picture and depth (docs/embedding.md).
 //! - [`method`]: one folder per method — [`LineAo`](method::line_ao::LineAo) and the
 //!   alternatives LineAO is measured against, [`Ssao`](method::ssao::Ssao) (Crytek),
 //!   [`VoLine`](method::vo_line::VoLine) and [`VoArea`](method::vo_area::VoArea) (Volumetric
