@@ -383,7 +383,7 @@ fn host_api_misuse_is_an_error_that_says_what_to_change() {
         HostConfig { normals: Some(HostNormals { world_space: false, unorm: true }), ..HostConfig::default() };
     host.set_config(d, normals).unwrap();
     expect(host.encode(d, &mut encoder, &with(&depth, None, None), None), "HostInputs::normals is None");
-    host.set_config(d, HostConfig::default()).unwrap();
+    pollster::block_on(host.set_config_async(d, HostConfig::default())).unwrap();
 
     // The composite's target: its format, its size, its usage.
     let wrong_format = texture(&gpu, size, F::Rgba16Float, U::RENDER_ATTACHMENT, 1);

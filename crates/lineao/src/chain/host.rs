@@ -78,9 +78,15 @@ impl HostAo {
     }
 
     /// Follows a change of the host's buffers (its depth's samples or convention, its normals).
+    /// Blocks as [`HostAo::new`] does; [`HostAo::set_config_async`] awaits.
     pub fn set_config(&mut self, device: &wgpu::Device, config: HostConfig) -> Result<(), Error> {
+        pollster::block_on(self.set_config_async(device, config))
+    }
+
+    /// [`HostAo::set_config`] as a future.
+    pub async fn set_config_async(&mut self, device: &wgpu::Device, config: HostConfig) -> Result<(), Error> {
         if self.pass.config() != config {
-            self.pass = pollster::block_on(Self::pass(device, config))?;
+            self.pass = Self::pass(device, config).await?;
         }
         Ok(())
     }
