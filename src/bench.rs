@@ -2,33 +2,34 @@
 //!
 //! Every pass runs in its own submission, `--frames` times after `--warmup` frames, on the same
 //! G-buffer. With timestamp queries the time is the GPU's (`"on": "gpu"`); without, CPU wall time
-//! around submit + wait (`"on": "cpu"`, `"timestamps": false`). Baselines measured in the same
-//! run give the ratios the numbers are judged by:
+//! around submit + wait (`"on": "cpu"`, `"timestamps": false`), which for a method's pass is its
+//! whole stage's (`ssao-12` with the blur, `lineao` with the pyramid). Baselines measured in the
+//! same run give the ratios the numbers are judged by.
 //!
-//! - `lines-native-1px`: the same segments as the rasterizer's native 1-px `LineList`;
-//! - `lines-full-strip`: the same lines always from the full strip (both sides of every point),
+//! The bench's own passes are the geometry and what every method shares:
+//! - `lines`; `lines-native-1px`: the same segments as the rasterizer's native 1-px `LineList`;
+//!   `lines-full-strip`: the same lines always from the full strip (both sides of every point),
 //!   against which `lines` shows what its alternating strip saves;
-//! - `lineao-tap-floor`: the LineAO shader with the same sample addresses that only sums the
-//!   fetched depths ([`Evaluation::TapFloor`]);
-//! - `lineao-chain`: pyramid + LineAO in one span (what a frame pays for the occlusion);
-//! - `lineao-level`, `lineao-chain-level`: the same with `outer = level` (CONTRACT.md);
-//! - `ssao-12`: Crytek SSAO with 12 point samples (the VO paper's comparison);
-//! - `ssao-16-chain`: SSAO with 16 samples and its 4 × 4 blur in one span (the LineAO paper's
-//!   baseline frame, against `lineao-chain`);
-//! - `vo-line-5`: Volumetric Obscurance with 5 line samples (against `ssao-12`: the VO paper's
-//!   0.56×);
-//! - `vo-area-1`: VO with one area sample, moments pyramid included (what the method costs);
-//! - `bilateral`: the separable bilateral blur (radius 4), which can follow any method;
+//! - `nd-pyramid`, `composite`; `bilateral`: the separable bilateral blur (radius 4), which can
+//!   follow any method;
 //! - `tubes`: the same streamlines as ray-cast tubes of radius 0.5 mm (against `lines`);
 //! - `nd-from-depth`: the ND and zoom maps derived from the G-buffer's depth, as from a host
-//!   renderer's (what embedding costs besides the method);
-//! - `raytraced-1spp`: a frame of the GPU ray tracer that continues a picture with one more ray
-//!   per geometry pixel (binary AO to 2 mm): what each progressive frame costs per ray, against
-//!   `lineao-chain`; the table adds rays per second;
-//! - `raytraced-start-1spp`: a picture's first frame, which also finds each pixel's own segment
-//!   and tests its origin for being buried (kept for the frames after it);
-//! - `ray-denoise`: the ray tracer's edge-aware denoiser (7 × 7 window) over that picture's
-//!   accumulation, against `raytraced-1spp`.
+//!   renderer's (what embedding costs besides the method).
+//!
+//! Every method's passes come from the registry: each method's folder lists them
+//! ([`lineao::method::BenchPass`]: a name, what it changes of the settings, which of its stage's
+//! spans it times), and the bench builds, prepares and records that stage on the G-buffer:
+//! - LineAO: `lineao`; `lineao-tap-floor`, the LineAO shader with the same sample addresses
+//!   that only sums the fetched depths; `lineao-chain` (pyramid + LineAO in one span, what a
+//!   frame pays for the occlusion); `lineao-level`, `lineao-chain-level` with `outer = level`;
+//! - VO: `vo-line-5` (5 line samples, against `ssao-12`: the VO paper's 0.56×), `vo-area-1`
+//!   (one area sample, moments pyramid included);
+//! - SSAO: `ssao-12` (12 point samples, the VO paper's comparison), `ssao-16-chain` (16 samples
+//!   and the 4 × 4 blur: the LineAO paper's baseline frame, against `lineao-chain`);
+//! - the GPU ray tracer: `raytraced-1spp`, a frame that continues a picture with one more ray per
+//!   geometry pixel (binary AO to 2 mm; the table adds rays per second); `raytraced-start-1spp`,
+//!   a picture's first frame, which also finds each pixel's own segment and tests its origin for
+//!   being buried; `ray-denoise`, the edge-aware denoiser (7 × 7 window) over a picture.
 //!
 //! The object-space passes run on the CPU (`"on": "cpu"`), `--frames` times up to 3 (each takes
 //! seconds) without warm-up, on the scene's streamlines:
@@ -50,13 +51,8 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use lineao::camera::{FrameView, Projection};
 use lineao::gbuffer::Load;
-use lineao::method::line_ao::{Evaluation, LineAo};
 use lineao::method::raytraced::RayTracedAo;
-use lineao::method::raytraced::denoise::RayDenoise;
-use lineao::method::ssao::Ssao;
-use lineao::method::ssao::blur::SsaoBlur;
-use lineao::method::vo_area::VoArea;
-use lineao::method::vo_line::VoLine;
+use lineao::method::{BenchPass, Stage};
 use lineao::passes::bilateral::Bilateral;
 use lineao::passes::composite::Composite;
 use lineao::passes::lines::{GeometryOptions, LineGeometry, LineRenderer, LineStyle};
@@ -69,57 +65,43 @@ use lineao::volume::density::{DensityOptions, voxelize};
 use lineao::volume::sweep::{self, SweepSettings};
 use lineao::volume::variance::{VarianceMaps, VarianceSettings};
 use lineao::volume::vertex_tangents;
-use lineao::{
-    AoChain, BilateralSettings, ChainSettings, Gpu, LineAoOuter, LineAoSettings, RayDenoiseSettings, SsaoSettings,
-    VoSettings,
-};
+use lineao::{AoChain, AoMethod, BilateralSettings, ChainSettings, Gpu, LineAoSettings};
 use serde_json::json;
 
-use crate::cli::{BenchArgs, GPU_PASSES};
+use crate::cli::{BenchArgs, gpu_passes};
 
 /// The radius of pass `tubes` in zoom units (0.5 mm for tractograms).
 const TUBE_RADIUS: f32 = 0.5;
 
-/// Every pass of the benchmark, prepared for one view over one G-buffer.
+/// Every pass of the benchmark, prepared for one view over one G-buffer: the bench's own (the
+/// geometry, the shared passes) and every method's from the registry ([`StagePass`]).
 struct Passes {
     lines: LineRenderer,
     lines_native: LineRenderer,
     lines_full: LineRenderer,
     pyramid: NdPyramid,
-    line_ao: LineAo,
-    tap_floor: LineAo,
-    line_ao_level: LineAo,
     composite: Composite,
-    ssao_12: Ssao,
-    ssao_16: Ssao,
-    ssao_blur: SsaoBlur,
-    /// SSAO's occlusion before its blur (the SSAO stage's own in the chain).
-    ssao_raw: Target,
-    vo_line_5: VoLine,
-    vo_area_1: VoArea,
-    /// The chain's G-buffer copied into one-level targets of its own, for `vo_area_1`. On the
-    /// shared targets (the same size and content) `vo-area-1` measured 1.82–1.92 × `ssao-12` on
-    /// lavapipe against 1.58–1.60 here, two runs each; the cause was not found.
-    area_targets: FrameTargets,
     bilateral: Bilateral,
     tubes: TubeRenderer,
     /// The ND and zoom maps from the G-buffer's own depth, as from a host's (whose bind group
     /// is made per frame, on the device).
     nd_from_depth: NdFromDepth,
-    /// One ray per pixel: every frame ray 1 of a picture, or ray 0 (prepared once).
-    raytraced: RayTracedAo,
-    raytraced_start: RayTracedAo,
-    /// Over `raytraced`'s accumulation, at 4 rays per pixel (its window at full width).
-    ray_denoise: RayDenoise,
-    /// What the ray tracer's frames are prepared with, before each (one `encode` per `prepare`):
-    /// one ray per pixel, and the view.
-    one_ray: ChainSettings,
-    view: FrameView,
-    /// Seeds of `raytraced-start-1spp`'s pictures: a new seed each frame starts a new picture.
-    start_seed: std::cell::Cell<u32>,
+    stages: Vec<StagePass>,
     device: wgpu::Device,
-    queue: wgpu::Queue,
     output: Target,
+}
+
+/// A method's bench pass ([`BenchPass`], from the registry) and its stage, bound to the chain's
+/// targets (whose pyramid has LineAO's levels; the other methods read its finest).
+///
+/// Every stage reads the G-buffer `lines` wrote. On lavapipe a pass over one-level targets of
+/// its own (a copy of the G-buffer made once) measured 0.03–0.08 ms by its timestamps where on
+/// the chain's it took 1.7–5 ms; VO area there measured 40.6 ms by timestamps and 48.5 ms by
+/// the wall clock, 45.8–47.6 ms by timestamps on the chain's (docs/measurements.md).
+struct StagePass {
+    method: AoMethod,
+    pass: &'static BenchPass,
+    stage: Box<dyn Stage>,
 }
 
 impl Passes {
@@ -129,40 +111,20 @@ impl Passes {
         targets: &FrameTargets,
         view: &FrameView,
         scene: std::sync::Arc<lineao::RayScene>,
-    ) -> Passes {
+    ) -> Result<Passes> {
         let (device, queue) = (&gpu.device, &gpu.queue);
         let format = wgpu::TextureFormat::Rgba8UnormSrgb;
-        let level = LineAoSettings { outer: LineAoOuter::Level, ..settings.line_ao.clone() };
         let mut passes = Passes {
             lines: LineRenderer::new(device),
             lines_native: LineRenderer::with_style(device, LineStyle::Native1px),
             lines_full: LineRenderer::with_style(device, LineStyle::FullStrip),
             pyramid: NdPyramid::new(device),
-            line_ao: LineAo::new(device, &settings.line_ao, &settings.lighting),
-            tap_floor: LineAo::with_evaluation(device, &settings.line_ao, &settings.lighting, Evaluation::TapFloor),
-            line_ao_level: LineAo::new(device, &level, &settings.lighting),
             composite: Composite::new(device, format),
-            ssao_12: Ssao::new(device, &SsaoSettings { samples: 12, ..settings.ssao.clone() }),
-            ssao_16: Ssao::new(device, &SsaoSettings { samples: 16, ..settings.ssao.clone() }),
-            ssao_blur: SsaoBlur::new(device),
-            vo_line_5: VoLine::new(device, &VoSettings { samples: 5, ..settings.vo.clone() }),
-            vo_area_1: VoArea::new(device, &VoSettings { area_samples: 1, ..settings.vo.clone() }),
-            area_targets: FrameTargets::new(device, view.width, view.height, targets.guard, 1),
-            ssao_raw: Target::ao(device, "lineao::bench::ssao_raw", targets.size),
             bilateral: Bilateral::new(device),
             tubes: TubeRenderer::new(device, false),
             nd_from_depth: NdFromDepth::new(device, HostConfig::default()),
-            raytraced: RayTracedAo::new(device),
-            raytraced_start: RayTracedAo::new(device),
-            ray_denoise: RayDenoise::new(device),
-            one_ray: ChainSettings {
-                raytraced: lineao::RayTracedSettings { rays_per_frame: 1, ..Default::default() },
-                ..settings.clone()
-            },
-            view: *view,
-            start_seed: std::cell::Cell::new(1),
+            stages: Vec::new(),
             device: device.clone(),
-            queue: queue.clone(),
             output: Target::output(device, "lineao::bench::output", (view.width, view.height), format),
         };
         for renderer in [&passes.lines, &passes.lines_native, &passes.lines_full] {
@@ -171,41 +133,19 @@ impl Passes {
         passes.tubes.prepare(queue, view, TUBE_RADIUS * view.zoom_unit, settings.line_color, &settings.lighting);
         passes.nd_from_depth.prepare(queue, view);
         passes.pyramid.resize(device, targets);
-        for (pass, line_ao) in [
-            (&mut passes.line_ao, &settings.line_ao),
-            (&mut passes.tap_floor, &settings.line_ao),
-            (&mut passes.line_ao_level, &level),
-        ] {
-            pass.resize(device, targets);
-            pass.prepare(queue, targets, view, line_ao, settings.r0(), &settings.lighting);
+        for (method, pass) in lineao::method::bench_passes() {
+            let first = pass.settings_for(method, settings, 0);
+            let Some(mut stage) = pass.stage(method, device, &first) else { continue };
+            // The one stage that traces the scene.
+            if let Some(tracer) = (stage.as_mut() as &mut dyn std::any::Any).downcast_mut::<RayTracedAo>() {
+                tracer.set_scene(Some(scene.clone()));
+            }
+            if let Some(span) = pass.spans.iter().find(|span| !stage.spans(&first).contains(span)) {
+                anyhow::bail!("bench pass {}: its stage records no span '{span}' with these settings", pass.name);
+            }
+            stage.resize(device, targets);
+            passes.stages.push(StagePass { method, pass, stage });
         }
-        for (pass, samples) in [(&mut passes.ssao_12, 12), (&mut passes.ssao_16, 16)] {
-            pass.resize(device, targets, &passes.ssao_raw);
-            pass.prepare(queue, targets, view, &SsaoSettings { samples, ..settings.ssao.clone() });
-        }
-        passes.ssao_blur.resize(device, targets, &passes.ssao_raw);
-        passes.vo_line_5.resize(device, targets);
-        passes.vo_line_5.prepare(queue, targets, view, &VoSettings { samples: 5, ..settings.vo.clone() });
-        passes.vo_area_1.resize(device, &passes.area_targets);
-        passes.vo_area_1.prepare(
-            queue,
-            &passes.area_targets,
-            view,
-            &VoSettings { area_samples: 1, ..settings.vo.clone() },
-        );
-        for pass in [&mut passes.raytraced, &mut passes.raytraced_start] {
-            pass.set_scene(Some(scene.clone()));
-            pass.resize(device, targets);
-        }
-        // `raytraced` continues the picture its first frame started.
-        passes.raytraced.prepare(queue, targets, view, &passes.one_ray);
-        let mut encoder =
-            device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::bench") });
-        passes.raytraced.encode(&mut encoder, targets, None, None);
-        queue.submit([encoder.finish()]);
-        let accumulation = passes.raytraced.accumulation().expect("sized above");
-        passes.ray_denoise.resize(device, targets, accumulation);
-        passes.ray_denoise.prepare(queue, targets, view, &RayDenoiseSettings::default(), (4, false));
         passes.bilateral.resize(device, targets);
         passes.bilateral.prepare(queue, view, &BilateralSettings::default());
         passes.composite.resize(device, targets, &targets.ao);
@@ -217,66 +157,48 @@ impl Passes {
             settings.debug_view,
             lineao::passes::composite::Shown::Screen,
         );
-        passes
+        Ok(passes)
     }
 
-    /// Records pass `name` timed into `span`.
+    /// Records pass `name` of frame `frame` timed into `span`, after writing what its settings
+    /// make of that frame.
+    #[allow(clippy::too_many_arguments)]
     fn encode(
         &self,
         name: &str,
+        frame: u32,
         encoder: &mut wgpu::CommandEncoder,
         targets: &FrameTargets,
         geometry: &LineGeometry,
-        background: [f32; 3],
+        (settings, view, queue): (&ChainSettings, &FrameView, &wgpu::Queue),
         span: Option<Span>,
     ) {
+        let background = settings.background;
         match name {
             "lines" => self.lines.encode(encoder, targets, geometry, Load::Clear(background), span),
             "lines-native-1px" => self.lines_native.encode(encoder, targets, geometry, Load::Clear(background), span),
             "lines-full-strip" => self.lines_full.encode(encoder, targets, geometry, Load::Clear(background), span),
             "nd-pyramid" => self.pyramid.encode(encoder, targets, span),
-            "lineao" => self.line_ao.encode(encoder, targets, span),
-            "lineao-tap-floor" => self.tap_floor.encode(encoder, targets, span),
             "composite" => self.composite.encode(encoder, &self.output.view, span),
-            "lineao-chain" => {
-                self.pyramid.encode(encoder, targets, span.map(Span::begin_only));
-                self.line_ao.encode(encoder, targets, span.map(Span::end_only));
-            }
-            "lineao-level" => self.line_ao_level.encode(encoder, targets, span),
-            "lineao-chain-level" => {
-                self.pyramid.encode(encoder, targets, span.map(Span::begin_only));
-                self.line_ao_level.encode(encoder, targets, span.map(Span::end_only));
-            }
-            "ssao-12" => self.ssao_12.encode(encoder, targets, span),
-            "ssao-16-chain" => {
-                self.ssao_16.encode(encoder, targets, span.map(Span::begin_only));
-                self.ssao_blur.encode(encoder, targets, span.map(Span::end_only));
-            }
-            "vo-line-5" => self.vo_line_5.encode(encoder, targets, span),
-            "vo-area-1" => {
-                let area = &self.area_targets;
-                self.vo_area_1.encode(encoder, area, span.map(Span::begin_only), span.map(Span::end_only))
-            }
             "bilateral" => self.bilateral.encode(encoder, targets, span),
             "tubes" => self.tubes.encode(encoder, targets, geometry, Load::Clear(background), span),
-            "raytraced-1spp" => {
-                // The picture's next ray.
-                self.raytraced.prepare(&self.queue, targets, &self.view, &self.one_ray);
-                self.raytraced.encode(encoder, targets, span, None)
-            }
-            "raytraced-start-1spp" => {
-                // Another seed: a new picture, whose first frame this is.
-                let mut settings = self.one_ray.clone();
-                settings.raytraced.seed = self.start_seed.replace(self.start_seed.get() + 1);
-                self.raytraced_start.prepare(&self.queue, targets, &self.view, &settings);
-                self.raytraced_start.encode(encoder, targets, span, None)
-            }
-            "ray-denoise" => self.ray_denoise.encode(encoder, targets, span),
             "nd-from-depth" => {
                 let inputs = HostInputs { depth: &targets.depth.view, normals: None, color: None };
                 self.nd_from_depth.encode(&self.device, encoder, targets, &inputs, span);
             }
-            _ => unreachable!("unknown bench pass {name}"),
+            _ => {
+                let s = self.stages.iter().find(|s| s.pass.name == name).expect("every bench pass is listed");
+                s.stage.prepare(queue, targets, view, &s.pass.settings_for(s.method, settings, frame));
+                // The pass's spans as one: the first's start, the last's end.
+                let (first, last) = (s.pass.spans[0], s.pass.spans[s.pass.spans.len() - 1]);
+                let of = |name: &'static str| match (name == first, name == last) {
+                    (true, true) => span,
+                    (true, false) => span.map(Span::begin_only),
+                    (false, true) => span.map(Span::end_only),
+                    (false, false) => None,
+                };
+                s.stage.encode(encoder, targets, &of);
+            }
         }
     }
 }
@@ -319,20 +241,19 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let ray_geometry =
         lineao::RayGeometry { positions: &tractogram.positions, offsets: &tractogram.offsets, ..Default::default() };
     let ray_scene = std::sync::Arc::new(lineao::RayScene::new(device, queue, &ray_geometry)?);
-    let passes = Passes::new(&gpu, &settings, targets, &view, ray_scene.clone());
-    let timer = if args.no_timestamps { None } else { PassTimer::new(device, queue, &GPU_PASSES) };
+    let passes = Passes::new(&gpu, &settings, targets, &view, ray_scene.clone())?;
+    let all = gpu_passes();
+    let timer = if args.no_timestamps { None } else { PassTimer::new(device, queue, &all) };
 
-    let mut times: Vec<Vec<f64>> = vec![Vec::new(); GPU_PASSES.len()];
+    let mut times: Vec<Vec<f64>> = vec![Vec::new(); all.len()];
     // `lines` last among the line passes, so the G-buffer the later passes read is the chain's.
     let first = ["lines-native-1px", "lines-full-strip"];
-    let order = first.into_iter().chain(GPU_PASSES.into_iter().filter(|p| !first.contains(p)));
+    let order = first.into_iter().chain(all.iter().copied().filter(|p| !first.contains(p)));
+    let context = (&settings, &view, queue);
     // The G-buffer and pyramid every later pass reads, also when `--passes` leaves them out.
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::bench") });
-    passes.encode("lines", &mut encoder, targets, &geometry, settings.background, None);
-    passes.encode("nd-pyramid", &mut encoder, targets, &geometry, settings.background, None);
-    for (from, to) in [(&targets.nd[0], &passes.area_targets.nd[0]), (&targets.zoom, &passes.area_targets.zoom)] {
-        encoder.copy_texture_to_texture(from.texture.as_image_copy(), to.texture.as_image_copy(), from.texture.size());
-    }
+    passes.encode("lines", 0, &mut encoder, targets, &geometry, context, None);
+    passes.encode("nd-pyramid", 0, &mut encoder, targets, &geometry, context, None);
     queue.submit([encoder.finish()]);
     let selected = |name: &str| args.passes.is_empty() || args.passes.iter().any(|p| p == name);
     for frame in 0..args.warmup + args.frames {
@@ -340,14 +261,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             let mut encoder =
                 device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::bench") });
             encoder.push_debug_group(name);
-            passes.encode(
-                name,
-                &mut encoder,
-                targets,
-                &geometry,
-                settings.background,
-                timer.as_ref().and_then(|t| t.span(name)),
-            );
+            let span = timer.as_ref().and_then(|t| t.span(name));
+            passes.encode(name, frame, &mut encoder, targets, &geometry, context, span);
             encoder.pop_debug_group();
             if let Some(timer) = &timer {
                 timer.resolve(&mut encoder);
@@ -361,18 +276,14 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 None => wall_ms,
             };
             if frame >= args.warmup {
-                times[GPU_PASSES.iter().position(|p| *p == name).expect("every pass is listed")].push(ms);
+                times[all.iter().position(|p| *p == name).expect("every pass is listed")].push(ms);
             }
         }
     }
 
     let on = if timer.is_some() { "gpu" } else { "cpu" };
-    let mut passes: Vec<_> = GPU_PASSES
-        .iter()
-        .zip(times)
-        .filter(|(name, _)| selected(name))
-        .map(|(name, ms)| summary(name, on, ms))
-        .collect();
+    let mut passes: Vec<_> =
+        all.iter().zip(times).filter(|(name, _)| selected(name)).map(|(name, ms)| summary(name, on, ms)).collect();
     let runs = args.frames.min(3);
     for (name, ms) in object_space_times(&tractogram.positions, &tractogram.offsets, runs, &selected)? {
         passes.push(summary(name, "cpu", ms));

@@ -40,9 +40,8 @@ pub struct ScoreArgs {
     /// signed error).
     #[command(flatten)]
     pub render: RenderArgs,
-    /// Methods to score, comma-separated (`lineao`, `lineao-reference`, `vo-line`, `vo-area`,
-    /// `ssao`, `raytraced` = the truth again with the next --ray-seed, traced on the GPU, or on the CPU with --cpu) [default: all of them].
-    #[arg(long, value_delimiter = ',', value_parser = parse_score_method)]
+    /// Methods to score, comma-separated [default: all of them].
+    #[arg(long, value_delimiter = ',', value_parser = Listed { parse: parse_score_method, values: ScoreMethod::listed })]
     pub methods: Vec<ScoreMethod>,
     /// Print JSON (CONTRACT.md `lineao score --json`) instead of a table.
     #[arg(long)]
@@ -96,6 +95,20 @@ impl ScoreMethod {
             (lineao::AoMethod::LineAo, lineao::LineAoVariant::Reference) => "lineao-reference",
             (method, _) => method.name(),
         }
+    }
+
+    /// Every row's name and help, for `--help`.
+    fn listed() -> Vec<(&'static str, &'static str)> {
+        let help = |m: ScoreMethod| match (m.method, m.variant) {
+            (lineao::AoMethod::LineAo, lineao::LineAoVariant::Reference) => {
+                "LineAO's `reference` variant (the authors' LineVis: radius in zoom units, no pyramid)"
+            }
+            (lineao::AoMethod::RayTraced, _) => {
+                "The truth again with the next --ray-seed, traced on the GPU (on the CPU with --cpu)"
+            }
+            (method, _) => method.info().help,
+        };
+        ScoreMethod::all().into_iter().map(|m| (m.name(), help(m))).collect()
     }
 }
 
@@ -177,7 +190,7 @@ pub struct ViewArgs {
     #[arg(long)]
     pub vertices: Option<usize>,
     /// The method shown first (as `render --method`).
-    #[arg(long, default_value = "lineao", value_parser = parse_method)]
+    #[arg(long, default_value = "lineao", value_parser = Listed { parse: parse_method, values: Method::listed })]
     pub method: Method,
     /// Start in compare mode with these two methods (e.g. `lineao,ssao`).
     #[arg(long, value_name = "A,B", value_parser = parse_pair, conflicts_with = "method")]
@@ -280,7 +293,7 @@ fn parse_bench_pass(s: &str) -> Result<String, String> {
     if is_pass(s) {
         Ok(s.to_string())
     } else {
-        let all = [&GPU_PASSES[..], &CPU_PASSES[..]].concat();
+        let all = [gpu_passes(), CPU_PASSES.to_vec()].concat();
         Err(format!("unknown pass '{s}' (one of {})", all.join(", ")))
     }
 }
@@ -303,6 +316,22 @@ impl Method {
         let volume = VolumeMethod::ALL.map(|v| Method { screen: lineao::AoMethod::None, volume: Some(v) });
         let both = VolumeMethod::ALL.map(|v| Method { screen: lineao::AoMethod::LineAo, volume: Some(v) });
         screen.chain(volume).chain(both).collect()
+    }
+
+    /// The single methods' names and help, for `--help`: the registry's, then the object-space
+    /// ones (a sum such as `lineao+sweep` is parsed, not listed).
+    fn listed() -> Vec<(&'static str, &'static str)> {
+        use lineao::volume::VolumeMethod;
+        let volume = |v: VolumeMethod| match v {
+            VolumeMethod::Sweep => {
+                "Object space: fast occlusion sweeping (Singh, Yuksel, House 2009) over a density volume"
+            }
+            VolumeMethod::VarianceVolume => {
+                "Object space: variance occlusion maps (Penner & Mitchell 2008) over a density volume"
+            }
+        };
+        let screen = lineao::AoMethod::REGISTRY.iter().map(|m| (m.name(), m.info().help));
+        screen.chain(VolumeMethod::ALL.into_iter().map(|v| (v.name(), volume(v)))).collect()
     }
 
     pub fn name(&self) -> String {
@@ -430,19 +459,17 @@ pub struct RenderArgs {
     /// Seed of the built-in scene.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Ambient occlusion method: none, lineao, ssao (Crytek, with its 4 × 4 blur), vo-line or
-    /// vo-area (Volumetric Obscurance with line or area samples); object-space sweep (occlusion
-    /// sweeping) or variance-volume (variance occlusion maps); or a screen-space method with an
-    /// object-space one, e.g. lineao+sweep (see --volume-combine).
-    #[arg(long, default_value = "lineao", value_parser = parse_method)]
+    /// Ambient occlusion method: one of the list, or a screen-space method with an object-space
+    /// one, e.g. lineao+sweep (see --volume-combine).
+    #[arg(long, default_value = "lineao", value_parser = Listed { parse: parse_method, values: Method::listed })]
     pub method: Method,
     /// Split screen: method A on the left, B on the right, a labelled divider (e.g.
     /// `lineao,ssao`).
     #[arg(long, value_name = "A,B", value_parser = parse_pair, conflicts_with = "grid")]
     pub compare: Option<[Method; 2]>,
-    /// Every method in one labelled image (a 3 × 3 grid of --width × --height tiles: none,
-    /// lineao, its `reference` variant, vo-line, vo-area, ssao, sweep, variance-volume,
-    /// lineao+sweep).
+    /// Every method in one labelled image (a grid of --width × --height tiles, three a row:
+    /// the screen-space methods with LineAO's `reference` variant third, the object-space ones
+    /// and lineao+sweep).
     #[arg(long)]
     pub grid: bool,
     /// LineAO variant.
@@ -754,6 +781,32 @@ fn parse_debug_view(s: &str) -> Result<lineao::DebugView, String> {
     })
 }
 
+/// A parser that lists its values with their help in `--help` (from the registry, not a copy)
+/// and parses with `parse`, which also takes what the list does not show (`lineao+sweep`).
+#[derive(Clone)]
+struct Listed<T> {
+    parse: fn(&str) -> Result<T, String>,
+    values: fn() -> Vec<(&'static str, &'static str)>,
+}
+
+impl<T: Clone + Send + Sync + 'static> clap::builder::TypedValueParser for Listed<T> {
+    type Value = T;
+
+    fn parse_ref(
+        &self,
+        cmd: &clap::Command,
+        arg: Option<&clap::Arg>,
+        value: &std::ffi::OsStr,
+    ) -> Result<T, clap::Error> {
+        self.parse.parse_ref(cmd, arg, value)
+    }
+
+    fn possible_values(&self) -> Option<Box<dyn Iterator<Item = clap::builder::PossibleValue> + '_>> {
+        let values = (self.values)().into_iter();
+        Some(Box::new(values.map(|(name, help)| clap::builder::PossibleValue::new(name).help(help))))
+    }
+}
+
 /// A parser of a library setting's own names ([`lineao::Named`]), listing each with its help:
 /// the CLI mirrors no enum of the library's.
 fn named<T: Named>() -> impl clap::builder::TypedValueParser<Value = T> {
@@ -764,29 +817,15 @@ fn named<T: Named>() -> impl clap::builder::TypedValueParser<Value = T> {
 
 // The passes `lineao bench --passes` names (its vocabulary, so the CLI needs nothing of the
 // bench itself).
-/// The GPU passes of one run, in CONTRACT.md's order.
-pub const GPU_PASSES: [&str; 20] = [
-    "lines",
-    "lines-native-1px",
-    "lines-full-strip",
-    "nd-pyramid",
-    "lineao",
-    "lineao-tap-floor",
-    "composite",
-    "lineao-chain",
-    "lineao-level",
-    "lineao-chain-level",
-    "ssao-12",
-    "ssao-16-chain",
-    "vo-line-5",
-    "vo-area-1",
-    "bilateral",
-    "tubes",
-    "nd-from-depth",
-    "raytraced-1spp",
-    "raytraced-start-1spp",
-    "ray-denoise",
-];
+/// The bench's own GPU passes: the geometry and what every method shares.
+const OWN_GPU_PASSES: [&str; 8] =
+    ["lines", "lines-native-1px", "lines-full-strip", "nd-pyramid", "composite", "bilateral", "tubes", "nd-from-depth"];
+
+/// The GPU passes of one run: the bench's own, then every method's from the registry
+/// ([`lineao::method::BenchPass`]), in its order.
+pub fn gpu_passes() -> Vec<&'static str> {
+    OWN_GPU_PASSES.into_iter().chain(lineao::method::bench_passes().map(|(_, pass)| pass.name)).collect()
+}
 
 /// The CPU passes, after the GPU's.
 pub const CPU_PASSES: [&str; 6] =
@@ -794,7 +833,7 @@ pub const CPU_PASSES: [&str; 6] =
 
 /// Whether `name` is a pass of the benchmark.
 pub fn is_pass(name: &str) -> bool {
-    GPU_PASSES.contains(&name) || CPU_PASSES.contains(&name)
+    gpu_passes().contains(&name) || CPU_PASSES.contains(&name)
 }
 
 #[cfg(test)]

@@ -289,37 +289,42 @@ fn bench_json_is_the_contract() {
     let on = if report["timestamps"] == true { "gpu" } else { "cpu" };
     let passes = report["passes"].as_array().unwrap();
     let names: Vec<&str> = passes.iter().map(|p| p["name"].as_str().unwrap()).collect();
-    assert_eq!(
-        names,
-        [
-            "lines",
-            "lines-native-1px",
-            "lines-full-strip",
-            "nd-pyramid",
-            "lineao",
-            "lineao-tap-floor",
-            "composite",
-            "lineao-chain",
-            "lineao-level",
-            "lineao-chain-level",
-            "ssao-12",
-            "ssao-16-chain",
-            "vo-line-5",
-            "vo-area-1",
-            "bilateral",
-            "tubes",
-            "nd-from-depth",
-            "raytraced-1spp",
-            "raytraced-start-1spp",
-            "ray-denoise",
-            "density-256",
-            "sweep-256",
-            "variance-volume-256",
-            "bvh-build-1m",
-            "raytraced-cpu-64",
-            "bvh-upload"
-        ]
-    );
+    // Every pass of CONTRACT.md, and the test build's `toy` (the registry's methods list
+    // theirs); in the bench's order, its own passes first.
+    let mut sorted = names.clone();
+    sorted.sort_unstable();
+    let mut expected = [
+        "lines",
+        "lines-native-1px",
+        "lines-full-strip",
+        "nd-pyramid",
+        "lineao",
+        "lineao-tap-floor",
+        "composite",
+        "lineao-chain",
+        "lineao-level",
+        "lineao-chain-level",
+        "ssao-12",
+        "ssao-16-chain",
+        "vo-line-5",
+        "vo-area-1",
+        "bilateral",
+        "tubes",
+        "nd-from-depth",
+        "raytraced-1spp",
+        "raytraced-start-1spp",
+        "ray-denoise",
+        "density-256",
+        "sweep-256",
+        "variance-volume-256",
+        "bvh-build-1m",
+        "raytraced-cpu-64",
+        "bvh-upload",
+        "toy",
+    ];
+    expected.sort_unstable();
+    assert_eq!(sorted, expected);
+    assert_eq!(names[..4], ["lines", "lines-native-1px", "lines-full-strip", "nd-pyramid"]);
     for p in passes {
         let cpu_pass =
             ["density-256", "sweep-256", "variance-volume-256", "bvh-build-1m", "raytraced-cpu-64", "bvh-upload"]
@@ -778,7 +783,9 @@ fn score_ranks_the_truth_first() {
     assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
     let report: Value = serde_json::from_slice(&out.stdout).unwrap();
     let methods = report["methods"].as_array().unwrap();
-    let names: Vec<&str> = methods.iter().map(|m| m["method"].as_str().unwrap()).collect();
+    let mut names: Vec<&str> = methods.iter().map(|m| m["method"].as_str().unwrap()).collect();
+    // The test build's registry has the toy method (feature `toy-method`), scored after SSAO.
+    names.retain(|name| *name != "toy");
     assert_eq!(names, ["lineao", "lineao-reference", "vo-line", "vo-area", "ssao", "raytraced"]);
     let correlation =
         |name: &str| methods.iter().find(|m| m["method"] == name).unwrap()["correlation"].as_f64().unwrap();
@@ -822,7 +829,8 @@ fn score_ranks_the_truth_first() {
     let reach = bundle["ao_distance_world"].as_f64().unwrap();
     assert!(reach > 10.0 && reach < 100.0, "{reach}");
     assert!(bundle["mean"].as_f64().unwrap() > report["truth_mean"].as_f64().unwrap(), "the bundle reach sees more");
-    assert_eq!(common::read_png(&grid).0, (3 * 200, 6 * 160));
+    // A row of three tiles per method (and the toy's).
+    assert_eq!(common::read_png(&grid).0, (3 * 200, 7 * 160));
     let again = lineao(&args);
     let again: Value = serde_json::from_slice(&again.stdout).unwrap();
     assert_eq!(report["methods"][0]["truth_mean"], again["methods"][0]["truth_mean"]);
@@ -870,4 +878,40 @@ fn score_without_geometry_in_view_says_so() {
     ]);
     assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
     assert!(stderr(&out).contains("no geometry in view"), "{}", stderr(&out));
+}
+
+/// A method made by the registry alone (`toy`: a folder and one line in lineao's `registry!`,
+/// compiled into the tests' build by the feature `toy-method`) is listed by every part of the
+/// command line that lists methods: `render --help` with its help, the bench's passes (timed),
+/// `score`'s rows; and it renders. (Python's `methods()`: test_render.py.)
+#[test]
+fn a_method_of_the_registry_alone_is_listed_everywhere() {
+    let help = lineao(&["render", "--help"]);
+    let help = String::from_utf8_lossy(&help.stdout);
+    assert!(help.contains("- toy:") && help.contains("the registry's test"), "{help}");
+    let score_help = lineao(&["score", "--help"]);
+    assert!(String::from_utf8_lossy(&score_help.stdout).contains("- toy:"));
+
+    let small = ["--vertices", "2000", "--width", "64", "--height", "48"];
+    let bench =
+        lineao(&[&["bench", "--passes", "toy", "--frames", "1", "--warmup", "0", "--json"][..], &small].concat());
+    assert_eq!(bench.status.code(), Some(0), "{}", stderr(&bench));
+    let report: Value = serde_json::from_slice(&bench.stdout).unwrap();
+    assert_eq!(report["passes"][0]["name"], "toy", "{report}");
+    assert!(report["passes"][0]["ms_median"].as_f64().unwrap() >= 0.0);
+    // An unknown pass is refused with the registry's passes listed, the toy's among them.
+    let unknown = lineao(&["bench", "--passes", "gtao"]);
+    assert_eq!(unknown.status.code(), Some(2));
+    assert!(stderr(&unknown).contains("toy"), "{}", stderr(&unknown));
+
+    let score = lineao(&[&["score", "--methods", "lineao,toy", "--rays", "4", "--json"][..], &small].concat());
+    assert_eq!(score.status.code(), Some(0), "{}", stderr(&score));
+    let report: Value = serde_json::from_slice(&score.stdout).unwrap();
+    let rows: Vec<&str> = report["methods"].as_array().unwrap().iter().map(|m| m["method"].as_str().unwrap()).collect();
+    assert_eq!(rows, ["lineao", "toy"]);
+
+    let dir = scratch("toy");
+    let png = dir.join("toy.png");
+    let render = lineao(&[&["render", "--method", "toy", "-o", png.to_str().unwrap()][..], &small].concat());
+    assert_eq!(render.status.code(), Some(0), "{}", stderr(&render));
 }

@@ -11,7 +11,9 @@ venv="$root/target/python-venv"
 export PATH="$venv/bin:$PATH"   # as `activate` does: the build backend runs `maturin`
 pip=("$venv/bin/pip" install -q --disable-pip-version-check)
 "${pip[@]}" -r tests/requirements.txt
-"${pip[@]}" --no-build-isolation --force-reinstall --no-deps .
+# With the registry's test method `toy`, as the workspace's test build has it (and so that
+# build's lineao is reused): the tests find it in `methods()`.
+MATURIN_PEP517_ARGS="--features toy-method" "${pip[@]}" --no-build-isolation --force-reinstall --no-deps .
 # The binary the tests compare with, from the same build as `cargo test --workspace` (a no-op
 # right after it; a build of the binary alone would resolve features differently and rebuild).
 cargo test -q --workspace --no-run

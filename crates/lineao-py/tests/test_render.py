@@ -65,6 +65,15 @@ def test_names_and_defaults_come_from_the_library():
     assert {"lineao", "ssao", "vo-line", "raytraced", "sweep", "lineao+sweep"} <= set(lineao.methods())
 
 
+def test_a_method_of_the_registry_alone_is_listed_and_renders():
+    # run-tests.sh builds the package with the registry's test method `toy` (a folder and one
+    # registry line in lineao, feature `toy-method`): Python lists it and renders it by name.
+    assert "toy" in lineao.methods()
+    line = np.array([[-4, 0, 0], [4, 0, 0]], dtype=np.float32)
+    image = lineao.render([line], method="toy", width=32, height=16)
+    assert image.shape == (16, 32, 4)
+
+
 def test_a_renderer_keeps_its_session_for_many_frames():
     t = lineao.load(TRK)
     r = lineao.Renderer(t, **SMALL)

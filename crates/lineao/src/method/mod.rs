@@ -28,7 +28,7 @@ use crate::timing::Span;
 pub mod line_ao;
 pub mod raytraced;
 pub mod ssao;
-#[cfg(test)]
+#[cfg(any(test, feature = "toy-method"))]
 mod toy;
 pub mod vo_area;
 pub mod vo_line;
@@ -60,6 +60,53 @@ pub struct MethodInfo {
     pub(crate) fits: fn((u32, u32), &wgpu::Limits) -> Result<(), crate::Error>,
     /// Sets `preset`'s values of its own settings and the strength it is shown with.
     pub(crate) preset: fn(Preset, &mut ChainSettings),
+    /// What `lineao bench` times of it, by CONTRACT.md's names.
+    pub bench: &'static [BenchPass],
+}
+
+/// A pass of `lineao bench` that times a method: its stage, built and prepared with the bench's
+/// settings as [`BenchPass::settings`] changes them, on the bench's G-buffer.
+pub struct BenchPass {
+    /// The pass's name in `lineao bench` (CONTRACT.md's).
+    pub name: &'static str,
+    /// Changes the bench's settings (the papers', LineAO's preset, and this method) for frame
+    /// `frame` of the run: a sample count, a variant, a new seed each frame for a new picture.
+    pub settings: fn(&mut ChainSettings, u32),
+    /// Of the stage's spans, those timed as one, from the first's start to the last's end; the
+    /// stage's others run untimed in the same submission (so without timestamp queries, where
+    /// the bench times the submission, the pass reports its whole stage).
+    pub spans: &'static [&'static str],
+    /// Its stage when not the method's (`lineao-tap-floor`: LineAO's shader that only sums its
+    /// taps).
+    pub(crate) build: Option<BuildStage>,
+}
+
+impl BenchPass {
+    /// A pass of the method's own stage.
+    pub(crate) const fn of(
+        name: &'static str,
+        spans: &'static [&'static str],
+        settings: fn(&mut ChainSettings, u32),
+    ) -> BenchPass {
+        BenchPass { name, settings, spans, build: None }
+    }
+
+    /// The stage it times, for `method` (whose registry entry lists it).
+    pub fn stage(&self, method: AoMethod, device: &wgpu::Device, settings: &ChainSettings) -> Option<Box<dyn Stage>> {
+        self.build.or(method.info().build).map(|build| build(device, settings))
+    }
+
+    /// The bench's settings for this pass of `method` in frame `frame`.
+    pub fn settings_for(&self, method: AoMethod, bench: &ChainSettings, frame: u32) -> ChainSettings {
+        let mut settings = ChainSettings { method, ..bench.clone() };
+        (self.settings)(&mut settings, frame);
+        settings
+    }
+}
+
+/// Every method's bench passes, in the registry's order.
+pub fn bench_passes() -> impl Iterator<Item = (AoMethod, &'static BenchPass)> {
+    AoMethod::REGISTRY.iter().flat_map(|&m| m.info().bench.iter().map(move |pass| (m, pass)))
 }
 
 /// The registry: the methods, in the order front ends list them. A method is its folder and
@@ -101,8 +148,9 @@ registry! {
     /// Ray-traced AO on the GPU, progressive: the ground truth ([`crate::truth`]) where the view
     /// rests. Rays go through the scene, not the screen, so it needs no guard band.
     RayTraced => raytraced::METHOD,
-    /// A method made by the registry alone, which the tests find everywhere methods are listed.
-    #[cfg(test)]
+    /// A method made by the registry alone, which the tests find everywhere methods are listed
+    /// (feature `toy-method`, for tests only).
+    #[cfg(any(test, feature = "toy-method"))]
     Toy => toy::METHOD,
 }
 
@@ -124,6 +172,7 @@ const NONE: MethodInfo = MethodInfo {
     build: None,
     fits: fits_always,
     preset: |_, settings| settings.strength = 1.0,
+    bench: &[],
 };
 
 impl AoMethod {

@@ -58,6 +58,7 @@
 use crate::binding::{self, Slot};
 use crate::camera::FrameView;
 use crate::lighting::{Lighting, LightingUniform};
+use crate::method::BenchPass;
 use crate::noise;
 use crate::passes::dispatch_full_screen;
 use crate::settings::ChainSettings;
@@ -77,6 +78,16 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     build: Some(|device, settings| Box::new(LineAoStage::new(device, settings))),
     fits: super::fits_always,
     preset: settings::preset,
+    bench: &[
+        BenchPass::of("lineao", &["lineao"], |_, _| {}),
+        BenchPass {
+            build: Some(|device, settings| Box::new(LineAoStage::tap_floor(device, settings))),
+            ..BenchPass::of("lineao-tap-floor", &["lineao"], |_, _| {})
+        },
+        BenchPass::of("lineao-chain", &["nd-pyramid", "lineao"], |_, _| {}),
+        BenchPass::of("lineao-level", &["lineao"], |s, _| s.line_ao.outer = LineAoOuter::Level),
+        BenchPass::of("lineao-chain-level", &["nd-pyramid", "lineao"], |s, _| s.line_ao.outer = LineAoOuter::Level),
+    ],
 };
 use crate::targets::{AO_FORMAT, FrameTargets, LevelsUniform, Target};
 use crate::timing::Span;
@@ -363,6 +374,15 @@ impl LineAoStage {
         LineAoStage {
             pyramid: crate::passes::nd_pyramid::NdPyramid::new(device),
             line_ao: LineAo::new(device, &settings.line_ao, &settings.lighting),
+        }
+    }
+
+    /// The stage with [`Evaluation::TapFloor`]: what `lineao-tap-floor` times.
+    fn tap_floor(device: &wgpu::Device, settings: &ChainSettings) -> LineAoStage {
+        let evaluation = Evaluation::TapFloor;
+        LineAoStage {
+            pyramid: crate::passes::nd_pyramid::NdPyramid::new(device),
+            line_ao: LineAo::with_evaluation(device, &settings.line_ao, &settings.lighting, evaluation),
         }
     }
 

@@ -38,6 +38,8 @@ pub(crate) mod reference;
 mod settings;
 pub use settings::{RayDenoiseSettings, RayTracedSettings};
 
+use crate::method::BenchPass;
+
 /// The GPU ray tracer in the registry ([`crate::method`]).
 pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     name: "raytraced",
@@ -52,7 +54,31 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     build: Some(|device, _| Box::new(RayTracedAo::new(device))),
     fits,
     preset: |_, settings| settings.strength = 1.0,
+    bench: &[
+        // One ray per pixel each frame, continuing one picture (started by the first warm-up
+        // frame, over the G-buffer).
+        BenchPass::of("raytraced-1spp", &["raytraced"], |s, _| one_ray(s)),
+        // A new seed each frame: a picture's first frame, which also finds each pixel's own
+        // segment and tests its origin for being buried.
+        BenchPass::of("raytraced-start-1spp", &["raytraced"], |s, frame| {
+            one_ray(s);
+            s.raytraced.seed = frame + 1;
+        }),
+        // The denoiser over a picture of one ray per pixel (its window at full width): after
+        // the first frame the tracer only copies the converged sums.
+        BenchPass::of("ray-denoise", &["ray-denoise"], |s, _| {
+            one_ray(s);
+            s.raytraced.max_rays = 1;
+            s.raytraced.denoise = Some(RayDenoiseSettings::default());
+        }),
+    ],
 };
+
+/// The bench's ray tracer: one ray per pixel and frame, no denoiser.
+fn one_ray(settings: &mut ChainSettings) {
+    settings.raytraced.rays_per_frame = 1;
+    settings.raytraced.denoise = None;
+}
 use crate::targets::{AO_FORMAT, FrameTargets};
 use crate::timing::Span;
 use crate::truth::{EPSILON_PER_DISTANCE, Falloff};

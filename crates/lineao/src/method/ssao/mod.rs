@@ -29,6 +29,8 @@ pub(crate) mod reference;
 mod settings;
 pub use settings::{SsaoKernel, SsaoSettings};
 
+use crate::method::BenchPass;
+
 /// Crytek SSAO in the registry ([`crate::method`]).
 pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     name: "ssao",
@@ -40,6 +42,10 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     build: Some(|device, settings| Box::new(SsaoStage::new(device, settings))),
     fits: super::fits_always,
     preset: settings::preset,
+    bench: &[
+        BenchPass::of("ssao-12", &["ssao"], |s, _| s.ssao.samples = 12),
+        BenchPass::of("ssao-16-chain", &["ssao", "ssao-blur"], |s, _| s.ssao.samples = 16),
+    ],
 };
 use crate::targets::{AO_FORMAT, FrameTargets, Target};
 use crate::timing::Span;

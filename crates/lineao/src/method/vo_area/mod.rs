@@ -43,6 +43,7 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     build: Some(|device, settings| Box::new(VoArea::new(device, &settings.vo))),
     fits: moments::fits,
     preset: |preset, settings| crate::method::vo_line::preset(preset, settings, 1.0, 1.0),
+    bench: &[super::BenchPass::of("vo-area-1", &["moments", "vo-area"], |s, _| s.vo.area_samples = 1)],
 };
 use crate::targets::FrameTargets;
 use crate::timing::Span;

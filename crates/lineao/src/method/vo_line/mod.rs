@@ -51,6 +51,7 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     build: Some(|device, settings| Box::new(VoLine::new(device, &settings.vo))),
     fits: super::fits_always,
     preset: |preset, settings| settings::preset(preset, settings, 2.0, 1.5),
+    bench: &[super::BenchPass::of("vo-line-5", &["vo-line"], |s, _| s.vo.samples = 5)],
 };
 use crate::method::vo_area::moments::Moments;
 use crate::targets::{AO_FORMAT, FrameTargets};
