@@ -7,7 +7,7 @@ use crate::lighting::Lighting;
 // Each method's settings are its folder's (and the crate root's); named here for the crate.
 pub(crate) use crate::colormap::{COLORMAP_ENTRIES, Colormap};
 pub(crate) use crate::method::AoMethod;
-pub(crate) use crate::method::line_ao::{LineAoOuter, LineAoSettings, LineAoVariant, R0};
+pub(crate) use crate::method::line_ao::{LineAoSettings, LineAoVariant, R0};
 pub(crate) use crate::method::raytraced::{RayDenoiseSettings, RayTracedSettings};
 pub(crate) use crate::method::ssao::SsaoSettings;
 pub(crate) use crate::method::vo_line::{VoCombine, VoSettings};

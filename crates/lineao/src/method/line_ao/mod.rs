@@ -63,6 +63,7 @@ use crate::noise;
 use crate::passes::dispatch_full_screen;
 use crate::settings::ChainSettings;
 
+#[cfg(feature = "reference")]
 pub(crate) mod reference;
 mod settings;
 pub use settings::{LineAoOuter, LineAoSettings, LineAoVariant, R0};

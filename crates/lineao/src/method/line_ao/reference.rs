@@ -4,10 +4,11 @@
 
 use glam::Vec3;
 
+use super::{LineAoOuter, LineAoVariant};
 use crate::camera::FrameView;
 use crate::lighting::Light;
 use crate::reference::{Image, NdImage, level_texel};
-use crate::settings::{ChainSettings, LineAoOuter, LineAoVariant};
+use crate::settings::ChainSettings;
 
 /// Every number LineAO reads besides the images and the noise.
 #[derive(Clone, Debug, PartialEq)]

@@ -34,6 +34,7 @@ use crate::settings::{AoMethod, ChainSettings};
 use denoise::RayDenoise;
 
 pub mod denoise;
+#[cfg(feature = "reference")]
 pub(crate) mod reference;
 mod settings;
 pub use settings::{RayDenoiseSettings, RayTracedSettings};

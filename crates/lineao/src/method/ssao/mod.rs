@@ -25,6 +25,7 @@ use crate::passes::dispatch_full_screen;
 use crate::settings::ChainSettings;
 
 pub mod blur;
+#[cfg(feature = "reference")]
 pub(crate) mod reference;
 mod settings;
 pub use settings::{SsaoKernel, SsaoSettings};

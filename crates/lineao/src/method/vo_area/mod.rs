@@ -29,6 +29,7 @@ use crate::settings::ChainSettings;
 use moments::MomentsPyramid;
 
 pub mod moments;
+#[cfg(feature = "reference")]
 pub(crate) mod reference;
 
 /// VO with area samples in the registry ([`crate::method`]); its settings are VO's

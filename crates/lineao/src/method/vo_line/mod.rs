@@ -35,6 +35,7 @@ use crate::passes::dispatch_full_screen;
 use crate::sample_sets;
 use crate::settings::ChainSettings;
 
+#[cfg(feature = "reference")]
 pub(crate) mod reference;
 mod settings;
 pub(crate) use settings::preset;
