@@ -14,9 +14,9 @@
 //! ```
 
 use glam::Vec3;
-use lineao::camera::{Bounds, FrameView};
 use lineao::passes::nd_from_depth::{HostConfig, HostInputs, HostNormals};
 use lineao::{AoChain, ChainSettings, HostAo};
+use lineao::{Bounds, FrameView};
 use wgpu::util::DeviceExt;
 
 /// The host's shaders: one vertex stage for both passes (bit-identical depth), Lambert shading.

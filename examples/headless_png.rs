@@ -9,9 +9,9 @@
 use std::path::Path;
 
 use glam::Vec3;
-use lineao::camera::{Camera, Projection};
-use lineao::passes::lines::LineGeometry;
+use lineao::LineGeometry;
 use lineao::{AoChain, ChainSettings, Gpu};
+use lineao::{Camera, Projection};
 use lineao_tracts::{SceneKind, ViewHint};
 
 /// Renders `file` (or the built-in spiral) at `width` × `height`: RGBA8 sRGB pixels.

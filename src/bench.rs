@@ -49,13 +49,13 @@
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use lineao::camera::{FrameView, Projection};
-use lineao::gbuffer::Load;
+use lineao::LineGeometry;
 use lineao::method::raytraced::RayTracedAo;
 use lineao::method::{BenchPass, Stage};
+use lineao::passes::Load;
 use lineao::passes::bilateral::Bilateral;
 use lineao::passes::composite::Composite;
-use lineao::passes::lines::{GeometryOptions, LineGeometry, LineRenderer, LineStyle};
+use lineao::passes::lines::{GeometryOptions, LineRenderer, LineStyle};
 use lineao::passes::nd_from_depth::{HostConfig, HostInputs, NdFromDepth};
 use lineao::passes::nd_pyramid::NdPyramid;
 use lineao::passes::tubes::TubeRenderer;
@@ -66,6 +66,7 @@ use lineao::volume::sweep::{self, SweepSettings};
 use lineao::volume::variance::{VarianceMaps, VarianceSettings};
 use lineao::volume::vertex_tangents;
 use lineao::{AoChain, AoMethod, BilateralSettings, ChainSettings, Gpu, LineAoSettings};
+use lineao::{FrameView, Projection};
 use serde_json::json;
 
 use crate::cli::{BenchArgs, gpu_passes};

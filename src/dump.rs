@@ -23,12 +23,12 @@ use std::io::BufWriter;
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use lineao::camera::{Camera, Projection};
 use lineao::method::ssao::SsaoStage;
 use lineao::method::vo_area::VoArea;
 use lineao::readback::read_texture;
 use lineao::volume::{ScalarForm, VolumeAoOptions, VolumeMethod};
 use lineao::{AoChain, AoMethod, Gpu, LineAoVariant, noise};
+use lineao::{Camera, Projection};
 use npyz::WriterBuilder;
 use serde_json::json;
 

@@ -6,7 +6,6 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 use glam::Vec3;
-use lineao::camera::{Bounds, Camera, Projection};
 use lineao::passes::meshes::MeshGeometry;
 use lineao::volume::density::DensityOptions;
 use lineao::volume::sweep::SweepSettings;
@@ -15,6 +14,7 @@ use lineao::{
     AoChain, AoMethod, BilateralSettings, ChainSettings, Gpu, LineAoSettings, LineAoVariant, LineColor, SsaoSettings,
     SurfaceSettings, TubeSettings, VoSettings, VolumeAoSettings,
 };
+use lineao::{Bounds, Camera, Projection};
 use lineao_tracts::scenes::ViewHint;
 
 use crate::cli::{ColorArg, GeometryArg, Method, RenderArgs, SkyArg, VolumeNormal};
@@ -531,7 +531,7 @@ impl Session {
 
 /// The longest side of the axis-aligned box around the finite `points` (0 without any).
 fn longest_side<'a>(points: impl Iterator<Item = &'a [f32; 3]>) -> f32 {
-    lineao::camera::axis_aligned_box(points).map_or(0.0, |(lo, hi)| (hi - lo).max_element())
+    lineao::Bounds::corners_of(points).map_or(0.0, |(lo, hi)| (hi - lo).max_element())
 }
 
 /// The camera of the command line (--eye, --target, --up, --fov, --ortho), the rest from `hint`.

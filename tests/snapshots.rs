@@ -9,11 +9,11 @@ mod common;
 use common::read_png;
 
 use glam::Vec3;
-use lineao::camera::{Camera, Projection};
-use lineao::passes::lines::LineGeometry;
+use lineao::LineGeometry;
 use lineao::readback::read_texture;
 use lineao::targets::Target;
 use lineao::{AoChain, AoMethod, BilateralSettings, ChainSettings, DebugView, Gpu, LineAoSettings, LineAoVariant};
+use lineao::{Camera, Projection};
 use lineao_tracts::SceneKind;
 
 const SIZE: (u32, u32) = (160, 128);

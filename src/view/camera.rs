@@ -4,7 +4,7 @@
 //! at the target, so switching keeps the scale.
 
 use glam::Vec3;
-use lineao::camera::{Camera, Projection};
+use lineao::{Camera, Projection};
 use lineao_tracts::ViewHint;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -115,7 +115,7 @@ mod tests {
         assert!(camera.eye().distance(Vec3::from_array(hint.eye)) < 1e-3);
         // Orthographic shows what perspective shows at the target.
         camera.orthographic = true;
-        let lineao::camera::Projection::Orthographic { height } = camera.camera().projection else { panic!() };
+        let lineao::Projection::Orthographic { height } = camera.camera().projection else { panic!() };
         assert!((height - 2.0 * d * 15f32.to_radians().tan()).abs() < 1e-3);
     }
 }

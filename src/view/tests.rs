@@ -123,7 +123,7 @@ fn the_viewer_renders_what_the_library_renders() {
     let gpu = lineao::Gpu::headless().unwrap();
     let built = SceneKind::Spiral.build(1, 30_000);
     let t = &built.tractogram;
-    let geometry = lineao::passes::lines::LineGeometry::new(&gpu.device, &gpu.queue, &t.positions, &t.offsets).unwrap();
+    let geometry = lineao::LineGeometry::new(&gpu.device, &gpu.queue, &t.positions, &t.offsets).unwrap();
     let format = wgpu::TextureFormat::Rgba8UnormSrgb;
     let mut chain = lineao::AoChain::new(&gpu.device, format, frame.view.panels[0].settings.clone()).unwrap();
     chain.resize(frame.size.0, frame.size.1).unwrap();
@@ -303,7 +303,7 @@ fn keys_orbit_zoom_reset_and_switch_to_orthographic() {
     assert!(reset.orthographic);
     settle(&mut harness);
     let frame = harness.state().shown.as_ref().unwrap();
-    assert!(matches!(frame.view.camera.projection, lineao::camera::Projection::Orthographic { .. }));
+    assert!(matches!(frame.view.camera.projection, lineao::Projection::Orthographic { .. }));
 }
 
 #[test]
@@ -340,7 +340,7 @@ fn the_ray_traced_method_accumulates_while_the_camera_rests_and_shows_lineao_whi
     let gpu = lineao::Gpu::headless().unwrap();
     let (d, q) = (&gpu.device, &gpu.queue);
     let t = SceneKind::Spiral.build(1, 30_000).tractogram;
-    let geometry = lineao::passes::lines::LineGeometry::new(d, q, &t.positions, &t.offsets).unwrap();
+    let geometry = lineao::LineGeometry::new(d, q, &t.positions, &t.offsets).unwrap();
     let rays = lineao::RayGeometry { positions: &t.positions, offsets: &t.offsets, ..Default::default() };
     let format = wgpu::TextureFormat::Rgba8UnormSrgb;
     let mut chain = lineao::AoChain::new(d, format, frame.view.panels[0].settings.clone()).unwrap();

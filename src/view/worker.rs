@@ -18,9 +18,10 @@
 use std::sync::Arc;
 use std::sync::mpsc::{Receiver, Sender, TryRecvError};
 
-use lineao::camera::Camera;
+use lineao::Camera;
+use lineao::LineGeometry;
 use lineao::method::raytraced::RayProgress;
-use lineao::passes::lines::{LineGeometry, VertexAttributes};
+use lineao::passes::lines::VertexAttributes;
 use lineao::timing::PassTime;
 use lineao::volume::VolumeAoOptions;
 use lineao::{AoChain, AoMethod, ChainSettings, Gpu, LineColor, RayScene};

@@ -508,8 +508,8 @@ impl Renderer {
         dict.set_item("target", PyTuple::new(py, camera.target.to_array())?)?;
         dict.set_item("up", PyTuple::new(py, camera.up.to_array())?)?;
         match camera.projection {
-            lineao::camera::Projection::Perspective { fov_y_deg } => dict.set_item("fov", fov_y_deg)?,
-            lineao::camera::Projection::Orthographic { height } => dict.set_item("ortho", height)?,
+            lineao::Projection::Perspective { fov_y_deg } => dict.set_item("fov", fov_y_deg)?,
+            lineao::Projection::Orthographic { height } => dict.set_item("ortho", height)?,
         }
         Ok(dict)
     }

@@ -46,23 +46,23 @@ pub struct Bounds {
     pub radius: f32,
 }
 
-/// The corners (min, max) of the axis-aligned box around the finite `points`; `None` when there
-/// are none.
-pub fn axis_aligned_box<'a>(points: impl IntoIterator<Item = &'a [f32; 3]>) -> Option<(Vec3, Vec3)> {
-    let (lo, hi) = points
-        .into_iter()
-        .map(|p| Vec3::from_array(*p))
-        .filter(|p| p.is_finite())
-        .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(p), hi.max(p)));
-    lo.is_finite().then_some((lo, hi))
-}
-
 impl Bounds {
+    /// The corners (min, max) of the axis-aligned box around the finite `points`; `None` when
+    /// there are none.
+    pub fn corners_of<'a>(points: impl IntoIterator<Item = &'a [f32; 3]>) -> Option<(Vec3, Vec3)> {
+        let (lo, hi) = points
+            .into_iter()
+            .map(|p| Vec3::from_array(*p))
+            .filter(|p| p.is_finite())
+            .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(p), hi.max(p)));
+        lo.is_finite().then_some((lo, hi))
+    }
+
     /// The sphere around the axis-aligned box of `points` that contains them all; `None` when
     /// there are no finite points. Two passes over the slice, no copy.
     pub fn of_points(points: &[[f32; 3]]) -> Option<Bounds> {
         let finite = || points.iter().map(|p| Vec3::from_array(*p)).filter(|p| p.is_finite());
-        let (lo, hi) = axis_aligned_box(points)?;
+        let (lo, hi) = Bounds::corners_of(points)?;
         let center = (lo + hi) * 0.5;
         let radius = finite().map(|p| p.distance(center)).fold(0.0f32, f32::max);
         Some(Bounds { center, radius: radius.max(1e-6) })

@@ -67,7 +67,7 @@ impl Colormap {
         std::array::from_fn(|c| decode(points[k][c] * (1.0 - f) + points[k + 1][c] * f))
     }
 
-    /// [`COLORMAP_ENTRIES`] linear RGB entries from 0 to 1, as the shaders interpolate them.
+    /// `COLORMAP_ENTRIES` linear RGB entries from 0 to 1, as the shaders interpolate them.
     pub fn table(self) -> [[f32; 4]; COLORMAP_ENTRIES] {
         std::array::from_fn(|k| {
             let [r, g, b] = self.color(k as f32 / (COLORMAP_ENTRIES - 1) as f32);

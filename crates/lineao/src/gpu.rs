@@ -48,13 +48,8 @@ pub fn check_adapter(adapter: &wgpu::Adapter) -> Result<(), Error> {
 }
 
 /// Runs `create` inside a validation error scope of `device`: what wgpu would report to its
-/// uncaptured-error handler (a panic by default) comes back as [`Error::Unsupported`]. Blocks
-/// on the scope's answer (immediate on native; on the web use [`validated_async`]).
-pub fn validated<T>(device: &wgpu::Device, what: &str, create: impl FnOnce() -> T) -> Result<T, Error> {
-    pollster::block_on(validated_async(device, what, create))
-}
-
-/// [`validated`] as a future: for hosts that must not block (the web, an async runtime).
+/// uncaptured-error handler (a panic by default) comes back as [`Error::Unsupported`]. A
+/// future, for hosts that must not block (the web); native callers block on it.
 pub async fn validated_async<T>(device: &wgpu::Device, what: &str, create: impl FnOnce() -> T) -> Result<T, Error> {
     let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
     let value = create();

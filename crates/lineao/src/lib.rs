@@ -16,20 +16,25 @@
 //!   [`VoLine`](method::vo_line::VoLine) and [`VoArea`](method::vo_area::VoArea) (Volumetric
 //!   Obscurance), and the GPU ray tracer — each a [`method::Stage`] of the chain, listed by
 //!   one registry that names, times and presets them.
-//! - [`passes`]: what every method shares — [`LineRenderer`] (fixed-width lines writing the
+//! - [`passes`]: what every method shares — [`LineRenderer`](passes::lines::LineRenderer)
+//!   (fixed-width lines writing the
 //!   G-buffer), [`NdPyramid`](passes::nd_pyramid::NdPyramid), the
 //!   [`Bilateral`](passes::bilateral::Bilateral) blur and the
 //!   [`Composite`](passes::composite::Composite), each usable alone.
-//! - [`mod@reference`]: the CPU reference of each pass.
-//! - [`truth`]: the ground truth — ambient occlusion ray traced on the geometry the frame shows
-//!   (a BVH over rounded cones and triangles), and the [`truth::metrics`] that score a method
-//!   against it.
+//! - [`mod@reference`] (feature `reference`): the CPU reference of each pass, and [`verify`],
+//!   which compares a chain's targets with it.
+//! - [`truth`]: the ground truth's settings; with the feature `truth`, ambient occlusion ray
+//!   traced on the CPU on the geometry the frame shows (a BVH over rounded cones and triangles),
+//!   and the [`truth::metrics`] that score a method against it.
+//! - [`volume`]: object-space AO's per-pixel term; with the feature `volume`, its density
+//!   volumes, occlusion sweeping and variance maps on the CPU.
 //!
-//! The G-buffer contract (the ND map, the zoom map, normalized depth) is in [`targets`] and
-//! [`camera`]; CONTRACT.md in the repository is the full specification.
+//! An embedder's build (no feature) compiles the passes and the chain; the tools turn the
+//! features on. The G-buffer contract (the ND map, the zoom map, normalized depth) is in
+//! [`targets`] and [`FrameView`]; CONTRACT.md in the repository is the full specification.
 //!
 //! ```no_run
-//! use lineao::{AoChain, ChainSettings, Gpu, camera::{Camera, Projection}, passes::lines::LineGeometry};
+//! use lineao::{AoChain, Camera, ChainSettings, Gpu, LineGeometry, Projection};
 //! # fn main() -> Result<(), lineao::Error> {
 //! let gpu = Gpu::headless()?;
 //! let positions = [[0.0, 0.0, 0.0], [10.0, 0.0, 0.0], [10.0, 10.0, 0.0]];
@@ -55,31 +60,41 @@
     allow(rustdoc::broken_intra_doc_links)
 )]
 
+// What an embedding names is at the root (below); the modules that stay public are the passes
+// and the parts a tool builds on: each method's stage, the targets, timing, readback, the
+// truth's settings; with the feature `reference` also the CPU reference, `verify` and the
+// tables the shaders use (noise, sample sets), which the tests recompute frames from.
 pub(crate) mod binding;
-pub mod camera;
-pub mod chain;
-pub mod colormap;
-pub mod gbuffer;
-pub mod gpu;
+mod camera;
+mod chain;
+mod colormap;
+mod gbuffer;
+mod gpu;
 pub mod lighting;
-pub mod line_geometry;
+mod line_geometry;
 pub mod method;
+#[cfg(feature = "reference")]
 pub mod noise;
+#[cfg(not(feature = "reference"))]
+pub(crate) mod noise;
 pub mod passes;
-pub mod ray_scene;
+mod ray_scene;
 pub mod readback;
 #[cfg(feature = "reference")]
 pub mod reference;
+#[cfg(feature = "reference")]
 pub mod sample_sets;
-pub mod settings;
+#[cfg(not(feature = "reference"))]
+pub(crate) mod sample_sets;
+mod settings;
 pub mod shader;
-pub mod stage;
+mod stage;
 pub mod targets;
 pub mod timing;
 pub mod truth;
 #[cfg(feature = "reference")]
 pub mod verify;
-pub mod view_params;
+mod view_params;
 pub mod volume;
 
 // The exact versions lineao's API speaks: a host names `lineao::wgpu` and `lineao::glam` and
@@ -91,17 +106,16 @@ pub use wgpu;
 pub use camera::{Bounds, Camera, FrameView, Projection};
 pub use chain::{AoChain, HostAo, OverlayAo};
 pub use colormap::Colormap;
-pub use gpu::Gpu;
+pub use gpu::{Gpu, check_adapter};
+pub use line_geometry::LineGeometry;
 pub use method::AoMethod;
-pub use method::line_ao::{LineAoOuter, LineAoSettings, LineAoVariant, R0};
-pub use method::raytraced::{RayDenoiseSettings, RayTracedSettings};
-pub use method::ssao::{SsaoKernel, SsaoSettings};
-pub use method::vo_line::{VoCombine, VoSettings};
+pub use method::line_ao::settings::{LineAoOuter, LineAoSettings, LineAoVariant, R0};
+pub use method::raytraced::settings::{RayDenoiseSettings, RayTracedSettings};
+pub use method::ssao::settings::{SsaoKernel, SsaoSettings};
+pub use method::vo_line::settings::{VoCombine, VoSettings};
 pub use passes::composite::OverlayDepth;
-pub use passes::lines::{LineGeometry, LineRenderer, LineStyle};
-pub use passes::meshes::{MeshGeometry, MeshRenderer};
+pub use passes::meshes::MeshGeometry;
 pub use passes::nd_from_depth::{HostConfig, HostInputs};
-pub use passes::tubes::TubeRenderer;
 pub use ray_scene::{RayGeometry, RayScene};
 pub use settings::{
     BilateralSettings, ChainSettings, DebugView, LineColor, Named, Preset, SurfaceSettings, TubeSettings,

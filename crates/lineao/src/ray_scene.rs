@@ -46,7 +46,7 @@ use wgpu::util::DeviceExt;
 
 use crate::Error;
 use crate::truth::bvh::{Bvh, Node, TRIANGLE_BIT};
-use crate::truth::{RoundedCone, Triangle};
+use crate::truth::primitive::{RoundedCone, Triangle};
 
 /// Most primitives in a leaf of the GPU tree.
 pub const GPU_LEAF: usize = 8;

@@ -73,7 +73,8 @@ macro_rules! serde_by_name {
 pub(crate) use serde_by_name;
 
 /// What an unknown name of a [`Named`] setting is told: the names it could have been.
-pub fn unknown<T: Named>(name: &str) -> String {
+#[cfg(feature = "serde")]
+pub(crate) fn unknown<T: Named>(name: &str) -> String {
     let names: Vec<&str> = T::VALUES.iter().map(|v| v.name()).collect();
     format!("unknown value '{name}' (one of {})", names.join(", "))
 }

@@ -7,13 +7,13 @@ mod common;
 
 use common::{cameras_for_polylines, gpu, host_depth, is_geometry, polylines, sphere_triangles};
 use glam::{Mat4, Vec3, Vec4Swizzles};
-use lineao::camera::{Bounds, Camera, FrameView, Projection};
-use lineao::passes::lines::LineGeometry;
+use lineao::LineGeometry;
 use lineao::passes::nd_from_depth::{HostConfig, HostInputs, HostNormals};
 use lineao::reference::tubes::pixel_ray;
 use lineao::reference::{Image, NdImage};
 use lineao::verify::{read_f32, read_rgba};
 use lineao::{AoChain, AoMethod, ChainSettings, HostAo, OverlayAo, TubeSettings};
+use lineao::{Bounds, Camera, FrameView, Projection};
 
 /// What the host path leaves in the chain's targets.
 struct HostFrame {

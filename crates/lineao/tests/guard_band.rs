@@ -6,10 +6,10 @@ mod common;
 
 use common::{Frame, gpu, line_ao_on, render_geometry};
 use glam::Vec3;
-use lineao::camera::{Camera, Projection};
-use lineao::passes::lines::LineGeometry;
+use lineao::LineGeometry;
 use lineao::reference::Image;
 use lineao::verify::line_ao_flip_bound;
+use lineao::{Camera, Projection};
 use lineao::{ChainSettings, Gpu, LineAoSettings};
 
 /// Dense random-walk polylines filling a cube of side 100 around the origin.

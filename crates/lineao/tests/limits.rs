@@ -5,9 +5,9 @@ mod common;
 
 use common::{gpu, render_geometry};
 use glam::Vec3;
-use lineao::camera::{Bounds, Camera, Projection};
-use lineao::passes::lines::LineGeometry;
+use lineao::LineGeometry;
 use lineao::{AoChain, AoMethod, ChainSettings, Error, Gpu};
+use lineao::{Bounds, Camera, Projection};
 
 fn spiral_bundle(lines: usize, points: usize) -> (Vec<[f32; 3]>, Vec<u64>) {
     let mut positions = Vec::with_capacity(lines * points);
@@ -107,7 +107,7 @@ fn a_moments_pyramid_beyond_the_storage_limit_is_an_error() {
 #[test]
 fn what_the_device_cannot_do_is_a_clear_error() {
     let gpu = gpu();
-    lineao::gpu::check_adapter(&gpu.adapter).expect("the test adapter runs lineao");
+    lineao::check_adapter(&gpu.adapter).expect("the test adapter runs lineao");
     // A host's surface format that cannot be rendered to: refused by `new`, not wgpu's panic.
     let error = AoChain::new(&gpu.device, wgpu::TextureFormat::Rgb9e5Ufloat, ChainSettings::default()).err();
     let message = error.as_ref().map(ToString::to_string).unwrap_or_default();

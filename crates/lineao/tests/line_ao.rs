@@ -5,13 +5,13 @@ mod common;
 
 use common::{cameras_for_polylines, flat_view, gpu, is_geometry, line_ao_on, polylines, render};
 use glam::Vec3;
-use lineao::camera::FrameView;
-use lineao::camera::{Camera, Projection};
+use lineao::FrameView;
 use lineao::lighting::{Light, Lighting};
 use lineao::method::line_ao::sample_table;
 use lineao::noise::noise_tile;
 use lineao::reference::{self, Image, LineAoParams, NdImage};
 use lineao::verify::{check_policy, compare, line_ao_flip_bound, line_ao_reference_flip_bound};
+use lineao::{Camera, Projection};
 use lineao::{ChainSettings, LineAoOuter, LineAoSettings, LineAoVariant};
 
 fn settings(s_r: u32, r0_px: f32, light_attenuation: bool) -> ChainSettings {
@@ -199,7 +199,7 @@ fn parallel_lines_occlude_within_r0_only() {
         let back = [[-40.0, 0.0, 0.0], [40.0, 0.0, 0.0]];
         let front = [[-40.0, gap, 2.0], [40.0, gap, 2.0]];
         let positions = [back, front].concat();
-        let bounds = lineao::camera::Bounds { center: Vec3::ZERO, radius: 50.0 };
+        let bounds = lineao::Bounds { center: Vec3::ZERO, radius: 50.0 };
         let s = settings(1, r0, false);
         let frame = render(&gpu, &positions, &[0, 2, 4], &cam, Some(bounds), s.clone(), (100, 100));
         let g = frame.guard;
@@ -462,7 +462,7 @@ fn reference_variant_matches_its_cpu_reference_on_rendered_lines() {
 fn chain_reports_gpu_time_per_pass() {
     let gpu = gpu();
     let (positions, offsets) = polylines(40, 0.7);
-    let geometry = lineao::passes::lines::LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap();
+    let geometry = lineao::LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap();
     let (camera, _) = cameras_for_polylines();
     let has_timestamps = gpu.device.features().contains(wgpu::Features::TIMESTAMP_QUERY);
     let variants = [(LineAoVariant::Paper, 4), (LineAoVariant::Reference, 3)];
@@ -493,7 +493,7 @@ fn chain_reports_gpu_time_per_pass() {
 fn pass_times_can_be_polled_without_waiting() {
     let gpu = gpu();
     let (positions, offsets) = polylines(40, 0.7);
-    let geometry = lineao::passes::lines::LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap();
+    let geometry = lineao::LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap();
     let (camera, _) = cameras_for_polylines();
     let mut chain = lineao::AoChain::new(&gpu.device, common::OUTPUT_FORMAT, ChainSettings::default()).unwrap();
     let timed = chain.set_timing(&gpu.device, &gpu.queue, true);

@@ -6,12 +6,13 @@ mod common;
 
 use common::{Frame, gpu, is_geometry, render};
 use glam::Vec3;
-use lineao::camera::FrameView;
-use lineao::camera::{Bounds, Camera, Projection};
+use lineao::FrameView;
+use lineao::LineGeometry;
 use lineao::lighting::{LineShading, illuminated_line};
-use lineao::passes::lines::{GeometryOptions, LineGeometry, LineRenderer, LineStyle};
+use lineao::passes::lines::{GeometryOptions, LineRenderer, LineStyle};
 use lineao::targets::FrameTargets;
 use lineao::{AoMethod, ChainSettings, LineColor};
+use lineao::{Bounds, Camera, Projection};
 
 const SIZE: (u32, u32) = (200, 100);
 
@@ -335,7 +336,7 @@ fn native_lines_are_one_pixel_and_need_their_segments() {
         let options = GeometryOptions { native_lines, ..Default::default() };
         let geometry = LineGeometry::with_options(d, q, &positions, &offsets, options).unwrap();
         let mut encoder = d.create_command_encoder(&Default::default());
-        renderer.encode(&mut encoder, &targets, &geometry, lineao::gbuffer::Load::Clear(s.background), None);
+        renderer.encode(&mut encoder, &targets, &geometry, lineao::passes::Load::Clear(s.background), None);
         q.submit([encoder.finish()]);
         let nd = lineao::verify::read_rgba(d, q, &targets.nd[0]).unwrap();
         (60..140).map(|x| (0..SIZE.1 as usize).filter(|&y| is_geometry(nd.get(x, y))).count()).collect::<Vec<_>>()
@@ -490,7 +491,7 @@ fn draw(
     let s = plain(2.0);
     renderer.prepare(q, &view, s.line_width_px, s.line_color, &s.lighting);
     let mut encoder = d.create_command_encoder(&Default::default());
-    renderer.encode(&mut encoder, &targets, geometry, lineao::gbuffer::Load::Clear(s.background), None);
+    renderer.encode(&mut encoder, &targets, geometry, lineao::passes::Load::Clear(s.background), None);
     q.submit([encoder.finish()]);
     (lineao::verify::read_rgba(d, q, &targets.nd[0]).unwrap(), renderer.alternates(geometry))
 }

@@ -8,13 +8,13 @@ use std::sync::Arc;
 
 use common::{OUTPUT_FORMAT, gpu};
 use glam::Vec3;
-use lineao::camera::{Bounds, Camera, FrameView, Projection};
 use lineao::passes::meshes::MeshGeometry;
 use lineao::reference::{Image, NdImage};
 use lineao::targets::Target;
 use lineao::truth::{self, Bvh, Falloff};
 use lineao::verify::{read_f32, read_rgba};
 use lineao::{AoChain, AoMethod, ChainSettings, Gpu, LineGeometry, RayGeometry, RayScene, SurfaceSettings};
+use lineao::{Bounds, Camera, FrameView, Projection};
 
 const SIZE: (u32, u32) = (128, 96);
 

@@ -5,12 +5,12 @@ mod common;
 
 use common::{Frame, gpu, is_geometry, render_scene};
 use glam::Vec3;
-use lineao::camera::{Camera, Projection};
-use lineao::passes::lines::LineGeometry;
+use lineao::LineGeometry;
 use lineao::passes::meshes::MeshGeometry;
 use lineao::reference;
 use lineao::verify::{check_policy, line_ao_flip_bound};
 use lineao::{AoMethod, ChainSettings, SurfaceSettings};
+use lineao::{Camera, Projection};
 
 /// A square of half-size `s` in the plane z = `z`, facing +z (two triangles).
 fn square(s: f32, z: f32) -> ([[f32; 3]; 4], [[f32; 3]; 4], [u32; 6]) {

@@ -7,12 +7,13 @@ mod common;
 
 use common::{Frame, cameras_for_polylines, gpu, is_geometry, polylines, polylines_with_octants, render_geometry};
 use glam::{Mat4, Vec3, Vec4Swizzles};
-use lineao::camera::{Camera, FrameView, Projection};
-use lineao::passes::lines::{GeometryOptions, LineGeometry, VertexAttributes};
+use lineao::LineGeometry;
+use lineao::passes::lines::{GeometryOptions, VertexAttributes};
 use lineao::reference;
 use lineao::reference::tubes::{intersect_rounded_cone, pixel_ray, rounded_cone_distance, rounded_cone_normal};
 use lineao::verify::{check_policy, line_ao_flip_bound};
 use lineao::{AoMethod, ChainSettings, TubeSettings};
+use lineao::{Camera, FrameView, Projection};
 
 fn random(k: u32, stream: u32) -> f32 {
     lineao::noise::uniform(21, stream, k)

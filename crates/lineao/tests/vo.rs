@@ -7,7 +7,6 @@
 mod common;
 
 use common::{cameras_for_polylines, flat_view, gpu, polylines, render};
-use lineao::camera::{Bounds, Camera, FrameView, Projection};
 use lineao::method::vo_area::VoArea;
 use lineao::method::vo_area::moments::MomentsPyramid;
 use lineao::method::vo_line::VoLine;
@@ -18,6 +17,7 @@ use lineao::sample_sets::{
 use lineao::targets::FrameTargets;
 use lineao::verify::{check_policy, compare, read_f32, read_moments, write_target};
 use lineao::{AoMethod, ChainSettings, Gpu, VoCombine, VoSettings, noise};
+use lineao::{Bounds, Camera, FrameView, Projection};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Sampling {

@@ -310,8 +310,9 @@ fn chebyshev_is_exact_for_two_values_and_soft_shadows_fall_behind_occluders() {
 mod common;
 
 use common::{Frame, cameras_for_polylines, gpu, is_geometry, polylines, polylines_with_octants, render_geometry};
-use lineao::camera::Camera;
-use lineao::passes::lines::{GeometryOptions, LineGeometry, VertexAttributes};
+use lineao::Camera;
+use lineao::LineGeometry;
+use lineao::passes::lines::{GeometryOptions, VertexAttributes};
 use lineao::passes::volume_ao::view_to_world;
 use lineao::reference::{self, Image};
 use lineao::verify::compare;

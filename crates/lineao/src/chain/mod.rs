@@ -43,14 +43,15 @@ mod overlay;
 use std::sync::Arc;
 
 use crate::Error;
+use crate::LineGeometry;
 use crate::camera::{self, Bounds, Camera, FrameView};
 use crate::gbuffer::Load;
 use crate::method::raytraced::RayProgress;
 use crate::method::{self, Reach};
 use crate::passes::bilateral::Bilateral;
 use crate::passes::composite::{Composite, Shown};
+use crate::passes::lines::LineRenderer;
 use crate::passes::lines::LineStyle;
-use crate::passes::lines::{LineGeometry, LineRenderer};
 use crate::passes::meshes::{MeshGeometry, MeshRenderer};
 use crate::passes::tubes::TubeRenderer;
 use crate::passes::volume_ao::VolumeAo;

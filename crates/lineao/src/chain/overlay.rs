@@ -10,8 +10,8 @@
 
 use super::AoChain;
 use crate::Error;
+use crate::LineGeometry;
 use crate::passes::composite::OverlayDepth;
-use crate::passes::lines::LineGeometry;
 use crate::passes::meshes::MeshGeometry;
 
 /// An [`AoChain`] that draws its geometry into a host's frame.

@@ -8,16 +8,17 @@
 //! specular and hardware depth.
 //!
 //! The geometry it draws — the strip, its buffers and the alternating strip — is
-//! [`crate::line_geometry`]'s.
+//! `line_geometry.rs`'s.
 
 use std::sync::atomic::{AtomicU32, Ordering};
 
 use crate::camera::FrameView;
 use crate::gbuffer::{self, GeometryBindings, GeometryUniform, Load, PipelineSpec};
 use crate::lighting::Lighting;
+use crate::line_geometry::LineGeometry;
 pub use crate::line_geometry::{
-    DEFAULT_CHUNK_BYTES, FLAG_UNIT, GeometryOptions, LineAttributes, LineGeometry, LinePoint, VertexAttributes,
-    VertexFlags, validate_offsets,
+    DEFAULT_CHUNK_BYTES, FLAG_UNIT, GeometryOptions, LineAttributes, LinePoint, VertexAttributes, VertexFlags,
+    validate_offsets,
 };
 use crate::line_geometry::{
     MAX_ALTERNATING_WIDTH_PX, MAX_TOLERANCE_PX, STRIP_ATTRIBUTES, attribute_layout, strip_layout,

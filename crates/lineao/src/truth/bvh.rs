@@ -110,7 +110,7 @@ impl Bvh {
 
     /// [`Bvh::build`] where every node of at most `leaf` primitives is a leaf (the SAH decides
     /// above that): bigger leaves, fewer nodes, for the GPU tree whose memory is what counts
-    /// ([`crate::ray_scene`]). `build` is `leaf` 2: the SAH decides down to pairs.
+    /// (`RayScene`). `build` is `leaf` 2: the SAH decides down to pairs.
     pub fn build_with_leaves(cones: Vec<RoundedCone>, triangles: Vec<Triangle>, leaf: usize) -> Bvh {
         let finite = |lo: Vec3, hi: Vec3| lo.is_finite() && hi.is_finite();
         let mut items: Vec<Item> = Vec::with_capacity(cones.len() + triangles.len());

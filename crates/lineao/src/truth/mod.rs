@@ -30,7 +30,7 @@
 //! position (about 1e-7 of the depth range) and far below every feature that occludes.
 //!
 //! **What is estimated.** N cosine-weighted rays over the normal's hemisphere
-//! ([`sequence`]: stratified, scrambled per pixel, deterministic for a seed), each up to world
+//! (`sequence.rs`: stratified, scrambled per pixel, deterministic for a seed), each up to world
 //! distance R:
 //! - [`Falloff::None`]: binary AO, the fraction of rays that hit within R;
 //! - [`Falloff::Linear`]: obscurance, the mean of 1 − t/R over hits.
@@ -45,21 +45,28 @@
 //! The work is split by rows over all cores; a progress callback sees each finished row and a
 //! flag stops it between rows.
 
-pub mod bvh;
+// The GPU ray tracer's scene is built from the BVH and primitives; walking them (and the ray
+// sequence) is the CPU truth's, compiled but unused without it.
+#[cfg_attr(not(feature = "truth"), allow(dead_code))]
+pub(crate) mod bvh;
 #[cfg(feature = "truth")]
 mod cpu;
 #[cfg(feature = "truth")]
 pub mod legibility;
 #[cfg(feature = "truth")]
 pub mod metrics;
-pub mod primitive;
-pub mod sequence;
+#[cfg_attr(not(feature = "truth"), allow(dead_code))]
+pub(crate) mod primitive;
+#[cfg_attr(not(feature = "truth"), allow(dead_code))]
+pub(crate) mod sequence;
 
 use crate::Error;
 use crate::settings::Named;
+#[cfg(feature = "truth")]
 pub use bvh::{Bvh, Prim};
 #[cfg(feature = "truth")]
 pub use cpu::*;
+#[cfg(feature = "truth")]
 pub use primitive::{RoundedCone, Triangle};
 
 /// ε, the rays' offset along the normal, as a share of the distance R.

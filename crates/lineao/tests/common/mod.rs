@@ -2,15 +2,15 @@
 //! fails the test, it never skips) and ways to run the chain or single passes and read back.
 #![allow(dead_code)]
 
-use lineao::camera::{Bounds, Camera, FrameView};
+use lineao::LineGeometry;
 use lineao::method::line_ao::LineAo;
-use lineao::passes::lines::LineGeometry;
 use lineao::passes::meshes::MeshGeometry;
 use lineao::passes::nd_pyramid::NdPyramid;
 use lineao::reference::{Image, NdImage};
 use lineao::targets::{FrameTargets, Target};
 use lineao::verify::{read_f32, read_rgba, write_target};
 use lineao::{AoChain, ChainSettings, Gpu};
+use lineao::{Bounds, Camera, FrameView};
 
 pub fn gpu() -> Gpu {
     if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
@@ -123,7 +123,7 @@ pub fn flat_view(width: u32, height: u32, guard: u32) -> FrameView {
         eye: glam::Vec3::new(0.0, 0.0, 10.0),
         target: glam::Vec3::ZERO,
         up: glam::Vec3::Y,
-        projection: lineao::camera::Projection::Perspective { fov_y_deg: 45.0 },
+        projection: lineao::Projection::Perspective { fov_y_deg: 45.0 },
     };
     FrameView::new(&camera, &Bounds { center: glam::Vec3::ZERO, radius: 1.0 }, width, height, guard, 1.0)
 }
@@ -193,9 +193,9 @@ pub fn cameras_for_polylines() -> (Camera, Camera) {
         eye: glam::Vec3::new(20.0, 30.0, 140.0),
         target: glam::Vec3::ZERO,
         up: glam::Vec3::Y,
-        projection: lineao::camera::Projection::Perspective { fov_y_deg: 40.0 },
+        projection: lineao::Projection::Perspective { fov_y_deg: 40.0 },
     };
-    (perspective, Camera { projection: lineao::camera::Projection::Orthographic { height: 110.0 }, ..perspective })
+    (perspective, Camera { projection: lineao::Projection::Orthographic { height: 110.0 }, ..perspective })
 }
 
 /// A minimal host renderer: `triangles` (world positions, three per triangle) into a new
@@ -320,7 +320,7 @@ pub fn unit_sphere_view() -> (Camera, Bounds) {
         eye: glam::Vec3::new(0.0, 0.0, 5.0),
         target: glam::Vec3::ZERO,
         up: glam::Vec3::Y,
-        projection: lineao::camera::Projection::Perspective { fov_y_deg: 45.0 },
+        projection: lineao::Projection::Perspective { fov_y_deg: 45.0 },
     };
     (camera, Bounds { center: glam::Vec3::ZERO, radius: 1.0 })
 }

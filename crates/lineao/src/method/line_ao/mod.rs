@@ -13,7 +13,7 @@
 //!   g_light   = 1 − min(Σ_lights BRDF(L, I, n_j(P), ω), 1)                  (Eq. 14–15)
 //! ```
 //!
-//! ω_i = reflect(R1(P), `R2[j][i]`) flipped into the hemisphere of n_j(P) (§3.4, [`crate::noise`]).
+//! ω_i = reflect(R1(P), `R2[j][i]`) flipped into the hemisphere of n_j(P) (§3.4, `noise.rs`).
 //! Where we depart from the paper (the ε test, the third case of Eq. 12) is in CONTRACT.md.
 //! The CPU reference is [`crate::reference::line_ao`]; `line_ao.wgsl` is the shader.
 //!
@@ -65,8 +65,8 @@ use crate::settings::ChainSettings;
 
 #[cfg(feature = "reference")]
 pub(crate) mod reference;
-mod settings;
-pub use settings::{LineAoOuter, LineAoSettings, LineAoVariant, R0};
+pub(crate) mod settings;
+pub(crate) use settings::{LineAoOuter, LineAoSettings, LineAoVariant, R0};
 
 /// LineAO in the registry ([`crate::method`]).
 pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {

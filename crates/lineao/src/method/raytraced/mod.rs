@@ -4,7 +4,7 @@
 //!
 //! Each frame, every geometry pixel traces k = `rays_per_frame` cosine-weighted rays and adds
 //! them to its running sum; `ao` is the sum over the rays so far. The rays are the CPU truth's:
-//! ray i of a pixel is point i of its scrambled Sobol' sequence ([`crate::truth::sequence`]), and
+//! ray i of a pixel is point i of its scrambled Sobol' sequence (`truth/sequence.rs`), and
 //! frame f traces rays f·k .. f·k + k, so after F frames the image *is* the CPU truth with F·k
 //! rays (up to f32 against f64 at grazing hits; the tests measure it). The origin, the pixel's
 //! own segment, buried origins and both falloffs follow [`crate::truth`] step by step.
@@ -36,8 +36,8 @@ use denoise::RayDenoise;
 pub mod denoise;
 #[cfg(feature = "reference")]
 pub(crate) mod reference;
-mod settings;
-pub use settings::{RayDenoiseSettings, RayTracedSettings};
+pub(crate) mod settings;
+pub(crate) use settings::{RayDenoiseSettings, RayTracedSettings};
 
 use crate::method::BenchPass;
 

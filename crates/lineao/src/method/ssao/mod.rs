@@ -27,8 +27,8 @@ use crate::settings::ChainSettings;
 pub mod blur;
 #[cfg(feature = "reference")]
 pub(crate) mod reference;
-mod settings;
-pub use settings::{SsaoKernel, SsaoSettings};
+pub(crate) mod settings;
+pub(crate) use settings::{SsaoKernel, SsaoSettings};
 
 use crate::method::BenchPass;
 

@@ -16,7 +16,7 @@
 //! The normal clamp, the thickness model, the per-pixel reflection and two radii work as in
 //! [`crate::method::vo_line`]. The footprint of sample i covers π r² A_i/ΣA pixels for a sphere
 //! of r pixels: one log2 per pixel plus a precomputed per-sample offset gives its level of
-//! detail ([`crate::sample_sets::vo_area_lod_offsets`]); reads are trilinear. One sample — the
+//! detail (`sample_sets::vo_area_lod_offsets`); reads are trilinear. One sample — the
 //! whole sphere — already darkens creases and contacts without any noise; more samples keep
 //! finer structure. σ below 1e-3 · (far − near) is f32 cancellation and counts as 0
 //! (CONTRACT.md). The CPU reference is [`crate::reference::vo_area`].

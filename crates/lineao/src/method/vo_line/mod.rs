@@ -12,7 +12,7 @@
 //!   ao(P) = 1 − Σ A_i |free ∩ allowed|_i / Σ A_i |allowed|_i
 //! ```
 //!
-//! - **Weights** A_i come with the sample sets ([`crate::sample_sets`]): the Voronoi column of
+//! - **Weights** A_i come with the sample sets (`sample_sets`): the Voronoi column of
 //!   each disk point, so every line stands for its share of the sphere.
 //! - **Normal clamp** (§4.4): only the half above the tangent plane n · q ≥ 0 is allowed, a
 //!   bound on z_d per sample (the plane's depth at s). A plane facing the camera is then wholly
@@ -37,9 +37,9 @@ use crate::settings::ChainSettings;
 
 #[cfg(feature = "reference")]
 pub(crate) mod reference;
-mod settings;
+pub(crate) mod settings;
 pub(crate) use settings::preset;
-pub use settings::{VoCombine, VoSettings};
+pub(crate) use settings::{VoCombine, VoSettings};
 
 /// VO with line samples in the registry ([`crate::method`]).
 pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
