@@ -120,7 +120,7 @@ pub fn parse_score_method(s: &str) -> Result<ScoreMethod, String> {
 }
 
 /// A positive, finite number (a radius, a range).
-fn parse_positive(s: &str) -> Result<f32, String> {
+pub(crate) fn parse_positive(s: &str) -> Result<f32, String> {
     match s.trim().parse::<f32>() {
         Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
         Ok(v) => Err(format!("must be positive and finite, got {v}")),
@@ -129,7 +129,7 @@ fn parse_positive(s: &str) -> Result<f32, String> {
 }
 
 /// LineAO's δ scale, in (0, 1].
-fn parse_delta_scale(s: &str) -> Result<f32, String> {
+pub(crate) fn parse_delta_scale(s: &str) -> Result<f32, String> {
     match s.trim().parse::<f32>() {
         Ok(v) if v > 0.0 && v <= 1.0 => Ok(v),
         Ok(v) => Err(format!("the δ scale must be in (0, 1], got {v}")),
@@ -165,7 +165,7 @@ impl std::fmt::Display for AoDistance {
     }
 }
 
-fn parse_ao_distance(s: &str) -> Result<AoDistance, String> {
+pub(crate) fn parse_ao_distance(s: &str) -> Result<AoDistance, String> {
     match s.trim().strip_suffix('%') {
         Some(share) => match share.trim().parse::<f32>() {
             Ok(p) if p > 0.0 && p <= 100.0 => Ok(AoDistance::Share(p / 100.0)),
@@ -369,7 +369,7 @@ pub fn parse_method(s: &str) -> Result<Method, String> {
     }
 }
 
-fn parse_pair(s: &str) -> Result<[Method; 2], String> {
+pub(crate) fn parse_pair(s: &str) -> Result<[Method; 2], String> {
     match s.split(',').collect::<Vec<_>>()[..] {
         [a, b] => match [parse_method(a.trim())?, parse_method(b.trim())?] {
             [a, b] if a == b => Err(format!("compare two different methods, got '{s}'")),
@@ -446,12 +446,15 @@ pub struct ConvertArgs {
     pub output: PathBuf,
 }
 
-#[derive(Args, Clone, Debug)]
+#[derive(Args, Clone, Debug, serde::Deserialize)]
+// Python's keyword arguments deserialize into it (crate::kwargs); the defaults are clap's.
+#[serde(default, deny_unknown_fields)]
 pub struct RenderArgs {
     /// Tractography file to render (any format `lineao info` reads) instead of a built-in scene.
     pub file: Option<PathBuf>,
     /// Built-in scene.
     #[arg(long, default_value = "bundles", value_parser = parse_scene)]
+    #[serde(deserialize_with = "crate::kwargs::scene")]
     pub scene: SceneKind,
     /// Approximate vertex count of the built-in scene [default: 400000].
     #[arg(long)]
@@ -462,10 +465,12 @@ pub struct RenderArgs {
     /// Ambient occlusion method: one of the list, or a screen-space method with an object-space
     /// one, e.g. lineao+sweep (see --volume-combine).
     #[arg(long, default_value = "lineao", value_parser = Listed { parse: parse_method, values: Method::listed })]
+    #[serde(deserialize_with = "crate::kwargs::method")]
     pub method: Method,
     /// Split screen: method A on the left, B on the right, a labelled divider (e.g.
     /// `lineao,ssao`).
     #[arg(long, value_name = "A,B", value_parser = parse_pair, conflicts_with = "grid")]
+    #[serde(deserialize_with = "crate::kwargs::opt_pair")]
     pub compare: Option<[Method; 2]>,
     /// Every method in one labelled image (a grid of --width × --height tiles, three a row:
     /// the screen-space methods with LineAO's `reference` variant third, the object-space ones
@@ -491,6 +496,7 @@ pub struct RenderArgs {
     pub line_width: f32,
     /// Streamlines as lines or tubes.
     #[arg(long, value_enum, default_value_t = GeometryArg::Lines)]
+    #[serde(deserialize_with = "crate::kwargs::geometry")]
     pub geometry: GeometryArg,
     /// Tubes: radius in world units [default: 0.5 mm].
     #[arg(long)]
@@ -503,9 +509,11 @@ pub struct RenderArgs {
     /// Context surface shown with the tracts (OBJ or glTF triangles, optionally gzipped); may be
     /// given several times. It occludes the lines and is occluded, and the AO sees it.
     #[arg(long = "surface", value_name = "MESH")]
+    #[serde(deserialize_with = "crate::kwargs::paths")]
     pub surfaces: Vec<PathBuf>,
     /// Linear RGB of the context surfaces.
     #[arg(long, default_value = "0.8,0.8,0.8", value_parser = parse_vec3)]
+    #[serde(deserialize_with = "crate::kwargs::vec3")]
     pub surface_color: [f32; 3],
     /// Tubes: the file's per-vertex field holding each vertex's radius in world units (e.g. a
     /// TRX dpv or a .trk scalar); vertices without a positive value take --tube-radius.
@@ -513,12 +521,15 @@ pub struct RenderArgs {
     pub tube_radius_field: Option<String>,
     /// Camera position, world units: X,Y,Z [default: the scene's].
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    #[serde(deserialize_with = "crate::kwargs::opt_vec3")]
     pub eye: Option<[f32; 3]>,
     /// Point the camera looks at: X,Y,Z [default: the scene's].
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    #[serde(deserialize_with = "crate::kwargs::opt_vec3")]
     pub target: Option<[f32; 3]>,
     /// Camera up vector: X,Y,Z [default: the scene's].
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    #[serde(deserialize_with = "crate::kwargs::opt_vec3")]
     pub up: Option<[f32; 3]>,
     /// Vertical field of view in degrees (perspective) [default: the scene's].
     #[arg(long, conflicts_with = "ortho")]
@@ -557,6 +568,7 @@ pub struct RenderArgs {
     pub vo_area_samples: Option<u32>,
     /// VO: a second sphere radius in world units, combined with --radius (VO paper, Fig. 8).
     #[arg(long, value_parser = parse_positive)]
+    #[serde(deserialize_with = "crate::kwargs::opt_positive")]
     pub radius2: Option<f32>,
     /// VO with two radii: how they combine.
     #[arg(long, value_parser = named::<VoCombine>(), default_value = "product", requires = "radius2")]
@@ -579,15 +591,19 @@ pub struct RenderArgs {
     /// The shown method's sphere radius: --ssao-radius or --vo-radius, whichever --method names
     /// (with --grid or --compare, both).
     #[arg(long, value_parser = parse_positive)]
+    #[serde(deserialize_with = "crate::kwargs::opt_positive")]
     pub radius: Option<f32>,
     /// SSAO: sphere radius in world units (mm for tractograms) [default: the preset's; paper 2].
     #[arg(long, value_parser = parse_positive)]
+    #[serde(deserialize_with = "crate::kwargs::opt_positive")]
     pub ssao_radius: Option<f32>,
     /// VO (line and area sampling): sphere radius in world units [default: the preset's; paper 2].
     #[arg(long, value_parser = parse_positive)]
+    #[serde(deserialize_with = "crate::kwargs::opt_positive")]
     pub vo_radius: Option<f32>,
     /// SSAO: range check in world units [default: the radius].
     #[arg(long, value_parser = parse_positive)]
+    #[serde(deserialize_with = "crate::kwargs::opt_positive")]
     pub ssao_range: Option<f32>,
     /// SSAO: the kernel's points.
     #[arg(long, value_parser = named::<SsaoKernel>(), default_value = "crytek")]
@@ -598,6 +614,7 @@ pub struct RenderArgs {
     /// LineAO: scale of the falloff δ(j) = scale · (1 − j/s_r)², in (0, 1]; below 1 occluders
     /// far in front (in normalized depth) stop counting [default: the preset's; paper 1].
     #[arg(long, value_parser = parse_delta_scale)]
+    #[serde(deserialize_with = "crate::kwargs::opt_delta_scale")]
     pub delta_scale: Option<f32>,
     /// LineAO ε: occluded iff Δd > ε.
     #[arg(long, default_value_t = 1e-6)]
@@ -609,12 +626,14 @@ pub struct RenderArgs {
     /// lines lie deeper, `lineao score --fit`), `physical` (fitted to binary AO within 2 mm, was
     /// `calibrated`: faint) or `paper` (the papers' values). Explicit options win.
     #[arg(long, default_value = "legible", value_parser = parse_preset)]
+    #[serde(deserialize_with = "crate::kwargs::preset")]
     pub preset: lineao::Preset,
     /// Settings over the preset and every other option: `lineao::ChainSettings` as JSON, a file
     /// or the text itself (starting with `{`). Only the keys it names change, e.g.
     /// `{"ssao": {"samples": 12}, "strength": 0.8}` (docs/render.md); not `method`, which
     /// --method, --compare and --grid choose.
     #[arg(long, value_name = "FILE|JSON", value_parser = parse_settings)]
+    #[serde(deserialize_with = "crate::kwargs::opt_settings")]
     pub settings: Option<SettingsPatch>,
     /// Disable LineAO's light attenuation (g_light = 1).
     #[arg(long)]
@@ -628,15 +647,18 @@ pub struct RenderArgs {
     /// Line color: `tangent` (|T| as RGB), R,G,B in [0, 1], or `field:NAME` (the file's
     /// per-vertex field NAME through --colormap, its 2nd to 98th percentile spanning the map).
     #[arg(long, default_value = "tangent", value_parser = parse_color)]
+    #[serde(deserialize_with = "crate::kwargs::color")]
     pub color: ColorArg,
     /// The colormap of `--color field:NAME`.
     #[arg(long, value_parser = named::<Colormap>(), default_value = "viridis")]
     pub colormap: Colormap,
     /// Background color R,G,B in [0, 1].
     #[arg(long, default_value = "1,1,1", value_parser = parse_vec3)]
+    #[serde(deserialize_with = "crate::kwargs::vec3")]
     pub background: [f32; 3],
     /// What to show: final, ao, normals, depth, zoom, or level:K (pyramid level K).
     #[arg(long, default_value = "final", value_parser = parse_debug_view)]
+    #[serde(deserialize_with = "crate::kwargs::debug_view")]
     pub debug_view: lineao::DebugView,
     /// Object-space AO: voxels of the density volume along its longest axis (64–256 typical).
     #[arg(long, default_value_t = 128, value_parser = clap::value_parser!(u32).range(8..=1024))]
@@ -647,9 +669,11 @@ pub struct RenderArgs {
     pub occupancy_radius: Option<f32>,
     /// Object-space AO: where the light comes from.
     #[arg(long, value_enum, default_value_t = SkyArg::Uniform)]
+    #[serde(deserialize_with = "crate::kwargs::sky")]
     pub sky: SkyArg,
     /// Object-space AO: how the eight octant visibilities meet the line's normal.
     #[arg(long, value_enum, default_value_t = VolumeNormal::Pixel)]
+    #[serde(deserialize_with = "crate::kwargs::volume_normal")]
     pub volume_normal: VolumeNormal,
     /// Occlusion sweeping: opacity α of the translucent transmittance (Eq. 8), in (0, 1].
     #[arg(long, default_value_t = 1.0)]
@@ -667,6 +691,7 @@ pub struct RenderArgs {
     /// the reach VO and SSAO sample by default and that of LineAO's widest hemisphere
     /// (r0 + 2 z(P) px).
     #[arg(long, default_value = "2", value_parser = parse_ao_distance)]
+    #[serde(deserialize_with = "crate::kwargs::ao_distance")]
     pub ao_distance: AoDistance,
     /// Ray-traced AO: binary (`none`) or obscurance with a linear falloff (`linear`).
     #[arg(long, value_parser = named::<Falloff>(), default_value = "none")]
@@ -725,7 +750,7 @@ impl SettingsPatch {
     }
 }
 
-fn parse_settings(s: &str) -> Result<SettingsPatch, String> {
+pub(crate) fn parse_settings(s: &str) -> Result<SettingsPatch, String> {
     let (text, source) = if s.trim_start().starts_with('{') {
         (s.to_string(), "the settings".to_string())
     } else {
@@ -743,22 +768,22 @@ fn parse_settings(s: &str) -> Result<SettingsPatch, String> {
     Ok(patch)
 }
 
-fn parse_preset(s: &str) -> Result<lineao::Preset, String> {
+pub(crate) fn parse_preset(s: &str) -> Result<lineao::Preset, String> {
     lineao::Preset::from_name(s).ok_or_else(|| format!("unknown preset '{s}' (legible, physical, paper, sparse)"))
 }
 
-fn parse_scene(s: &str) -> Result<SceneKind, String> {
+pub(crate) fn parse_scene(s: &str) -> Result<SceneKind, String> {
     s.parse()
 }
 
-fn parse_vec3(s: &str) -> Result<[f32; 3], String> {
+pub(crate) fn parse_vec3(s: &str) -> Result<[f32; 3], String> {
     let parts: Vec<f32> =
         s.split(',').map(|p| p.trim().parse::<f32>().map_err(|e| format!("'{p}': {e}"))).collect::<Result<_, _>>()?;
     let v: [f32; 3] = parts.try_into().map_err(|_| format!("expected three numbers X,Y,Z, got '{s}'"))?;
     if v.iter().all(|c| c.is_finite()) { Ok(v) } else { Err(format!("'{s}' is not finite")) }
 }
 
-fn parse_color(s: &str) -> Result<ColorArg, String> {
+pub(crate) fn parse_color(s: &str) -> Result<ColorArg, String> {
     match s.strip_prefix("field:") {
         Some(name) if !name.is_empty() => Ok(ColorArg::Field(name.to_string())),
         _ if s == "tangent" => Ok(ColorArg::Tangent),
@@ -766,7 +791,7 @@ fn parse_color(s: &str) -> Result<ColorArg, String> {
     }
 }
 
-fn parse_debug_view(s: &str) -> Result<lineao::DebugView, String> {
+pub(crate) fn parse_debug_view(s: &str) -> Result<lineao::DebugView, String> {
     use lineao::DebugView as D;
     Ok(match s {
         "final" => D::Final,
@@ -779,6 +804,11 @@ fn parse_debug_view(s: &str) -> Result<lineao::DebugView, String> {
             _ => return Err(format!("unknown debug view '{s}' (final, ao, normals, depth, zoom, level:K)")),
         },
     })
+}
+
+/// A `ValueEnum` by its command-line name (for keyword arguments).
+pub(crate) fn parse_value_enum<T: ValueEnum>(s: &str) -> Result<T, String> {
+    T::from_str(s, false)
 }
 
 /// A parser that lists its values with their help in `--help` (from the registry, not a copy)

@@ -9,6 +9,7 @@ pub mod cli;
 pub mod dump;
 pub mod fit;
 pub mod info;
+pub mod kwargs;
 pub mod label;
 pub mod output;
 pub mod render;

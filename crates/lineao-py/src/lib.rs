@@ -5,16 +5,18 @@
 //!   without a copy (the array's `base` is the Rust allocation), and the GIL is released while
 //!   the file is read; the progress callback takes the GIL back every 4 MiB to check for
 //!   Ctrl-C, which cancels the load (`KeyboardInterrupt`).
-//! - **Rendering** parses the keyword arguments as `lineao render`'s command line (the names
-//!   with `_` for `-`), so the methods, settings, defaults and checks are the binary's, and the
+//! - **Rendering** takes `lineao render`'s options as keyword arguments (the names with `_` for
+//!   `-`), typed: they deserialize into the command line's own arguments
+//!   (`RenderArgs::from_keywords`), each value parsed as its option parses it, with the same
+//!   defaults and checks and errors that name the keyword — no command line is built. The
 //!   picture is the binary's pixel for pixel: [`Renderer`] holds a `lineao_cli` render session
 //!   (device, geometry on the GPU, one chain per panel) for many frames.
 
 use std::ops::ControlFlow;
 use std::path::PathBuf;
 
-use clap::{Args, FromArgMatches};
 use lineao_cli::cli::RenderArgs;
+use lineao_cli::kwargs::KwargError;
 use lineao_cli::render::Session;
 use lineao_cli::source::Loaded;
 use lineao_tracts::{Field, Group, Tractogram, ViewHint, VoxelSpace};
@@ -23,7 +25,7 @@ use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMetho
 use pyo3::create_exception;
 use pyo3::exceptions::{PyKeyboardInterrupt, PyRuntimeError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList, PyString, PyTuple};
+use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 
 create_exception!(
     _lineao,
@@ -272,115 +274,75 @@ fn save(
     py.detach(|| lineao_tracts::save(&t, &path)).map_err(|e| load_error(py, e))
 }
 
-/// `render`'s command line from keyword arguments: `line_width=2.0` → `--line-width 2.0`,
-/// `grid=True` → `--grid`, `compare=("lineao", "ssao")` → `--compare lineao,ssao`, a dict → JSON
-/// (`settings={"ssao": {"samples": 12}}`), `None` and
-/// `False` → left out. Unknown names are a `TypeError` that lists the known ones.
-fn argv(settings: &Bound<'_, PyDict>) -> PyResult<Vec<String>> {
-    let command = RenderArgs::augment_args(clap::Command::new("render"));
-    let mut argv = vec!["render".to_string()];
+/// A Python value as JSON for [`RenderArgs::from_keywords`]: `None`, bools, numbers (numpy's
+/// scalars through `.item()`), strings and paths, sequences and dicts.
+fn to_json(value: &Bound<'_, PyAny>) -> PyResult<serde_json::Value> {
+    use serde_json::Value;
+    if value.is_none() {
+        return Ok(Value::Null);
+    }
+    if let Ok(b) = value.cast::<PyBool>() {
+        return Ok(Value::Bool(b.is_true()));
+    }
+    if value.is_instance_of::<PyInt>() {
+        let n: i128 = value.extract()?;
+        return Ok(i64::try_from(n)
+            .map(Value::from)
+            .or_else(|_| u64::try_from(n).map(Value::from))
+            .unwrap_or(Value::Null));
+    }
+    if value.is_instance_of::<PyFloat>() {
+        return Ok(serde_json::Number::from_f64(value.extract()?).map_or(Value::Null, Value::Number));
+    }
+    if let Ok(s) = value.cast::<PyString>() {
+        return Ok(Value::String(s.to_cow()?.into_owned()));
+    }
+    if let Ok(dict) = value.cast::<PyDict>() {
+        let mut map = serde_json::Map::new();
+        for (k, v) in dict {
+            map.insert(k.str()?.to_string(), to_json(&v)?);
+        }
+        return Ok(Value::Object(map));
+    }
+    if value.is_instance_of::<PyList>() || value.is_instance_of::<PyTuple>() {
+        return value.try_iter()?.map(|item| to_json(&item?)).collect::<PyResult<_>>().map(Value::Array);
+    }
+    // numpy scalars and 0-d arrays, then paths.
+    if value.hasattr("item")? && value.hasattr("dtype")? {
+        return to_json(&value.call_method0("item")?);
+    }
+    if value.hasattr("__fspath__")? {
+        return to_json(&value.call_method0("__fspath__")?);
+    }
+    Ok(Value::String(value.str()?.to_string()))
+}
+
+/// `render`'s arguments from keyword arguments, typed as the library's settings are
+/// ([`RenderArgs::from_keywords`]): `None` leaves a keyword out; an unknown one is a
+/// `TypeError` listing the known ones, a bad value a `ValueError` naming its keyword.
+fn parse(settings: &Bound<'_, PyDict>, file: Option<&PathBuf>) -> PyResult<RenderArgs> {
+    let mut values = serde_json::Map::new();
     for (key, value) in settings {
-        let key: String = key.extract()?;
-        let Some(arg) = command.get_arguments().find(|a| a.get_id() == key.as_str() && a.get_long().is_some()) else {
-            let known: Vec<&str> = settings_names(&command).collect();
-            return Err(PyTypeError::new_err(format!(
-                "unexpected keyword argument '{key}'; the settings are: {}",
-                known.join(", ")
-            )));
-        };
-        let flag = format!("--{}", arg.get_long().expect("found with a long name"));
-        let is_switch = matches!(arg.get_action(), clap::ArgAction::SetTrue);
-        if value.is_none() {
-            continue;
-        }
-        if is_switch {
-            let on: bool = value
-                .extract()
-                .map_err(|_| PyTypeError::new_err(format!("{key}: expected True or False, got {value}")))?;
-            if on {
-                argv.push(flag);
-            }
-            continue;
-        }
-        // Typed settings as a dict (`settings={"ssao": {"samples": 12}}`) → `--settings` JSON.
-        if value.is_instance_of::<PyDict>() {
-            let json = value.py().import("json")?.call_method1("dumps", (value,))?;
-            argv.extend([flag, json.str()?.to_string()]);
-            continue;
-        }
-        let items: Option<Vec<String>> = if value.is_instance_of::<PyString>() {
-            None
-        } else if value.is_instance_of::<PyTuple>() || value.is_instance_of::<PyList>() {
-            let items = value.try_iter()?.map(|x| x.and_then(|x| x.str().map(|s| s.to_string())));
-            Some(items.collect::<PyResult<_>>()?)
-        } else {
-            None
-        };
-        match items {
-            // An option given several times (`surfaces=[a, b]` → `--surface a --surface b`).
-            Some(items)
-                if matches!(arg.get_action(), clap::ArgAction::Append) && arg.get_value_delimiter().is_none() =>
-            {
-                for item in items {
-                    argv.extend([flag.clone(), item]);
-                }
-            }
-            // A value of several numbers or names (`background=(0, 0, 0)` → `0,0,0`).
-            Some(items) => argv.extend([flag, items.join(",")]),
-            None => argv.extend([flag, value.str()?.to_string()]),
+        if !value.is_none() {
+            values.insert(key.extract()?, to_json(&value)?);
         }
     }
-    Ok(argv)
-}
-
-/// The keyword arguments `render` takes: `render`'s options, less the input and the output
-/// file (Python passes the streamlines and gets the image back).
-fn settings_names(command: &clap::Command) -> impl Iterator<Item = &str> {
-    command
-        .get_arguments()
-        .filter(|a| a.get_long().is_some() && !matches!(a.get_id().as_str(), "output" | "help"))
-        .map(|a| a.get_id().as_str())
-}
-
-/// `render`'s arguments from `argv`, or a `ValueError` with clap's message (the bad value,
-/// what is allowed) with the flag named as the keyword argument.
-fn parse(argv: &[String]) -> PyResult<RenderArgs> {
-    let command = RenderArgs::augment_args(clap::Command::new("render").no_binary_name(false));
-    let matches = command.try_get_matches_from(argv).map_err(|e| PyValueError::new_err(clap_message(&e)))?;
-    RenderArgs::from_arg_matches(&matches).map_err(|e| PyValueError::new_err(clap_message(&e)))
-}
-
-fn clap_message(e: &clap::Error) -> String {
-    let text = e.render().to_string();
-    let first = text.lines().next().unwrap_or("invalid settings").trim_start_matches("error: ");
-    // "invalid value 'abc' for '--line-width <LINE_WIDTH>': …" names the keyword: 'line_width'.
-    match first.split_once("'--") {
-        Some((before, rest)) => match rest.split_once('\'') {
-            Some((flag, after)) => {
-                let name = flag.split(' ').next().unwrap_or(flag).replace('-', "_");
-                format!("{before}'{name}'{after}")
-            }
-            None => first.to_string(),
-        },
-        None => first.to_string(),
+    let mut args = RenderArgs::from_keywords(values).map_err(|e| match e {
+        KwargError::Unknown { .. } => PyTypeError::new_err(e.to_string()),
+        KwargError::Invalid(_) => PyValueError::new_err(e.to_string()),
+    })?;
+    args.file = file.cloned();
+    if args.tube_radius_field.is_some() && args.file.is_none() {
+        return Err(PyValueError::new_err("'tube_radius_field' needs a file"));
     }
+    Ok(args)
 }
 
 /// The settings `render` takes, each as (name, help, default): for the Python docs and
 /// `lineao.settings()`, read from the command line's definition.
 #[pyfunction]
 fn settings() -> Vec<(String, String, Option<String>)> {
-    let command = RenderArgs::augment_args(clap::Command::new("render"));
-    let names: Vec<String> = settings_names(&command).map(str::to_string).collect();
-    names
-        .into_iter()
-        .filter_map(|name| {
-            let arg = command.get_arguments().find(|a| a.get_id().as_str() == name)?;
-            let help = arg.get_help().map(|h| h.to_string()).unwrap_or_default();
-            let default = arg.get_default_values().first().map(|d| d.to_string_lossy().into_owned());
-            Some((name, help, default))
-        })
-        .collect()
+    RenderArgs::keywords().into_iter().map(|k| (k.name, k.help, k.default)).collect()
 }
 
 /// The method names `render` accepts (`method=`, `compare=`): the registry's (the ray-traced
@@ -433,11 +395,7 @@ impl Renderer {
         lengths: Option<&Bound<'_, PyAny>>,
         name: String,
     ) -> PyResult<Renderer> {
-        let mut argv = argv(settings)?;
-        if let Some(path) = &path {
-            argv.push(path.display().to_string());
-        }
-        let args = parse(&argv)?;
+        let args = parse(settings, path.as_ref())?;
         let session = match (points, offsets, lengths) {
             (Some(points), Some(offsets), Some(lengths)) => {
                 let lines = Streamlines::extract(points, offsets, lengths)?;
@@ -529,8 +487,7 @@ impl Renderer {
     /// A frame's arguments from `settings`, checked against what the session was opened with;
     /// the session's camera (when they name one) and sky follow them.
     fn frame_args(&mut self, settings: &Bound<'_, PyDict>) -> PyResult<RenderArgs> {
-        let mut args = parse(&argv(settings)?)?;
-        args.file.clone_from(&self.opened.file);
+        let args = parse(settings, self.opened.file.as_ref())?;
         let same = |a: &RenderArgs| {
             let field = match &a.color {
                 lineao_cli::cli::ColorArg::Field(name) => Some(name.clone()),

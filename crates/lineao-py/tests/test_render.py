@@ -149,6 +149,15 @@ def test_bad_input_names_the_argument(tmp_path):
         lineao.render(lineao.load(TRK), method="bogus")
     with pytest.raises(ValueError, match="ssao.sample: unknown field `sample`"):
         lineao.render(lineao.load(TRK), settings={"ssao": {"sample": 12}})
+    # Typed values, each checked by its option's own parser, the keyword named.
+    with pytest.raises(ValueError, match="background: expected three numbers"):
+        lineao.render(lineao.load(TRK), background=(0, 0))
+    with pytest.raises(ValueError, match="line_width: invalid type: string"):
+        lineao.render(lineao.load(TRK), line_width="thick")
+    with pytest.raises(ValueError, match="'compare' cannot be used with 'grid'"):
+        lineao.render(lineao.load(TRK), compare=("lineao", "ssao"), grid=True)
+    image = lineao.render(lineao.load(TRK), width=np.int64(32), height=16, line_width=np.float32(2))
+    assert image.shape == (16, 32, 4)
     with pytest.raises(ValueError, match="no finite points"):
         lineao.render([])
     with pytest.raises(ValueError, match="outside the"):

@@ -1,0 +1,274 @@
+//! `render`'s arguments from typed values — Python's keyword arguments, as JSON — without a
+//! command line: [`RenderArgs`] deserializes with serde, each option's value parsed by the
+//! same function the command line parses it with (a method name, `20%`, `x,y,z`, a settings
+//! object), its defaults the command line's, and every error names the keyword.
+
+use std::collections::BTreeSet;
+
+use clap::Args;
+use serde::Deserialize;
+
+use crate::cli::RenderArgs;
+
+/// A keyword argument of `render`: its name (the option's with `_`), help and default.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Keyword {
+    pub name: String,
+    pub help: String,
+    pub default: Option<String>,
+}
+
+/// What a keyword argument got wrong.
+#[derive(Debug, PartialEq)]
+pub enum KwargError {
+    /// A name `render` does not take (Python: `TypeError`).
+    Unknown { name: String, known: Vec<String> },
+    /// A value its option refuses, or options that exclude or need each other (`ValueError`).
+    Invalid(String),
+}
+
+impl std::fmt::Display for KwargError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            KwargError::Unknown { name, known } => {
+                write!(f, "unexpected keyword argument '{name}'; the settings are: {}", known.join(", "))
+            }
+            KwargError::Invalid(text) => f.write_str(text),
+        }
+    }
+}
+
+impl std::error::Error for KwargError {}
+
+impl Default for RenderArgs {
+    /// The command line's defaults (`lineao render` with no option): one definition for both.
+    fn default() -> RenderArgs {
+        let command = RenderArgs::augment_args(clap::Command::new("render").no_binary_name(true));
+        let matches = command.try_get_matches_from(std::iter::empty::<&str>()).expect("every option has a default");
+        <RenderArgs as clap::FromArgMatches>::from_arg_matches(&matches).expect("the defaults parse")
+    }
+}
+
+impl RenderArgs {
+    /// The keyword arguments `render` takes: its options without the output file, each with
+    /// its help and default, read from the command line's definition.
+    pub fn keywords() -> Vec<Keyword> {
+        let command = RenderArgs::augment_args(clap::Command::new("render"));
+        let options = command
+            .get_arguments()
+            .filter(|a| a.get_long().is_some() && !matches!(a.get_id().as_str(), "output" | "help"));
+        options
+            .map(|a| Keyword {
+                name: a.get_id().to_string(),
+                help: a.get_help().map(|h| h.to_string()).unwrap_or_default(),
+                default: a.get_default_values().first().map(|d| d.to_string_lossy().into_owned()),
+            })
+            .collect()
+    }
+
+    /// The arguments from `values` (a JSON object of keyword arguments; `None`s left out),
+    /// checked as the command line checks them: each value by its option's parser, the ranges,
+    /// and the options that exclude or need each other.
+    pub fn from_keywords(values: serde_json::Map<String, serde_json::Value>) -> Result<RenderArgs, KwargError> {
+        let known: Vec<String> = RenderArgs::keywords().into_iter().map(|k| k.name).collect();
+        if let Some(name) = values.keys().find(|name| !known.contains(name)) {
+            return Err(KwargError::Unknown { name: name.clone(), known });
+        }
+        // A switch set to False is a switch not given, as on the command line.
+        let given: BTreeSet<String> =
+            values.iter().filter(|(_, v)| **v != serde_json::Value::Bool(false)).map(|(k, _)| k.clone()).collect();
+        let args: RenderArgs = serde_path_to_error::deserialize(serde_json::Value::Object(values))
+            .map_err(|e| KwargError::Invalid(format!("{}: {}", e.path(), e.inner())))?;
+        args.check(&given).map_err(KwargError::Invalid)?;
+        Ok(args)
+    }
+
+    /// What clap's attributes check on the command line: the ranges of the counted options and
+    /// the options that exclude (`conflicts_with`) or need (`requires`) another.
+    fn check(&self, given: &BTreeSet<String>) -> Result<(), String> {
+        let ranges = [
+            ("width", self.width, 1, 8192),
+            ("height", self.height, 1, 8192),
+            ("s_h", self.s_h, 1, 256),
+            ("volume_resolution", self.volume_resolution, 8, 1024),
+            ("rays", self.rays, 1, 1_048_576),
+        ];
+        for (name, value, lo, hi) in ranges {
+            if !(lo..=hi).contains(&value) {
+                return Err(format!("invalid value '{value}' for '{name}': {value} is not in {lo}..={hi}"));
+            }
+        }
+        let has = |name: &str| given.contains(name);
+        for (a, b) in [("compare", "grid"), ("fov", "ortho"), ("cpu", "bilateral"), ("cpu", "denoise")] {
+            if has(a) && has(b) {
+                return Err(format!("'{a}' cannot be used with '{b}'"));
+            }
+        }
+        for (a, b) in [("combine", "radius2"), ("bilateral_radius", "bilateral"), ("bilateral_sigma", "bilateral")] {
+            if has(a) && !has(b) {
+                return Err(format!("'{a}' needs '{b}'"));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A value as the command line's text: a string as it is, a number or bool as written, a
+/// sequence of them joined by commas (`(0, 0, 0)` → `0,0,0`, `("lineao", "ssao")` → `lineao,ssao`).
+struct Text(String);
+
+impl<'de> Deserialize<'de> for Text {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Text, D::Error> {
+        match serde_json::Value::deserialize(d)? {
+            serde_json::Value::Array(items) => {
+                let items: Result<Vec<String>, String> = items.iter().map(scalar).collect();
+                items.map(|items| Text(items.join(","))).map_err(serde::de::Error::custom)
+            }
+            value => scalar(&value).map(Text).map_err(serde::de::Error::custom),
+        }
+    }
+}
+
+fn scalar(value: &serde_json::Value) -> Result<String, String> {
+    match value {
+        serde_json::Value::String(s) => Ok(s.clone()),
+        serde_json::Value::Number(n) => Ok(n.to_string()),
+        serde_json::Value::Bool(b) => Ok(b.to_string()),
+        other => Err(format!("expected a string, a number or a sequence of them, got {other}")),
+    }
+}
+
+/// `deserialize_with` functions: the value's text through the command line's parser of the
+/// option (`opt_…` for an optional one).
+macro_rules! parsed {
+    ($($name:ident: $ty:ty = $parse:path;)*) => {$(
+        pub(crate) fn $name<'de, D: serde::Deserializer<'de>>(d: D) -> Result<$ty, D::Error> {
+            let Text(text) = Text::deserialize(d)?;
+            $parse(&text).map_err(serde::de::Error::custom)
+        }
+    )*};
+}
+
+macro_rules! optional {
+    ($($name:ident: $ty:ty = $parse:path;)*) => {$(
+        pub(crate) fn $name<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<$ty>, D::Error> {
+            let Text(text) = Text::deserialize(d)?;
+            $parse(&text).map(Some).map_err(serde::de::Error::custom)
+        }
+    )*};
+}
+
+parsed! {
+    scene: lineao_tracts::SceneKind = crate::cli::parse_scene;
+    method: crate::cli::Method = crate::cli::parse_method;
+    vec3: [f32; 3] = crate::cli::parse_vec3;
+    preset: lineao::Preset = crate::cli::parse_preset;
+    color: crate::cli::ColorArg = crate::cli::parse_color;
+    debug_view: lineao::DebugView = crate::cli::parse_debug_view;
+    ao_distance: crate::cli::AoDistance = crate::cli::parse_ao_distance;
+    geometry: crate::cli::GeometryArg = crate::cli::parse_value_enum::<crate::cli::GeometryArg>;
+    sky: crate::cli::SkyArg = crate::cli::parse_value_enum::<crate::cli::SkyArg>;
+    volume_normal: crate::cli::VolumeNormal = crate::cli::parse_value_enum::<crate::cli::VolumeNormal>;
+}
+
+optional! {
+    opt_pair: [crate::cli::Method; 2] = crate::cli::parse_pair;
+    opt_vec3: [f32; 3] = crate::cli::parse_vec3;
+    opt_positive: f32 = crate::cli::parse_positive;
+    opt_delta_scale: f32 = crate::cli::parse_delta_scale;
+}
+
+/// `settings`: an object of `ChainSettings` keys, or the command line's text (JSON or a file).
+pub(crate) fn opt_settings<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> Result<Option<crate::cli::SettingsPatch>, D::Error> {
+    let text = match serde_json::Value::deserialize(d)? {
+        serde_json::Value::String(s) => s,
+        value => value.to_string(),
+    };
+    crate::cli::parse_settings(&text).map(Some).map_err(serde::de::Error::custom)
+}
+
+/// `surfaces`: one file or several.
+pub(crate) fn paths<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<std::path::PathBuf>, D::Error> {
+    #[derive(Deserialize)]
+    #[serde(untagged)]
+    enum OneOrMany {
+        One(std::path::PathBuf),
+        Many(Vec<std::path::PathBuf>),
+    }
+    Ok(match OneOrMany::deserialize(d)? {
+        OneOrMany::One(path) => vec![path],
+        OneOrMany::Many(paths) => paths,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    fn from(value: serde_json::Value) -> Result<RenderArgs, KwargError> {
+        RenderArgs::from_keywords(value.as_object().unwrap().clone())
+    }
+
+    #[test]
+    fn keywords_parse_as_the_command_line_parses_them() {
+        let args = from(json!({
+            "width": 320, "line_width": 3, "compare": ["lineao", "ssao"], "background": [0, 0, 0.5],
+            "ao_distance": "20%", "color": "tangent", "eye": "1,2,3", "grid": false, "surfaces": "brain.obj",
+            "settings": {"ssao": {"samples": 12}}, "method": "lineao+sweep", "debug_view": "level:1",
+        }))
+        .unwrap();
+        let cli = <crate::cli::Cli as clap::Parser>::parse_from([
+            "lineao",
+            "render",
+            "--width",
+            "320",
+            "--line-width",
+            "3",
+            "--compare",
+            "lineao,ssao",
+            "--background",
+            "0,0,0.5",
+            "--ao-distance",
+            "20%",
+            "--eye",
+            "1,2,3",
+            "--surface",
+            "brain.obj",
+            "--settings",
+            r#"{"ssao": {"samples": 12}}"#,
+            "--method",
+            "lineao+sweep",
+            "--debug-view",
+            "level:1",
+        ]);
+        let crate::cli::Command::Render(expected) = cli.command else { panic!("render") };
+        assert_eq!(format!("{args:?}"), format!("{expected:?}"));
+        // No keyword: the command line's defaults.
+        let defaults = <crate::cli::Cli as clap::Parser>::parse_from(["lineao", "render"]);
+        let crate::cli::Command::Render(defaults) = defaults.command else { panic!("render") };
+        assert_eq!(format!("{:?}", from(json!({})).unwrap()), format!("{defaults:?}"));
+    }
+
+    #[test]
+    fn every_error_names_its_keyword() {
+        let err = |v| from(v).unwrap_err().to_string();
+        assert!(
+            err(json!({"linewidth": 2})).starts_with("unexpected keyword argument 'linewidth'; the settings are: ")
+        );
+        assert_eq!(err(json!({"width": 0})), "invalid value '0' for 'width': 0 is not in 1..=8192");
+        assert!(
+            err(json!({"method": "bogus"})).starts_with("method: unknown method 'bogus'"),
+            "{}",
+            err(json!({"method": "bogus"}))
+        );
+        assert!(err(json!({"line_width": "thick"})).starts_with("line_width: invalid type"));
+        assert!(err(json!({"settings": {"ssao": {"sample": 12}}})).contains("ssao.sample: unknown field `sample`"));
+        assert!(err(json!({"ssao_radius": -1})).starts_with("ssao_radius: "));
+        assert_eq!(err(json!({"compare": ["lineao", "ssao"], "grid": true})), "'compare' cannot be used with 'grid'");
+        assert_eq!(err(json!({"combine": "min"})), "'combine' needs 'radius2'");
+        assert!(err(json!({"eye": [1, 2]})).starts_with("eye: expected three numbers"));
+    }
+}
