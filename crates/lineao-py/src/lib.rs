@@ -9,16 +9,16 @@
 //!   `-`), typed: they deserialize into the command line's own arguments
 //!   (`RenderArgs::from_keywords`), each value parsed as its option parses it, with the same
 //!   defaults and checks and errors that name the keyword — no command line is built. The
-//!   picture is the binary's pixel for pixel: [`Renderer`] holds a `lineao_cli` render session
+//!   picture is the binary's pixel for pixel: [`Renderer`] holds a `lineao_session` render session
 //!   (device, geometry on the GPU, one chain per panel) for many frames.
 
 use std::ops::ControlFlow;
 use std::path::PathBuf;
 
-use lineao_cli::cli::RenderArgs;
-use lineao_cli::kwargs::KwargError;
-use lineao_cli::render::Session;
-use lineao_cli::source::Loaded;
+use lineao_session::args::RenderArgs;
+use lineao_session::kwargs::KwargError;
+use lineao_session::render::Session;
+use lineao_session::source::Loaded;
 use lineao_tracts::{Field, Group, Tractogram, ViewHint, VoxelSpace};
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
@@ -82,7 +82,7 @@ fn load<'py>(py: Python<'py>, path: PathBuf, progress: Option<Bound<'py, PyAny>>
     // True: a bar on a terminal (as the CLI's, for files over 32 MiB); a callable: called.
     let wants_bar = progress.as_ref().is_some_and(|p| !p.is_callable() && p.is_truthy().unwrap_or(false));
     let callback = progress.filter(|p| p.is_callable()).map(Bound::unbind);
-    let bar = if wants_bar { lineao_cli::source::progress_bar(&path) } else { None };
+    let bar = if wants_bar { lineao_session::source::progress_bar(&path) } else { None };
     let mut interrupted: Option<PyErr> = None;
     let loaded = py.detach(|| {
         let mut report = |p: lineao_tracts::Progress| {
@@ -159,7 +159,7 @@ fn tractogram_dict<'py>(py: Python<'py>, t: Tractogram, format: &str) -> PyResul
 #[pyfunction]
 fn info(py: Python<'_>, path: PathBuf) -> PyResult<String> {
     let loaded = py.detach(|| lineao_tracts::load(&path)).map_err(|e| load_error(py, e))?;
-    Ok(lineao_cli::info::describe(&loaded).to_string())
+    Ok(lineao_session::info::describe(&loaded).to_string())
 }
 
 /// Streamlines handed over from Python: points (N, 3) float32 C-contiguous, and per
@@ -350,7 +350,7 @@ fn settings() -> Vec<(String, String, Option<String>)> {
 #[pyfunction]
 fn methods() -> Vec<String> {
     let mut names: Vec<String> = lineao::AoMethod::REGISTRY.iter().map(|m| m.name().to_string()).collect();
-    for method in lineao_cli::cli::Method::all() {
+    for method in lineao_session::args::Method::all() {
         if !names.contains(&method.name()) {
             names.push(method.name());
         }
@@ -410,8 +410,8 @@ impl Renderer {
                 })?
             }
             _ => py.detach(|| Session::open(&args)).map_err(|e| {
-                match e.downcast::<lineao_cli::source::SourceError>() {
-                    Ok(lineao_cli::source::SourceError::Load(load)) => load_error(py, load),
+                match e.downcast::<lineao_session::source::SourceError>() {
+                    Ok(lineao_session::source::SourceError::Load(load)) => load_error(py, load),
                     Ok(other) => render_error(other.into()),
                     Err(e) => render_error(e),
                 }
@@ -442,18 +442,20 @@ impl Renderer {
     ) -> PyResult<String> {
         let args = self.frame_args(settings)?;
         let methods = match methods {
-            None => lineao_cli::cli::ScoreMethod::all(),
+            None => lineao_session::args::ScoreMethod::all(),
             Some(names) => names
                 .iter()
                 .map(|n| {
-                    lineao_cli::cli::parse_score_method(n).map_err(|e| PyValueError::new_err(format!("methods: {e}")))
+                    lineao_session::args::parse_score_method(n)
+                        .map_err(|e| PyValueError::new_err(format!("methods: {e}")))
                 })
                 .collect::<PyResult<_>>()?,
         };
         let session = &self.session;
         py.detach(|| {
-            let report = lineao_cli::score::score(session, &args, &methods, lineao_cli::score::BUNDLE_DISTANCE)?;
-            anyhow::Ok(lineao_cli::score::to_json(session, &args, &report).to_string())
+            let report =
+                lineao_session::score::score(session, &args, &methods, lineao_session::score::BUNDLE_DISTANCE)?;
+            anyhow::Ok(lineao_session::score::to_json(session, &args, &report).to_string())
         })
         .map_err(render_error)
     }
@@ -490,7 +492,7 @@ impl Renderer {
         let args = parse(settings, self.opened.file.as_ref())?;
         let same = |a: &RenderArgs| {
             let field = match &a.color {
-                lineao_cli::cli::ColorArg::Field(name) => Some(name.clone()),
+                lineao_session::args::ColorArg::Field(name) => Some(name.clone()),
                 _ => None,
             };
             (a.surfaces.clone(), a.tube_radius_field.clone(), field, a.scene, a.vertices, a.seed, a.file.clone())
@@ -508,9 +510,9 @@ impl Renderer {
             || args.ortho.is_some()
         {
             let hint = self.session.lines.hint;
-            self.session.camera = lineao_cli::render::camera(&args, &hint).map_err(render_error)?;
+            self.session.camera = lineao_session::render::camera(&args, &hint).map_err(render_error)?;
         }
-        self.session.sky = lineao_cli::render::sky(&args, self.session.camera.up);
+        self.session.sky = lineao_session::render::sky(&args, self.session.camera.up);
         Ok(args)
     }
 }
@@ -534,8 +536,8 @@ fn encode_png(
         Err(_) => image.as_array().iter().copied().collect(),
     };
     py.detach(|| match path {
-        Some(path) => lineao_cli::output::write_png(&path, w, h, &bytes).map(|()| None),
-        None => lineao_cli::output::encode_png(w, h, &bytes).map(Some),
+        Some(path) => lineao_session::output::write_png(&path, w, h, &bytes).map(|()| None),
+        None => lineao_session::output::encode_png(w, h, &bytes).map(Some),
     })
     .map_err(|e| PyRuntimeError::new_err(format!("{e:#}")))
 }

@@ -17,7 +17,7 @@ use lineao::truth::{Falloff, Reach, Truth, TruthSettings, VoBall};
 use lineao::{AoMethod, ChainSettings};
 use serde_json::json;
 
-use crate::cli::{AoDistance, Method, ScoreArgs, ScoreMethod};
+use crate::args::{AoDistance, Method, ScoreArgs, ScoreMethod};
 use crate::label::Rgba8;
 use crate::render::{Panel, Session};
 
@@ -71,10 +71,10 @@ pub struct Report {
 }
 
 /// The methods' chain settings: the command line's, the method and variant set.
-pub fn method_settings(session: &Session, args: &crate::cli::RenderArgs, m: ScoreMethod) -> ChainSettings {
+pub fn method_settings(session: &Session, args: &crate::args::RenderArgs, m: ScoreMethod) -> ChainSettings {
     // The variant first, so that the preset gives this variant's values and explicit options
     // still win.
-    let args = crate::cli::RenderArgs { variant: m.variant, ..args.clone() };
+    let args = crate::args::RenderArgs { variant: m.variant, ..args.clone() };
     let mut settings = session.settings(&args, Method { screen: m.method, volume: None });
     settings.blur = None;
     settings.raytraced.denoise = None;
@@ -150,7 +150,7 @@ pub fn raw_ao(
 /// truth reaching `bundle_distance`.
 pub fn score(
     session: &Session,
-    args: &crate::cli::RenderArgs,
+    args: &crate::args::RenderArgs,
     methods: &[ScoreMethod],
     bundle_distance: AoDistance,
 ) -> Result<Report> {
@@ -169,7 +169,7 @@ pub fn score(
     let truth_settings = TruthSettings { vo: wants_vo.then_some(vo_ball), second: Some(second), ..local };
 
     // The truth's G-buffer: a chain without a method (and so without a guard band).
-    let quiet = crate::cli::RenderArgs { timings: false, dump: None, ..args.clone() };
+    let quiet = crate::args::RenderArgs { timings: false, dump: None, ..args.clone() };
     let plain = ScoreMethod { method: AoMethod::None, variant: Default::default() };
     let panel = Panel::new(Method { screen: AoMethod::None, volume: None }, method_settings(session, args, plain));
     let rendered = session.render(&quiet, &panel, None, None, None)?;
@@ -400,12 +400,12 @@ fn legibility_json(l: &Result<Legibility, Absent>) -> serde_json::Value {
     }
 }
 
-fn truth_settings_falloff(args: &crate::cli::RenderArgs) -> &'static str {
+fn truth_settings_falloff(args: &crate::args::RenderArgs) -> &'static str {
     args.ao_falloff.name()
 }
 
 /// CONTRACT.md's `lineao score --json` object.
-pub fn to_json(session: &Session, args: &crate::cli::RenderArgs, report: &Report) -> serde_json::Value {
+pub fn to_json(session: &Session, args: &crate::args::RenderArgs, report: &Report) -> serde_json::Value {
     let errors = |e: &metrics::Errors| json!({"bias": e.bias, "mean_abs": e.mean_abs, "rmse": e.rmse, "ssim": e.ssim});
     let settings = crate::truth::settings(args, session.longest_side);
     let bundle = &report.bundle;

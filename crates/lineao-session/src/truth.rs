@@ -13,7 +13,7 @@ use lineao::truth::{Bvh, LineShape, Truth, TruthSettings};
 use lineao::{AoChain, Gpu};
 use lineao_tracts::{Tractogram, TriangleMesh};
 
-use crate::cli::RenderArgs;
+use crate::args::RenderArgs;
 
 /// What the frame drew, on the CPU.
 pub struct Scene<'a> {

@@ -6,7 +6,7 @@ use anyhow::Result;
 use lineao_tracts::{LoadOptions, Loaded, Tractogram};
 use serde_json::{Value, json};
 
-use crate::cli::{ConvertArgs, InfoArgs};
+use crate::args::{ConvertArgs, InfoArgs};
 
 /// Loads a file, with a progress bar on a terminal for files over 32 MiB.
 pub fn load(path: &Path) -> Result<Loaded> {

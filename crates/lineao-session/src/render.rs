@@ -17,7 +17,7 @@ use lineao::{
 use lineao::{Bounds, Camera, Projection};
 use lineao_tracts::scenes::ViewHint;
 
-use crate::cli::{ColorArg, GeometryArg, Method, RenderArgs, SkyArg, VolumeNormal};
+use crate::args::{ColorArg, GeometryArg, Method, RenderArgs, SkyArg, VolumeNormal};
 use crate::label::Rgba8;
 use crate::source::{AttributeKey, Lines, Loaded, Source, submit_frame, vertex_field};
 
@@ -559,7 +559,7 @@ pub fn camera_from_hint(hint: &ViewHint) -> Camera {
     }
 }
 
-pub(crate) fn validate_camera(camera: &Camera) -> Result<()> {
+pub fn validate_camera(camera: &Camera) -> Result<()> {
     let forward = camera.target - camera.eye;
     anyhow::ensure!(forward.length() > 0.0, "the camera's eye and target coincide");
     anyhow::ensure!(
@@ -583,11 +583,9 @@ mod tests {
     /// `lineao render` with no option gives each method is `ChainSettings::default()`'s preset.
     #[test]
     fn the_librarys_default_is_the_command_lines() {
-        use clap::Parser;
-        let cli = crate::cli::Cli::parse_from(["lineao", "render"]);
-        let crate::cli::Command::Render(args) = cli.command else { panic!("render") };
+        let args = crate::args::parse_render(["lineao", "render"]);
         for screen in [lineao::AoMethod::LineAo, lineao::AoMethod::Ssao, lineao::AoMethod::VoLine] {
-            let method = crate::cli::Method { screen, volume: None };
+            let method = crate::args::Method { screen, volume: None };
             let cli = super::settings(&args, method, 1.0, lineao::volume::Sky::Uniform, 100.0);
             let library = lineao::ChainSettings { method: screen, ..lineao::ChainSettings::default() }
                 .with_preset(lineao::Preset::default());
@@ -608,13 +606,11 @@ mod tests {
     /// shorthand `--samples` counts the shown method's only (each panel's).
     #[test]
     fn each_method_takes_its_own_samples_and_radius() {
-        use clap::Parser;
         use lineao::AoMethod;
         let parse = |extra: &[&str]| {
-            let cli = crate::cli::Cli::parse_from(["lineao", "render"].iter().chain(extra));
-            let crate::cli::Command::Render(args) = cli.command else { panic!("render") };
+            let args = crate::args::parse_render(["lineao", "render"].iter().chain(extra));
             move |screen| {
-                let method = crate::cli::Method { screen, volume: None };
+                let method = crate::args::Method { screen, volume: None };
                 super::settings(&args, method, 1.0, lineao::volume::Sky::Uniform, 100.0)
             }
         };
@@ -631,11 +627,9 @@ mod tests {
     /// `--settings` changes the keys it names, over the preset and the options, and nothing else.
     #[test]
     fn settings_as_json_change_only_their_keys() {
-        use clap::Parser;
         let settings = |extra: &[&str]| {
-            let cli = crate::cli::Cli::parse_from(["lineao", "render", "--ssao-samples", "24"].iter().chain(extra));
-            let crate::cli::Command::Render(args) = cli.command else { panic!("render") };
-            let method = crate::cli::Method { screen: lineao::AoMethod::Ssao, volume: None };
+            let args = crate::args::parse_render(["lineao", "render", "--ssao-samples", "24"].iter().chain(extra));
+            let method = crate::args::Method { screen: lineao::AoMethod::Ssao, volume: None };
             super::settings(&args, method, 1.0, lineao::volume::Sky::Uniform, 100.0)
         };
         let plain = settings(&[]);

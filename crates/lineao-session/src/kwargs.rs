@@ -8,7 +8,7 @@ use std::collections::BTreeSet;
 use clap::Args;
 use serde::Deserialize;
 
-use crate::cli::RenderArgs;
+use crate::args::RenderArgs;
 
 /// A keyword argument of `render`: its name (the option's with `_`), help and default.
 #[derive(Clone, Debug, PartialEq)]
@@ -159,34 +159,34 @@ macro_rules! optional {
 }
 
 parsed! {
-    scene: lineao_tracts::SceneKind = crate::cli::parse_scene;
-    method: crate::cli::Method = crate::cli::parse_method;
-    vec3: [f32; 3] = crate::cli::parse_vec3;
-    preset: lineao::Preset = crate::cli::parse_preset;
-    color: crate::cli::ColorArg = crate::cli::parse_color;
-    debug_view: lineao::DebugView = crate::cli::parse_debug_view;
-    ao_distance: crate::cli::AoDistance = crate::cli::parse_ao_distance;
-    geometry: crate::cli::GeometryArg = crate::cli::parse_value_enum::<crate::cli::GeometryArg>;
-    sky: crate::cli::SkyArg = crate::cli::parse_value_enum::<crate::cli::SkyArg>;
-    volume_normal: crate::cli::VolumeNormal = crate::cli::parse_value_enum::<crate::cli::VolumeNormal>;
+    scene: lineao_tracts::SceneKind = crate::args::parse_scene;
+    method: crate::args::Method = crate::args::parse_method;
+    vec3: [f32; 3] = crate::args::parse_vec3;
+    preset: lineao::Preset = crate::args::parse_preset;
+    color: crate::args::ColorArg = crate::args::parse_color;
+    debug_view: lineao::DebugView = crate::args::parse_debug_view;
+    ao_distance: crate::args::AoDistance = crate::args::parse_ao_distance;
+    geometry: crate::args::GeometryArg = crate::args::parse_value_enum::<crate::args::GeometryArg>;
+    sky: crate::args::SkyArg = crate::args::parse_value_enum::<crate::args::SkyArg>;
+    volume_normal: crate::args::VolumeNormal = crate::args::parse_value_enum::<crate::args::VolumeNormal>;
 }
 
 optional! {
-    opt_pair: [crate::cli::Method; 2] = crate::cli::parse_pair;
-    opt_vec3: [f32; 3] = crate::cli::parse_vec3;
-    opt_positive: f32 = crate::cli::parse_positive;
-    opt_delta_scale: f32 = crate::cli::parse_delta_scale;
+    opt_pair: [crate::args::Method; 2] = crate::args::parse_pair;
+    opt_vec3: [f32; 3] = crate::args::parse_vec3;
+    opt_positive: f32 = crate::args::parse_positive;
+    opt_delta_scale: f32 = crate::args::parse_delta_scale;
 }
 
 /// `settings`: an object of `ChainSettings` keys, or the command line's text (JSON or a file).
 pub(crate) fn opt_settings<'de, D: serde::Deserializer<'de>>(
     d: D,
-) -> Result<Option<crate::cli::SettingsPatch>, D::Error> {
+) -> Result<Option<crate::args::SettingsPatch>, D::Error> {
     let text = match serde_json::Value::deserialize(d)? {
         serde_json::Value::String(s) => s,
         value => value.to_string(),
     };
-    crate::cli::parse_settings(&text).map(Some).map_err(serde::de::Error::custom)
+    crate::args::parse_settings(&text).map(Some).map_err(serde::de::Error::custom)
 }
 
 /// `surfaces`: one file or several.
@@ -212,6 +212,10 @@ mod tests {
         RenderArgs::from_keywords(value.as_object().unwrap().clone())
     }
 
+    fn parsed(argv: &[&str]) -> RenderArgs {
+        *crate::args::parse_render(["lineao", "render"].iter().chain(argv))
+    }
+
     #[test]
     fn keywords_parse_as_the_command_line_parses_them() {
         let args = from(json!({
@@ -220,9 +224,7 @@ mod tests {
             "settings": {"ssao": {"samples": 12}}, "method": "lineao+sweep", "debug_view": "level:1",
         }))
         .unwrap();
-        let cli = <crate::cli::Cli as clap::Parser>::parse_from([
-            "lineao",
-            "render",
+        let expected = parsed(&[
             "--width",
             "320",
             "--line-width",
@@ -244,12 +246,9 @@ mod tests {
             "--debug-view",
             "level:1",
         ]);
-        let crate::cli::Command::Render(expected) = cli.command else { panic!("render") };
         assert_eq!(format!("{args:?}"), format!("{expected:?}"));
         // No keyword: the command line's defaults.
-        let defaults = <crate::cli::Cli as clap::Parser>::parse_from(["lineao", "render"]);
-        let crate::cli::Command::Render(defaults) = defaults.command else { panic!("render") };
-        assert_eq!(format!("{:?}", from(json!({})).unwrap()), format!("{defaults:?}"));
+        assert_eq!(format!("{:?}", from(json!({})).unwrap()), format!("{:?}", parsed(&[])));
     }
 
     #[test]

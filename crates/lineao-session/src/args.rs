@@ -1,0 +1,721 @@
+//! `render`'s and `score`'s arguments: every option with its help and default (clap derives
+//! the command line from them, Python's keyword arguments deserialize into them:
+//! [`crate::kwargs`]), and the parsers of their values.
+
+use std::path::PathBuf;
+
+use clap::{Args, ValueEnum};
+use lineao::lighting::LineShading;
+use lineao::truth::Falloff;
+use lineao::{Colormap, LineAoOuter, LineAoVariant, Named, SsaoKernel, VoCombine};
+use lineao_tracts::SceneKind;
+
+#[derive(Args, Debug)]
+pub struct ScoreArgs {
+    /// The frame to score on: a file or --scene, the camera, the geometry and every method
+    /// setting as for `render`; -o writes a labelled grid (per method its AO, the truth, the
+    /// signed error).
+    #[command(flatten)]
+    pub render: RenderArgs,
+    /// Methods to score, comma-separated [default: all of them].
+    #[arg(long, value_delimiter = ',', value_parser = Listed { parse: parse_score_method, values: ScoreMethod::listed })]
+    pub methods: Vec<ScoreMethod>,
+    /// Print JSON (CONTRACT.md `lineao score --json`) instead of a table.
+    #[arg(long)]
+    pub json: bool,
+    /// The bundle-scale truth's reach (obscurance with the linear falloff, the second truth
+    /// beside the local one of --ao-distance and --ao-falloff): world units or a share of the
+    /// scene's longest side.
+    #[arg(long, default_value = "20%", value_parser = parse_ao_distance)]
+    pub bundle_distance: AoDistance,
+    /// Calibrate: search each method's main parameters and strength for the least RMSE against
+    /// the truth over every built-in scene and every tractogram under --data, --views cameras
+    /// each; fit on half the views, report on the other half.
+    #[arg(long)]
+    pub fit: bool,
+    /// --fit: the folder searched for tractograms.
+    #[arg(long, default_value = "../shared/data", requires = "fit")]
+    pub data: PathBuf,
+    /// --fit: cameras per scene, orbiting the scene's own about its up axis (even ones fit, odd
+    /// ones report).
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(2..=64), requires = "fit")]
+    pub views: u32,
+}
+
+/// A method `score` compares with the truth.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ScoreMethod {
+    pub method: lineao::AoMethod,
+    pub variant: lineao::LineAoVariant,
+}
+
+impl ScoreMethod {
+    /// What `score` compares, in the registry's order: every method with a picture of its own
+    /// (not `none`), LineAO's authors' variant after LineAO.
+    pub fn all() -> Vec<ScoreMethod> {
+        let mut all = Vec::new();
+        for &method in lineao::AoMethod::REGISTRY.iter().filter(|&&m| m != lineao::AoMethod::None) {
+            all.push(ScoreMethod::paper(method));
+            if method == lineao::AoMethod::LineAo {
+                all.push(ScoreMethod { method, variant: lineao::LineAoVariant::Reference });
+            }
+        }
+        all
+    }
+
+    const fn paper(method: lineao::AoMethod) -> ScoreMethod {
+        ScoreMethod { method, variant: lineao::LineAoVariant::Paper }
+    }
+
+    pub fn name(&self) -> &'static str {
+        match (self.method, self.variant) {
+            (lineao::AoMethod::LineAo, lineao::LineAoVariant::Reference) => "lineao-reference",
+            (method, _) => method.name(),
+        }
+    }
+
+    /// Every row's name and help, for `--help`.
+    pub fn listed() -> Vec<(&'static str, &'static str)> {
+        let help = |m: ScoreMethod| match (m.method, m.variant) {
+            (lineao::AoMethod::LineAo, lineao::LineAoVariant::Reference) => {
+                "LineAO's `reference` variant (the authors' LineVis: radius in zoom units, no pyramid)"
+            }
+            (lineao::AoMethod::RayTraced, _) => {
+                "The truth again with the next --ray-seed, traced on the GPU (on the CPU with --cpu)"
+            }
+            (method, _) => method.info().help,
+        };
+        ScoreMethod::all().into_iter().map(|m| (m.name(), help(m))).collect()
+    }
+}
+
+pub fn parse_score_method(s: &str) -> Result<ScoreMethod, String> {
+    ScoreMethod::all().into_iter().find(|m| m.name() == s).ok_or_else(|| {
+        let names: Vec<_> = ScoreMethod::all().iter().map(|m| m.name()).collect();
+        format!("unknown method '{s}' (one of {})", names.join(", "))
+    })
+}
+
+/// A positive, finite number (a radius, a range).
+pub fn parse_positive(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        Ok(v) => Err(format!("must be positive and finite, got {v}")),
+        Err(e) => Err(format!("'{s}': {e}")),
+    }
+}
+
+/// LineAO's δ scale, in (0, 1].
+pub fn parse_delta_scale(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(v) if v > 0.0 && v <= 1.0 => Ok(v),
+        Ok(v) => Err(format!("the δ scale must be in (0, 1], got {v}")),
+        Err(e) => Err(format!("'{s}': {e}")),
+    }
+}
+
+/// How far a truth's rays look: world units, or a share of the scene's longest side (`20%`,
+/// LineVis's default reach), resolved against the scene's bounds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AoDistance {
+    World(f32),
+    /// A share in (0, 1] of the longest side of the scene's axis-aligned bounds.
+    Share(f32),
+}
+
+impl AoDistance {
+    /// The reach in world units in a scene whose bounds' longest side is `longest_side`.
+    pub fn world(self, longest_side: f32) -> f32 {
+        match self {
+            AoDistance::World(d) => d,
+            AoDistance::Share(s) => s * longest_side,
+        }
+    }
+}
+
+impl std::fmt::Display for AoDistance {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            AoDistance::World(d) => write!(f, "{d}"),
+            AoDistance::Share(s) => write!(f, "{}%", s * 100.0),
+        }
+    }
+}
+
+pub fn parse_ao_distance(s: &str) -> Result<AoDistance, String> {
+    match s.trim().strip_suffix('%') {
+        Some(share) => match share.trim().parse::<f32>() {
+            Ok(p) if p > 0.0 && p <= 100.0 => Ok(AoDistance::Share(p / 100.0)),
+            Ok(p) => Err(format!("a share of the scene's longest side must be in (0 %, 100 %], got {p} %")),
+            Err(e) => Err(format!("'{s}': {e} (a distance in world units, or a share such as 20%)")),
+        },
+        None => parse_positive(s)
+            .map(AoDistance::World)
+            .map_err(|e| format!("{e} (a distance in world units, or a share such as 20%)")),
+    }
+}
+
+/// What `--method` and `--compare` name: a screen-space method (CONTRACT.md: none, lineao,
+/// ssao, vo-line, vo-area), object-space AO (sweep, variance-volume), or both (`lineao+sweep`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Method {
+    pub screen: lineao::AoMethod,
+    pub volume: Option<lineao::volume::VolumeMethod>,
+}
+
+impl Method {
+    /// Every method the viewer lists and `--grid` shows (the grid all but the last, with
+    /// LineAO's other variant inserted third), in that order: the registry's screen-space ones,
+    /// the object-space ones, and LineAO with each object-space one.
+    pub fn all() -> Vec<Method> {
+        use lineao::volume::VolumeMethod;
+        let screen = lineao::AoMethod::screen_space().map(|screen| Method { screen, volume: None });
+        let volume = VolumeMethod::ALL.map(|v| Method { screen: lineao::AoMethod::None, volume: Some(v) });
+        let both = VolumeMethod::ALL.map(|v| Method { screen: lineao::AoMethod::LineAo, volume: Some(v) });
+        screen.chain(volume).chain(both).collect()
+    }
+
+    /// The single methods' names and help, for `--help`: the registry's, then the object-space
+    /// ones (a sum such as `lineao+sweep` is parsed, not listed).
+    pub fn listed() -> Vec<(&'static str, &'static str)> {
+        use lineao::volume::VolumeMethod;
+        let volume = |v: VolumeMethod| match v {
+            VolumeMethod::Sweep => {
+                "Object space: fast occlusion sweeping (Singh, Yuksel, House 2009) over a density volume"
+            }
+            VolumeMethod::VarianceVolume => {
+                "Object space: variance occlusion maps (Penner & Mitchell 2008) over a density volume"
+            }
+        };
+        let screen = lineao::AoMethod::REGISTRY.iter().map(|m| (m.name(), m.info().help));
+        screen.chain(VolumeMethod::ALL.into_iter().map(|v| (v.name(), volume(v)))).collect()
+    }
+
+    pub fn name(&self) -> String {
+        match (self.screen, self.volume) {
+            (screen, None) => screen.name().to_string(),
+            (lineao::AoMethod::None, Some(volume)) => volume.name().to_string(),
+            (screen, Some(volume)) => format!("{}+{}", screen.name(), volume.name()),
+        }
+    }
+}
+
+pub fn parse_method(s: &str) -> Result<Method, String> {
+    use lineao::volume::VolumeMethod;
+    let screen = |name: &str| lineao::AoMethod::from_name(name);
+    let unknown = || {
+        let screen: Vec<_> = lineao::AoMethod::screen_space().map(|m| m.name()).collect();
+        let volume: Vec<_> = VolumeMethod::ALL.iter().map(|m| m.name()).collect();
+        format!(
+            "unknown method '{s}' (one of {}, {}, or SCREEN+VOLUME such as lineao+sweep)",
+            screen.join(", "),
+            volume.join(", ")
+        )
+    };
+    match s.split_once('+') {
+        None => match (screen(s), VolumeMethod::from_name(s)) {
+            (Some(screen), _) => Ok(Method { screen, volume: None }),
+            (None, Some(volume)) => Ok(Method { screen: lineao::AoMethod::None, volume: Some(volume) }),
+            (None, None) => Err(unknown()),
+        },
+        Some((a, b)) => match (screen(a.trim()), VolumeMethod::from_name(b.trim())) {
+            (Some(lineao::AoMethod::None), Some(_)) => Err(format!("'{s}': name the volume method alone")),
+            (Some(screen), Some(volume)) => Ok(Method { screen, volume: Some(volume) }),
+            _ => Err(unknown()),
+        },
+    }
+}
+
+pub fn parse_pair(s: &str) -> Result<[Method; 2], String> {
+    match s.split(',').collect::<Vec<_>>()[..] {
+        [a, b] => match [parse_method(a.trim())?, parse_method(b.trim())?] {
+            [a, b] if a == b => Err(format!("compare two different methods, got '{s}'")),
+            pair => Ok(pair),
+        },
+        _ => Err(format!("expected two methods A,B, got '{s}'")),
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum GeometryArg {
+    /// Lines of a fixed width in pixels (--line-width).
+    Lines,
+    /// Tubes of a radius in world units (--tube-radius), ray-cast with true depth and normals.
+    Tubes,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum SkyArg {
+    /// Light from every direction.
+    Uniform,
+    /// Light only from above (the octants toward the camera's up axis; +z, superior, for
+    /// tractograms): a cloudy day.
+    Cloudy,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum VolumeNormal {
+    /// The geometry term with each pixel's (view-dependent) line normal, as the paper does it.
+    Pixel,
+    /// The geometry term averaged over the normals around the tangent: view-independent.
+    Tangent,
+    /// No geometry term: every octant counts the same (view-independent).
+    None,
+}
+
+#[derive(Args, Clone, Debug, serde::Deserialize)]
+// Python's keyword arguments deserialize into it (crate::kwargs); the defaults are clap's.
+#[serde(default, deny_unknown_fields)]
+pub struct RenderArgs {
+    /// Tractography file to render (any format `lineao info` reads) instead of a built-in scene.
+    pub file: Option<PathBuf>,
+    /// Built-in scene.
+    #[arg(long, default_value = "bundles", value_parser = parse_scene)]
+    #[serde(deserialize_with = "crate::kwargs::scene")]
+    pub scene: SceneKind,
+    /// Approximate vertex count of the built-in scene [default: 400000].
+    #[arg(long)]
+    pub vertices: Option<usize>,
+    /// Seed of the built-in scene.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Ambient occlusion method: one of the list, or a screen-space method with an object-space
+    /// one, e.g. lineao+sweep (see --volume-combine).
+    #[arg(long, default_value = "lineao", value_parser = Listed { parse: parse_method, values: Method::listed })]
+    #[serde(deserialize_with = "crate::kwargs::method")]
+    pub method: Method,
+    /// Split screen: method A on the left, B on the right, a labelled divider (e.g.
+    /// `lineao,ssao`).
+    #[arg(long, value_name = "A,B", value_parser = parse_pair, conflicts_with = "grid")]
+    #[serde(deserialize_with = "crate::kwargs::opt_pair")]
+    pub compare: Option<[Method; 2]>,
+    /// Every method in one labelled image (a grid of --width × --height tiles, three a row:
+    /// the screen-space methods with LineAO's `reference` variant third, the object-space ones
+    /// and lineao+sweep).
+    #[arg(long)]
+    pub grid: bool,
+    /// LineAO variant.
+    #[arg(long, value_parser = named::<LineAoVariant>(), default_value = "paper")]
+    pub variant: LineAoVariant,
+    /// LineAO (variant paper): hemispheres j ≥ 1 at every pixel (`full`) or at their pyramid
+    /// level's resolution, upsampled depth-aware (`level`: faster).
+    #[arg(long, value_parser = named::<LineAoOuter>(), default_value = "full")]
+    pub outer: LineAoOuter,
+    /// Output PNG [default: lineao.png; `score`: no grid].
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    #[arg(long, default_value_t = 1280, value_parser = clap::value_parser!(u32).range(1..=8192))]
+    pub width: u32,
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=8192))]
+    pub height: u32,
+    /// Line width in pixels.
+    #[arg(long, default_value_t = 2.0)]
+    pub line_width: f32,
+    /// Streamlines as lines or tubes.
+    #[arg(long, value_enum, default_value_t = GeometryArg::Lines)]
+    #[serde(deserialize_with = "crate::kwargs::geometry")]
+    pub geometry: GeometryArg,
+    /// Tubes: radius in world units [default: 0.5 mm].
+    #[arg(long)]
+    pub tube_radius: Option<f32>,
+    /// Lines: the illuminated-lines specular on top of the AO (`specular`, the paper's), or
+    /// diffuse and specular averaged over the visible half of the line's cylinder (`cylinder`:
+    /// Mallo et al. 2005).
+    #[arg(long, value_parser = named::<LineShading>(), default_value = "specular")]
+    pub line_shading: LineShading,
+    /// Context surface shown with the tracts (OBJ or glTF triangles, optionally gzipped); may be
+    /// given several times. It occludes the lines and is occluded, and the AO sees it.
+    #[arg(long = "surface", value_name = "MESH")]
+    #[serde(deserialize_with = "crate::kwargs::paths")]
+    pub surfaces: Vec<PathBuf>,
+    /// Linear RGB of the context surfaces.
+    #[arg(long, default_value = "0.8,0.8,0.8", value_parser = parse_vec3)]
+    #[serde(deserialize_with = "crate::kwargs::vec3")]
+    pub surface_color: [f32; 3],
+    /// Tubes: the file's per-vertex field holding each vertex's radius in world units (e.g. a
+    /// TRX dpv or a .trk scalar); vertices without a positive value take --tube-radius.
+    #[arg(long, requires = "file")]
+    pub tube_radius_field: Option<String>,
+    /// Camera position, world units: X,Y,Z [default: the scene's].
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    #[serde(deserialize_with = "crate::kwargs::opt_vec3")]
+    pub eye: Option<[f32; 3]>,
+    /// Point the camera looks at: X,Y,Z [default: the scene's].
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    #[serde(deserialize_with = "crate::kwargs::opt_vec3")]
+    pub target: Option<[f32; 3]>,
+    /// Camera up vector: X,Y,Z [default: the scene's].
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    #[serde(deserialize_with = "crate::kwargs::opt_vec3")]
+    pub up: Option<[f32; 3]>,
+    /// Vertical field of view in degrees (perspective) [default: the scene's].
+    #[arg(long, conflicts_with = "ortho")]
+    pub fov: Option<f32>,
+    /// Orthographic camera showing this many world units vertically.
+    #[arg(long)]
+    pub ortho: Option<f32>,
+    /// World units per zoom unit of z(P) [default: the scene's, 1 mm].
+    #[arg(long)]
+    pub zoom_unit: Option<f32>,
+    /// LineAO s_r: hemispheres and pyramid levels (1..=5) [default: the preset's; paper 3].
+    #[arg(long)]
+    pub s_r: Option<u32>,
+    /// LineAO s_h: samples on the first hemisphere (1..=256).
+    #[arg(long, default_value_t = 32, value_parser = clap::value_parser!(u32).range(1..=256))]
+    pub s_h: u32,
+    /// LineAO r0 in pixels [default: 1.5 × line width].
+    #[arg(long)]
+    pub r0: Option<f32>,
+    /// Variant `reference`: base radius in pixels at the home zoom (the authors' u_lineAORadius).
+    /// [default: the preset's; paper 2]
+    #[arg(long)]
+    pub reference_radius: Option<f32>,
+    /// The shown method's samples (each panel's with --grid or --compare): --ssao-samples,
+    /// --vo-samples or --vo-area-samples, whichever method it shows.
+    #[arg(long)]
+    pub samples: Option<u32>,
+    /// SSAO: point samples in the sphere (8..=32) [default: 16].
+    #[arg(long)]
+    pub ssao_samples: Option<u32>,
+    /// VO line sampling: line samples (5, 7, 9, 12, 13 or 16) [default: 9].
+    #[arg(long)]
+    pub vo_samples: Option<u32>,
+    /// VO area sampling: area samples (1 or a line count) [default: 1].
+    #[arg(long)]
+    pub vo_area_samples: Option<u32>,
+    /// VO: a second sphere radius in world units, combined with --radius (VO paper, Fig. 8).
+    #[arg(long, value_parser = parse_positive)]
+    #[serde(deserialize_with = "crate::kwargs::opt_positive")]
+    pub radius2: Option<f32>,
+    /// VO with two radii: how they combine.
+    #[arg(long, value_parser = named::<VoCombine>(), default_value = "product", requires = "radius2")]
+    pub combine: VoCombine,
+    /// Bilateral (depth-aware, separable) blur after the method.
+    #[arg(long)]
+    pub bilateral: bool,
+    /// Bilateral blur: taps on each side (1..=16).
+    #[arg(long, default_value_t = 4, requires = "bilateral")]
+    pub bilateral_radius: u32,
+    /// Bilateral blur: σ of the depth weight, world units.
+    #[arg(long, default_value_t = 1.0, requires = "bilateral")]
+    pub bilateral_sigma: f32,
+    /// VO: no normal clamp (the whole sphere, not the half above the surface).
+    #[arg(long)]
+    pub no_normal_clamp: bool,
+    /// VO: thickness model, world units (0 = off).
+    #[arg(long, default_value_t = 0.0)]
+    pub thickness: f32,
+    /// The shown method's sphere radius: --ssao-radius or --vo-radius, whichever --method names
+    /// (with --grid or --compare, both).
+    #[arg(long, value_parser = parse_positive)]
+    #[serde(deserialize_with = "crate::kwargs::opt_positive")]
+    pub radius: Option<f32>,
+    /// SSAO: sphere radius in world units (mm for tractograms) [default: the preset's; paper 2].
+    #[arg(long, value_parser = parse_positive)]
+    #[serde(deserialize_with = "crate::kwargs::opt_positive")]
+    pub ssao_radius: Option<f32>,
+    /// VO (line and area sampling): sphere radius in world units [default: the preset's; paper 2].
+    #[arg(long, value_parser = parse_positive)]
+    #[serde(deserialize_with = "crate::kwargs::opt_positive")]
+    pub vo_radius: Option<f32>,
+    /// SSAO: range check in world units [default: the radius].
+    #[arg(long, value_parser = parse_positive)]
+    #[serde(deserialize_with = "crate::kwargs::opt_positive")]
+    pub ssao_range: Option<f32>,
+    /// SSAO: the kernel's points.
+    #[arg(long, value_parser = named::<SsaoKernel>(), default_value = "crytek")]
+    pub ssao_kernel: SsaoKernel,
+    /// LineAO δ0.
+    #[arg(long, default_value_t = 1e-4)]
+    pub delta0: f32,
+    /// LineAO: scale of the falloff δ(j) = scale · (1 − j/s_r)², in (0, 1]; below 1 occluders
+    /// far in front (in normalized depth) stop counting [default: the preset's; paper 1].
+    #[arg(long, value_parser = parse_delta_scale)]
+    #[serde(deserialize_with = "crate::kwargs::opt_delta_scale")]
+    pub delta_scale: Option<f32>,
+    /// LineAO ε: occluded iff Δd > ε.
+    #[arg(long, default_value_t = 1e-6)]
+    pub epsilon: f32,
+    /// AO strength in the composite [default: the preset's for the method; paper 1].
+    #[arg(long)]
+    pub strength: Option<f32>,
+    /// Parameter set: `legible` (each method's strength and reach chosen so that visibly darker
+    /// lines lie deeper, `lineao score --fit`), `physical` (fitted to binary AO within 2 mm, was
+    /// `calibrated`: faint) or `paper` (the papers' values). Explicit options win.
+    #[arg(long, default_value = "legible", value_parser = parse_preset)]
+    #[serde(deserialize_with = "crate::kwargs::preset")]
+    pub preset: lineao::Preset,
+    /// Settings over the preset and every other option: `lineao::ChainSettings` as JSON, a file
+    /// or the text itself (starting with `{`). Only the keys it names change, e.g.
+    /// `{"ssao": {"samples": 12}, "strength": 0.8}` (docs/render.md); not `method`, which
+    /// --method, --compare and --grid choose.
+    #[arg(long, value_name = "FILE|JSON", value_parser = parse_settings)]
+    #[serde(deserialize_with = "crate::kwargs::opt_settings")]
+    pub settings: Option<SettingsPatch>,
+    /// Disable LineAO's light attenuation (g_light = 1).
+    #[arg(long)]
+    pub no_light_attenuation: bool,
+    /// Seed of the R1/R2 noise.
+    #[arg(long, default_value_t = 1)]
+    pub noise_seed: u32,
+    /// Upper bound of the guard band in pixels.
+    #[arg(long, default_value_t = 128)]
+    pub guard_max: u32,
+    /// Line color: `tangent` (|T| as RGB), R,G,B in [0, 1], or `field:NAME` (the file's
+    /// per-vertex field NAME through --colormap, its 2nd to 98th percentile spanning the map).
+    #[arg(long, default_value = "tangent", value_parser = parse_color)]
+    #[serde(deserialize_with = "crate::kwargs::color")]
+    pub color: ColorArg,
+    /// The colormap of `--color field:NAME`.
+    #[arg(long, value_parser = named::<Colormap>(), default_value = "viridis")]
+    pub colormap: Colormap,
+    /// Background color R,G,B in [0, 1].
+    #[arg(long, default_value = "1,1,1", value_parser = parse_vec3)]
+    #[serde(deserialize_with = "crate::kwargs::vec3")]
+    pub background: [f32; 3],
+    /// What to show: final, ao, normals, depth, zoom, or level:K (pyramid level K).
+    #[arg(long, default_value = "final", value_parser = parse_debug_view)]
+    #[serde(deserialize_with = "crate::kwargs::debug_view")]
+    pub debug_view: lineao::DebugView,
+    /// Object-space AO: voxels of the density volume along its longest axis (64–256 typical).
+    #[arg(long, default_value_t = 128, value_parser = clap::value_parser!(u32).range(8..=1024))]
+    pub volume_resolution: u32,
+    /// Object-space AO: occupancy radius of the streamlines in world units [default: the tube
+    /// radius with --geometry tubes, else 0.5 mm].
+    #[arg(long)]
+    pub occupancy_radius: Option<f32>,
+    /// Object-space AO: where the light comes from.
+    #[arg(long, value_enum, default_value_t = SkyArg::Uniform)]
+    #[serde(deserialize_with = "crate::kwargs::sky")]
+    pub sky: SkyArg,
+    /// Object-space AO: how the eight octant visibilities meet the line's normal.
+    #[arg(long, value_enum, default_value_t = VolumeNormal::Pixel)]
+    #[serde(deserialize_with = "crate::kwargs::volume_normal")]
+    pub volume_normal: VolumeNormal,
+    /// Occlusion sweeping: opacity α of the translucent transmittance (Eq. 8), in (0, 1].
+    #[arg(long, default_value_t = 1.0)]
+    pub sweep_alpha: f32,
+    /// A screen-space method with object-space AO: brightness multiplied (`product`) or the
+    /// darker of the two (`min`).
+    #[arg(long, value_parser = named::<VoCombine>(), default_value = "product")]
+    pub volume_combine: VoCombine,
+    /// Ray-traced AO (`--method raytraced`, `score`): rays per geometry pixel. 256 is LineVis's
+    /// reference count: a standard error of at most 0.03 per pixel.
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
+    pub rays: u32,
+    /// Ray-traced AO: how far a ray looks, in world units, or as a share of the longest side of
+    /// the scene's bounds (`20%`, LineVis's default reach; `score`'s bundle-scale truth). 2 is
+    /// the reach VO and SSAO sample by default and that of LineAO's widest hemisphere
+    /// (r0 + 2 z(P) px).
+    #[arg(long, default_value = "2", value_parser = parse_ao_distance)]
+    #[serde(deserialize_with = "crate::kwargs::ao_distance")]
+    pub ao_distance: AoDistance,
+    /// Ray-traced AO: binary (`none`) or obscurance with a linear falloff (`linear`).
+    #[arg(long, value_parser = named::<Falloff>(), default_value = "none")]
+    pub ao_falloff: Falloff,
+    /// Ray-traced AO: seed of the per-pixel scrambled ray sequence.
+    #[arg(long, default_value_t = 1)]
+    pub ray_seed: u32,
+    /// Ray-traced AO: trace on the CPU (the reference, f64, all cores) instead of the GPU.
+    /// The reference is shown as traced: `--denoise` and `--bilateral` are the GPU tracer's.
+    #[arg(long, conflicts_with_all = ["bilateral", "denoise"])]
+    pub cpu: bool,
+    /// Ray-traced AO on the GPU: the edge-aware denoiser after the rays (same line or surface,
+    /// a window narrowing as 1/√rays; `lineao::method::raytraced::denoise`), for low `--rays`.
+    #[arg(long)]
+    pub denoise: bool,
+    /// Write the method's inputs and output as .npy files and params.json into this folder.
+    #[arg(long)]
+    pub dump: Option<PathBuf>,
+    /// Print the time of each pass (GPU timestamps, or the frame's CPU wall time without them).
+    #[arg(long)]
+    pub timings: bool,
+}
+
+#[derive(Clone, Debug)]
+pub enum ColorArg {
+    Tangent,
+    Constant([f32; 3]),
+    /// A per-vertex field of the file through --colormap.
+    Field(String),
+}
+
+/// Keys of `lineao::ChainSettings` in JSON that replace what the options give, checked against
+/// the settings' types when parsed (a typo is a bad command line, naming the key).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SettingsPatch(serde_json::Map<String, serde_json::Value>);
+
+impl SettingsPatch {
+    /// `settings` with the patch's keys: objects merge key by key, anything else replaces.
+    pub fn apply(&self, settings: &lineao::ChainSettings) -> Result<lineao::ChainSettings, String> {
+        fn merge(into: &mut serde_json::Value, patch: &serde_json::Value) {
+            match (into, patch) {
+                (serde_json::Value::Object(into), serde_json::Value::Object(patch)) => {
+                    for (key, value) in patch {
+                        merge(into.entry(key.clone()).or_insert(serde_json::Value::Null), value);
+                    }
+                }
+                (into, patch) => *into = patch.clone(),
+            }
+        }
+        let mut value = serde_json::to_value(settings).map_err(|e| e.to_string())?;
+        merge(&mut value, &serde_json::Value::Object(self.0.clone()));
+        serde_path_to_error::deserialize(value).map_err(|e| match e.path().to_string().as_str() {
+            "." => e.inner().to_string(),
+            path => format!("{path}: {}", e.inner()),
+        })
+    }
+}
+
+pub fn parse_settings(s: &str) -> Result<SettingsPatch, String> {
+    let (text, source) = if s.trim_start().starts_with('{') {
+        (s.to_string(), "the settings".to_string())
+    } else {
+        (std::fs::read_to_string(s).map_err(|e| format!("{s}: {e}"))?, s.to_string())
+    };
+    let patch = match serde_json::from_str(&text) {
+        Ok(serde_json::Value::Object(map)) => SettingsPatch(map),
+        Ok(_) => return Err(format!("{source}: expected a JSON object of settings")),
+        Err(e) => return Err(format!("{source}: {e}")),
+    };
+    if patch.0.contains_key("method") {
+        return Err(format!("{source}: `method` is chosen by --method, --compare or --grid"));
+    }
+    patch.apply(&lineao::ChainSettings::default()).map_err(|e| format!("{source}: {e}"))?;
+    Ok(patch)
+}
+
+pub fn parse_preset(s: &str) -> Result<lineao::Preset, String> {
+    lineao::Preset::from_name(s).ok_or_else(|| format!("unknown preset '{s}' (legible, physical, paper, sparse)"))
+}
+
+pub fn parse_scene(s: &str) -> Result<SceneKind, String> {
+    s.parse()
+}
+
+pub fn parse_vec3(s: &str) -> Result<[f32; 3], String> {
+    let parts: Vec<f32> =
+        s.split(',').map(|p| p.trim().parse::<f32>().map_err(|e| format!("'{p}': {e}"))).collect::<Result<_, _>>()?;
+    let v: [f32; 3] = parts.try_into().map_err(|_| format!("expected three numbers X,Y,Z, got '{s}'"))?;
+    if v.iter().all(|c| c.is_finite()) { Ok(v) } else { Err(format!("'{s}' is not finite")) }
+}
+
+pub fn parse_color(s: &str) -> Result<ColorArg, String> {
+    match s.strip_prefix("field:") {
+        Some(name) if !name.is_empty() => Ok(ColorArg::Field(name.to_string())),
+        _ if s == "tangent" => Ok(ColorArg::Tangent),
+        _ => parse_vec3(s).map(ColorArg::Constant),
+    }
+}
+
+pub fn parse_debug_view(s: &str) -> Result<lineao::DebugView, String> {
+    use lineao::DebugView as D;
+    Ok(match s {
+        "final" => D::Final,
+        "ao" => D::Ao,
+        "normals" => D::Normals,
+        "depth" => D::Depth,
+        "zoom" => D::Zoom,
+        _ => match s.strip_prefix("level:").map(str::parse::<u32>) {
+            Some(Ok(k)) => D::Level(k),
+            _ => return Err(format!("unknown debug view '{s}' (final, ao, normals, depth, zoom, level:K)")),
+        },
+    })
+}
+
+/// A `ValueEnum` by its command-line name (for keyword arguments).
+pub fn parse_value_enum<T: ValueEnum>(s: &str) -> Result<T, String> {
+    T::from_str(s, false)
+}
+
+/// A parser that lists its values with their help in `--help` (from the registry, not a copy)
+/// and parses with `parse`, which also takes what the list does not show (`lineao+sweep`).
+#[derive(Clone)]
+pub struct Listed<T> {
+    pub parse: fn(&str) -> Result<T, String>,
+    pub values: fn() -> Vec<(&'static str, &'static str)>,
+}
+
+impl<T: Clone + Send + Sync + 'static> clap::builder::TypedValueParser for Listed<T> {
+    type Value = T;
+
+    fn parse_ref(
+        &self,
+        cmd: &clap::Command,
+        arg: Option<&clap::Arg>,
+        value: &std::ffi::OsStr,
+    ) -> Result<T, clap::Error> {
+        self.parse.parse_ref(cmd, arg, value)
+    }
+
+    fn possible_values(&self) -> Option<Box<dyn Iterator<Item = clap::builder::PossibleValue> + '_>> {
+        let values = (self.values)().into_iter();
+        Some(Box::new(values.map(|(name, help)| clap::builder::PossibleValue::new(name).help(help))))
+    }
+}
+
+/// A parser of a library setting's own names ([`lineao::Named`]), listing each with its help:
+/// the CLI mirrors no enum of the library's.
+pub fn named<T: Named>() -> impl clap::builder::TypedValueParser<Value = T> {
+    use clap::builder::{PossibleValue, PossibleValuesParser, TypedValueParser};
+    PossibleValuesParser::new(T::VALUES.iter().map(|v| PossibleValue::new(v.name()).help(v.help())))
+        .map(|name| T::from_name(&name).expect("clap accepts the listed names only"))
+}
+
+/// `lineao info`'s arguments.
+#[derive(Args, Debug)]
+pub struct InfoArgs {
+    /// A .trk, .tck, .tsf, .trx (zip or directory), .vtk, .vtp, .tt.gz, .gltf/.glb or .obj file,
+    /// optionally gzip-wrapped.
+    pub file: PathBuf,
+    /// Print CONTRACT.md's JSON.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// `lineao convert`'s arguments.
+#[derive(Args, Debug)]
+pub struct ConvertArgs {
+    pub input: PathBuf,
+    /// .tck, .trk or .trx.
+    pub output: PathBuf,
+}
+
+/// `lineao render ARGS…` as the command line parses it (`argv` from the program's name on).
+#[cfg(test)]
+pub(crate) fn parse_render<I, T>(argv: I) -> Box<RenderArgs>
+where
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
+    #[derive(clap::Parser)]
+    struct Cli {
+        #[command(subcommand)]
+        command: Command,
+    }
+    #[derive(clap::Subcommand)]
+    enum Command {
+        Render(Box<RenderArgs>),
+    }
+    let Command::Render(args) = <Cli as clap::Parser>::parse_from(argv).command;
+    args
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_ao_distance_is_world_units_or_a_share_of_the_longest_side() {
+        assert_eq!(parse_ao_distance("2"), Ok(AoDistance::World(2.0)));
+        assert_eq!(parse_ao_distance("20%"), Ok(AoDistance::Share(0.2)));
+        assert_eq!(parse_ao_distance(" 100 % "), Ok(AoDistance::Share(1.0)));
+        // 20 % of a 150 mm brain is 30 mm; a world distance ignores the scene.
+        assert!((AoDistance::Share(0.2).world(150.0) - 30.0).abs() < 1e-5);
+        assert_eq!(AoDistance::World(2.0).world(150.0), 2.0);
+        assert_eq!(AoDistance::Share(0.2).to_string(), "20%");
+        for bad in ["0%", "100.5%", "-1%", "x%", "0", "-2", "inf", ""] {
+            assert!(parse_ao_distance(bad).is_err(), "{bad}");
+        }
+    }
+}
