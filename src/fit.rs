@@ -196,9 +196,15 @@ impl Frame {
 
 pub fn run(args: &ScoreArgs) -> Result<()> {
     // The candidates change the paper's values, the strength is searched apart.
-    let base = &RenderArgs { preset: lineao::Preset::Paper, ..args.render.clone() };
-    let mut sources: Vec<RenderArgs> =
-        lineao_tracts::SceneKind::ALL.iter().map(|&scene| RenderArgs { scene, file: None, ..base.clone() }).collect();
+    let mut base = args.render.clone();
+    base.shown.preset = lineao::Preset::Paper;
+    let base = &base;
+    let scene = |scene| {
+        let mut source = RenderArgs { file: None, ..base.clone() };
+        source.source.scene = scene;
+        source
+    };
+    let mut sources: Vec<RenderArgs> = lineao_tracts::SceneKind::ALL.iter().map(|&kind| scene(kind)).collect();
     let files = real_files(&args.data);
     eprintln!(
         "lineao: fitting on {} scenes and {} tractograms from {}",
@@ -207,7 +213,7 @@ pub fn run(args: &ScoreArgs) -> Result<()> {
         args.data.display()
     );
     sources.extend(files.into_iter().map(|f| RenderArgs { file: Some(f), ..base.clone() }));
-    let families = families(base.line_width);
+    let families = families(base.style.line_width);
     let mut views: Vec<View> = Vec::new();
     for source in &sources {
         let mut session = Session::open(source)?;
@@ -231,7 +237,7 @@ pub fn run(args: &ScoreArgs) -> Result<()> {
                 for candidate in &family.candidates {
                     let mut settings = crate::score::method_settings(&session, source, family.method);
                     (candidate.apply)(&mut settings);
-                    let view = raw_ao(&session, &mut chain, settings, source.width, source.height)?;
+                    let view = raw_ao(&session, &mut chain, settings, source.image.width, source.image.height)?;
                     per_candidate.push(strengths().map(|s| frame.measure(&view.ao.data, s)).collect());
                 }
                 per_family.push(per_candidate);
@@ -248,7 +254,7 @@ pub fn run(args: &ScoreArgs) -> Result<()> {
 fn frame(session: &Session, source: &RenderArgs, bundle: &TruthSettings) -> Result<Option<(Frame, Measure)>> {
     let plain = session.settings(source, Method { screen: AoMethod::None, volume: None });
     let mut chain = None;
-    let gbuffer = raw_ao(session, &mut chain, plain, source.width, source.height)?;
+    let gbuffer = raw_ao(session, &mut chain, plain, source.image.width, source.image.height)?;
     let chain = chain.expect("rendered");
     let truth = session.trace(&chain, bundle)?;
     let (nd, shading) = crate::score::read_frame(session, &chain)?;

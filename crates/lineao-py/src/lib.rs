@@ -332,7 +332,7 @@ fn parse(settings: &Bound<'_, PyDict>, file: Option<&PathBuf>) -> PyResult<Rende
         KwargError::Invalid(_) => PyValueError::new_err(e.to_string()),
     })?;
     args.file = file.cloned();
-    if args.tube_radius_field.is_some() && args.file.is_none() {
+    if args.style.tube_radius_field.is_some() && args.file.is_none() {
         return Err(PyValueError::new_err("'tube_radius_field' needs a file"));
     }
     Ok(args)
@@ -491,11 +491,19 @@ impl Renderer {
     fn frame_args(&mut self, settings: &Bound<'_, PyDict>) -> PyResult<RenderArgs> {
         let args = parse(settings, self.opened.file.as_ref())?;
         let same = |a: &RenderArgs| {
-            let field = match &a.color {
+            let field = match &a.style.color {
                 lineao_session::args::ColorArg::Field(name) => Some(name.clone()),
                 _ => None,
             };
-            (a.surfaces.clone(), a.tube_radius_field.clone(), field, a.scene, a.vertices, a.seed, a.file.clone())
+            (
+                a.style.surfaces.clone(),
+                a.style.tube_radius_field.clone(),
+                field,
+                a.source.scene,
+                a.source.vertices,
+                a.source.seed,
+                a.file.clone(),
+            )
         };
         if same(&args) != same(&self.opened) {
             return Err(PyValueError::new_err(
@@ -503,11 +511,11 @@ impl Renderer {
             ));
         }
         // A frame without a camera keeps the last one (Python passes whole cameras).
-        if args.eye.is_some()
-            || args.target.is_some()
-            || args.up.is_some()
-            || args.fov.is_some()
-            || args.ortho.is_some()
+        if args.camera.eye.is_some()
+            || args.camera.target.is_some()
+            || args.camera.up.is_some()
+            || args.camera.fov.is_some()
+            || args.camera.ortho.is_some()
         {
             let hint = self.session.lines.hint;
             self.session.camera = lineao_session::render::camera(&args, &hint).map_err(render_error)?;

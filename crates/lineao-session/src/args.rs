@@ -263,12 +263,54 @@ pub enum VolumeNormal {
     None,
 }
 
+/// `lineao render`'s arguments (and `score`'s frame), in groups: each option's name, help and
+/// default are here once; clap derives the command line from them, Python's keyword
+/// arguments deserialize into them ([`crate::kwargs`]: the groups' fields are the keywords).
 #[derive(Args, Clone, Debug, serde::Deserialize)]
-// Python's keyword arguments deserialize into it (crate::kwargs); the defaults are clap's.
-#[serde(default, deny_unknown_fields)]
+#[serde(default)]
 pub struct RenderArgs {
     /// Tractography file to render (any format `lineao info` reads) instead of a built-in scene.
     pub file: Option<PathBuf>,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub source: SourceArgs,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub shown: ShownArgs,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub image: ImageArgs,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub style: StyleArgs,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub camera: CameraArgs,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub line_ao: LineAoArgs,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub ssao: SsaoArgs,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub vo: VoArgs,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub chain: ChainArgs,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub volume: VolumeArgs,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub truth: TruthArgs,
+}
+
+/// Where the streamlines come from: a built-in scene (the file is the positional argument).
+#[derive(Args, Clone, Debug, serde::Deserialize)]
+#[command(next_help_heading = "Source")]
+#[serde(default)]
+pub struct SourceArgs {
     /// Built-in scene.
     #[arg(long, default_value = "bundles", value_parser = parse_scene)]
     #[serde(deserialize_with = "crate::kwargs::scene")]
@@ -279,6 +321,13 @@ pub struct RenderArgs {
     /// Seed of the built-in scene.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+}
+
+/// What is shown: the method or methods, the preset and typed settings, and the shorthands for the shown method.
+#[derive(Args, Clone, Debug, serde::Deserialize)]
+#[command(next_help_heading = "Method")]
+#[serde(default)]
+pub struct ShownArgs {
     /// Ambient occlusion method: one of the list, or a screen-space method with an object-space
     /// one, e.g. lineao+sweep (see --volume-combine).
     #[arg(long, default_value = "lineao", value_parser = Listed { parse: parse_method, values: Method::listed })]
@@ -294,13 +343,38 @@ pub struct RenderArgs {
     /// and lineao+sweep).
     #[arg(long)]
     pub grid: bool,
-    /// LineAO variant.
-    #[arg(long, value_parser = named::<LineAoVariant>(), default_value = "paper")]
-    pub variant: LineAoVariant,
-    /// LineAO (variant paper): hemispheres j ≥ 1 at every pixel (`full`) or at their pyramid
-    /// level's resolution, upsampled depth-aware (`level`: faster).
-    #[arg(long, value_parser = named::<LineAoOuter>(), default_value = "full")]
-    pub outer: LineAoOuter,
+    /// Parameter set: `legible` (each method's strength and reach chosen so that visibly darker
+    /// lines lie deeper, `lineao score --fit`), `physical` (fitted to binary AO within 2 mm, was
+    /// `calibrated`: faint) or `paper` (the papers' values). Explicit options win.
+    #[arg(long, default_value = "legible", value_parser = parse_preset)]
+    #[serde(deserialize_with = "crate::kwargs::preset")]
+    pub preset: lineao::Preset,
+    /// Settings over the preset and every other option: `lineao::ChainSettings` as JSON, a file
+    /// or the text itself (starting with `{`). Only the keys it names change, e.g.
+    /// `{"ssao": {"samples": 12}, "strength": 0.8}` (docs/render.md); not `method`, which
+    /// --method, --compare and --grid choose.
+    #[arg(long, value_name = "FILE|JSON", value_parser = parse_settings)]
+    #[serde(deserialize_with = "crate::kwargs::opt_settings")]
+    pub settings: Option<SettingsPatch>,
+    /// AO strength in the composite [default: the preset's for the method; paper 1].
+    #[arg(long)]
+    pub strength: Option<f32>,
+    /// The shown method's samples (each panel's with --grid or --compare): --ssao-samples,
+    /// --vo-samples or --vo-area-samples, whichever method it shows.
+    #[arg(long)]
+    pub samples: Option<u32>,
+    /// The shown method's sphere radius: --ssao-radius or --vo-radius, whichever --method names
+    /// (with --grid or --compare, both).
+    #[arg(long, value_parser = parse_positive)]
+    #[serde(deserialize_with = "crate::kwargs::opt_positive")]
+    pub radius: Option<f32>,
+}
+
+/// The picture: its file and size, the debug view, the dump of every input, timings.
+#[derive(Args, Clone, Debug, serde::Deserialize)]
+#[command(next_help_heading = "Image")]
+#[serde(default)]
+pub struct ImageArgs {
     /// Output PNG [default: lineao.png; `score`: no grid].
     #[arg(short, long)]
     pub output: Option<PathBuf>,
@@ -308,6 +382,23 @@ pub struct RenderArgs {
     pub width: u32,
     #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=8192))]
     pub height: u32,
+    /// What to show: final, ao, normals, depth, zoom, or level:K (pyramid level K).
+    #[arg(long, default_value = "final", value_parser = parse_debug_view)]
+    #[serde(deserialize_with = "crate::kwargs::debug_view")]
+    pub debug_view: lineao::DebugView,
+    /// Write the method's inputs and output as .npy files and params.json into this folder.
+    #[arg(long)]
+    pub dump: Option<PathBuf>,
+    /// Print the time of each pass (GPU timestamps, or the frame's CPU wall time without them).
+    #[arg(long)]
+    pub timings: bool,
+}
+
+/// How the streamlines and surfaces are drawn.
+#[derive(Args, Clone, Debug, serde::Deserialize)]
+#[command(next_help_heading = "Drawing")]
+#[serde(default)]
+pub struct StyleArgs {
     /// Line width in pixels.
     #[arg(long, default_value_t = 2.0)]
     pub line_width: f32,
@@ -318,6 +409,10 @@ pub struct RenderArgs {
     /// Tubes: radius in world units [default: 0.5 mm].
     #[arg(long)]
     pub tube_radius: Option<f32>,
+    /// Tubes: the file's per-vertex field holding each vertex's radius in world units (e.g. a
+    /// TRX dpv or a .trk scalar); vertices without a positive value take --tube-radius.
+    #[arg(long, requires = "file")]
+    pub tube_radius_field: Option<String>,
     /// Lines: the illuminated-lines specular on top of the AO (`specular`, the paper's), or
     /// diffuse and specular averaged over the visible half of the line's cylinder (`cylinder`:
     /// Mallo et al. 2005).
@@ -332,10 +427,25 @@ pub struct RenderArgs {
     #[arg(long, default_value = "0.8,0.8,0.8", value_parser = parse_vec3)]
     #[serde(deserialize_with = "crate::kwargs::vec3")]
     pub surface_color: [f32; 3],
-    /// Tubes: the file's per-vertex field holding each vertex's radius in world units (e.g. a
-    /// TRX dpv or a .trk scalar); vertices without a positive value take --tube-radius.
-    #[arg(long, requires = "file")]
-    pub tube_radius_field: Option<String>,
+    /// Line color: `tangent` (|T| as RGB), R,G,B in [0, 1], or `field:NAME` (the file's
+    /// per-vertex field NAME through --colormap, its 2nd to 98th percentile spanning the map).
+    #[arg(long, default_value = "tangent", value_parser = parse_color)]
+    #[serde(deserialize_with = "crate::kwargs::color")]
+    pub color: ColorArg,
+    /// The colormap of `--color field:NAME`.
+    #[arg(long, value_parser = named::<Colormap>(), default_value = "viridis")]
+    pub colormap: Colormap,
+    /// Background color R,G,B in [0, 1].
+    #[arg(long, default_value = "1,1,1", value_parser = parse_vec3)]
+    #[serde(deserialize_with = "crate::kwargs::vec3")]
+    pub background: [f32; 3],
+}
+
+/// The camera (the rest from the scene).
+#[derive(Args, Clone, Debug, serde::Deserialize)]
+#[command(next_help_heading = "Camera")]
+#[serde(default)]
+pub struct CameraArgs {
     /// Camera position, world units: X,Y,Z [default: the scene's].
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     #[serde(deserialize_with = "crate::kwargs::opt_vec3")]
@@ -357,6 +467,20 @@ pub struct RenderArgs {
     /// World units per zoom unit of z(P) [default: the scene's, 1 mm].
     #[arg(long)]
     pub zoom_unit: Option<f32>,
+}
+
+/// LineAO (Eichelbaum et al. 2013).
+#[derive(Args, Clone, Debug, serde::Deserialize)]
+#[command(next_help_heading = "LineAO")]
+#[serde(default)]
+pub struct LineAoArgs {
+    /// LineAO variant.
+    #[arg(long, value_parser = named::<LineAoVariant>(), default_value = "paper")]
+    pub variant: LineAoVariant,
+    /// LineAO (variant paper): hemispheres j ≥ 1 at every pixel (`full`) or at their pyramid
+    /// level's resolution, upsampled depth-aware (`level`: faster).
+    #[arg(long, value_parser = named::<LineAoOuter>(), default_value = "full")]
+    pub outer: LineAoOuter,
     /// LineAO s_r: hemispheres and pyramid levels (1..=5) [default: the preset's; paper 3].
     #[arg(long)]
     pub s_r: Option<u32>,
@@ -370,61 +494,6 @@ pub struct RenderArgs {
     /// [default: the preset's; paper 2]
     #[arg(long)]
     pub reference_radius: Option<f32>,
-    /// The shown method's samples (each panel's with --grid or --compare): --ssao-samples,
-    /// --vo-samples or --vo-area-samples, whichever method it shows.
-    #[arg(long)]
-    pub samples: Option<u32>,
-    /// SSAO: point samples in the sphere (8..=32) [default: 16].
-    #[arg(long)]
-    pub ssao_samples: Option<u32>,
-    /// VO line sampling: line samples (5, 7, 9, 12, 13 or 16) [default: 9].
-    #[arg(long)]
-    pub vo_samples: Option<u32>,
-    /// VO area sampling: area samples (1 or a line count) [default: 1].
-    #[arg(long)]
-    pub vo_area_samples: Option<u32>,
-    /// VO: a second sphere radius in world units, combined with --radius (VO paper, Fig. 8).
-    #[arg(long, value_parser = parse_positive)]
-    #[serde(deserialize_with = "crate::kwargs::opt_positive")]
-    pub radius2: Option<f32>,
-    /// VO with two radii: how they combine.
-    #[arg(long, value_parser = named::<VoCombine>(), default_value = "product", requires = "radius2")]
-    pub combine: VoCombine,
-    /// Bilateral (depth-aware, separable) blur after the method.
-    #[arg(long)]
-    pub bilateral: bool,
-    /// Bilateral blur: taps on each side (1..=16).
-    #[arg(long, default_value_t = 4, requires = "bilateral")]
-    pub bilateral_radius: u32,
-    /// Bilateral blur: σ of the depth weight, world units.
-    #[arg(long, default_value_t = 1.0, requires = "bilateral")]
-    pub bilateral_sigma: f32,
-    /// VO: no normal clamp (the whole sphere, not the half above the surface).
-    #[arg(long)]
-    pub no_normal_clamp: bool,
-    /// VO: thickness model, world units (0 = off).
-    #[arg(long, default_value_t = 0.0)]
-    pub thickness: f32,
-    /// The shown method's sphere radius: --ssao-radius or --vo-radius, whichever --method names
-    /// (with --grid or --compare, both).
-    #[arg(long, value_parser = parse_positive)]
-    #[serde(deserialize_with = "crate::kwargs::opt_positive")]
-    pub radius: Option<f32>,
-    /// SSAO: sphere radius in world units (mm for tractograms) [default: the preset's; paper 2].
-    #[arg(long, value_parser = parse_positive)]
-    #[serde(deserialize_with = "crate::kwargs::opt_positive")]
-    pub ssao_radius: Option<f32>,
-    /// VO (line and area sampling): sphere radius in world units [default: the preset's; paper 2].
-    #[arg(long, value_parser = parse_positive)]
-    #[serde(deserialize_with = "crate::kwargs::opt_positive")]
-    pub vo_radius: Option<f32>,
-    /// SSAO: range check in world units [default: the radius].
-    #[arg(long, value_parser = parse_positive)]
-    #[serde(deserialize_with = "crate::kwargs::opt_positive")]
-    pub ssao_range: Option<f32>,
-    /// SSAO: the kernel's points.
-    #[arg(long, value_parser = named::<SsaoKernel>(), default_value = "crytek")]
-    pub ssao_kernel: SsaoKernel,
     /// LineAO δ0.
     #[arg(long, default_value_t = 1e-4)]
     pub delta0: f32,
@@ -436,47 +505,89 @@ pub struct RenderArgs {
     /// LineAO ε: occluded iff Δd > ε.
     #[arg(long, default_value_t = 1e-6)]
     pub epsilon: f32,
-    /// AO strength in the composite [default: the preset's for the method; paper 1].
-    #[arg(long)]
-    pub strength: Option<f32>,
-    /// Parameter set: `legible` (each method's strength and reach chosen so that visibly darker
-    /// lines lie deeper, `lineao score --fit`), `physical` (fitted to binary AO within 2 mm, was
-    /// `calibrated`: faint) or `paper` (the papers' values). Explicit options win.
-    #[arg(long, default_value = "legible", value_parser = parse_preset)]
-    #[serde(deserialize_with = "crate::kwargs::preset")]
-    pub preset: lineao::Preset,
-    /// Settings over the preset and every other option: `lineao::ChainSettings` as JSON, a file
-    /// or the text itself (starting with `{`). Only the keys it names change, e.g.
-    /// `{"ssao": {"samples": 12}, "strength": 0.8}` (docs/render.md); not `method`, which
-    /// --method, --compare and --grid choose.
-    #[arg(long, value_name = "FILE|JSON", value_parser = parse_settings)]
-    #[serde(deserialize_with = "crate::kwargs::opt_settings")]
-    pub settings: Option<SettingsPatch>,
     /// Disable LineAO's light attenuation (g_light = 1).
     #[arg(long)]
     pub no_light_attenuation: bool,
+}
+
+/// Crytek SSAO.
+#[derive(Args, Clone, Debug, serde::Deserialize)]
+#[command(next_help_heading = "Crytek SSAO")]
+#[serde(default)]
+pub struct SsaoArgs {
+    /// SSAO: point samples in the sphere (8..=32) [default: 16].
+    #[arg(long)]
+    pub ssao_samples: Option<u32>,
+    /// SSAO: sphere radius in world units (mm for tractograms) [default: the preset's; paper 2].
+    #[arg(long, value_parser = parse_positive)]
+    #[serde(deserialize_with = "crate::kwargs::opt_positive")]
+    pub ssao_radius: Option<f32>,
+    /// SSAO: range check in world units [default: the radius].
+    #[arg(long, value_parser = parse_positive)]
+    #[serde(deserialize_with = "crate::kwargs::opt_positive")]
+    pub ssao_range: Option<f32>,
+    /// SSAO: the kernel's points.
+    #[arg(long, value_parser = named::<SsaoKernel>(), default_value = "crytek")]
+    pub ssao_kernel: SsaoKernel,
+}
+
+/// Volumetric Obscurance (line and area sampling).
+#[derive(Args, Clone, Debug, serde::Deserialize)]
+#[command(next_help_heading = "Volumetric Obscurance")]
+#[serde(default)]
+pub struct VoArgs {
+    /// VO line sampling: line samples (5, 7, 9, 12, 13 or 16) [default: 9].
+    #[arg(long)]
+    pub vo_samples: Option<u32>,
+    /// VO area sampling: area samples (1 or a line count) [default: 1].
+    #[arg(long)]
+    pub vo_area_samples: Option<u32>,
+    /// VO (line and area sampling): sphere radius in world units [default: the preset's; paper 2].
+    #[arg(long, value_parser = parse_positive)]
+    #[serde(deserialize_with = "crate::kwargs::opt_positive")]
+    pub vo_radius: Option<f32>,
+    /// VO: a second sphere radius in world units, combined with --radius (VO paper, Fig. 8).
+    #[arg(long, value_parser = parse_positive)]
+    #[serde(deserialize_with = "crate::kwargs::opt_positive")]
+    pub radius2: Option<f32>,
+    /// VO with two radii: how they combine.
+    #[arg(long, value_parser = named::<VoCombine>(), default_value = "product", requires = "radius2")]
+    pub combine: VoCombine,
+    /// VO: no normal clamp (the whole sphere, not the half above the surface).
+    #[arg(long)]
+    pub no_normal_clamp: bool,
+    /// VO: thickness model, world units (0 = off).
+    #[arg(long, default_value_t = 0.0)]
+    pub thickness: f32,
+}
+
+/// What every screen-space method shares: the noise, the guard band, the bilateral blur.
+#[derive(Args, Clone, Debug, serde::Deserialize)]
+#[command(next_help_heading = "Noise, guard band, blur")]
+#[serde(default)]
+pub struct ChainArgs {
     /// Seed of the R1/R2 noise.
     #[arg(long, default_value_t = 1)]
     pub noise_seed: u32,
     /// Upper bound of the guard band in pixels.
     #[arg(long, default_value_t = 128)]
     pub guard_max: u32,
-    /// Line color: `tangent` (|T| as RGB), R,G,B in [0, 1], or `field:NAME` (the file's
-    /// per-vertex field NAME through --colormap, its 2nd to 98th percentile spanning the map).
-    #[arg(long, default_value = "tangent", value_parser = parse_color)]
-    #[serde(deserialize_with = "crate::kwargs::color")]
-    pub color: ColorArg,
-    /// The colormap of `--color field:NAME`.
-    #[arg(long, value_parser = named::<Colormap>(), default_value = "viridis")]
-    pub colormap: Colormap,
-    /// Background color R,G,B in [0, 1].
-    #[arg(long, default_value = "1,1,1", value_parser = parse_vec3)]
-    #[serde(deserialize_with = "crate::kwargs::vec3")]
-    pub background: [f32; 3],
-    /// What to show: final, ao, normals, depth, zoom, or level:K (pyramid level K).
-    #[arg(long, default_value = "final", value_parser = parse_debug_view)]
-    #[serde(deserialize_with = "crate::kwargs::debug_view")]
-    pub debug_view: lineao::DebugView,
+    /// Bilateral (depth-aware, separable) blur after the method.
+    #[arg(long)]
+    pub bilateral: bool,
+    /// Bilateral blur: taps on each side (1..=16).
+    #[arg(long, default_value_t = 4, requires = "bilateral")]
+    pub bilateral_radius: u32,
+    /// Bilateral blur: σ of the depth weight, world units.
+    #[arg(long, default_value_t = 1.0, requires = "bilateral")]
+    pub bilateral_sigma: f32,
+}
+
+/// Object-space AO (occlusion sweeping, variance occlusion maps).
+#[derive(Args, Clone, Debug, serde::Deserialize)]
+#[command(next_help_heading = "Object-space AO")]
+#[serde(default)]
+pub struct VolumeArgs {
     /// Object-space AO: voxels of the density volume along its longest axis (64–256 typical).
     #[arg(long, default_value_t = 128, value_parser = clap::value_parser!(u32).range(8..=1024))]
     pub volume_resolution: u32,
@@ -499,6 +610,13 @@ pub struct RenderArgs {
     /// darker of the two (`min`).
     #[arg(long, value_parser = named::<VoCombine>(), default_value = "product")]
     pub volume_combine: VoCombine,
+}
+
+/// The ray-traced truth (`--method raytraced`, `score`).
+#[derive(Args, Clone, Debug, serde::Deserialize)]
+#[command(next_help_heading = "Ray-traced truth")]
+#[serde(default)]
+pub struct TruthArgs {
     /// Ray-traced AO (`--method raytraced`, `score`): rays per geometry pixel. 256 is LineVis's
     /// reference count: a standard error of at most 0.03 per pixel.
     #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
@@ -524,12 +642,31 @@ pub struct RenderArgs {
     /// a window narrowing as 1/√rays; `lineao::method::raytraced::denoise`), for low `--rays`.
     #[arg(long)]
     pub denoise: bool,
-    /// Write the method's inputs and output as .npy files and params.json into this folder.
-    #[arg(long)]
-    pub dump: Option<PathBuf>,
-    /// Print the time of each pass (GPU timestamps, or the frame's CPU wall time without them).
-    #[arg(long)]
-    pub timings: bool,
+}
+
+/// Each group's defaults are the command line's (`RenderArgs::default`).
+macro_rules! defaults_from_render_args {
+    ($($field:ident: $ty:ty),* $(,)?) => {$(
+        impl Default for $ty {
+            fn default() -> $ty {
+                RenderArgs::default().$field
+            }
+        }
+    )*};
+}
+
+defaults_from_render_args! {
+    source: SourceArgs,
+    shown: ShownArgs,
+    image: ImageArgs,
+    style: StyleArgs,
+    camera: CameraArgs,
+    line_ao: LineAoArgs,
+    ssao: SsaoArgs,
+    vo: VoArgs,
+    chain: ChainArgs,
+    volume: VolumeArgs,
+    truth: TruthArgs,
 }
 
 #[derive(Clone, Debug)]

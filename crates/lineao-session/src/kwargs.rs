@@ -77,8 +77,20 @@ impl RenderArgs {
         // A switch set to False is a switch not given, as on the command line.
         let given: BTreeSet<String> =
             values.iter().filter(|(_, v)| **v != serde_json::Value::Bool(false)).map(|(k, _)| k.clone()).collect();
-        let args: RenderArgs = serde_path_to_error::deserialize(serde_json::Value::Object(values))
-            .map_err(|e| KwargError::Invalid(format!("{}: {}", e.path(), e.inner())))?;
+        let args: RenderArgs = match serde_json::from_value(serde_json::Value::Object(values.clone())) {
+            Ok(args) => args,
+            // The groups are flattened, so serde's error has lost the key: the first keyword
+            // that fails alone is the one to name.
+            Err(e) => {
+                let alone = |(key, value): (&String, &serde_json::Value)| {
+                    let one = serde_json::Map::from_iter([(key.clone(), value.clone())]);
+                    serde_json::from_value::<RenderArgs>(serde_json::Value::Object(one))
+                        .err()
+                        .map(|e| format!("{key}: {e}"))
+                };
+                return Err(KwargError::Invalid(values.iter().find_map(alone).unwrap_or_else(|| e.to_string())));
+            }
+        };
         args.check(&given).map_err(KwargError::Invalid)?;
         Ok(args)
     }
@@ -87,11 +99,11 @@ impl RenderArgs {
     /// the options that exclude (`conflicts_with`) or need (`requires`) another.
     fn check(&self, given: &BTreeSet<String>) -> Result<(), String> {
         let ranges = [
-            ("width", self.width, 1, 8192),
-            ("height", self.height, 1, 8192),
-            ("s_h", self.s_h, 1, 256),
-            ("volume_resolution", self.volume_resolution, 8, 1024),
-            ("rays", self.rays, 1, 1_048_576),
+            ("width", self.image.width, 1, 8192),
+            ("height", self.image.height, 1, 8192),
+            ("s_h", self.line_ao.s_h, 1, 256),
+            ("volume_resolution", self.volume.volume_resolution, 8, 1024),
+            ("rays", self.truth.rays, 1, 1_048_576),
         ];
         for (name, value, lo, hi) in ranges {
             if !(lo..=hi).contains(&value) {

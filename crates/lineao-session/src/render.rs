@@ -23,7 +23,7 @@ use crate::source::{AttributeKey, Lines, Loaded, Source, submit_frame, vertex_fi
 
 /// The sky of object-space AO: open, or lit from the world axis nearest to the camera's `up`.
 pub fn sky(args: &RenderArgs, up: Vec3) -> Sky {
-    match args.sky {
+    match args.volume.sky {
         SkyArg::Uniform => Sky::Uniform,
         SkyArg::Cloudy => Sky::above_nearest_axis(up.to_array()),
     }
@@ -34,15 +34,15 @@ pub fn volume_options(args: &RenderArgs, method: VolumeMethod, sky: Sky, zoom_un
     VolumeAoOptions {
         method,
         density: DensityOptions {
-            resolution: args.volume_resolution as usize,
-            occupancy_radius: args.occupancy_radius.unwrap_or(match args.geometry {
+            resolution: args.volume.volume_resolution as usize,
+            occupancy_radius: args.volume.occupancy_radius.unwrap_or(match args.style.geometry {
                 GeometryArg::Tubes => tube_radius(args, zoom_unit),
                 GeometryArg::Lines => 0.5 * zoom_unit,
             }),
             threads: 0,
         },
-        sweep: SweepSettings { alpha: args.sweep_alpha, threads: 0 },
-        form: match args.volume_normal {
+        sweep: SweepSettings { alpha: args.volume.sweep_alpha, threads: 0 },
+        form: match args.volume.volume_normal {
             VolumeNormal::Pixel => None,
             VolumeNormal::Tangent => Some(ScalarForm::AroundTangent),
             VolumeNormal::None => Some(ScalarForm::NoGeometryTerm),
@@ -54,7 +54,7 @@ pub fn volume_options(args: &RenderArgs, method: VolumeMethod, sky: Sky, zoom_un
 
 /// The tubes' radius in world units: --tube-radius or 0.5 mm.
 fn tube_radius(args: &RenderArgs, zoom_unit: f32) -> f32 {
-    args.tube_radius.unwrap_or(0.5 * zoom_unit)
+    args.style.tube_radius.unwrap_or(0.5 * zoom_unit)
 }
 
 /// The chain's settings from the command line, for `method` (object-space AO lit by `sky`), in
@@ -62,100 +62,102 @@ fn tube_radius(args: &RenderArgs, zoom_unit: f32) -> f32 {
 pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky, longest_side: f32) -> ChainSettings {
     let volume = method.volume.map(|_| VolumeAoSettings {
         // The view-independent forms hold the sky already.
-        sky: if args.volume_normal == VolumeNormal::Pixel { sky.weights() } else { [1.0; 8] },
-        combine: args.volume_combine,
+        sky: if args.volume.volume_normal == VolumeNormal::Pixel { sky.weights() } else { [1.0; 8] },
+        combine: args.volume.volume_combine,
     });
     let method = method.screen;
     // Each method's own flag, else --samples where it is the method shown, else its default.
-    let samples =
-        |m: AoMethod, own: Option<u32>, default: u32| own.or(args.samples.filter(|_| method == m)).unwrap_or(default);
+    let samples = |m: AoMethod, own: Option<u32>, default: u32| {
+        own.or(args.shown.samples.filter(|_| method == m)).unwrap_or(default)
+    };
     let vo_default = VoSettings::default();
     let mut settings = ChainSettings {
         method,
         volume,
         vo: VoSettings {
-            samples: samples(AoMethod::VoLine, args.vo_samples, vo_default.samples),
-            area_samples: samples(AoMethod::VoArea, args.vo_area_samples, vo_default.area_samples),
+            samples: samples(AoMethod::VoLine, args.vo.vo_samples, vo_default.samples),
+            area_samples: samples(AoMethod::VoArea, args.vo.vo_area_samples, vo_default.area_samples),
             radius_world: vo_default.radius_world,
-            radius2_world: args.radius2,
-            combine: args.combine,
-            normal_clamp: !args.no_normal_clamp,
-            thickness_world: args.thickness,
-            noise_seed: args.noise_seed,
+            radius2_world: args.vo.radius2,
+            combine: args.vo.combine,
+            normal_clamp: !args.vo.no_normal_clamp,
+            thickness_world: args.vo.thickness,
+            noise_seed: args.chain.noise_seed,
         },
         ssao: SsaoSettings {
-            samples: samples(AoMethod::Ssao, args.ssao_samples, SsaoSettings::default().samples),
+            samples: samples(AoMethod::Ssao, args.ssao.ssao_samples, SsaoSettings::default().samples),
             radius_world: SsaoSettings::default().radius_world,
             range_world: SsaoSettings::default().range_world,
-            noise_seed: args.noise_seed,
-            kernel: args.ssao_kernel,
+            noise_seed: args.chain.noise_seed,
+            kernel: args.ssao.ssao_kernel,
         },
-        blur: args
-            .bilateral
-            .then_some(BilateralSettings { radius_px: args.bilateral_radius, depth_sigma_world: args.bilateral_sigma }),
+        blur: args.chain.bilateral.then_some(BilateralSettings {
+            radius_px: args.chain.bilateral_radius,
+            depth_sigma_world: args.chain.bilateral_sigma,
+        }),
         line_ao: LineAoSettings {
             s_r: LineAoSettings::default().s_r,
-            s_h: args.s_h,
-            r0_px: args.r0,
+            s_h: args.line_ao.s_h,
+            r0_px: args.line_ao.r0,
             r0_per_width: LineAoSettings::default().r0_per_width,
-            delta0: args.delta0,
+            delta0: args.line_ao.delta0,
             delta_scale: LineAoSettings::default().delta_scale,
-            epsilon: args.epsilon,
-            light_attenuation: !args.no_light_attenuation,
-            noise_seed: args.noise_seed,
-            variant: args.variant,
+            epsilon: args.line_ao.epsilon,
+            light_attenuation: !args.line_ao.no_light_attenuation,
+            noise_seed: args.chain.noise_seed,
+            variant: args.line_ao.variant,
             reference_radius_px: LineAoSettings::default().reference_radius_px,
-            outer: args.outer,
+            outer: args.line_ao.outer,
         },
         raytraced: crate::truth::gpu_settings(args, longest_side),
-        line_width_px: args.line_width,
+        line_width_px: args.style.line_width,
         lighting: lineao::lighting::Lighting {
-            line_shading: args.line_shading,
+            line_shading: args.style.line_shading,
             ..lineao::lighting::Lighting::default()
         },
-        tubes: (args.geometry == GeometryArg::Tubes)
+        tubes: (args.style.geometry == GeometryArg::Tubes)
             .then(|| TubeSettings { radius_world: tube_radius(args, zoom_unit) }),
-        surfaces: (!args.surfaces.is_empty()).then_some(SurfaceSettings { color: args.surface_color }),
-        line_color: match &args.color {
+        surfaces: (!args.style.surfaces.is_empty()).then_some(SurfaceSettings { color: args.style.surface_color }),
+        line_color: match &args.style.color {
             ColorArg::Tangent => LineColor::Tangent,
             ColorArg::Constant(rgb) => LineColor::Constant(*rgb),
             // The range comes from the data (`run` sets it).
-            ColorArg::Field(_) => LineColor::Scalar { colormap: args.colormap, range: [0.0, 1.0] },
+            ColorArg::Field(_) => LineColor::Scalar { colormap: args.style.colormap, range: [0.0, 1.0] },
         },
-        background: args.background,
+        background: args.style.background,
         strength: 1.0,
-        debug_view: args.debug_view,
-        zoom_unit: args.zoom_unit.unwrap_or(zoom_unit),
-        guard_max_px: args.guard_max,
+        debug_view: args.image.debug_view,
+        zoom_unit: args.camera.zoom_unit.unwrap_or(zoom_unit),
+        guard_max_px: args.chain.guard_max,
     }
-    .with_preset(args.preset);
+    .with_preset(args.shown.preset);
     // What the command line names explicitly wins over the preset.
-    if let Some(strength) = args.strength {
+    if let Some(strength) = args.shown.strength {
         settings.strength = strength;
     }
-    if let Some(s_r) = args.s_r {
+    if let Some(s_r) = args.line_ao.s_r {
         settings.line_ao.s_r = s_r;
     }
-    if let Some(r0) = args.r0 {
+    if let Some(r0) = args.line_ao.r0 {
         settings.line_ao.r0_px = Some(r0);
     }
-    if let Some(scale) = args.delta_scale {
+    if let Some(scale) = args.line_ao.delta_scale {
         settings.line_ao.delta_scale = scale;
     }
-    if let Some(radius) = args.reference_radius {
+    if let Some(radius) = args.line_ao.reference_radius {
         settings.line_ao.reference_radius_px = radius;
     }
-    if let Some(radius) = args.vo_radius.or(args.radius) {
+    if let Some(radius) = args.vo.vo_radius.or(args.shown.radius) {
         settings.vo.radius_world = radius;
     }
-    if let Some(radius) = args.ssao_radius.or(args.radius) {
+    if let Some(radius) = args.ssao.ssao_radius.or(args.shown.radius) {
         settings.ssao.radius_world = radius;
         settings.ssao.range_world = radius;
     }
-    if let Some(range) = args.ssao_range {
+    if let Some(range) = args.ssao.ssao_range {
         settings.ssao.range_world = range;
     }
-    match &args.settings {
+    match &args.shown.settings {
         // Checked against the same types when parsed: it applies to any settings.
         Some(patch) => patch.apply(&settings).expect("--settings was checked when parsed"),
         None => settings,
@@ -193,18 +195,19 @@ fn grid_methods() -> Vec<Method> {
 /// The panels the command line asks for: one method, two (--compare) or all (--grid).
 fn panels(args: &RenderArgs, zoom_unit: f32, sky: Sky, longest_side: f32) -> Vec<Panel> {
     let panel = |method| Panel::new(method, settings(args, method, zoom_unit, sky, longest_side));
-    if let Some(pair) = args.compare {
+    if let Some(pair) = args.shown.compare {
         return pair.into_iter().map(panel).collect();
     }
-    if !args.grid {
-        return vec![panel(args.method)];
+    if !args.shown.grid {
+        return vec![panel(args.shown.method)];
     }
     let mut all: Vec<Panel> = grid_methods().into_iter().map(panel).collect();
     // The third tile: LineAO as the authors' code computes it, next to the paper's.
     let lineao = Method { screen: AoMethod::LineAo, volume: None };
     let variant =
-        if args.variant == LineAoVariant::Reference { LineAoVariant::Paper } else { LineAoVariant::Reference };
-    let other = RenderArgs { variant, ..args.clone() };
+        if args.line_ao.variant == LineAoVariant::Reference { LineAoVariant::Paper } else { LineAoVariant::Reference };
+    let mut other = args.clone();
+    other.line_ao.variant = variant;
     let reference = settings(&other, lineao, zoom_unit, sky, longest_side);
     all.insert(2, Panel::new(lineao, reference));
     all
@@ -238,9 +241,9 @@ impl Session {
         let source = match &args.file {
             Some(path) => Source::File(path.clone()),
             None => Source::Scene {
-                kind: args.scene,
-                vertices: args.vertices.unwrap_or(args.scene.default_vertices()),
-                seed: args.seed,
+                kind: args.source.scene,
+                vertices: args.source.vertices.unwrap_or(args.source.scene.default_vertices()),
+                seed: args.source.seed,
             },
         };
         Session::with_loaded(args, source.load_on_terminal()?)
@@ -251,16 +254,17 @@ impl Session {
         let camera = camera(args, &loaded.hint)?;
         let sky = sky(args, camera.up);
         let surfaces = args
+            .style
             .surfaces
             .iter()
             .map(|path| lineao_tracts::load_mesh(path).map_err(anyhow::Error::from))
             .collect::<Result<Vec<_>>>()?;
         let base = AttributeKey {
-            scalar: match &args.color {
+            scalar: match &args.style.color {
                 ColorArg::Field(field) => Some(field.clone()),
                 _ => None,
             },
-            radius: args.tube_radius_field.clone(),
+            radius: args.style.tube_radius_field.clone(),
             volume: None,
         };
         // The fields exist, before any GPU work.
@@ -316,7 +320,7 @@ impl Session {
 pub fn run(args: &RenderArgs) -> Result<()> {
     let mut session = Session::open(args)?;
     let (image, panels) = session.compose(args, &mut Vec::new())?;
-    let output = args.output.clone().unwrap_or_else(|| "lineao.png".into());
+    let output = args.image.output.clone().unwrap_or_else(|| "lineao.png".into());
     crate::output::write_png(&output, image.width, image.height, &image.data)?;
     let methods: Vec<&str> = panels.iter().map(|p| p.label.as_str()).collect();
     eprintln!(
@@ -325,8 +329,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         session.lines.geometry.streamlines,
         session.lines.geometry.vertices,
         methods.join(", "),
-        args.width,
-        args.height,
+        args.image.width,
+        args.image.height,
         session.gpu.describe(),
         output.display()
     );
@@ -364,13 +368,13 @@ impl Session {
                     eprintln!(
                         "lineao: {} at {} voxels along the longest axis: {:.2} s on the CPU",
                         method.name(),
-                        args.volume_resolution,
+                        args.volume.volume_resolution,
                         start.elapsed().as_secs_f64()
                     );
                 }
             }
             // One method dumps into DIR itself, several into DIR/<label>/.
-            let dump = args.dump.as_ref().map(|dir| match panels.len() {
+            let dump = args.image.dump.as_ref().map(|dir| match panels.len() {
                 1 => dir.clone(),
                 _ => dir.join(panel.label.replace(" (reference)", "-reference")),
             });
@@ -381,7 +385,7 @@ impl Session {
         }
         let image = match &images[..] {
             [single] => single.clone(),
-            [a, b] if args.compare.is_some() => {
+            [a, b] if args.shown.compare.is_some() => {
                 crate::label::split(a, b, [&panels[0].label, &panels[1].label]).context("composing --compare")?
             }
             tiles => {
@@ -433,16 +437,16 @@ impl Session {
             }
             None => AoChain::new(&gpu.device, format, panel.settings.clone())?,
         };
-        if args.timings {
+        if args.image.timings {
             chain.set_timing(&gpu.device, &gpu.queue, true);
         }
-        chain.resize(args.width, args.height)?;
-        let size = (args.width, args.height);
+        chain.resize(args.image.width, args.image.height)?;
+        let size = (args.image.width, args.image.height);
         let target = lineao::targets::Target::output(&gpu.device, "lineao::render::output", size, format);
         let meshes: Vec<&MeshGeometry> = self.meshes.iter().collect();
         let start = std::time::Instant::now();
         let scene = (&self.lines.geometry, &meshes[..]);
-        let gpu_rays = panel.settings.method == AoMethod::RayTraced && !args.cpu;
+        let gpu_rays = panel.settings.method == AoMethod::RayTraced && !args.truth.cpu;
         if gpu_rays {
             chain.set_ray_scene(&gpu.device, Some(self.ray_scene()?));
         }
@@ -452,7 +456,7 @@ impl Session {
                 submit_frame(gpu, chain, scene, (&self.camera, &self.bounds), &target.view)
             })?;
         }
-        if args.timings {
+        if args.image.timings {
             gpu.wait()?;
             let wall_ms = start.elapsed().as_secs_f64() * 1e3;
             let label = &panel.label;
@@ -467,7 +471,7 @@ impl Session {
                 None => eprintln!("lineao: {label}: frame {wall_ms:.2} ms (CPU wall time: no timestamp queries)"),
             }
         }
-        let truth = if panel.settings.method == AoMethod::RayTraced && args.cpu {
+        let truth = if panel.settings.method == AoMethod::RayTraced && args.truth.cpu {
             let truth = self.trace(&chain, &crate::truth::settings(args, self.longest_side))?;
             let targets = chain.targets().context("nothing was rendered")?;
             lineao::verify::write_target(&gpu.queue, &targets.ao, &truth.ao);
@@ -490,7 +494,7 @@ impl Session {
                 crate::dump::write_truth(dir, truth, &crate::truth::settings(args, self.longest_side))?;
             }
         }
-        let image = Rgba8 { width: args.width, height: args.height, data: image.bytes };
+        let image = Rgba8 { width: args.image.width, height: args.image.height, data: image.bytes };
         Ok(Rendered { image, chain })
     }
 
@@ -537,10 +541,10 @@ fn longest_side<'a>(points: impl Iterator<Item = &'a [f32; 3]>) -> f32 {
 /// The camera of the command line (--eye, --target, --up, --fov, --ortho), the rest from `hint`.
 pub fn camera(args: &RenderArgs, hint: &ViewHint) -> Result<Camera> {
     let camera = Camera {
-        eye: Vec3::from_array(args.eye.unwrap_or(hint.eye)),
-        target: Vec3::from_array(args.target.unwrap_or(hint.target)),
-        up: Vec3::from_array(args.up.unwrap_or(hint.up)),
-        projection: match (args.ortho, args.fov) {
+        eye: Vec3::from_array(args.camera.eye.unwrap_or(hint.eye)),
+        target: Vec3::from_array(args.camera.target.unwrap_or(hint.target)),
+        up: Vec3::from_array(args.camera.up.unwrap_or(hint.up)),
+        projection: match (args.camera.ortho, args.camera.fov) {
             (Some(height), _) => Projection::Orthographic { height },
             (None, fov) => Projection::Perspective { fov_y_deg: fov.unwrap_or(hint.fov_y_deg) },
         },

@@ -74,7 +74,8 @@ pub struct Report {
 pub fn method_settings(session: &Session, args: &crate::args::RenderArgs, m: ScoreMethod) -> ChainSettings {
     // The variant first, so that the preset gives this variant's values and explicit options
     // still win.
-    let args = crate::args::RenderArgs { variant: m.variant, ..args.clone() };
+    let mut args = args.clone();
+    args.line_ao.variant = m.variant;
     let mut settings = session.settings(&args, Method { screen: m.method, volume: None });
     settings.blur = None;
     settings.raytraced.denoise = None;
@@ -154,8 +155,8 @@ pub fn score(
     methods: &[ScoreMethod],
     bundle_distance: AoDistance,
 ) -> Result<Report> {
-    let (w, h) = (args.width as usize, args.height as usize);
-    let vo_ball = if args.no_normal_clamp { VoBall::Whole } else { VoBall::Half };
+    let (w, h) = (args.image.width as usize, args.image.height as usize);
+    let vo_ball = if args.vo.no_normal_clamp { VoBall::Whole } else { VoBall::Half };
     let wants_vo = methods.iter().any(|m| matches!(m.method, AoMethod::VoLine | AoMethod::VoArea));
     let local = crate::truth::settings(args, session.longest_side);
     let bundle_settings = TruthSettings {
@@ -169,7 +170,8 @@ pub fn score(
     let truth_settings = TruthSettings { vo: wants_vo.then_some(vo_ball), second: Some(second), ..local };
 
     // The truth's G-buffer: a chain without a method (and so without a guard band).
-    let quiet = crate::args::RenderArgs { timings: false, dump: None, ..args.clone() };
+    let mut quiet = args.clone();
+    (quiet.image.timings, quiet.image.dump) = (false, None);
     let plain = ScoreMethod { method: AoMethod::None, variant: Default::default() };
     let panel = Panel::new(Method { screen: AoMethod::None, volume: None }, method_settings(session, args, plain));
     let rendered = session.render(&quiet, &panel, None, None, None)?;
@@ -205,7 +207,7 @@ pub fn score(
             ),
             _ => (&ao_truth, "ao"),
         };
-        let ao = if m.method == AoMethod::RayTraced && args.cpu {
+        let ao = if m.method == AoMethod::RayTraced && args.truth.cpu {
             let again = TruthSettings { seed: truth_settings.seed.wrapping_add(1), vo: None, ..truth_settings.clone() };
             session.trace(&rendered.chain, &again)?.ao
         } else {
@@ -213,7 +215,7 @@ pub fn score(
             let mut settings = method_settings(session, args, m);
             // The ray tracer on the GPU traces the truth again with the next seed.
             settings.raytraced.seed = settings.raytraced.seed.wrapping_add(1);
-            let view = raw_ao(session, &mut chain, settings, args.width, args.height)?;
+            let view = raw_ao(session, &mut chain, settings, args.image.width, args.image.height)?;
             mask.iter_mut().zip(&view.geometry).for_each(|(m, g)| *m &= g);
             let strength = strength_of(m);
             Image { data: view.ao.data.iter().map(|a| (strength * a).clamp(0.0, 1.0)).collect(), ..view.ao }
@@ -280,11 +282,11 @@ pub fn run(args: &ScoreArgs) -> Result<()> {
             "{}: {} x {}, {} geometry pixels, {} rays; local truth to {} ({} falloff), mean {:.3}, {:.1} % buried; \
              bundle truth to {} = {:.1} ({} falloff), mean {:.3}",
             session.lines.name,
-            render.width,
-            render.height,
+            render.image.width,
+            render.image.height,
             truth.geometry_pixels,
-            render.rays,
-            render.ao_distance,
+            render.truth.rays,
+            render.truth.ao_distance,
             truth_settings_falloff(render),
             mean_over(&report.ao, &report.mask),
             100.0 * truth.buried_share(),
@@ -331,7 +333,7 @@ pub fn run(args: &ScoreArgs) -> Result<()> {
         println!();
         print!("{}", legibility_table(&report));
     }
-    if let Some(path) = &render.output {
+    if let Some(path) = &render.image.output {
         let image = grid(&report);
         crate::output::write_png(path, image.width, image.height, &image.data)?;
         eprintln!("lineao: score grid -> {}", path.display());
@@ -401,7 +403,7 @@ fn legibility_json(l: &Result<Legibility, Absent>) -> serde_json::Value {
 }
 
 fn truth_settings_falloff(args: &crate::args::RenderArgs) -> &'static str {
-    args.ao_falloff.name()
+    args.truth.ao_falloff.name()
 }
 
 /// CONTRACT.md's `lineao score --json` object.
@@ -411,8 +413,8 @@ pub fn to_json(session: &Session, args: &crate::args::RenderArgs, report: &Repor
     let bundle = &report.bundle;
     json!({
         "scene": session.lines.name,
-        "width": args.width,
-        "height": args.height,
+        "width": args.image.width,
+        "height": args.image.height,
         "rays": settings.rays,
         "ao_distance_world": settings.distance_world,
         "ao_falloff": settings.falloff.name(),

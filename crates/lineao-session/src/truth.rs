@@ -27,10 +27,10 @@ pub struct Scene<'a> {
 /// `longest_side` world units (what `--ao-distance 20%` is a share of).
 pub fn settings(args: &RenderArgs, longest_side: f32) -> TruthSettings {
     TruthSettings {
-        rays: args.rays,
-        distance_world: args.ao_distance.world(longest_side),
-        falloff: args.ao_falloff,
-        seed: args.ray_seed,
+        rays: args.truth.rays,
+        distance_world: args.truth.ao_distance.world(longest_side),
+        falloff: args.truth.ao_falloff,
+        seed: args.truth.ray_seed,
         vo: None,
         second: None,
         threads: 0,
@@ -42,12 +42,12 @@ pub fn settings(args: &RenderArgs, longest_side: f32) -> TruthSettings {
 /// `longest_side`.
 pub fn gpu_settings(args: &RenderArgs, longest_side: f32) -> lineao::RayTracedSettings {
     lineao::RayTracedSettings {
-        rays_per_frame: args.rays.min(RAYS_PER_FRAME),
-        max_rays: args.rays,
-        distance_world: args.ao_distance.world(longest_side),
-        falloff: args.ao_falloff,
-        seed: args.ray_seed,
-        denoise: args.denoise.then(lineao::RayDenoiseSettings::default),
+        rays_per_frame: args.truth.rays.min(RAYS_PER_FRAME),
+        max_rays: args.truth.rays,
+        distance_world: args.truth.ao_distance.world(longest_side),
+        falloff: args.truth.ao_falloff,
+        seed: args.truth.ray_seed,
+        denoise: args.truth.denoise.then(lineao::RayDenoiseSettings::default),
     }
 }
 
