@@ -88,7 +88,11 @@ struct Passes {
     /// is made per frame, on the device).
     nd_from_depth: NdFromDepth,
     stages: Vec<StagePass>,
+    /// What the stages are prepared with each frame: the bench's settings and view.
+    settings: ChainSettings,
+    view: FrameView,
     device: wgpu::Device,
+    queue: wgpu::Queue,
     output: Target,
 }
 
@@ -125,7 +129,10 @@ impl Passes {
             tubes: TubeRenderer::new(device, false),
             nd_from_depth: NdFromDepth::new(device, HostConfig::default()),
             stages: Vec::new(),
+            settings: settings.clone(),
+            view: *view,
             device: device.clone(),
+            queue: queue.clone(),
             output: Target::output(device, "lineao::bench::output", (view.width, view.height), format),
         };
         for renderer in [&passes.lines, &passes.lines_native, &passes.lines_full] {
@@ -161,9 +168,8 @@ impl Passes {
         Ok(passes)
     }
 
-    /// Records pass `name` of frame `frame` timed into `span`, after writing what its settings
-    /// make of that frame.
-    #[allow(clippy::too_many_arguments)]
+    /// Records pass `name` of frame `frame` timed into `span` (a method's stage prepared with
+    /// what its settings make of that frame first).
     fn encode(
         &self,
         name: &str,
@@ -171,10 +177,9 @@ impl Passes {
         encoder: &mut wgpu::CommandEncoder,
         targets: &FrameTargets,
         geometry: &LineGeometry,
-        (settings, view, queue): (&ChainSettings, &FrameView, &wgpu::Queue),
         span: Option<Span>,
     ) {
-        let background = settings.background;
+        let background = self.settings.background;
         match name {
             "lines" => self.lines.encode(encoder, targets, geometry, Load::Clear(background), span),
             "lines-native-1px" => self.lines_native.encode(encoder, targets, geometry, Load::Clear(background), span),
@@ -189,7 +194,8 @@ impl Passes {
             }
             _ => {
                 let s = self.stages.iter().find(|s| s.pass.name == name).expect("every bench pass is listed");
-                s.stage.prepare(queue, targets, view, &s.pass.settings_for(s.method, settings, frame));
+                let settings = s.pass.settings_for(s.method, &self.settings, frame);
+                s.stage.prepare(&self.queue, targets, &self.view, &settings);
                 // The pass's spans as one: the first's start, the last's end.
                 let (first, last) = (s.pass.spans[0], s.pass.spans[s.pass.spans.len() - 1]);
                 let of = |name: &'static str| match (name == first, name == last) {
@@ -250,11 +256,10 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     // `lines` last among the line passes, so the G-buffer the later passes read is the chain's.
     let first = ["lines-native-1px", "lines-full-strip"];
     let order = first.into_iter().chain(all.iter().copied().filter(|p| !first.contains(p)));
-    let context = (&settings, &view, queue);
     // The G-buffer and pyramid every later pass reads, also when `--passes` leaves them out.
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::bench") });
-    passes.encode("lines", 0, &mut encoder, targets, &geometry, context, None);
-    passes.encode("nd-pyramid", 0, &mut encoder, targets, &geometry, context, None);
+    passes.encode("lines", 0, &mut encoder, targets, &geometry, None);
+    passes.encode("nd-pyramid", 0, &mut encoder, targets, &geometry, None);
     queue.submit([encoder.finish()]);
     let selected = |name: &str| args.passes.is_empty() || args.passes.iter().any(|p| p == name);
     for frame in 0..args.warmup + args.frames {
@@ -263,7 +268,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::bench") });
             encoder.push_debug_group(name);
             let span = timer.as_ref().and_then(|t| t.span(name));
-            passes.encode(name, frame, &mut encoder, targets, &geometry, context, span);
+            passes.encode(name, frame, &mut encoder, targets, &geometry, span);
             encoder.pop_debug_group();
             if let Some(timer) = &timer {
                 timer.resolve(&mut encoder);
