@@ -825,6 +825,16 @@ where
     I: IntoIterator<Item = T>,
     T: Into<std::ffi::OsString> + Clone,
 {
+    try_parse_render(argv).expect("a valid command line")
+}
+
+/// [`parse_render`], or clap's refusal.
+#[cfg(test)]
+pub(crate) fn try_parse_render<I, T>(argv: I) -> Result<Box<RenderArgs>, clap::Error>
+where
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
     #[derive(clap::Parser)]
     struct Cli {
         #[command(subcommand)]
@@ -834,8 +844,8 @@ where
     enum Command {
         Render(Box<RenderArgs>),
     }
-    let Command::Render(args) = <Cli as clap::Parser>::parse_from(argv).command;
-    args
+    let Command::Render(args) = <Cli as clap::Parser>::try_parse_from(argv)?.command;
+    Ok(args)
 }
 
 #[cfg(test)]

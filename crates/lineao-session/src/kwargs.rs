@@ -4,6 +4,7 @@
 //! object), its defaults the command line's, and every error names the keyword.
 
 use std::collections::BTreeSet;
+use std::sync::OnceLock;
 
 use clap::Args;
 use serde::Deserialize;
@@ -41,11 +42,19 @@ impl std::fmt::Display for KwargError {
 impl std::error::Error for KwargError {}
 
 impl Default for RenderArgs {
-    /// The command line's defaults (`lineao render` with no option): one definition for both.
+    /// The command line's defaults (`lineao render` with no option): one definition for both,
+    /// parsed once (serde asks for them once per group on every call of
+    /// [`RenderArgs::from_keywords`], which Python makes every frame).
     fn default() -> RenderArgs {
-        let command = RenderArgs::augment_args(clap::Command::new("render").no_binary_name(true));
-        let matches = command.try_get_matches_from(std::iter::empty::<&str>()).expect("every option has a default");
-        <RenderArgs as clap::FromArgMatches>::from_arg_matches(&matches).expect("the defaults parse")
+        static DEFAULTS: OnceLock<RenderArgs> = OnceLock::new();
+        DEFAULTS
+            .get_or_init(|| {
+                let command = RenderArgs::augment_args(clap::Command::new("render").no_binary_name(true));
+                let matches =
+                    command.try_get_matches_from(std::iter::empty::<&str>()).expect("every option has a default");
+                <RenderArgs as clap::FromArgMatches>::from_arg_matches(&matches).expect("the defaults parse")
+            })
+            .clone()
     }
 }
 
@@ -70,9 +79,10 @@ impl RenderArgs {
     /// checked as the command line checks them: each value by its option's parser, the ranges,
     /// and the options that exclude or need each other.
     pub fn from_keywords(values: serde_json::Map<String, serde_json::Value>) -> Result<RenderArgs, KwargError> {
-        let known: Vec<String> = RenderArgs::keywords().into_iter().map(|k| k.name).collect();
+        static KNOWN: OnceLock<Vec<String>> = OnceLock::new();
+        let known = KNOWN.get_or_init(|| RenderArgs::keywords().into_iter().map(|k| k.name).collect());
         if let Some(name) = values.keys().find(|name| !known.contains(name)) {
-            return Err(KwargError::Unknown { name: name.clone(), known });
+            return Err(KwargError::Unknown { name: name.clone(), known: known.clone() });
         }
         // A switch set to False is a switch not given, as on the command line.
         let given: BTreeSet<String> =
@@ -111,12 +121,21 @@ impl RenderArgs {
             }
         }
         let has = |name: &str| given.contains(name);
-        for (a, b) in [("compare", "grid"), ("fov", "ortho"), ("cpu", "bilateral"), ("cpu", "denoise")] {
-            if has(a) && has(b) {
-                return Err(format!("'{a}' cannot be used with '{b}'"));
-            }
+        // The conflicts are clap's own (`conflicts_with`); clap keeps `requires` to itself, so
+        // those are listed here, and a test holds the list to what the command line refuses.
+        static CONFLICTS: OnceLock<Vec<(String, String)>> = OnceLock::new();
+        let conflicts = CONFLICTS.get_or_init(|| {
+            let command = RenderArgs::augment_args(clap::Command::new("render"));
+            let pairs = command.get_arguments().flat_map(|a| {
+                let others = command.get_arg_conflicts_with(a).into_iter().map(|b| b.get_id().to_string());
+                others.map(|b| (a.get_id().to_string(), b)).collect::<Vec<_>>()
+            });
+            pairs.collect()
+        });
+        if let Some((a, b)) = conflicts.iter().find(|(a, b)| has(a) && has(b)) {
+            return Err(format!("'{a}' cannot be used with '{b}'"));
         }
-        for (a, b) in [("combine", "radius2"), ("bilateral_radius", "bilateral"), ("bilateral_sigma", "bilateral")] {
+        for (a, b) in REQUIRES {
             if has(a) && !has(b) {
                 return Err(format!("'{a}' needs '{b}'"));
             }
@@ -124,6 +143,10 @@ impl RenderArgs {
         Ok(())
     }
 }
+
+/// The options that need another (clap's `requires`, which it does not expose).
+const REQUIRES: [(&str, &str); 3] =
+    [("combine", "radius2"), ("bilateral_radius", "bilateral"), ("bilateral_sigma", "bilateral")];
 
 /// A value as the command line's text: a string as it is, a number or bool as written, a
 /// sequence of them joined by commas (`(0, 0, 0)` → `0,0,0`, `("lineao", "ssao")` → `lineao,ssao`).
@@ -261,6 +284,25 @@ mod tests {
         assert_eq!(format!("{args:?}"), format!("{expected:?}"));
         // No keyword: the command line's defaults.
         assert_eq!(format!("{:?}", from(json!({})).unwrap()), format!("{:?}", parsed(&[])));
+    }
+
+    /// What `check` lists by hand (the ranges, `requires`) the command line refuses too.
+    #[test]
+    fn the_hand_listed_checks_are_the_command_lines() {
+        let refuses = |argv: &[&str]| crate::args::try_parse_render(["lineao", "render"].iter().chain(argv)).is_err();
+        let flag = |name: &str| format!("--{}", name.replace('_', "-"));
+        for (a, b) in REQUIRES {
+            let value = if a == "combine" { "min" } else { "1" };
+            assert!(refuses(&[&flag(a), value]), "{a} without {b}");
+            assert!(from(json!({a: value})).is_err(), "{a} without {b}");
+        }
+        for (name, out) in
+            [("width", 0), ("width", 8193), ("height", 0), ("s_h", 257), ("volume_resolution", 7), ("rays", 0)]
+        {
+            let text = out.to_string();
+            assert!(refuses(&[&flag(name), &text]), "{name} {out}");
+            assert!(from(json!({name: out})).is_err(), "{name} {out}");
+        }
     }
 
     #[test]

@@ -45,8 +45,8 @@
 //! The work is split by rows over all cores; a progress callback sees each finished row and a
 //! flag stops it between rows.
 
-// The GPU ray tracer's scene is built from the BVH and primitives; walking them (and the ray
-// sequence) is the CPU truth's, compiled but unused without it.
+// The GPU ray tracer's scene is built from the BVH and primitives; walking them is the CPU
+// truth's, compiled but unused without it.
 #[cfg_attr(not(feature = "truth"), allow(dead_code))]
 pub(crate) mod bvh;
 #[cfg(feature = "truth")]
@@ -57,7 +57,9 @@ pub mod legibility;
 pub mod metrics;
 #[cfg_attr(not(feature = "truth"), allow(dead_code))]
 pub(crate) mod primitive;
-#[cfg_attr(not(feature = "truth"), allow(dead_code))]
+// The rays' sequence on the CPU (the GPU tracer's WGSL has its own; the tests compare the
+// two tracers' pictures ray for ray).
+#[cfg(feature = "truth")]
 pub(crate) mod sequence;
 
 use crate::Error;
