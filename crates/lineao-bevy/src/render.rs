@@ -187,6 +187,11 @@ impl LineAoViews {
         self.views.get(&entity)
     }
 
+    /// Every camera's chains.
+    pub fn iter(&self) -> impl Iterator<Item = &ViewAo> {
+        self.views.values()
+    }
+
     /// As [`LineAoViews::get`], to turn timing on ([`AoChain::set_timing`]).
     pub fn get_mut(&mut self, entity: Entity) -> Option<&mut ViewAo> {
         self.views.get_mut(&entity)

@@ -149,11 +149,7 @@ pub fn render_images(app: &mut App, images: &[Handle<Image>], frames: usize) -> 
         };
         *grab.1.lock().unwrap() = Some(grab.0.iter().map(read).collect());
     }
-    while app.plugins_state() == PluginsState::Adding {
-        bevy::tasks::tick_global_task_pools_on_main_thread();
-    }
-    app.finish();
-    app.cleanup();
+    finish(app);
     let state = Grab(images.iter().map(Handle::id).collect(), Arc::default(), Arc::default());
     let render = app.sub_app_mut(RenderApp);
     render.insert_resource(state.clone());
@@ -164,6 +160,15 @@ pub fn render_images(app: &mut App, images: &[Handle<Image>], frames: usize) -> 
     *state.2.lock().unwrap() = true;
     app.update();
     state.1.lock().unwrap().take().expect("the render world read the images")
+}
+
+/// Finishes building an app that is updated by hand (what `App::run` does first).
+pub fn finish(app: &mut App) {
+    while app.plugins_state() == PluginsState::Adding {
+        bevy::tasks::tick_global_task_pools_on_main_thread();
+    }
+    app.finish();
+    app.cleanup();
 }
 
 /// Pictures side by side (same height) into one PNG.
