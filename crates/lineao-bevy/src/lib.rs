@@ -63,6 +63,11 @@ pub use lineao;
 pub use polylines::Polylines;
 pub use render::{LineAoSystems, LineAoViews, ViewAo};
 
+// The README's code compiles as it stands: `cargo test --doc` checks it.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;
+
 /// Adds lineao's passes to every 3D camera that has a [`LineAo`], and draws [`Polylines`].
 pub struct LineAoPlugin;
 

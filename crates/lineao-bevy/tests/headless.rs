@@ -324,7 +324,7 @@ fn cameras_switches_missing_prepass_and_bad_settings() {
     meshes(&mut app);
     let ldr = target(&mut app, TextureFormat::Rgba8UnormSrgb);
     let hdr = target(&mut app, TextureFormat::Rgba16Float);
-    let first = camera(&mut app, ldr, Some(LineAo::default()));
+    let first = camera(&mut app, ldr.clone(), Some(LineAo::default()));
     let second = camera(&mut app, hdr, Some(LineAo::with_method(AoMethod::Ssao)));
     app.world_mut().entity_mut(second).insert(Hdr);
     let captured = run(&mut app, 2);
@@ -357,4 +357,36 @@ fn cameras_switches_missing_prepass_and_bad_settings() {
     app.world_mut().entity_mut(first).insert(LineAo::default());
     let captured = run(&mut app, 0);
     assert_eq!(ao_of(&captured, first), first_ao, "the default settings again give the first frame's AO");
+
+    // The target resized: the chain follows.
+    let extent = bevy::render::render_resource::Extent3d { width: 96, height: 64, depth_or_array_layers: 1 };
+    app.world_mut().resource_mut::<Assets<Image>>().get_mut(&ldr).unwrap().resize(extent);
+    let captured = run(&mut app, 1);
+    assert_eq!(ao_of(&captured, first).len(), 96 * 64);
+}
+
+/// MSAA: the AO reads the multisampled depth (normals reconstructed from it: Bevy's normal
+/// prepass is multisampled too) and still darkens the contacts and leaves open ground; the
+/// polylines, which need one sample, are skipped with a warning that says so.
+#[test]
+fn msaa_reads_the_multisampled_depth_and_skips_polylines() {
+    let (mut app, _probe) = probed_app();
+    meshes(&mut app);
+    let (positions, offsets) = helices();
+    app.world_mut().spawn(Polylines::new(positions, offsets).unwrap());
+    let image = target(&mut app, TextureFormat::Rgba8UnormSrgb);
+    let camera = camera(&mut app, image, Some(LineAo::default()));
+    app.world_mut().entity_mut(camera).insert(Msaa::Sample4);
+    let captured = run(&mut app, 2);
+    let (_, warnings, meshes) = &captured.views[0];
+    assert_eq!(warnings.len(), 1, "{warnings:?}");
+    assert!(warnings[0].contains("Msaa::Off"), "{warnings:?}");
+    let (ao, _) = meshes.as_ref().expect("the meshes' AO ran with MSAA");
+    let at = |p: Vec3| {
+        let (x, y) = pixel_of(p);
+        ao.data[y * ao.width + x]
+    };
+    let (open, contact) = (at(Vec3::new(-1.5, 0.0, 1.5)), at(Vec3::new(0.0, 0.0, 0.53)));
+    println!("MSAA 4: open ground {open}, contact {contact}");
+    assert!(open < 0.02 && contact > 0.1, "open ground {open}, contact {contact}");
 }
