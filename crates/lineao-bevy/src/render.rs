@@ -341,7 +341,16 @@ fn lineao_camera(view: &ExtractedView) -> lineao::Camera {
     lineao::Camera { eye, target: eye + forward, up, projection }
 }
 
-#[allow(clippy::too_many_arguments)]
+/// The merged polylines on the GPU, with their scalars.
+fn upload(device: &wgpu::Device, queue: &wgpu::Queue, merged: &MergedLines) -> Result<LineGeometry, lineao::Error> {
+    let mut geometry = LineGeometry::new(device, queue, &merged.positions, &merged.offsets)?;
+    if let Some(scalars) = &merged.scalars {
+        let attributes = lineao::passes::lines::VertexAttributes { scalar: Some(scalars), ..Default::default() };
+        geometry.set_attributes(device, queue, &attributes)?;
+    }
+    Ok(geometry)
+}
+
 fn prepare(
     mut views: ResMut<LineAoViews>,
     mut lines: ResMut<RenderLines>,
@@ -351,18 +360,12 @@ fn prepare(
 ) {
     let (device, queue): (&wgpu::Device, &wgpu::Queue) = (device.wgpu_device(), &queue);
     if let Some(merged) = lines.pending.take() {
-        lines.geometry = None;
-        let made = LineGeometry::new(device, queue, &merged.positions, &merged.offsets).and_then(|mut geometry| {
-            if let Some(scalars) = &merged.scalars {
-                let attributes =
-                    lineao::passes::lines::VertexAttributes { scalar: Some(scalars), ..Default::default() };
-                geometry.set_attributes(device, queue, &attributes)?;
-            }
-            Ok(geometry)
-        });
+        // No visible polylines (all removed or hidden): nothing to draw, nothing to say.
+        let made = (!merged.positions.is_empty()).then(|| upload(device, queue, &merged)).transpose();
         match made {
-            Ok(geometry) => (lines.geometry, lines.error) = (Some(geometry).filter(|g| g.bounds.is_some()), None),
+            Ok(geometry) => (lines.geometry, lines.error) = (geometry.filter(|g| g.bounds.is_some()), None),
             Err(error) => {
+                lines.geometry = None;
                 let error = error.to_string();
                 if lines.error.as_ref() != Some(&error) {
                     warn!("Polylines not drawn: {error}");

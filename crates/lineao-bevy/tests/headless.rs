@@ -262,7 +262,7 @@ fn the_plugin_adds_no_error_to_lineaos_chains() {
     let (mut app, probe) = probed_app();
     meshes(&mut app);
     let (positions, offsets) = helices();
-    app.world_mut().spawn(Polylines::new(positions.clone(), offsets.clone()).unwrap());
+    let polylines = app.world_mut().spawn(Polylines::new(positions.clone(), offsets.clone()).unwrap()).id();
     let image = target(&mut app, TextureFormat::Rgba8UnormSrgb);
     let ao = LineAo::default();
     let camera = camera(&mut app, image, Some(ao.clone()));
@@ -312,6 +312,13 @@ fn the_plugin_adds_no_error_to_lineaos_chains() {
     println!("lines: {agreement:?}");
     let lines = nd.data.iter().filter(|p| p[..3] != [0.0; 3]).count();
     assert!(lines > 500, "the helices cover {lines} pixels");
+
+    // The polylines despawned: the frame renders, nothing is said.
+    app.world_mut().despawn(polylines);
+    *probe.standalone.lock().unwrap() = None;
+    let captured = run(&mut app, 1);
+    assert!(captured.views[0].1.is_empty(), "{:?}", captured.views[0].1);
+    assert!(captured.views[0].2.is_some(), "the meshes' AO still runs");
 }
 
 /// Two cameras, one HDR: each gets its own chains in its target's format; switching one's
