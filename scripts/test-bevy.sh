@@ -17,4 +17,4 @@ cargo test "${flags[@]}"
 mkdir -p target/screenshots
 cargo run -q "${flags[@]}" --example meshes -- --screenshot target/screenshots/meshes.png
 cargo run -q "${flags[@]}" --example tractogram -- --scene bundles --screenshot target/screenshots/tractogram.png
-echo "test-bevy: tests and examples passed; screenshots in crates/lineao-bevy/target/screenshots"
+echo "test-bevy: tests and examples passed in ${SECONDS} s; screenshots in crates/lineao-bevy/target/screenshots"
