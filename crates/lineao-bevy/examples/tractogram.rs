@@ -5,7 +5,7 @@
 //! opens any file lineao-tracts reads (.trk, .tck, .trx, .vtk, … gzip'd or not) or a built-in
 //! scene (default `bundles`). Drag to turn, scroll to zoom; keys 1–4 switch the first window's
 //! method (LineAO, SSAO, VO line, VO area), 0 its AO off and on. `--no-compare`: one window.
-//! `-- --screenshot compare.png` renders LineAO | SSAO side by side without a window.
+//! `-- --screenshot compare.png` renders no AO | LineAO | SSAO side by side without a window.
 
 mod common;
 
@@ -84,8 +84,11 @@ fn main() {
     };
     let (width, height) = (640, 560);
     let mut images = app.world_mut().resource_mut::<Assets<Image>>();
-    let targets = [common::target_image(&mut images, width, height), common::target_image(&mut images, width, height)];
-    for (target, ao) in targets.iter().zip([LineAo::default(), ssao()]) {
+    let targets: Vec<_> = (0..3).map(|_| common::target_image(&mut images, width, height)).collect();
+    // No AO (the lines' strength 0) | LineAO | Crytek SSAO.
+    let mut none = LineAo::default();
+    none.lines.strength = 0.0;
+    for (target, ao) in targets.iter().zip([none, LineAo::default(), ssao()]) {
         app.world_mut().spawn((
             common::camera_3d(),
             projection(),

@@ -57,7 +57,7 @@ mod render;
 
 use bevy::core_pipeline::prepass::{DepthPrepass, NormalPrepass};
 use bevy::prelude::*;
-use lineao::{AoMethod, Bounds, ChainSettings};
+use lineao::{AoMethod, Bounds, ChainSettings, Preset};
 
 pub use lineao;
 pub use polylines::Polylines;
@@ -118,17 +118,19 @@ impl Default for LineAo {
 }
 
 impl LineAo {
-    /// The default with `method` for both the meshes and the polylines (each with that
-    /// method's default settings otherwise).
+    /// The default with `method` for both the meshes and the polylines ([`LineAo::set_method`]).
     pub fn with_method(method: AoMethod) -> LineAo {
         let mut ao = LineAo::default();
         ao.set_method(method);
         ao
     }
 
-    /// Switches the meshes' and the polylines' method; the chain is rebuilt at the next frame.
+    /// Switches the meshes' and the polylines' method; the chains are rebuilt at the next frame.
+    /// The polylines get the method's strength and reach of lineao's default preset, as
+    /// `lineao render --method` and the viewer do ([`ChainSettings::with_preset`]); the meshes
+    /// keep their world-unit reach and strength (the presets are made for lines).
     pub fn set_method(&mut self, method: AoMethod) {
         self.settings.method = method;
-        self.lines.method = method;
+        self.lines = ChainSettings { method, ..self.lines.clone() }.with_preset(Preset::default());
     }
 }
