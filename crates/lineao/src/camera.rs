@@ -84,8 +84,10 @@ impl Bounds {
 }
 
 /// Everything about one frame's view that the passes need: matrices for the guard-banded
-/// G-buffer, the depth range and the zoom.
+/// G-buffer, the depth range and the zoom. With `serde` it travels with a frame read back
+/// elsewhere (the web page's), for the CPU reference to run on exactly what the passes saw.
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct FrameView {
     pub view: Mat4,
     /// Projection of the guard-banded G-buffer (wgpu clip space, depth in [0, 1]).

@@ -331,7 +331,8 @@ fn build_node(items: &mut [Item], base: u32, depth: u32, leaf: usize, nodes: &mu
     let me = nodes.len();
     nodes.push(Node { min: bounds.lo.into(), first: base, max: bounds.hi.into(), count: items.len() as u32 });
     let Some(mid) = split(items, &bounds, &centroids, leaf) else { return };
-    let parallel = items.len() >= PARALLEL_MIN && depth < PARALLEL_DEPTH;
+    // A web page has no threads: there the tree is built on the page's own.
+    let parallel = items.len() >= PARALLEL_MIN && depth < PARALLEL_DEPTH && !cfg!(target_arch = "wasm32");
     let (left, right) = items.split_at_mut(mid);
     if parallel {
         let right_base = base + mid as u32;
