@@ -44,6 +44,12 @@ pub enum Source {
         seed: u64,
     },
     File(PathBuf),
+    /// A file's bytes already in memory, under its name (whose extension, and `.gz`, tell the
+    /// format): a file dropped on or fetched by the web page, which has no file system.
+    Bytes {
+        name: String,
+        bytes: std::sync::Arc<[u8]>,
+    },
 }
 
 /// A loaded source: its name (the scene's, or the file's path), its streamlines and the
@@ -59,7 +65,7 @@ impl Source {
     pub fn load_on_terminal(&self) -> Result<Loaded> {
         let bar = match self {
             Source::File(path) => progress_bar(path),
-            Source::Scene { .. } => None,
+            Source::Scene { .. } | Source::Bytes { .. } => None,
         };
         let Some(bar) = bar else { return self.load(None) };
         let loaded = self.load(Some(&mut |p: Progress| {
@@ -86,6 +92,14 @@ impl Source {
                 }
                 let hint = ViewHint::for_tractogram(&loaded.tractogram);
                 Ok(Loaded { name: path.display().to_string(), tracts: loaded.tractogram, hint })
+            }
+            Source::Bytes { name, bytes } => {
+                let loaded = lineao_tracts::load_from_bytes(bytes, name, &Default::default())?;
+                if !loaded.tractogram.has_points() {
+                    return Err(SourceError::ValuesWithoutPoints { path: name.clone(), format: loaded.format.name() });
+                }
+                let hint = ViewHint::for_tractogram(&loaded.tractogram);
+                Ok(Loaded { name: name.clone(), tracts: loaded.tractogram, hint })
             }
         }
     }

@@ -161,6 +161,7 @@ fn cancel_on_ctrl_c() -> &'static AtomicBool {
     static HANDLER: OnceLock<()> = OnceLock::new();
     HANDLER.get_or_init(|| {
         // Without a handler (another one is installed) Ctrl-C ends the process as usual.
+        #[cfg(not(target_arch = "wasm32"))]
         let _ = ctrlc::set_handler(|| CANCEL.store(true, Ordering::Relaxed));
     });
     &CANCEL
