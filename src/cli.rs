@@ -75,6 +75,10 @@ pub struct ViewArgs {
     /// Start with an orthographic camera.
     #[arg(long)]
     pub ortho: bool,
+    /// Start the orbit camera at AZIMUTH and ELEVATION (degrees around the data's up) and ZOOM
+    /// times the data's default distance: what a web page's link keeps of the view.
+    #[arg(long, value_name = "AZIMUTH,ELEVATION,ZOOM", value_parser = parse_orbit)]
+    pub orbit: Option<[f32; 3]>,
     /// Show each pass's GPU time over the image.
     #[arg(long)]
     pub timings: bool,
@@ -92,6 +96,17 @@ pub struct ViewArgs {
     /// With --screenshot: UI frames to run at least before saving.
     #[arg(long, default_value_t = 3, requires = "screenshot")]
     pub frames: u32,
+}
+
+fn parse_orbit(s: &str) -> Result<[f32; 3], String> {
+    let values: Vec<Option<f32>> =
+        s.split(',').map(|v| v.trim().parse::<f32>().ok().filter(|v| v.is_finite())).collect();
+    match values[..] {
+        [Some(azimuth), Some(elevation), Some(zoom)] if zoom > 0.0 && elevation.abs() <= 90.0 => {
+            Ok([azimuth, elevation, zoom])
+        }
+        _ => Err(format!("expected AZIMUTH,ELEVATION,ZOOM (degrees, degrees within ±90, a factor > 0), got '{s}'")),
+    }
 }
 
 fn parse_size(s: &str) -> Result<[u32; 2], String> {

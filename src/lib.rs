@@ -4,6 +4,8 @@
 //! its module names.
 
 pub mod bench;
+// Child processes and their peak memory (`wait4`): not in a web page.
+#[cfg(not(target_arch = "wasm32"))]
 pub mod bench_load;
 pub mod cli;
 pub mod fit;

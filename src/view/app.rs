@@ -5,11 +5,20 @@
 //! the last one requested goes to the render thread ([`super::worker`]), and finished frames
 //! come back as textures. The window never waits for the GPU: while a frame renders, the last
 //! one stays on screen (stretched if the window was resized) and input goes on.
+//!
+//! In a web page ([`App::inline`]) the worker runs on the page's thread, one step per UI frame,
+//! and its frames are textures on the window's own device.
 
+use std::cell::RefCell;
 use std::path::PathBuf;
-use std::sync::mpsc::{self, Receiver, Sender};
+use std::rc::Rc;
+#[cfg(not(target_arch = "wasm32"))]
+use std::sync::mpsc;
+use std::sync::mpsc::{Receiver, Sender};
 use std::sync::{Arc, Mutex};
-use std::time::{Duration, Instant};
+use std::time::Duration;
+
+use web_time::Instant;
 
 use egui::emath::GuiRounding;
 use egui::{Align2, Color32, ColorImage, FontId, Key, PointerButton, Pos2, Rect, Sense, TextureHandle, Vec2};
@@ -18,16 +27,19 @@ use lineao_tracts::SceneKind;
 
 use super::camera::OrbitCamera;
 use super::controls::{ColorMode, Controls, method_label};
-use super::worker::{self, Dataset, Frame, FromWorker, PREVIEW_VERTICES, Source, ToWorker, View};
+use super::worker::{self, Dataset, Frame, FromWorker, Output, PREVIEW_VERTICES, Source, ToWorker, View, Worker};
 
 /// How long after the last camera motion frames stay previews.
 const MOTION_REST: Duration = Duration::from_millis(300);
 
 /// What the viewer opens with.
 pub struct Options {
-    pub source: Source,
+    /// What to open first (`None`: nothing yet — the web page fetching `?url=`).
+    pub source: Option<Source>,
     pub controls: Controls,
     pub orthographic: bool,
+    /// `--orbit`: the camera of each dataset opened, as [`OrbitCamera::set_orbit_values`] takes.
+    pub orbit: Option<[f32; 3]>,
     /// `--screenshot PNG --frames N`: save the window after N frames once the image is complete,
     /// then close.
     pub screenshot: Option<(PathBuf, u32)>,
@@ -47,14 +59,40 @@ struct Loading {
     total: Option<u64>,
 }
 
+/// Where the worker runs.
+#[cfg_attr(target_arch = "wasm32", allow(dead_code))]
+enum Backend {
+    /// The native window: a render thread with a device of its own.
+    Thread {
+        /// `None` once dropped, which ends the render thread.
+        to_worker: Option<Sender<ToWorker>>,
+        render_thread: Option<std::thread::JoinHandle<()>>,
+        from_worker: Receiver<FromWorker>,
+    },
+    /// A web page: the worker on the page's thread and the window's device, one step at a time
+    /// run as a future of the page (it awaits the device's validation), started by the UI.
+    Inline {
+        worker: Rc<RefCell<Worker>>,
+        /// Whether a step is running (it holds the worker).
+        stepping: Rc<std::cell::Cell<bool>>,
+        /// What the steps sent.
+        inbox: Rc<RefCell<Vec<FromWorker>>>,
+        pending: Vec<ToWorker>,
+        /// The UI frame that last queued a command: commands wait one frame, so that what the
+        /// window says ("loading …") is painted before a step holds the page.
+        queued_at: u64,
+        render_state: eframe::egui_wgpu::RenderState,
+        /// The panels' textures as the window's renderer knows them.
+        ids: Vec<egui::TextureId>,
+    },
+}
+
 pub struct App {
-    /// `None` once dropped, which ends the render thread.
-    to_worker: Option<Sender<ToWorker>>,
-    render_thread: Option<std::thread::JoinHandle<()>>,
-    from_worker: Receiver<FromWorker>,
+    backend: Backend,
     pub controls: Controls,
     pub camera: Option<OrbitCamera>,
     orthographic: bool,
+    orbit: Option<[f32; 3]>,
     pub dataset: Option<Dataset>,
     loading: Option<Loading>,
     /// What the render thread is busy with besides rendering (object-space AO).
@@ -77,10 +115,13 @@ pub struct App {
     screenshot_requested: bool,
     pub outcome: Arc<Mutex<Outcome>>,
     frames: u64,
+    /// File ▸ Open… where the app has no file dialog of its own (the web page's file input).
+    pub open_file: Option<Box<dyn Fn()>>,
 }
 
 impl App {
     /// The viewer on `ctx`, whose repaint the render thread requests when a frame is ready.
+    #[cfg(not(target_arch = "wasm32"))]
     pub fn new(ctx: &egui::Context, options: Options) -> App {
         let (to_worker, worker_rx) = mpsc::channel();
         let (worker_tx, from_worker) = mpsc::channel();
@@ -89,14 +130,34 @@ impl App {
             .name("lineao-render".into())
             .spawn(move || worker::run(worker_rx, worker_tx, move || ctx.request_repaint()))
             .expect("spawning the render thread");
+        let backend = Backend::Thread { to_worker: Some(to_worker), render_thread: Some(render_thread), from_worker };
+        App::with_backend(backend, options)
+    }
+
+    /// The viewer of a web page: its worker on this thread, rendering with the window's device
+    /// (`render_state`), wrapped in `gpu` (lineao's device-lost callback installed).
+    pub fn inline(gpu: lineao::Gpu, render_state: eframe::egui_wgpu::RenderState, options: Options) -> App {
+        let worker = Rc::new(RefCell::new(Worker::new(gpu, Output::Textures)));
+        let backend = Backend::Inline {
+            worker,
+            stepping: Rc::default(),
+            inbox: Rc::default(),
+            pending: Vec::new(),
+            queued_at: 0,
+            render_state,
+            ids: Vec::new(),
+        };
+        App::with_backend(backend, options)
+    }
+
+    fn with_backend(backend: Backend, options: Options) -> App {
         let extensions = vec!["trk", "tck", "trx", "tsf", "vtk", "vtp", "gz", "gltf", "glb", "obj"];
         let mut app = App {
-            to_worker: Some(to_worker),
-            render_thread: Some(render_thread),
-            from_worker,
+            backend,
             controls: options.controls,
             camera: None,
             orthographic: options.orthographic,
+            orbit: options.orbit,
             dataset: None,
             loading: None,
             busy: None,
@@ -117,9 +178,39 @@ impl App {
             screenshot_requested: false,
             outcome: Arc::default(),
             frames: 0,
+            open_file: None,
         };
-        app.load(options.source);
+        if let Some(source) = options.source {
+            app.load(source);
+        }
         app
+    }
+
+    /// The worker, where it runs on this thread (the web page) and no step holds it.
+    pub fn worker(&self) -> Option<std::cell::Ref<'_, Worker>> {
+        match &self.backend {
+            Backend::Inline { worker, .. } => worker.try_borrow().ok(),
+            Backend::Thread { .. } => None,
+        }
+    }
+
+    /// Whether a file is being read or a dataset being built.
+    pub fn is_loading(&self) -> bool {
+        self.loading.is_some()
+    }
+
+    /// The message on screen for a failure, if any.
+    pub fn error(&self) -> Option<&str> {
+        self.error.as_deref()
+    }
+
+    /// Shows `name` as loading, `bytes` of `total` read: a file being read outside the worker
+    /// (the web page fetching it).
+    pub fn show_loading(&mut self, name: &str, bytes: u64, total: Option<u64>) {
+        if self.loading.as_ref().is_none_or(|l| l.name != name) {
+            (self.dataset, self.shown, self.requested, self.error, self.busy) = (None, None, None, None, None);
+        }
+        self.loading = Some(Loading { name: name.to_string(), bytes, total });
     }
 
     /// Opens a file or builds a scene (on the render thread).
@@ -127,15 +218,52 @@ impl App {
         let name = match &source {
             Source::Scene { kind, .. } => format!("scene {}", kind.name()),
             Source::File(path) => path.display().to_string(),
+            Source::Bytes { name, .. } => name.clone(),
         };
         self.loading = Some(Loading { name, bytes: 0, total: None });
         (self.dataset, self.shown, self.requested, self.error, self.busy) = (None, None, None, None, None);
         self.send(ToWorker::Load(source));
     }
 
-    fn send(&self, message: ToWorker) {
-        if let Some(to_worker) = &self.to_worker {
-            let _ = to_worker.send(message);
+    fn send(&mut self, message: ToWorker) {
+        match &mut self.backend {
+            Backend::Thread { to_worker, .. } => {
+                if let Some(to_worker) = to_worker {
+                    let _ = to_worker.send(message);
+                }
+            }
+            Backend::Inline { pending, queued_at, .. } => {
+                pending.push(message);
+                *queued_at = self.frames;
+            }
+        }
+    }
+
+    /// What the worker sent: from the render thread, or from a step of the inline worker.
+    // A step holds the worker across its awaits by design: nothing else borrows it mutably, the
+    // UI starts no step while one runs (`stepping`) and only `try_borrow`s it ([`App::worker`]).
+    #[allow(clippy::await_holding_refcell_ref)]
+    fn messages(&mut self, ctx: &egui::Context) -> Vec<FromWorker> {
+        match &mut self.backend {
+            Backend::Thread { from_worker, .. } => from_worker.try_iter().collect(),
+            Backend::Inline { worker, stepping, inbox, pending, queued_at, .. } => {
+                let ready = !pending.is_empty() && self.frames > *queued_at;
+                if !pending.is_empty() && !ready {
+                    ctx.request_repaint();
+                }
+                if !stepping.get() && (ready || worker.borrow().continuing()) {
+                    stepping.set(true);
+                    let (worker, stepping, sink, ctx) = (worker.clone(), stepping.clone(), inbox.clone(), ctx.clone());
+                    let commands = std::mem::take(pending);
+                    spawn(async move {
+                        let mut worker = worker.borrow_mut();
+                        worker.step_async(commands, &|m| sink.borrow_mut().push(m)).await;
+                        stepping.set(false);
+                        ctx.request_repaint();
+                    });
+                }
+                inbox.take()
+            }
         }
     }
 
@@ -156,8 +284,8 @@ impl App {
             && self.shown.as_ref().map(|f| &f.view) == self.requested.as_ref()
     }
 
-    /// The message shown for a failure, if any.
-    fn fail(&mut self, message: String) {
+    /// Shows `message` as a failure (and ends a load in progress).
+    pub fn fail(&mut self, message: String) {
         if self.loading.take().is_some() {
             (self.dataset, self.shown) = (None, None);
         }
@@ -167,7 +295,7 @@ impl App {
     }
 
     fn receive(&mut self, ctx: &egui::Context) {
-        while let Ok(message) = self.from_worker.try_recv() {
+        for message in self.messages(ctx) {
             match message {
                 FromWorker::Progress { bytes, total } => {
                     if let Some(loading) = &mut self.loading {
@@ -178,6 +306,9 @@ impl App {
                     self.loading = None;
                     let mut camera = OrbitCamera::from_hint(&dataset.hint);
                     camera.orthographic = self.orthographic;
+                    if let Some(orbit) = self.orbit {
+                        camera.set_orbit_values(orbit);
+                    }
                     self.camera = Some(camera);
                     self.controls.set_zoom_unit(dataset.hint.zoom_unit);
                     if let ColorMode::Field(name) = &self.controls.color
@@ -190,6 +321,17 @@ impl App {
                 FromWorker::Frame(frame) if self.loading.is_none() => {
                     self.busy = None;
                     self.frames_received += 1;
+                    if let Backend::Inline { render_state, ids, .. } = &mut self.backend {
+                        let mut renderer = render_state.renderer.write();
+                        ids.truncate(frame.textures.len());
+                        for (i, view) in frame.textures.iter().enumerate() {
+                            let (device, filter) = (&render_state.device, wgpu::FilterMode::Linear);
+                            match ids.get(i) {
+                                Some(&id) => renderer.update_egui_texture_from_wgpu_texture(device, view, filter, id),
+                                None => ids.push(renderer.register_native_texture(device, view, filter)),
+                            }
+                        }
+                    }
                     let (w, h) = (frame.size.0 as usize, frame.size.1 as usize);
                     self.textures.truncate(frame.images.len());
                     for (i, bytes) in frame.images.iter().enumerate() {
@@ -207,6 +349,11 @@ impl App {
                 }
                 FromWorker::Frame(_) => {}
                 FromWorker::Busy(what) => self.busy = Some(what),
+                FromWorker::Times(times) => {
+                    if let Some(frame) = &mut self.shown {
+                        frame.times = times;
+                    }
+                }
                 FromWorker::Error(message) => self.fail(message),
             }
         }
@@ -255,7 +402,10 @@ impl App {
             egui::MenuBar::new().ui(ui, |ui| {
                 ui.menu_button("File", |ui| {
                     if ui.button("Open…").clicked() {
-                        self.open_dialog.pick_file();
+                        match &self.open_file {
+                            Some(open) => open(),
+                            None => self.open_dialog.pick_file(),
+                        }
                         ui.close();
                     }
                     ui.menu_button("Built-in scene", |ui| {
@@ -266,12 +416,16 @@ impl App {
                             }
                         }
                     });
-                    if ui.button("Save screenshot…").clicked() {
-                        self.save_dialog.save_file();
-                        ui.close();
-                    }
-                    if ui.button("Quit").clicked() {
-                        ui.ctx().send_viewport_cmd(egui::ViewportCommand::Close);
+                    // A page has no file system to save to (the browser saves its screenshots) and
+                    // is closed as a tab.
+                    if matches!(self.backend, Backend::Thread { .. }) {
+                        if ui.button("Save screenshot…").clicked() {
+                            self.save_dialog.save_file();
+                            ui.close();
+                        }
+                        if ui.button("Quit").clicked() {
+                            ui.ctx().send_viewport_cmd(egui::ViewportCommand::Close);
+                        }
                     }
                 });
                 ui.menu_button("View", |ui| {
@@ -327,7 +481,8 @@ impl App {
                     ui.label("rendering…");
                 } else if let Some(frame) = &self.shown {
                     let (w, h) = frame.size;
-                    ui.label(format!("{w} × {h} px · {:.0} ms (render and read back)", frame.render_ms));
+                    let what = if frame.images.is_empty() { "recorded" } else { "render and read back" };
+                    ui.label(format!("{w} × {h} px · {:.0} ms ({what})", frame.render_ms));
                     for status in frame.rays.iter().flatten() {
                         ui.separator();
                         if !status.progress.converged() {
@@ -350,17 +505,21 @@ impl App {
         painter.rect_filled(rect, 0.0, Color32::from_gray(255));
         let uv = |a: f32, b: f32| Rect::from_min_max(Pos2::new(a, 0.0), Pos2::new(b, 1.0));
         let split = rect.left() + self.divider * rect.width();
-        match (&self.shown, &self.textures[..]) {
+        let ids: Vec<egui::TextureId> = match &self.backend {
+            Backend::Inline { ids, .. } => ids.clone(),
+            Backend::Thread { .. } => self.textures.iter().map(TextureHandle::id).collect(),
+        };
+        match (&self.shown, &ids[..]) {
             (Some(_), [only]) => {
-                painter.image(only.id(), rect, uv(0.0, 1.0), Color32::WHITE);
+                painter.image(*only, rect, uv(0.0, 1.0), Color32::WHITE);
             }
             (Some(_), [left, right]) => {
                 let (l, r) = (
                     Rect::from_x_y_ranges(rect.left()..=split, rect.y_range()),
                     Rect::from_x_y_ranges(split..=rect.right(), rect.y_range()),
                 );
-                painter.image(left.id(), l, uv(0.0, self.divider), Color32::WHITE);
-                painter.image(right.id(), r, uv(self.divider, 1.0), Color32::WHITE);
+                painter.image(*left, l, uv(0.0, self.divider), Color32::WHITE);
+                painter.image(*right, r, uv(self.divider, 1.0), Color32::WHITE);
             }
             _ => {
                 let text = match (&self.loading, &self.error) {
@@ -554,9 +713,11 @@ impl Drop for App {
     /// Ends the render thread and waits for it: a process must not exit while another thread
     /// still submits Vulkan work (lavapipe's teardown then corrupts its heap).
     fn drop(&mut self) {
-        self.to_worker = None;
-        if let Some(thread) = self.render_thread.take() {
-            let _ = thread.join();
+        if let Backend::Thread { to_worker, render_thread, .. } = &mut self.backend {
+            *to_worker = None;
+            if let Some(thread) = render_thread.take() {
+                let _ = thread.join();
+            }
         }
     }
 }
@@ -598,16 +759,27 @@ fn panel_label(panel: &worker::Panel) -> String {
     label
 }
 
+/// Runs a step of the inline worker: as a task of the page, or (natively, where nothing runs
+/// an app inline but tests might) to its end.
+fn spawn(step: impl std::future::Future<Output = ()> + 'static) {
+    #[cfg(target_arch = "wasm32")]
+    wasm_bindgen_futures::spawn_local(step);
+    #[cfg(not(target_arch = "wasm32"))]
+    pollster::block_on(step);
+}
+
 /// What the status bar says of a ray-traced picture: rays per pixel so far and the speed.
 pub fn ray_status(status: &worker::RayStatus) -> String {
     let p = status.progress;
-    let speed = status.rays_per_second;
-    let speed =
-        if speed >= 1e6 { format!("{:.1} M rays/s", speed / 1e6) } else { format!("{:.0} k rays/s", speed / 1e3) };
+    let speed = match status.rays_per_second {
+        Some(speed) if speed >= 1e6 => format!(" · {:.1} M rays/s", speed / 1e6),
+        Some(speed) => format!(" · {:.0} k rays/s", speed / 1e3),
+        None => String::new(),
+    };
     if p.converged() {
         format!("ray traced: {} rays per pixel, complete", p.rays_per_pixel)
     } else {
-        format!("ray traced: {} of {} rays per pixel · {speed}", p.rays_per_pixel, p.max_rays)
+        format!("ray traced: {} of {} rays per pixel{speed}", p.rays_per_pixel, p.max_rays)
     }
 }
 

@@ -86,6 +86,20 @@ impl OrbitCamera {
         self.distance = (self.distance * factor).clamp(1e-3, 1e7);
     }
 
+    /// Azimuth and elevation in degrees, and the distance as a factor of the home distance:
+    /// `--orbit`'s values of this view.
+    pub fn orbit_values(&self) -> [f32; 3] {
+        [self.yaw.to_degrees(), self.pitch.to_degrees(), self.distance / self.home.1]
+    }
+
+    /// Turns to `--orbit`'s values ([`OrbitCamera::orbit_values`]) around the current target.
+    pub fn set_orbit_values(&mut self, [azimuth, elevation, zoom]: [f32; 3]) {
+        let limit = 89f32.to_radians();
+        self.yaw = azimuth.to_radians();
+        self.pitch = elevation.to_radians().clamp(-limit, limit);
+        self.distance = (self.home.1 * zoom).clamp(1e-3, 1e7);
+    }
+
     pub fn reset(&mut self) {
         (self.target, self.distance, self.yaw, self.pitch) = self.home;
     }
@@ -117,5 +131,13 @@ mod tests {
         camera.orthographic = true;
         let lineao::Projection::Orthographic { height } = camera.camera().projection else { panic!() };
         assert!((height - 2.0 * d * 15f32.to_radians().tan()).abs() < 1e-3);
+        // --orbit's values round-trip.
+        camera.orbit(0.4, 0.2);
+        camera.zoom(0.7);
+        let values = camera.orbit_values();
+        let eye = camera.eye();
+        camera.reset();
+        camera.set_orbit_values(values);
+        assert!(camera.eye().distance(eye) < 1e-3, "{values:?}");
     }
 }

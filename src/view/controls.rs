@@ -18,10 +18,16 @@ use super::worker::Panel;
 use crate::cli::Method;
 
 /// The methods the selector offers: `render --grid`'s ([`Method::all`], in its order), then
-/// the ray-traced truth converging while the view rests.
+/// the ray-traced truth converging while the view rests. A web page leaves out object-space AO
+/// ([`WEB_LEAVES_OUT`]).
 pub fn methods() -> Vec<Method> {
-    Method::all().into_iter().chain([RAY_TRACED]).collect()
+    let web = cfg!(target_arch = "wasm32");
+    Method::all().into_iter().chain([RAY_TRACED]).filter(|m| !web || m.volume.is_none()).collect()
 }
+
+/// Why a web page has no object-space AO: what it computes on the CPU runs on threads.
+pub const WEB_LEAVES_OUT: &str = "Object-space AO (occlusion sweep, variance volume) is left out of the web page: it \
+    computes on CPU threads, which a page does not have. `lineao view` has it.";
 
 /// The GPU ray tracer ([`lineao::method::raytraced`]), progressive.
 pub const RAY_TRACED: Method = Method { screen: AoMethod::RayTraced, volume: None };
@@ -210,6 +216,9 @@ impl Controls {
         ui.checkbox(&mut self.compare, "Compare side by side").on_hover_text("Drag the divider to move it");
         if self.compare {
             method_combo(ui, "method-right", &mut self.methods[1]);
+        }
+        if cfg!(target_arch = "wasm32") {
+            ui.small(WEB_LEAVES_OUT);
         }
         ui.separator();
 

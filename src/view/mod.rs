@@ -6,22 +6,28 @@
 //! - [`worker`]: the render thread with its own device, so that seconds-long lavapipe frames
 //!   never block input; previews while the camera moves.
 //! - [`camera`]: the orbit camera.
+//!
+//! The same viewer runs in a web page (the crate `lineao-web`): there the worker is stepped on
+//! the page's thread ([`App::inline`]) and the options come from the page's URL.
 
-mod app;
-mod camera;
-mod controls;
+pub mod app;
+pub mod camera;
+pub mod controls;
 #[cfg(test)]
 mod tests;
-mod worker;
+pub mod worker;
 
+#[cfg(not(target_arch = "wasm32"))]
 use anyhow::{Context, Result};
 
 use crate::cli::{ColorArg, GeometryArg, ViewArgs};
 use controls::{ColorMode, Controls, Geometry};
 use worker::Source;
 
-/// The viewer's opening state from the command line.
-fn options(args: &ViewArgs) -> app::Options {
+pub use app::{App, Options};
+
+/// The viewer's opening state from the command line (or a web page's URL).
+pub fn options(args: &ViewArgs) -> app::Options {
     let source = match &args.file {
         Some(path) => Source::File(path.clone()),
         None => {
@@ -50,13 +56,16 @@ fn options(args: &ViewArgs) -> app::Options {
     controls.timings = args.timings;
     controls.params.chain.raytraced.max_rays = args.rays;
     app::Options {
-        source,
+        source: Some(source),
         controls,
         orthographic: args.ortho,
+        orbit: args.orbit,
         screenshot: args.screenshot.clone().map(|path| (path, args.frames)),
     }
 }
 
+/// Opens the viewer's window and runs it until it closes.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn run(args: &ViewArgs) -> Result<()> {
     let options = options(args);
     let screenshot = options.screenshot.clone();

@@ -20,7 +20,13 @@ use lineao::Preset;
 const SIZE: [f32; 2] = [1000.0, 640.0];
 
 fn options(source: Source, methods: [crate::cli::Method; 2], compare: bool) -> Options {
-    Options { source, controls: Controls::new(methods, compare, Preset::Paper), orthographic: false, screenshot: None }
+    Options {
+        source: Some(source),
+        controls: Controls::new(methods, compare, Preset::Paper),
+        orthographic: false,
+        orbit: None,
+        screenshot: None,
+    }
 }
 
 fn scene(kind: SceneKind, vertices: usize) -> Source {

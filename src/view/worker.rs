@@ -14,8 +14,13 @@
 //! its `max_rays`. Any request ends it; the app asks for the view again (restarting the picture)
 //! when the camera or a setting changes. The ray tracer's scene (its BVH) is built once per
 //! dataset, on first use.
+//!
+//! **In a web page** there are no threads and one device, the page's: the app steps a
+//! [`Worker`] itself once per UI frame ([`Output::Textures`]), and frames stay on the GPU in
+//! textures the window's renderer draws, since reading one back would wait on the page.
 
 use std::sync::Arc;
+#[cfg(not(target_arch = "wasm32"))]
 use std::sync::mpsc::{Receiver, Sender, TryRecvError};
 
 use lineao::Camera;
@@ -68,13 +73,28 @@ pub struct Dataset {
     pub hint: ViewHint,
     /// One-column per-vertex fields, with their 2nd–98th percentile ranges.
     pub fields: Vec<(String, [f32; 2])>,
+    /// Milliseconds to parse the file (or build the scene), and to put it on the GPU.
+    pub load_ms: f64,
+    pub upload_ms: f64,
+}
+
+/// Where a worker's frames go.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Output {
+    /// Read back into RGBA images: the native window's render thread, on a device of its own.
+    Readback,
+    /// Left on the GPU in one texture per panel, which the window's renderer samples: the web
+    /// page, whose device is the window's.
+    Textures,
 }
 
 /// A rendered frame.
 pub struct Frame {
     pub view: View,
-    /// RGBA8 (sRGB) per panel, `size` each.
+    /// RGBA8 (sRGB) per panel, `size` each ([`Output::Readback`]).
     pub images: Vec<Vec<u8>>,
+    /// The panels' Rgba8UnormSrgb textures ([`Output::Textures`]).
+    pub textures: Vec<wgpu::TextureView>,
     pub size: (u32, u32),
     pub times: Vec<Option<Vec<PassTime>>>,
     /// Per panel: how far its ray-traced picture is (`None`: another method).
@@ -95,8 +115,9 @@ pub struct RayStatus {
     pub progress: RayProgress,
     /// Rays traced by the frame (its geometry pixels, guard band included, times the frame's
     /// rays per pixel) per second of the render thread's wall clock for the panel: recording,
-    /// the GPU's work and reading the image back.
-    pub rays_per_second: f64,
+    /// the GPU's work and reading the image back. `None` where frames are not read back
+    /// ([`Output::Textures`]): the wall clock then sees only the recording.
+    pub rays_per_second: Option<f64>,
 }
 
 pub enum FromWorker {
@@ -109,6 +130,9 @@ pub enum FromWorker {
     Frame(Box<Frame>),
     /// Something takes a while (computing object-space AO).
     Busy(String),
+    /// The GPU times of the frame on screen, per panel ([`Output::Textures`], which reads them
+    /// once the GPU has finished the frame, never waiting).
+    Times(Vec<Option<Vec<PassTime>>>),
     Error(String),
 }
 
@@ -136,30 +160,170 @@ struct Preview {
     attributes: AttributeKey,
 }
 
-/// Runs the worker until the app's sender is dropped. `repaint` asks the window for a frame
-/// when something arrives.
+/// The renderer behind the viewer: the loaded dataset on the GPU, a chain per panel, and the
+/// picture in progress. The native app runs it on its render thread ([`run`]); the web page
+/// steps it on its own thread.
+pub struct Worker {
+    gpu: Gpu,
+    output: Output,
+    scene: Option<Scene>,
+    chains: Vec<PanelChain>,
+    /// [`Output::Textures`]: each panel's texture.
+    textures: Vec<lineao::targets::Target>,
+    /// A view whose ray-traced picture is still accumulating: rendered again while nothing new
+    /// is asked.
+    continuing: Option<View>,
+    /// [`Output::Textures`] with timings: the frame whose GPU times are awaited.
+    timing: Option<Timing>,
+}
+
+/// A frame whose GPU times are awaited, and how often its view was rendered again for them.
+struct Timing {
+    view: View,
+    repeats: u32,
+    /// Per panel, once read.
+    times: Vec<Option<Vec<PassTime>>>,
+}
+
+/// Where times are read without waiting ([`Output::Textures`]), a view with timings is rendered
+/// this many times again once the previous frame's times are in: the times shown are then a
+/// frame's after the first, whose pipelines were new.
+pub const TIMED_REPEATS: u32 = 3;
+
+impl Worker {
+    pub fn new(gpu: Gpu, output: Output) -> Worker {
+        Worker { gpu, output, scene: None, chains: Vec::new(), textures: Vec::new(), continuing: None, timing: None }
+    }
+
+    pub fn gpu(&self) -> &Gpu {
+        &self.gpu
+    }
+
+    /// Whether a picture is still accumulating, or a frame's times are awaited (so a step has
+    /// work without commands).
+    pub fn continuing(&self) -> bool {
+        self.continuing.is_some() || self.timing.is_some()
+    }
+
+    /// Reads the awaited frame's times without waiting; `true` once every panel's are in (or
+    /// the device has no timestamp queries).
+    fn poll_times(&mut self) -> bool {
+        let Some(timing) = &mut self.timing else { return true };
+        if !self.gpu.device.features().contains(wgpu::Features::TIMESTAMP_QUERY) {
+            return true;
+        }
+        timing.times.resize(timing.view.panels.len(), None);
+        for (slot, panel) in timing.times.iter_mut().zip(&self.chains) {
+            if slot.is_none() {
+                *slot = panel.chain.try_pass_times(&self.gpu.device).ok().flatten();
+            }
+        }
+        timing.times.iter().all(Option::is_some)
+    }
+
+    /// The chain of `panel`, as the last frame left it.
+    pub fn chain(&self, panel: usize) -> Option<&AoChain> {
+        self.chains.get(panel).map(|p| &p.chain)
+    }
+
+    /// [`Worker::step_async`], blocking on it: the render thread's (native wgpu answers its
+    /// validation scopes at once).
+    #[cfg(not(target_arch = "wasm32"))]
+    pub fn step(&mut self, pending: Vec<ToWorker>, send: &dyn Fn(FromWorker)) {
+        pollster::block_on(self.step_async(pending, send));
+    }
+
+    /// Does what `pending` asks — every load in order, then the newest render asked after the
+    /// last load — or, with nothing pending, the next frame of the picture in progress. A
+    /// future: a web page's device answers validation scopes only once the page's event loop
+    /// runs, so the page awaits it where the native worker blocks.
+    pub async fn step_async(&mut self, mut pending: Vec<ToWorker>, send: &dyn Fn(FromWorker)) {
+        // Nothing asked: the awaited times, then (a few times) the same view again.
+        let mut repeats = 0;
+        if pending.is_empty() && self.continuing.is_none() {
+            if !self.poll_times() {
+                return;
+            }
+            let Some(timing) = self.timing.take() else { return };
+            send(FromWorker::Times(timing.times));
+            if timing.repeats >= TIMED_REPEATS {
+                return;
+            }
+            repeats = timing.repeats + 1;
+            pending.push(ToWorker::Render(timing.view));
+        }
+        let gpu = &self.gpu;
+        let last_load = pending.iter().rposition(|c| matches!(c, ToWorker::Load(_)));
+        let render =
+            pending.iter().rposition(|c| matches!(c, ToWorker::Render(_))).filter(|&r| last_load.is_none_or(|l| r > l));
+        if let Some(l) = last_load {
+            let ToWorker::Load(source) = &pending[l] else { unreachable!() };
+            (self.scene, self.continuing) = (None, None);
+            for panel in &mut self.chains {
+                // The old dataset's BVH is freed now, not when the next one replaces it.
+                panel.chain.set_ray_scene(&gpu.device, None);
+                panel.scene = None;
+            }
+            match load(gpu, source, send) {
+                Ok((loaded, dataset)) => {
+                    self.scene = Some(loaded);
+                    send(FromWorker::Loaded(dataset));
+                }
+                Err(e) => send(FromWorker::Error(e)),
+            }
+        }
+        let view = match render {
+            Some(r) => {
+                let ToWorker::Render(view) = pending.swap_remove(r) else { unreachable!() };
+                self.timing = None;
+                Some(view)
+            }
+            None if pending.is_empty() => self.continuing.take(),
+            None => None,
+        };
+        if let (Some(view), Some(scene)) = (view, self.scene.as_mut()) {
+            self.continuing = None;
+            let outputs = (self.output, &mut self.textures);
+            match render_frame(gpu, scene, &mut self.chains, outputs, &view, send).await {
+                Ok(frame) => {
+                    if self.output == Output::Textures && view.timings {
+                        self.timing = Some(Timing { view: view.clone(), repeats, times: Vec::new() });
+                    }
+                    if !frame.converged() {
+                        self.continuing = Some(view);
+                    }
+                    send(FromWorker::Frame(Box::new(frame)));
+                }
+                Err(e) => send(FromWorker::Error(e)),
+            }
+            // A lost device ends the picture with its reason, never a panic.
+            if let Some(why) = gpu.lost() {
+                self.continuing = None;
+                send(FromWorker::Error(format!("the GPU device was lost: {why}")));
+            }
+        }
+    }
+}
+
+/// Runs a worker on its own device until the app's sender is dropped. `repaint` asks the window
+/// for a frame when something arrives.
+#[cfg(not(target_arch = "wasm32"))]
 pub fn run(rx: Receiver<ToWorker>, tx: Sender<FromWorker>, repaint: impl Fn() + Send + 'static) {
     let send = |message: FromWorker| {
         let _ = tx.send(message);
         repaint();
     };
-    let gpu = match Gpu::headless() {
-        Ok(gpu) => gpu,
+    let mut worker = match Gpu::headless() {
+        Ok(gpu) => Worker::new(gpu, Output::Readback),
         Err(e) => {
             send(FromWorker::Error(e.to_string()));
             return;
         }
     };
-    let mut scene: Option<Scene> = None;
-    let mut chains: Vec<PanelChain> = Vec::new();
-    // A view whose ray-traced picture is still accumulating: rendered again while nothing new
-    // is asked.
-    let mut continuing: Option<View> = None;
     loop {
-        // The next command (or none, to continue a picture), then whatever else is waiting:
-        // loads in order, the newest render.
+        // The next command (or none, to continue a picture), then whatever else is waiting.
         let mut pending = Vec::new();
-        if continuing.is_none() {
+        if !worker.continuing() {
             let Ok(first) = rx.recv() else { return };
             pending.push(first);
         }
@@ -170,50 +334,7 @@ pub fn run(rx: Receiver<ToWorker>, tx: Sender<FromWorker>, repaint: impl Fn() + 
                 Err(TryRecvError::Disconnected) => return,
             }
         }
-        let last_load = pending.iter().rposition(|c| matches!(c, ToWorker::Load(_)));
-        let render =
-            pending.iter().rposition(|c| matches!(c, ToWorker::Render(_))).filter(|&r| last_load.is_none_or(|l| r > l));
-        if let Some(l) = last_load {
-            let ToWorker::Load(source) = &pending[l] else { unreachable!() };
-            (scene, continuing) = (None, None);
-            for panel in &mut chains {
-                // The old dataset's BVH is freed now, not when the next one replaces it.
-                panel.chain.set_ray_scene(&gpu.device, None);
-                panel.scene = None;
-            }
-            match load(&gpu, source, &send) {
-                Ok((loaded, dataset)) => {
-                    scene = Some(loaded);
-                    send(FromWorker::Loaded(dataset));
-                }
-                Err(e) => send(FromWorker::Error(e)),
-            }
-        }
-        let view = match render {
-            Some(r) => {
-                let ToWorker::Render(view) = pending.swap_remove(r) else { unreachable!() };
-                Some(view)
-            }
-            None if pending.is_empty() => continuing.take(),
-            None => None,
-        };
-        if let (Some(view), Some(scene)) = (view, scene.as_mut()) {
-            continuing = None;
-            match render_frame(&gpu, scene, &mut chains, &view, &send) {
-                Ok(frame) => {
-                    if !frame.converged() {
-                        continuing = Some(view);
-                    }
-                    send(FromWorker::Frame(Box::new(frame)));
-                }
-                Err(e) => send(FromWorker::Error(e)),
-            }
-            // A lost device ends the picture with its reason, never a panic.
-            if let Some(why) = gpu.lost() {
-                continuing = None;
-                send(FromWorker::Error(format!("the GPU device was lost: {why}")));
-            }
-        }
+        worker.step(pending, &send);
     }
 }
 
@@ -222,8 +343,11 @@ fn load(gpu: &Gpu, source: &Source, send: &dyn Fn(FromWorker)) -> Result<(Scene,
         send(FromWorker::Progress { bytes: p.bytes, total: p.total });
         std::ops::ControlFlow::Continue(())
     };
+    let start = web_time::Instant::now();
     let loaded = source.load(Some(&mut report)).map_err(|e| format!("{e:#}"))?;
+    let load_ms = start.elapsed().as_secs_f64() * 1e3;
     let lines = Lines::new(loaded, &gpu.device, &gpu.queue).map_err(|e| format!("{e:#}"))?;
+    let upload_ms = start.elapsed().as_secs_f64() * 1e3 - load_ms;
     let fields = lines
         .tracts
         .vertex_fields
@@ -232,7 +356,8 @@ fn load(gpu: &Gpu, source: &Source, send: &dyn Fn(FromWorker)) -> Result<(Scene,
         .map(|f| (f.name.clone(), crate::render::percentile_range(&f.values)))
         .collect();
     let (streamlines, vertices) = (lines.geometry.streamlines, lines.geometry.vertices);
-    let dataset = Dataset { name: lines.name.clone(), streamlines, vertices, hint: lines.hint, fields };
+    let dataset =
+        Dataset { name: lines.name.clone(), streamlines, vertices, hint: lines.hint, fields, load_ms, upload_ms };
     let scene = Scene { lines, preview: None, rays: None };
     Ok((scene, dataset))
 }
@@ -249,14 +374,15 @@ fn subset(tracts: &Tractogram, k: usize) -> (Vec<[f32; 3]>, Vec<u64>, Vec<usize>
     (positions, offsets, kept)
 }
 
-fn render_frame(
+async fn render_frame(
     gpu: &Gpu,
     scene: &mut Scene,
     chains: &mut Vec<PanelChain>,
+    (output, textures): (Output, &mut Vec<lineao::targets::Target>),
     view: &View,
     send: &dyn Fn(FromWorker),
 ) -> Result<Frame, String> {
-    let start = std::time::Instant::now();
+    let start = web_time::Instant::now();
     let (d, q) = (&gpu.device, &gpu.queue);
     let preview = view.preview && scene.lines.geometry.vertices > PREVIEW_VERTICES;
     let size = if preview { ((view.size.0 / 2).max(1), (view.size.1 / 2).max(1)) } else { view.size };
@@ -268,10 +394,23 @@ fn render_frame(
     }
     let bounds = scene.lines.geometry.bounds.expect("checked at load");
     let format = wgpu::TextureFormat::Rgba8UnormSrgb;
-    let target = lineao::targets::Target::output(d, "lineao::view::frame", size, format);
-    let (mut images, mut times, mut rays) = (Vec::new(), Vec::new(), Vec::new());
+    let readback = output == Output::Readback;
+    let target = match output {
+        Output::Readback => Some(lineao::targets::Target::output(d, "lineao::view::frame", size, format)),
+        Output::Textures => {
+            textures.truncate(view.panels.len());
+            textures.retain(|t| t.size() == size);
+            while textures.len() < view.panels.len() {
+                use wgpu::TextureUsages as U;
+                let usage = U::RENDER_ATTACHMENT | U::TEXTURE_BINDING | U::COPY_SRC;
+                textures.push(lineao::targets::Target::new(d, "lineao::view::panel", size, format, usage));
+            }
+            None
+        }
+    };
+    let (mut images, mut views, mut times, mut rays) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for (i, panel) in view.panels.iter().enumerate() {
-        let panel_start = std::time::Instant::now();
+        let panel_start = web_time::Instant::now();
         // The geometry's attributes this panel needs: the scalar's field and object-space AO.
         let wanted = AttributeKey { scalar: view.scalar_field.clone(), radius: None, volume: panel.volume.clone() };
         let busy = || {
@@ -314,10 +453,10 @@ fn render_frame(
         }
         let traced = settings.method == AoMethod::RayTraced;
         if chains.len() <= i {
-            let chain = AoChain::new(d, format, settings.clone()).map_err(|e| e.to_string())?;
+            let chain = AoChain::new_async(d, format, settings.clone()).await.map_err(|e| e.to_string())?;
             chains.push(PanelChain { chain, scene: None, geometry_pixels: 0 });
         } else if chains[i].chain.settings() != &settings {
-            chains[i].chain.set_settings(d, settings).map_err(|e| e.to_string())?;
+            chains[i].chain.set_settings_async(d, settings).await.map_err(|e| e.to_string())?;
         }
         if traced {
             // The ray tracer's scene: the full detail, whatever this frame draws.
@@ -326,8 +465,14 @@ fn render_frame(
                 None => {
                     send(FromWorker::Busy("building the ray tracer's BVH …".into()));
                     let tracts = &scene.lines.tracts;
-                    let cpu = crate::truth::Scene { tracts, surfaces: &[], radii: None };
-                    let rays = Arc::new(crate::truth::ray_scene(gpu, &cpu).map_err(|e| format!("{e:#}"))?);
+                    let geometry = lineao::RayGeometry {
+                        positions: &tracts.positions,
+                        offsets: &tracts.offsets,
+                        radii: None,
+                        meshes: &[],
+                    };
+                    let rays = lineao::RayScene::new(d, q, &geometry).map_err(|e| e.to_string())?;
+                    let rays = Arc::new(rays);
                     scene.rays.insert(rays).clone()
                 }
             };
@@ -341,11 +486,22 @@ fn render_frame(
         let chain = &mut panel.chain;
         chain.set_timing(d, q, view.timings);
         chain.resize(size.0, size.1).map_err(|e| e.to_string())?;
+        let target = match &target {
+            Some(shared) => shared,
+            None => &textures[i],
+        };
         submit_frame(gpu, chain, (geometry, &[]), (&view.camera, &bounds), &target.view);
-        times.push(if view.timings { chain.pass_times(d).map_err(|e| e.to_string())? } else { None });
-        images.push(lineao::readback::read_texture(d, q, &target.texture).map_err(|e| e.to_string())?.bytes);
+        if readback {
+            times.push(if view.timings { chain.pass_times(d).map_err(|e| e.to_string())? } else { None });
+            images.push(lineao::readback::read_texture(d, q, &target.texture).map_err(|e| e.to_string())?.bytes);
+        } else {
+            // Without waiting: they follow once the GPU has finished ([`FromWorker::Times`]).
+            times.push(None);
+            views.push(target.view.clone());
+        }
         let progress = if traced { chain.ray_progress() } else { None };
         rays.push(match progress {
+            Some(progress) if !readback => Some(RayStatus { progress, rays_per_second: None }),
             Some(progress) => {
                 if progress.rays_per_pixel <= progress.frame_rays || panel.geometry_pixels == 0 {
                     // A new picture: the pixels its rays start from.
@@ -354,10 +510,11 @@ fn render_frame(
                     panel.geometry_pixels = nd.data.iter().filter(|texel| texel[..3] != [0.0; 3]).count();
                 }
                 let rays = panel.geometry_pixels as f64 * progress.frame_rays as f64;
-                Some(RayStatus { progress, rays_per_second: rays / panel_start.elapsed().as_secs_f64() })
+                Some(RayStatus { progress, rays_per_second: Some(rays / panel_start.elapsed().as_secs_f64()) })
             }
             None => None,
         });
     }
-    Ok(Frame { view: view.clone(), images, size, times, rays, render_ms: start.elapsed().as_secs_f64() * 1e3 })
+    let render_ms = start.elapsed().as_secs_f64() * 1e3;
+    Ok(Frame { view: view.clone(), images, textures: views, size, times, rays, render_ms })
 }

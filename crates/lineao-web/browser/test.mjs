@@ -1,0 +1,213 @@
+// Drives the lineao web page in Debian's headless Chromium (WebGPU on SwiftShader), as a user
+// would: a built-in scene, a real file by ?url=, a file dropped on the page, bad files and bad
+// URLs, a browser without WebGPU. Saves what the checks natively need into OUT:
+//   OUT/<case>/<panel>/  the frame read back (lineao-web-check compares it with the CPU reference)
+//   OUT/results.json     statuses, counts and times;  OUT/*.png  screenshots.
+//
+// usage: node test.mjs BASE_URL OUT LINEAO_BIN DATA_DIR
+import { chromium } from 'playwright-core';
+import { execFileSync } from 'node:child_process';
+import fs from 'node:fs';
+import path from 'node:path';
+import assert from 'node:assert/strict';
+
+const [base, out, lineao, data] = process.argv.slice(2);
+const STROKE = 'niivue+niivue/packages/niivue/demos/images/stroke.trk.gz';
+const SMALL = 'niivue+niivue/packages/niivue/demos/images/tract.SLF1_R.tck';
+const results = {};
+fs.mkdirSync(out, { recursive: true });
+
+const chromiumArgs = [
+  '--headless=new', '--no-sandbox', '--enable-unsafe-webgpu', '--use-webgpu-adapter=swiftshader',
+  '--use-angle=swiftshader', '--enable-features=Vulkan', '--use-vulkan=swiftshader',
+  // This machine's network is closed: no background connections, no first-run.
+  '--no-first-run', '--disable-background-networking', '--disable-component-update', '--disable-sync', '--disable-quic',
+];
+const browser = await chromium.launch({ executablePath: '/usr/bin/chromium', headless: false, args: chromiumArgs });
+const context = await browser.newContext({ viewport: { width: 1280, height: 800 } });
+const page = await context.newPage();
+const log = [];
+page.on('console', (m) => log.push(`[${m.type()}] ${m.text()}`));
+page.on('pageerror', (e) => log.push(`[pageerror] ${e.message}`));
+
+function info(file) {
+  return JSON.parse(execFileSync(lineao, ['info', '--json', path.join(data, file)], { encoding: 'utf8' }));
+}
+
+const crashes = [];
+page.on('pageerror', (e) => crashes.push(e.message));
+
+/// Waits until the page's state is one of `states`; fails at once if the page crashed (a panic).
+async function settle(states = ['ready', 'error'], timeout = 300_000) {
+  const deadline = Date.now() + timeout;
+  for (;;) {
+    if (crashes.length) throw new Error(`the page crashed: ${crashes.join('; ')}`);
+    const status = await page.evaluate(() => window.lineaoStatus);
+    if (status && states.includes(status.state)) return status;
+    if (Date.now() > deadline) throw new Error(`still ${JSON.stringify(status)} after ${timeout / 1000} s`);
+    await new Promise((r) => setTimeout(r, 200));
+  }
+}
+
+/// Opens the page at `query`; waits until it is ready (or in error), timing both.
+async function open(query, states) {
+  const start = Date.now();
+  await page.goto(`${base}/${query}`);
+  const status = await settle(states);
+  return { status, ms: Date.now() - start };
+}
+
+/// Reads back panel `panel` and writes it where lineao-web-check reads it.
+async function readback(name, panel) {
+  // Base64 through the browser's own encoder: megabytes of floats as JSON numbers take minutes.
+  const frame = await page.evaluate(async (p) => {
+    const r = await window.lineaoReadback(p);
+    const base64 = (a) => new Promise((resolve) => {
+      const reader = new FileReader();
+      reader.onload = () => resolve(reader.result.slice(reader.result.indexOf(',') + 1));
+      reader.readAsDataURL(new Blob([a.buffer]));
+    });
+    return { meta: r.meta, nd: await Promise.all(r.nd.map(base64)), zoom: await base64(r.zoom), ao: await base64(r.ao) };
+  }, panel);
+  const dir = path.join(out, name, String(panel));
+  fs.mkdirSync(dir, { recursive: true });
+  fs.writeFileSync(path.join(dir, 'meta.json'), frame.meta);
+  const bytes = (b64) => Buffer.from(b64, 'base64');
+  frame.nd.forEach((level, j) => fs.writeFileSync(path.join(dir, `nd_${j}.f32`), bytes(level)));
+  fs.writeFileSync(path.join(dir, 'zoom.f32'), bytes(frame.zoom));
+  fs.writeFileSync(path.join(dir, 'ao.f32'), bytes(frame.ao));
+  const aoBytes = bytes(frame.ao);
+  const ao = new Float32Array(aoBytes.buffer, aoBytes.byteOffset, aoBytes.length / 4);
+  return { dir, occluded: ao.filter((a) => a > 0.05).length };
+}
+
+/// Drops a file of `bytes` named `name` on the page, as a user dragging it from a file manager.
+async function drop(name, bytes) {
+  await page.evaluate(async ([n, b64]) => {
+    const data = await (await fetch(`data:application/octet-stream;base64,${b64}`)).arrayBuffer();
+    const transfer = new DataTransfer();
+    transfer.items.add(new File([data], n));
+    const canvas = document.getElementById('lineao-canvas');
+    canvas.dispatchEvent(new DragEvent('drop', { dataTransfer: transfer, bubbles: true, cancelable: true }));
+  }, [name, Buffer.from(bytes).toString('base64')]);
+}
+
+async function check(name, fn) {
+  const start = Date.now();
+  try {
+    await fn();
+    console.log(`ok   ${name} (${((Date.now() - start) / 1000).toFixed(1)} s)`);
+  } catch (e) {
+    console.log(`FAIL ${name}: ${e.stack || e}`);
+    console.log(log.slice(-30).join('\n'));
+    await page.screenshot({ path: path.join(out, `failed-${name.replace(/\W+/g, '-')}.png`) }).catch(() => {});
+    await browser.close();
+    process.exit(1);
+  }
+}
+
+await check('a built-in scene: LineAO | SSAO on WebGPU, read back', async () => {
+  const { status, ms } = await open('?scene=bundles&vertices=60000&compare=lineao,ssao');
+  assert.equal(status.state, 'ready', status.message);
+  assert.deepEqual(status.methods, ['lineao', 'ssao']);
+  assert.match(status.adapter, /./);
+  assert.ok(status.streamlines > 0 && status.vertices > 50000, JSON.stringify(status));
+  results.scene = { status, ms, panels: [await readback('scene', 0), await readback('scene', 1)] };
+  assert.ok(results.scene.panels.every((p) => p.occluded > 100), JSON.stringify(results.scene.panels));
+});
+
+await check('a real file by ?url=: counts as lineao info, screenshot, read back', async () => {
+  const expected = info(STROKE);
+  const { status, ms } = await open(`?url=data/${encodeURIComponent(STROKE)}&compare=lineao,ssao`);
+  assert.equal(status.state, 'ready', status.message);
+  assert.equal(status.streamlines, expected.streamlines);
+  assert.equal(status.vertices, expected.vertices);
+  await page.screenshot({ path: path.join(out, 'stroke-lineao-vs-ssao.png') });
+  results.stroke = { status, ms, info: { streamlines: expected.streamlines, vertices: expected.vertices },
+    panels: [await readback('stroke', 0), await readback('stroke', 1)] };
+  const link = await page.evaluate(() => location.search);
+  assert.match(link, /compare=lineao%2Cssao/, link);
+  results.stroke.link = link;
+});
+
+await check('the link of a view opens that view', async () => {
+  const { status } = await open(`?url=data/${encodeURIComponent(STROKE)}&method=ssao&preset=paper&orbit=60,20,0.8`);
+  assert.equal(status.state, 'ready', status.message);
+  assert.deepEqual(status.methods, ['ssao']);
+  const link = await page.evaluate(() => location.search);
+  assert.match(link, /method=ssao/);
+  assert.match(link, /preset=paper/);
+  assert.match(link, /orbit=60\.0%2C20\.0%2C0\.800/, link);
+});
+
+await check('GPU time per pass: the page\'s LineAO chain', async () => {
+  // 200 000 vertices: under the viewer's preview threshold, so every frame is the full one.
+  const { status } = await open('?scene=bundles&vertices=200000&method=lineao&timings');
+  assert.equal(status.state, 'ready', status.message);
+  // A view with timings is rendered four times (times are read a frame later, without waiting).
+  await page.waitForFunction(() => window.lineaoStatus.frames >= 4 && window.lineaoStatus.gpuMs[0] != null, null,
+    { timeout: 120_000 });
+  const timed = await page.evaluate(() => window.lineaoStatus);
+  results.timings = { size: timed.size, passes: timed.passes[0], sum: timed.gpuMs[0], adapter: timed.adapter };
+});
+
+await check('the progressive GPU ray tracer gains rays; a debug view', async () => {
+  let { status } = await open('?scene=bundles&vertices=30000&method=raytraced&rays=16');
+  assert.equal(status.state, 'ready', status.message);
+  assert.deepEqual(status.methods, ['raytraced']);
+  await page.waitForFunction(() => window.lineaoStatus.raysPerPixel[0] >= 16, null, { timeout: 120_000 });
+  ({ status } = await open('?scene=bundles&vertices=30000&debug-view=normals'));
+  assert.equal(status.state, 'ready', status.message);
+});
+
+await check('a file dropped on the page opens; a bad one is an error, and the page goes on', async () => {
+  await open('?scene=spiral&vertices=20000');
+  const bad = Buffer.from('TRACK\0this is not a TrackVis header at all');
+  await drop('bad.trk', bad);
+  let status = await settle(['error']);
+  assert.match(status.message, /bad\.trk/);
+  assert.match(status.message, /byte|offset|expected/i, status.message);
+  results.badDrop = status.message;
+  const expected = info(SMALL);
+  await drop('tract.SLF1_R.tck', fs.readFileSync(path.join(data, SMALL)));
+  await page.waitForFunction(() => window.lineaoStatus.name === 'tract.SLF1_R.tck', null, { timeout: 120_000 });
+  status = await settle();
+  assert.equal(status.state, 'ready', status.message);
+  assert.equal(status.streamlines, expected.streamlines);
+  assert.equal(status.vertices, expected.vertices);
+});
+
+await check('a URL that fails: the HTTP status; a file over the limit: refused by its size', async () => {
+  let { status } = await open('?url=data/no-such-file.trk');
+  assert.equal(status.state, 'error');
+  assert.match(status.message, /HTTP 404/, status.message);
+  results.missing = status.message;
+  ({ status } = await open('?url=too-large.trk'));
+  assert.equal(status.state, 'error');
+  assert.match(status.message, /too-large\.trk: \d+ MiB is more than this page can hold/, status.message);
+  results.tooLarge = status.message;
+  ({ status } = await open('?method=lineoa'));
+  assert.equal(status.state, 'error');
+  assert.match(status.message, /lineoa/);
+  results.badOption = status.message;
+});
+
+await check('a browser without WebGPU: the message, no blank canvas', async () => {
+  const plain = await browser.newContext();
+  const other = await plain.newPage();
+  await other.addInitScript(() => { delete Object.getPrototypeOf(navigator).gpu; });
+  await other.goto(`${base}/?scene=bundles`);
+  await other.waitForFunction(() => window.lineaoStatus && window.lineaoStatus.state === 'error', null, { timeout: 30_000 });
+  const { message, shown } = await other.evaluate(() => ({
+    message: window.lineaoStatus.message,
+    shown: document.body.classList.contains('failed') && document.getElementById('lineao-message').innerText,
+  }));
+  assert.match(message, /WebGPU/);
+  assert.match(shown, /Chrome and Edge 113/);
+  await other.screenshot({ path: path.join(out, 'no-webgpu.png') });
+  await plain.close();
+});
+
+fs.writeFileSync(path.join(out, 'results.json'), JSON.stringify(results, null, 2));
+await browser.close();
+console.log(`browser: all checks passed; ${path.join(out, 'results.json')}`);

@@ -1,0 +1,448 @@
+//! The page: eframe's web runner on WebGPU running the native viewer's [`App`] with its worker
+//! on this thread ([`App::inline`]); files from a drop, the file input or `?url=`, read in
+//! chunks with progress and refused by size before anything is allocated; `window.lineaoStatus`
+//! and [`readback`] for tests. `web/index.html` loads it and says what to do where WebGPU is
+//! missing.
+
+use std::cell::RefCell;
+use std::sync::{Arc, OnceLock};
+
+use eframe::egui_wgpu::{WgpuSetup, WgpuSetupCreateNew};
+use js_sys::{Array, Float32Array, Object, Promise, Reflect, Uint8Array};
+use lineao::method::ssao::SsaoStage;
+use lineao::readback::TextureData;
+use lineao_cli::source::Source;
+use lineao_cli::view::App;
+use wasm_bindgen::JsCast;
+use wasm_bindgen::prelude::*;
+use wasm_bindgen_futures::JsFuture;
+
+use crate::check::Meta;
+use crate::query::{self, LinkSource};
+
+/// What arrives from outside the UI frame: files read by futures, tests' requests.
+enum Inbound {
+    Progress { name: String, bytes: u64, total: Option<u64> },
+    Loaded { name: String, bytes: Arc<[u8]>, from_url: bool },
+    Failed(String),
+    Readback { panel: usize, resolve: js_sys::Function, reject: js_sys::Function },
+}
+
+thread_local! {
+    static INBOX: RefCell<Vec<Inbound>> = const { RefCell::new(Vec::new()) };
+    static CONTEXT: RefCell<Option<egui::Context>> = const { RefCell::new(None) };
+}
+
+fn post(message: Inbound) {
+    INBOX.with(|inbox| inbox.borrow_mut().push(message));
+    CONTEXT.with(|ctx| {
+        if let Some(ctx) = &*ctx.borrow() {
+            ctx.request_repaint();
+        }
+    });
+}
+
+/// A JavaScript error's message.
+fn js_message(value: &JsValue) -> String {
+    value
+        .dyn_ref::<js_sys::Error>()
+        .map(|e| String::from(e.message()))
+        .or_else(|| value.as_string())
+        .unwrap_or_else(|| format!("{value:?}"))
+}
+
+/// Starts the viewer in the canvas `canvas_id`, with the options of the page's URL.
+/// `adapter` names the browser's adapter (its `GPUAdapterInfo`, which wgpu does not pass on).
+#[wasm_bindgen]
+pub async fn start(canvas_id: String, adapter: String) -> Result<(), JsValue> {
+    let window = web_sys::window().ok_or("no window")?;
+    let document = window.document().ok_or("no document")?;
+    let canvas = document
+        .get_element_by_id(&canvas_id)
+        .and_then(|e| e.dyn_into::<web_sys::HtmlCanvasElement>().ok())
+        .ok_or_else(|| format!("no canvas '{canvas_id}'"))?;
+    let page = query::parse(&window.location().search()?).map_err(|e| JsValue::from(js_sys::Error::new(&e)))?;
+    let mut options = lineao_cli::view::options(&page.view);
+    if let Some(url) = &page.url {
+        options.source = None;
+        let url = url.clone();
+        wasm_bindgen_futures::spawn_local(async move {
+            match fetch(&url).await {
+                Ok(bytes) => post(Inbound::Loaded { name: url, bytes, from_url: true }),
+                Err(e) => post(Inbound::Failed(e)),
+            }
+        });
+    }
+    let mut setup = WgpuSetupCreateNew::without_display_handle();
+    // WebGPU only: lineao's passes are compute shaders and storage textures, which WebGL lacks.
+    setup.instance_descriptor.backends = wgpu::Backends::BROWSER_WEBGPU;
+    setup.device_descriptor = Arc::new(lineao::Gpu::device_descriptor);
+    let mut web_options = eframe::WebOptions::default();
+    web_options.wgpu_options.wgpu_setup = WgpuSetup::CreateNew(setup);
+    let source = match (&page.url, page.view.scene) {
+        (Some(url), _) => LinkSource::Url(url.clone()),
+        (None, scene) => LinkSource::Scene(scene.unwrap_or(lineao_tracts::SceneKind::Bundles).name().into()),
+    };
+    let runner = eframe::WebRunner::new();
+    runner
+        .start(
+            canvas,
+            web_options,
+            Box::new(move |cc| {
+                let state = cc.wgpu_render_state.clone().ok_or("eframe made no wgpu renderer")?;
+                lineao::check_adapter(&state.adapter)?;
+                let info = state.adapter.get_info();
+                let name = if adapter.is_empty() { info.name.clone() } else { adapter };
+                let adapter = format!("{name} ({:?})", info.backend);
+                let gpu = lineao::Gpu::new(
+                    state.instance.clone(),
+                    state.adapter.clone(),
+                    state.device.clone(),
+                    state.queue.clone(),
+                );
+                let mut app = App::inline(gpu, state, options);
+                app.open_file = Some(Box::new(pick_file));
+                CONTEXT.with(|c| *c.borrow_mut() = Some(cc.egui_ctx.clone()));
+                Ok(Box::new(Page {
+                    app,
+                    source,
+                    adapter,
+                    requests: Vec::new(),
+                    readbacks: Vec::new(),
+                    status: String::new(),
+                    link: None,
+                }))
+            }),
+        )
+        .await?;
+    // The runner lives as long as the page.
+    std::mem::forget(runner);
+    Ok(())
+}
+
+/// Opens `file` (dropped on the page or picked in its file input).
+#[wasm_bindgen]
+pub fn open_file(file: web_sys::File) {
+    let (name, size) = (file.name(), file.size() as u64);
+    if let Some(message) = crate::too_large(&name, size) {
+        return post(Inbound::Failed(message));
+    }
+    wasm_bindgen_futures::spawn_local(async move {
+        match read_stream(&name, file.stream(), Some(size)).await {
+            Ok(bytes) => post(Inbound::Loaded { name, bytes, from_url: false }),
+            Err(e) => post(Inbound::Failed(e)),
+        }
+    });
+}
+
+/// Reads back panel `panel`'s last frame: `{ meta (JSON text), nd: [Float32Array per level],
+/// zoom, ao }` — see [`crate::check`].
+#[wasm_bindgen]
+pub fn readback(panel: usize) -> Promise {
+    Promise::new(&mut |resolve, reject| post(Inbound::Readback { panel, resolve, reject }))
+}
+
+/// File ▸ Open…: the page's file input.
+fn pick_file() {
+    let input = web_sys::window().and_then(|w| w.document()).and_then(|d| d.get_element_by_id("lineao-file"));
+    if let Some(input) = input.and_then(|e| e.dyn_into::<web_sys::HtmlElement>().ok()) {
+        input.click();
+    }
+}
+
+/// Fetches `url` (relative to the page) in chunks, with progress.
+async fn fetch(url: &str) -> Result<Arc<[u8]>, String> {
+    post(Inbound::Progress { name: url.to_string(), bytes: 0, total: None });
+    let window = web_sys::window().ok_or("no window")?;
+    let response = JsFuture::from(window.fetch_with_str(url))
+        .await
+        .map_err(|e| format!("{url}: cannot fetch: {}", js_message(&e)))?;
+    let response: web_sys::Response = response.dyn_into().map_err(|_| format!("{url}: not a response"))?;
+    if !response.ok() {
+        return Err(format!("{url}: HTTP {} {}", response.status(), response.status_text()));
+    }
+    let total = response.headers().get("content-length").ok().flatten().and_then(|v| v.parse::<u64>().ok());
+    if let Some(message) = total.and_then(|t| crate::too_large(url, t)) {
+        return Err(message);
+    }
+    let body = response.body().ok_or_else(|| format!("{url}: the response has no body"))?;
+    read_stream(url, body, total).await
+}
+
+/// Reads `stream` to its end, telling the progress, refusing more than
+/// [`crate::MAX_FILE_BYTES`].
+async fn read_stream(name: &str, stream: web_sys::ReadableStream, total: Option<u64>) -> Result<Arc<[u8]>, String> {
+    let reader: web_sys::ReadableStreamDefaultReader = stream.get_reader().unchecked_into();
+    let capacity = total.unwrap_or(0).min(crate::MAX_FILE_BYTES) as usize;
+    let mut bytes = Vec::new();
+    bytes.try_reserve_exact(capacity).map_err(|_| crate::too_large(name, u64::MAX).unwrap_or_default())?;
+    loop {
+        let chunk =
+            JsFuture::from(reader.read()).await.map_err(|e| format!("{name}: cannot read: {}", js_message(&e)))?;
+        if Reflect::get(&chunk, &"done".into()).ok().and_then(|d| d.as_bool()).unwrap_or(true) {
+            break;
+        }
+        let value: Uint8Array = Reflect::get(&chunk, &"value".into()).map_err(|e| js_message(&e))?.unchecked_into();
+        let (start, length) = (bytes.len(), value.length() as usize);
+        if let Some(message) = crate::too_large(name, (start + length) as u64) {
+            let _ = reader.cancel();
+            return Err(message);
+        }
+        bytes.resize(start + length, 0);
+        value.copy_to(&mut bytes[start..]);
+        post(Inbound::Progress { name: name.to_string(), bytes: bytes.len() as u64, total });
+    }
+    Ok(bytes.into())
+}
+
+/// A texture being copied back: its buffer and layout, and whether the mapping finished.
+struct Copy {
+    buffer: wgpu::Buffer,
+    size: (u32, u32),
+    format: wgpu::TextureFormat,
+    padded_row: u32,
+    mapped: Arc<OnceLock<bool>>,
+}
+
+struct PendingReadback {
+    meta: Meta,
+    /// ND levels, then the zoom map, then the AO.
+    copies: Vec<Copy>,
+    resolve: js_sys::Function,
+    reject: js_sys::Function,
+}
+
+struct Page {
+    app: App,
+    source: LinkSource,
+    adapter: String,
+    /// Readbacks asked for, and those copying.
+    requests: Vec<(usize, js_sys::Function, js_sys::Function)>,
+    readbacks: Vec<PendingReadback>,
+    /// The last JSON published as `window.lineaoStatus`, and the last link put in the URL.
+    status: String,
+    link: Option<String>,
+}
+
+impl eframe::App for Page {
+    fn ui(&mut self, ui: &mut egui::Ui, _frame: &mut eframe::Frame) {
+        let ctx = ui.ctx().clone();
+        for message in INBOX.with(|inbox| std::mem::take(&mut *inbox.borrow_mut())) {
+            match message {
+                Inbound::Progress { name, bytes, total } => self.app.show_loading(&name, bytes, total),
+                Inbound::Loaded { name, bytes, from_url } => {
+                    self.source = if from_url { LinkSource::Url(name.clone()) } else { LinkSource::None };
+                    self.app.load(Source::Bytes { name, bytes });
+                }
+                Inbound::Failed(message) => self.app.fail(message),
+                Inbound::Readback { panel, resolve, reject } => self.requests.push((panel, resolve, reject)),
+            }
+        }
+        self.app.show(ui);
+        // Readbacks start between the worker's steps (a step holds the worker).
+        if !self.requests.is_empty() {
+            if self.app.worker().is_some() {
+                for (panel, resolve, reject) in std::mem::take(&mut self.requests) {
+                    if let Err(e) = self.start_readback(panel, resolve, &reject) {
+                        let _ = reject.call1(&JsValue::NULL, &js_sys::Error::new(&e));
+                    }
+                }
+            } else {
+                ctx.request_repaint();
+            }
+        }
+        self.finish_readbacks(&ctx);
+        self.publish_status();
+        self.publish_link();
+    }
+}
+
+impl Page {
+    /// Copies panel `panel`'s ND pyramid, zoom map and raw AO into mappable buffers.
+    fn start_readback(
+        &mut self,
+        panel: usize,
+        resolve: js_sys::Function,
+        reject: &js_sys::Function,
+    ) -> Result<(), String> {
+        let worker = self.app.worker().ok_or("the worker is busy")?;
+        let chain = worker.chain(panel).ok_or_else(|| format!("panel {panel} has rendered nothing"))?;
+        let (targets, view) = chain.targets().zip(chain.frame_view()).ok_or("nothing was rendered")?;
+        let settings = chain.settings().clone();
+        let raw = match settings.method {
+            lineao::AoMethod::Ssao => chain.stage::<SsaoStage>().and_then(SsaoStage::raw).unwrap_or(&targets.ao),
+            _ => &targets.ao,
+        };
+        let textures: Vec<&wgpu::Texture> =
+            targets.nd.iter().map(|t| &t.texture).chain([&targets.zoom.texture, &raw.texture]).collect();
+        let (device, queue) = (&worker.gpu().device, &worker.gpu().queue);
+        let mut encoder =
+            device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::web::readback") });
+        let mut copies = Vec::new();
+        for texture in textures {
+            let (w, h, format) = (texture.width(), texture.height(), texture.format());
+            let texel = format.block_copy_size(None).ok_or("a texture without a copy size")?;
+            let padded_row = (w * texel).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+            let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("lineao::web::readback"),
+                size: u64::from(padded_row) * u64::from(h),
+                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+                mapped_at_creation: false,
+            });
+            encoder.copy_texture_to_buffer(
+                texture.as_image_copy(),
+                wgpu::TexelCopyBufferInfo {
+                    buffer: &buffer,
+                    layout: wgpu::TexelCopyBufferLayout {
+                        offset: 0,
+                        bytes_per_row: Some(padded_row),
+                        rows_per_image: Some(h),
+                    },
+                },
+                texture.size(),
+            );
+            copies.push(Copy { buffer, size: (w, h), format, padded_row, mapped: Arc::default() });
+        }
+        queue.submit([encoder.finish()]);
+        for copy in &copies {
+            let mapped = copy.mapped.clone();
+            copy.buffer.slice(..).map_async(wgpu::MapMode::Read, move |result| {
+                let _ = mapped.set(result.is_ok());
+            });
+        }
+        let levels = targets.nd.iter().map(|t| [t.texture.width(), t.texture.height()]).collect();
+        let meta = Meta { settings, view: *view, levels, adapter: self.adapter.clone() };
+        self.readbacks.push(PendingReadback { meta, copies, resolve, reject: reject.clone() });
+        Ok(())
+    }
+
+    /// Resolves the readbacks whose buffers are mapped.
+    fn finish_readbacks(&mut self, ctx: &egui::Context) {
+        let (done, waiting): (Vec<_>, Vec<_>) = std::mem::take(&mut self.readbacks)
+            .into_iter()
+            .partition(|r| r.copies.iter().all(|c| c.mapped.get().is_some()));
+        self.readbacks = waiting;
+        if !self.readbacks.is_empty() {
+            ctx.request_repaint();
+        }
+        for readback in done {
+            match readback_value(&readback) {
+                Ok(value) => {
+                    let _ = readback.resolve.call1(&JsValue::NULL, &value);
+                }
+                Err(e) => {
+                    let _ = readback.reject.call1(&JsValue::NULL, &js_sys::Error::new(&e));
+                }
+            }
+        }
+    }
+
+    /// `window.lineaoStatus`: what the page shows, for tests and for scripts around it.
+    fn publish_status(&mut self) {
+        let app = &self.app;
+        let state = match (app.error(), app.is_loading() || !app.settled() || app.shown.is_none()) {
+            (Some(_), _) => "error",
+            (None, true) => "loading",
+            (None, false) => "ready",
+        };
+        let frame = app.shown.as_ref();
+        let methods: Vec<&str> =
+            frame.map(|f| f.view.panels.iter().map(|p| p.settings.method.name()).collect()).unwrap_or_default();
+        let gpu_ms: Vec<Option<f64>> = frame
+            .map(|f| f.times.iter().map(|t| t.as_ref().map(|t| t.iter().map(|p| p.ms).sum())).collect())
+            .unwrap_or_default();
+        let passes: Vec<Vec<(String, f64)>> = frame
+            .map(|f| f.times.iter().map(|t| t.iter().flatten().map(|p| (p.name.to_string(), p.ms)).collect()).collect())
+            .unwrap_or_default();
+        let message = match (app.error(), state) {
+            (Some(e), _) => e.to_string(),
+            (None, "ready") => "ready".into(),
+            _ => "loading".into(),
+        };
+        let status = serde_json::json!({
+            "state": state,
+            "message": message,
+            "name": app.dataset.as_ref().map(|d| d.name.clone()),
+            "streamlines": app.dataset.as_ref().map(|d| d.streamlines),
+            "vertices": app.dataset.as_ref().map(|d| d.vertices),
+            "loadMs": app.dataset.as_ref().map(|d| d.load_ms),
+            "uploadMs": app.dataset.as_ref().map(|d| d.upload_ms),
+            "method": methods.join(" | "),
+            "methods": methods,
+            "adapter": self.adapter,
+            "size": frame.map(|f| [f.size.0, f.size.1]),
+            "gpuMs": gpu_ms,
+            "passes": passes,
+            "frames": app.frames_received,
+            "raysPerPixel": frame.map(|f| f.rays.iter().map(|r| r.map(|r| r.progress.rays_per_pixel)).collect::<Vec<_>>()),
+        })
+        .to_string();
+        if status != self.status {
+            if let (Some(window), Ok(value)) = (web_sys::window(), js_sys::JSON::parse(&status)) {
+                let _ = Reflect::set(&window, &"lineaoStatus".into(), &value);
+            }
+            self.status = status;
+        }
+    }
+
+    /// Keeps the page's URL the link of what it shows (methods, preset, camera), once it rests.
+    fn publish_link(&mut self) {
+        let app = &self.app;
+        if !app.settled() || app.error().is_some() {
+            return;
+        }
+        let Some(frame) = &app.shown else { return };
+        if let Some(dataset) = &app.dataset
+            && let Ok(kind) = dataset.name.parse::<lineao_tracts::SceneKind>()
+        {
+            self.source = LinkSource::Scene(kind.name().into());
+        }
+        let methods: Vec<&str> = frame.view.panels.iter().map(|p| p.settings.method.name()).collect();
+        let orbit = app.camera.as_ref().map(|c| c.orbit_values());
+        let ortho = app.camera.as_ref().is_some_and(|c| c.orthographic);
+        let link = query::link(&self.source, &methods, app.controls.preset, orbit, ortho);
+        if self.link.as_ref() != Some(&link) {
+            if let Some(history) = web_sys::window().and_then(|w| w.history().ok()) {
+                let _ = history.replace_state_with_url(&JsValue::NULL, "", Some(&link));
+            }
+            self.link = Some(link);
+        }
+    }
+}
+
+/// The JavaScript value of a finished readback.
+fn readback_value(readback: &PendingReadback) -> Result<JsValue, String> {
+    let mut images = Vec::new();
+    for copy in &readback.copies {
+        if copy.mapped.get() != Some(&true) {
+            return Err("a readback buffer could not be mapped".into());
+        }
+        let (w, h) = copy.size;
+        let texel = copy.format.block_copy_size(None).unwrap_or(4);
+        let mut bytes = Vec::with_capacity((w * h * texel) as usize);
+        {
+            let mapped = copy.buffer.slice(..).get_mapped_range().map_err(|e| format!("a readback buffer: {e}"))?;
+            for row in mapped.chunks(copy.padded_row as usize).take(h as usize) {
+                bytes.extend_from_slice(&row[..(w * texel) as usize]);
+            }
+        }
+        copy.buffer.unmap();
+        images.push(TextureData { width: w, height: h, format: copy.format, bytes });
+    }
+    let (ao, rest) = images.split_last().ok_or("no images")?;
+    let (zoom, nd) = rest.split_last().ok_or("no zoom map")?;
+    let floats = |values: &[f32]| Float32Array::from(values);
+    let levels = Array::new();
+    for level in nd {
+        let texels: Vec<f32> = level.to_vec4().into_iter().flatten().collect();
+        levels.push(&floats(&texels));
+    }
+    let value = Object::new();
+    let meta = serde_json::to_string(&readback.meta).map_err(|e| e.to_string())?;
+    let set = |key: &str, v: &JsValue| Reflect::set(&value, &key.into(), v).map(|_| ()).map_err(|e| js_message(&e));
+    set("meta", &meta.into())?;
+    set("nd", &levels)?;
+    set("zoom", &floats(&zoom.to_f32()))?;
+    set("ao", &floats(&ao.to_f32()))?;
+    Ok(value.into())
+}

@@ -1,0 +1,158 @@
+//! The page's URL: `?url=FILE` or `?scene=NAME`, and the viewer's options as `lineao view`
+//! takes them — `?compare=lineao,ssao&preset=paper&orbit=30,10,0.8` is
+//! `lineao view --compare lineao,ssao --preset paper --orbit 30,10,0.8`. One typed settings
+//! layer (`ViewArgs`) for the command line and the link, parsed by the same clap definitions,
+//! so a link refuses what the command line refuses, with the same words.
+//!
+//! A key without a value is a flag (`?ortho&timings`). What a page cannot do is refused by
+//! name: a positional file (use `url=`), `screenshot`, `frames` and `size` (the page is the
+//! window), and object-space AO (CPU threads, see `lineao_cli::view::controls::WEB_LEAVES_OUT`).
+
+use clap::Parser;
+use lineao_cli::cli::ViewArgs;
+
+/// What the page opens: a file fetched from `url` (relative to the page), or the options' source.
+#[derive(Debug)]
+pub struct PageArgs {
+    pub url: Option<String>,
+    pub view: ViewArgs,
+}
+
+#[derive(Parser, Debug)]
+#[command(name = "lineao-web", no_binary_name = true, disable_help_flag = true, disable_version_flag = true)]
+struct PageCli {
+    #[command(flatten)]
+    view: ViewArgs,
+}
+
+/// Keys of `lineao view` that mean nothing in a page.
+const NOT_IN_A_PAGE: [&str; 3] = ["screenshot", "frames", "size"];
+
+/// Parses a URL's query string (`search`, with or without its `?`).
+pub fn parse(search: &str) -> Result<PageArgs, String> {
+    let query = search.strip_prefix('?').unwrap_or(search);
+    let (mut url, mut args) = (None, Vec::new());
+    for (key, value) in form_urlencoded::parse(query.as_bytes()) {
+        match &*key {
+            "url" if value.is_empty() => return Err("url= needs a file's address".into()),
+            "url" => url = Some(value.into_owned()),
+            key if NOT_IN_A_PAGE.contains(&key) => return Err(format!("'{key}' is not an option of the web page")),
+            key if key.starts_with('-') || key.is_empty() => return Err(format!("'{key}' is not an option")),
+            key => {
+                args.push(format!("--{key}"));
+                if !value.is_empty() {
+                    args.push(value.into_owned());
+                }
+            }
+        }
+    }
+    let cli = PageCli::try_parse_from(&args).map_err(|e| {
+        let text = e.render().to_string();
+        let first = text.lines().next().unwrap_or("invalid options").trim_start_matches("error: ").to_string();
+        format!("the page's URL: {first}")
+    })?;
+    let view = cli.view;
+    if url.is_some() && view.scene.is_some() {
+        return Err("the page's URL: url= and scene= exclude each other".into());
+    }
+    let methods = match view.compare {
+        Some(pair) => pair.to_vec(),
+        None => vec![view.method],
+    };
+    if methods.iter().any(|m| m.volume.is_some()) {
+        return Err(format!("the page's URL: {}", lineao_cli::view::controls::WEB_LEAVES_OUT));
+    }
+    Ok(PageArgs { url, view })
+}
+
+/// The query string of a view: the source and the options a link keeps (methods, preset,
+/// camera), in the form [`parse`] reads.
+pub fn link(
+    source: &LinkSource,
+    methods: &[&str],
+    preset: lineao::Preset,
+    orbit: Option<[f32; 3]>,
+    ortho: bool,
+) -> String {
+    let mut query = form_urlencoded::Serializer::new(String::new());
+    match source {
+        LinkSource::Url(url) => query.append_pair("url", url),
+        LinkSource::Scene(name) => query.append_pair("scene", name),
+        LinkSource::None => &mut query,
+    };
+    match methods {
+        [one] => query.append_pair("method", one),
+        many => query.append_pair("compare", &many.join(",")),
+    };
+    query.append_pair("preset", preset.name());
+    if let Some([azimuth, elevation, zoom]) = orbit {
+        query.append_pair("orbit", &format!("{azimuth:.1},{elevation:.1},{zoom:.3}"));
+    }
+    if ortho {
+        query.append_key_only("ortho");
+    }
+    format!("?{}", query.finish())
+}
+
+/// What a link names as the data.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LinkSource {
+    Url(String),
+    Scene(String),
+    /// A dropped or picked file, which no link can name.
+    None,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use lineao::AoMethod;
+
+    #[test]
+    fn the_query_is_the_view_commands_options() {
+        let page = parse("?url=data%2Fstroke.trk.gz&compare=lineao,ssao&preset=paper&orbit=30,-10,0.5&ortho").unwrap();
+        assert_eq!(page.url.as_deref(), Some("data/stroke.trk.gz"));
+        let v = &page.view;
+        assert_eq!(v.compare.map(|p| p.map(|m| m.screen)), Some([AoMethod::LineAo, AoMethod::Ssao]));
+        assert_eq!(v.preset, lineao::Preset::Paper);
+        assert_eq!(v.orbit, Some([30.0, -10.0, 0.5]));
+        assert!(v.ortho);
+        let scene = parse("scene=bundles&method=ssao&debug-view=ao").unwrap();
+        assert_eq!(scene.url, None);
+        assert_eq!(scene.view.scene.map(|s| s.name()), Some("bundles"));
+        assert_eq!(scene.view.method.screen, AoMethod::Ssao);
+        assert_eq!(parse("").unwrap().view.method.screen, AoMethod::LineAo, "lineao view's defaults");
+    }
+
+    #[test]
+    fn what_the_command_line_refuses_the_link_refuses_with_its_words() {
+        let error = |q: &str| parse(q).unwrap_err();
+        assert!(error("method=lineoa").contains("lineoa"), "{}", error("method=lineoa"));
+        assert!(error("preset=loud").contains("unknown preset 'loud'"), "{}", error("preset=loud"));
+        assert!(error("orbit=1,2").contains("AZIMUTH,ELEVATION,ZOOM"));
+        assert!(error("colour=red").contains("--colour"), "{}", error("colour=red"));
+        assert!(error("method=sweep").contains("CPU threads"));
+        assert!(error("compare=lineao,lineao%2Bsweep").contains("CPU threads"));
+        assert!(error("screenshot=a.png").contains("not an option of the web page"));
+        assert!(error("url=").contains("needs a file"));
+        assert!(error("url=a.trk&scene=bundles").contains("exclude each other"));
+    }
+
+    #[test]
+    fn a_link_reads_back_as_the_view_it_describes() {
+        let query = link(
+            &LinkSource::Url("data/a b.tck".into()),
+            &["lineao", "ssao"],
+            lineao::Preset::Sparse,
+            Some([12.345, -3.0, 0.75]),
+            true,
+        );
+        let page = parse(&query).unwrap();
+        assert_eq!(page.url.as_deref(), Some("data/a b.tck"));
+        assert_eq!(page.view.preset, lineao::Preset::Sparse);
+        assert_eq!(page.view.orbit, Some([12.3, -3.0, 0.75]));
+        assert!(page.view.ortho);
+        let one = parse(&link(&LinkSource::Scene("spiral".into()), &["ssao"], lineao::Preset::Legible, None, false));
+        assert_eq!(one.unwrap().view.method.screen, AoMethod::Ssao);
+    }
+}
