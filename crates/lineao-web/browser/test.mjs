@@ -160,7 +160,7 @@ await check('the progressive GPU ray tracer gains rays; a debug view', async () 
   assert.equal(status.state, 'ready', status.message);
 });
 
-await check('a file dropped on the page opens; a bad one is an error, and the page goes on', async () => {
+await check('a file dropped on the page opens; a bad one is an error, and the page goes on; the file picker', async () => {
   await open('?scene=spiral&vertices=20000');
   const bad = Buffer.from('TRACK\0this is not a TrackVis header at all');
   await drop('bad.trk', bad);
@@ -175,6 +175,12 @@ await check('a file dropped on the page opens; a bad one is an error, and the pa
   assert.equal(status.state, 'ready', status.message);
   assert.equal(status.streamlines, expected.streamlines);
   assert.equal(status.vertices, expected.vertices);
+  // The file picker (File ▸ Open… clicks this input).
+  await page.setInputFiles('#lineao-file', path.join(data, STROKE));
+  await page.waitForFunction(() => window.lineaoStatus.name === 'stroke.trk.gz', null, { timeout: 120_000 });
+  status = await settle();
+  assert.equal(status.state, 'ready', status.message);
+  assert.equal(status.vertices, info(STROKE).vertices);
 });
 
 await check('a URL that fails: the HTTP status; a file over the limit: refused by its size', async () => {
