@@ -234,7 +234,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     crate::render::validate_camera(&camera)?;
     let gpu = Gpu::headless()?;
     let (device, queue) = (&gpu.device, &gpu.queue);
-    let options = GeometryOptions { native_lines: true, bounded_staging: true, ..Default::default() };
+    let options = GeometryOptions { bounded_staging: true, ..Default::default() };
     let geometry = LineGeometry::with_options(device, queue, &scene.tracts.positions, &scene.tracts.offsets, options)?;
     let bounds = geometry.bounds.context("the scene has no finite points")?;
 

@@ -1,27 +1,16 @@
 // Line renderer: polylines at a fixed pixel width as triangle strips, writing the G-buffer of
 // CONTRACT.md (color, ND map, zoom map, specular, hardware depth).
 //
-// Every point comes twice (left, right; the sign of tangent.w); the vertex shader pushes it half
-// a line width sideways, perpendicular to the screen direction of its *vertex* tangent, so
-// consecutive segments share their join corners exactly: joins without gaps or overlaps.
-// `lineao::passes::lines` builds the strip, and the alternating index strip over it that takes
-// one side per point where that stays within half a pixel (the same shaders draw both).
+// The vertex shader pulls each strip vertex from the clusters (`shared/clusters.wgsl`):
+// instance = a cluster, vertex = a position along its strip, which takes every point twice
+// (left, right) — the full strip — or, for straight clusters drawn from afar, one side per
+// point by turns (the alternating strip; `lineao::line_geometry` has the tolerance argument).
+// It pushes the point half a line width sideways, perpendicular to the screen direction of its
+// *vertex* tangent, so consecutive segments share their join corners exactly: joins without
+// gaps or overlaps. Vertices past a cluster's strip repeat its last one and then collapse to
+// one point: zero-area triangles.
+#import shared/clusters.wgsl
 #import shared/geometry.wgsl
-
-struct StripVertex {
-    @location(0) p: vec3<f32>,
-    // xyz: unit world-space tangent; w: side (> 0 left, < 0 right) and flags in its magnitude.
-    @location(1) t: vec4<f32>,
-}
-
-// The attribute stream: octant visibilities (object-space AO) and the scalar of the colormap
-// (the radius at location 4 is the tubes'). Keep in sync with
-// `lineao::passes::lines::LineAttributes`.
-struct Attributes {
-    @location(2) octants_lo: vec4<f32>,
-    @location(3) octants_hi: vec4<f32>,
-    @location(5) scalar: f32,
-}
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
@@ -71,37 +60,96 @@ fn line_vertex(p: vec3<f32>, t_world: vec3<f32>, side: f32, scalar: f32) -> VsOu
     return out;
 }
 
-// Fixed-width lines: the triangle strip.
-@vertex
-fn vs_main(v: StripVertex) -> VsOut {
-    return line_vertex(v.p, v.t.xyz, sign(v.t.w), 0.0);
+// Which point of its cluster's strip a vertex is, and which side: `point` < 0 for a vertex
+// past the strip's end, which collapses.
+struct StripPosition {
+    point: i32,
+    side: f32,
 }
 
-// Fixed-width lines with the attribute stream (the scalar's color), no octants.
-@vertex
-fn vs_attributes(v: StripVertex, a: Attributes) -> VsOut {
-    return line_vertex(v.p, v.t.xyz, sign(v.t.w), a.scalar);
+// The full strip: point v / 2, left then right. Its last vertex is repeated once (a zero-area
+// triangle), then every further vertex collapses to one point.
+fn full_strip(v: u32, drawn: u32) -> StripPosition {
+    let side = select(1.0, -1.0, (v & 1u) != 0u);
+    if v < 2u * drawn {
+        return StripPosition(i32(v >> 1u), side);
+    }
+    return StripPosition(select(-1, i32(drawn) - 1, v == 2u * drawn), -1.0);
 }
 
-// Native 1-px lines (an indexed `LineList` over the same vertices): the rasterizer's own thin
+// The alternating strip: both sides of the first point, then one side per point by turns,
+// both sides of the last (L0 R0 L1 R2 L3 … for sides L, R).
+fn alternating_strip(v: u32, drawn: u32) -> StripPosition {
+    let side = select(1.0, -1.0, (v & 1u) != 0u);
+    if v <= drawn + 1u {
+        return StripPosition(i32(clamp(v, 1u, drawn) - 1u), side);
+    }
+    // The repeat of the last vertex (v = drawn + 1), then the collapsed ones.
+    let last = select(1.0, -1.0, ((drawn + 1u) & 1u) != 0u);
+    return StripPosition(select(-1, i32(drawn) - 1, v == drawn + 2u), last);
+}
+
+// A vertex that collapses with every other past its strip's end.
+fn collapsed() -> VsOut {
+    var out: VsOut;
+    out.clip = vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    return out;
+}
+
+fn strip_vertex(cluster: u32, at: StripPosition) -> VsOut {
+    if at.point < 0 {
+        return collapsed();
+    }
+    let q = pulled_point(clusters[cluster], u32(at.point));
+    return line_vertex(q.position, q.tangent, at.side, point_scalar(q.index));
+}
+
+@vertex
+fn vs_full(@builtin(vertex_index) v: u32, @builtin(instance_index) cluster: u32) -> VsOut {
+    return strip_vertex(cluster, full_strip(v, drawn_points(clusters[cluster])));
+}
+
+@vertex
+fn vs_alternating(@builtin(vertex_index) v: u32, @builtin(instance_index) cluster: u32) -> VsOut {
+    return strip_vertex(cluster, alternating_strip(v, drawn_points(clusters[cluster])));
+}
+
+// Native 1-px lines (a `LineList`: segment v / 2 of the cluster): the rasterizer's own thin
 // lines, the baseline the strip is measured against (`lineao bench`, pass `lines-native-1px`).
+// Segments past the cluster's end lie outside the clip volume.
 @vertex
-fn vs_native(v: StripVertex) -> VsOut {
-    return line_vertex(v.p, v.t.xyz, 0.0, 0.0);
+fn vs_native(@builtin(vertex_index) v: u32, @builtin(instance_index) cluster: u32) -> VsOut {
+    let c = clusters[cluster];
+    let segment = v >> 1u;
+    if segment + 1u >= drawn_points(c) {
+        var out: VsOut;
+        out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
+        return out;
+    }
+    let q = pulled_point(c, segment + (v & 1u));
+    return line_vertex(q.position, q.tangent, 0.0, point_scalar(q.index));
 }
 
-// Fixed-width lines with the octant visibilities of the attribute stream.
-@vertex
-fn vs_octants(v: StripVertex, a: Attributes) -> VsOutOctants {
-    let b = line_vertex(v.p, v.t.xyz, sign(v.t.w), a.scalar);
-    return VsOutOctants(b.clip, b.view_pos, b.view_tangent, b.color, a.octants_lo, a.octants_hi);
+fn with_point_octants(b: VsOut, cluster: u32, at: StripPosition) -> VsOutOctants {
+    var octants = array<vec4<f32>, 2>(vec4<f32>(1.0), vec4<f32>(1.0));
+    if at.point >= 0 {
+        let c = clusters[cluster];
+        octants = point_octants(c.first + u32(at.point));
+    }
+    return VsOutOctants(b.clip, b.view_pos, b.view_tangent, b.color, octants[0], octants[1]);
 }
 
-// Fixed-width lines of geometry without attributes, into a G-buffer with octants: all visible.
+// The strips with the points' octant visibilities (object-space AO), for `fs_octants`.
 @vertex
-fn vs_visible(v: StripVertex) -> VsOutOctants {
-    let b = line_vertex(v.p, v.t.xyz, sign(v.t.w), 0.0);
-    return VsOutOctants(b.clip, b.view_pos, b.view_tangent, b.color, vec4<f32>(1.0), vec4<f32>(1.0));
+fn vs_full_octants(@builtin(vertex_index) v: u32, @builtin(instance_index) cluster: u32) -> VsOutOctants {
+    let at = full_strip(v, drawn_points(clusters[cluster]));
+    return with_point_octants(strip_vertex(cluster, at), cluster, at);
+}
+
+@vertex
+fn vs_alternating_octants(@builtin(vertex_index) v: u32, @builtin(instance_index) cluster: u32) -> VsOutOctants {
+    let at = alternating_strip(v, drawn_points(clusters[cluster]));
+    return with_point_octants(strip_vertex(cluster, at), cluster, at);
 }
 
 @fragment

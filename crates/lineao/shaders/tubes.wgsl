@@ -3,32 +3,12 @@
 // writing true depth, the surface's normal and the G-buffer of CONTRACT.md. Overlapping
 // billboards at the joints each ray-cast their own segment and the depth test keeps the nearest
 // hit, so a polyline renders as the exact union of its segments' solids: seamless joints.
-// `lineao::passes::tubes` documents the instancing; `lineao::reference::tubes` is the CPU side.
+// The vertex shader pulls the segments from the clusters (`shared/clusters.wgsl`): instance = a
+// cluster, six vertices (two triangles) per segment. `lineao::passes::tubes` documents it;
+// `lineao::reference::tubes` is the CPU side.
+#import shared/clusters.wgsl
 #import shared/cone.wgsl
 #import shared/geometry.wgsl
-
-// The strip buffer read per instance with twice its stride: every left vertex (a point) and,
-// through a second binding 40 bytes ahead, the next point. Keep in sync with
-// `lineao::passes::lines::LinePoint`.
-struct Segment {
-    @location(0) a: vec3<f32>,
-    // xyz: unit world-space tangent; w: side and flags (`lineao::passes::lines::VertexFlags`).
-    @location(1) ta: vec4<f32>,
-    @location(2) b: vec3<f32>,
-    @location(3) tb: vec4<f32>,
-}
-
-// The attributes of both ends. Keep in sync with `lineao::passes::lines::LineAttributes`.
-struct SegmentAttributes {
-    @location(4) octants_a_lo: vec4<f32>,
-    @location(5) octants_a_hi: vec4<f32>,
-    @location(6) radius_a: f32,
-    @location(10) scalar_a: f32,
-    @location(7) octants_b_lo: vec4<f32>,
-    @location(8) octants_b_hi: vec4<f32>,
-    @location(9) radius_b: f32,
-    @location(11) scalar_b: f32,
-}
 
 struct TubeOut {
     @builtin(position) clip: vec4<f32>,
@@ -47,19 +27,6 @@ struct TubeOut {
     // projection, so the rasterizer interpolates it exactly.
     @location(9) ray_origin: vec3<f32>,
     @location(10) ray_direction: vec3<f32>,
-}
-
-const FLAG_UNIT: f32 = 4000.0;
-const SEGMENT: u32 = 1u;
-
-fn flags(w: f32) -> u32 {
-    return u32(round(abs(w) * 32767.0 / FLAG_UNIT)) - 1u;
-}
-
-// Whether this instance is a segment: a left vertex where one starts, followed by the next
-// point's left vertex (a join's repeated vertices, or a run's last point, are none).
-fn is_segment(s: Segment) -> bool {
-    return s.ta.w > 0.0 && (flags(s.ta.w) & SEGMENT) != 0u && s.tb.w > 0.0;
 }
 
 // A bound of the screen radius in pixels of a sphere of radius `r` at view position `p`:
@@ -81,22 +48,30 @@ fn to_pixels(clip: vec4<f32>) -> vec2<f32> {
     return (clip.xy / clip.w * vec2<f32>(0.5, -0.5) + 0.5) * frame.viewport;
 }
 
-fn tube_vertex(vertex: u32, s: Segment, ra: f32, rb: f32, scalar_a: f32, scalar_b: f32) -> TubeOut {
+// Corner `corner` (0..3 of the billboard: (−, −), (−, +), (+, −), (+, +)) of the segment from
+// `a` to `b` (world points with unit tangents `ta`, `tb`) of radii `ra`, `rb` (world units).
+fn tube_vertex(corner: u32, a_world: PulledPoint, b_world: PulledPoint, ra: f32, rb: f32) -> TubeOut {
     var out: TubeOut;
-    let a = (frame.view * vec4<f32>(s.a, 1.0)).xyz;
-    let b = (frame.view * vec4<f32>(s.b, 1.0)).xyz;
+    let a = (frame.view * vec4<f32>(a_world.position, 1.0)).xyz;
+    let b = (frame.view * vec4<f32>(b_world.position, 1.0)).xyz;
     out.a = a;
     out.b = b;
     out.radii = vec2<f32>(ra, rb);
-    out.color_a = base_color(s.ta.xyz, scalar_a);
-    out.color_b = base_color(s.tb.xyz, scalar_b);
-    // Not a segment, or an end behind the eye: a degenerate billboard (outside the clip volume).
-    if !is_segment(s) || (!is_orthographic() && (-a.z <= 0.0 || -b.z <= 0.0)) {
+    out.color_a = base_color(a_world.tangent, point_scalar(a_world.index));
+    out.color_b = base_color(b_world.tangent, point_scalar(b_world.index));
+    let octants_a = point_octants(a_world.index);
+    let octants_b = point_octants(b_world.index);
+    out.octants_a_lo = octants_a[0];
+    out.octants_a_hi = octants_a[1];
+    out.octants_b_lo = octants_b[0];
+    out.octants_b_hi = octants_b[1];
+    // An end behind the eye: a degenerate billboard (outside the clip volume).
+    if !is_orthographic() && (-a.z <= 0.0 || -b.z <= 0.0) {
         out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
         return out;
     }
     // The billboard: the ends' disks on screen, hulled by a rectangle along the segment, one
-    // pixel wider all round. Corners 0..3 of the strip: (−, −), (−, +), (+, −), (+, +).
+    // pixel wider all round.
     let clip_a = frame.proj * vec4<f32>(a, 1.0);
     let clip_b = frame.proj * vec4<f32>(b, 1.0);
     let pa = to_pixels(clip_a);
@@ -105,12 +80,12 @@ fn tube_vertex(vertex: u32, s: Segment, ra: f32, rb: f32, scalar_a: f32, scalar_
     let reach_b = screen_radius(b, rb) + 1.0;
     let along = select(vec2<f32>(1.0, 0.0), normalize(pb - pa), distance(pa, pb) > 1e-6);
     let across = vec2<f32>(-along.y, along.x) * max(reach_a, reach_b);
-    let end = (vertex & 2u) != 0u;
-    let side = select(-1.0, 1.0, (vertex & 1u) != 0u);
-    let corner = select(pa - along * reach_a, pb + along * reach_b, end) + across * side;
+    let end = (corner & 2u) != 0u;
+    let side = select(-1.0, 1.0, (corner & 1u) != 0u);
+    let pixel = select(pa - along * reach_a, pb + along * reach_b, end) + across * side;
     // Back to clip space at the nearer end's depth: the fragment shader writes the true depth.
     let near_clip = select(clip_b, clip_a, clip_a.z / clip_a.w < clip_b.z / clip_b.w);
-    let ndc = (corner / frame.viewport - 0.5) * vec2<f32>(2.0, -2.0);
+    let ndc = (pixel / frame.viewport - 0.5) * vec2<f32>(2.0, -2.0);
     out.clip = vec4<f32>(ndc, clamp(near_clip.z / near_clip.w, 0.0, 1.0), 1.0);
     let near = frame.inv_proj * vec4<f32>(ndc, 0.0, 1.0);
     let far = frame.inv_proj * vec4<f32>(ndc, 1.0, 1.0);
@@ -119,27 +94,25 @@ fn tube_vertex(vertex: u32, s: Segment, ra: f32, rb: f32, scalar_a: f32, scalar_
     return out;
 }
 
+// Vertex v of a cluster's tubes: segment v / 6, two triangles of its billboard's corners.
+// Segments past the cluster's end lie outside the clip volume.
 @vertex
-fn vs_tube(@builtin(vertex_index) vertex: u32, s: Segment) -> TubeOut {
-    var out = tube_vertex(vertex, s, frame.tube_radius, frame.tube_radius, 0.0, 0.0);
-    out.octants_a_lo = vec4<f32>(1.0);
-    out.octants_a_hi = vec4<f32>(1.0);
-    out.octants_b_lo = vec4<f32>(1.0);
-    out.octants_b_hi = vec4<f32>(1.0);
-    return out;
-}
-
-// With the geometry's attributes: per-vertex radii (0 = the frame's) and octant visibilities.
-@vertex
-fn vs_tube_attributes(@builtin(vertex_index) vertex: u32, s: Segment, at: SegmentAttributes) -> TubeOut {
-    let ra = select(frame.tube_radius, at.radius_a, at.radius_a > 0.0);
-    let rb = select(frame.tube_radius, at.radius_b, at.radius_b > 0.0);
-    var out = tube_vertex(vertex, s, ra, rb, at.scalar_a, at.scalar_b);
-    out.octants_a_lo = at.octants_a_lo;
-    out.octants_a_hi = at.octants_a_hi;
-    out.octants_b_lo = at.octants_b_lo;
-    out.octants_b_hi = at.octants_b_hi;
-    return out;
+fn vs_tube(@builtin(vertex_index) v: u32, @builtin(instance_index) cluster: u32) -> TubeOut {
+    let c = clusters[cluster];
+    let segment = v / 6u;
+    if segment + 1u >= drawn_points(c) {
+        var out: TubeOut;
+        out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
+        return out;
+    }
+    let corners = array<u32, 6>(0u, 1u, 2u, 2u, 1u, 3u);
+    let a = pulled_point(c, segment);
+    let b = pulled_point(c, segment + 1u);
+    let ra = point_radius(a.index);
+    let rb = point_radius(b.index);
+    let radius_a = select(frame.tube_radius, ra, ra > 0.0);
+    let radius_b = select(frame.tube_radius, rb, rb > 0.0);
+    return tube_vertex(corners[v % 6u], a, b, radius_a, radius_b);
 }
 
 // The first hit of the ray ro + t rd (|rd| = 1) with the rounded cone between spheres (pa, ra)

@@ -101,6 +101,8 @@ impl GeometryBindings {
 /// What differs between the geometry pipelines.
 pub(crate) struct PipelineSpec<'a> {
     pub label: &'a str,
+    /// Bind groups after the frame's (group 0): the lines' and tubes' page of clusters.
+    pub groups: &'a [&'a wgpu::BindGroupLayout],
     pub module: &'a wgpu::ShaderModule,
     pub vertex: &'a str,
     pub fragment: &'a str,
@@ -120,7 +122,13 @@ pub(crate) fn pipeline(
     if spec.octants {
         color_targets.push(color_target(targets::OCTANTS_FORMAT));
     }
-    let pipeline_layout = crate::binding::pipeline_layout(device, spec.label, layout);
+    let groups: Vec<Option<&wgpu::BindGroupLayout>> =
+        std::iter::once(layout).chain(spec.groups.iter().copied()).map(Some).collect();
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(spec.label),
+        bind_group_layouts: &groups,
+        immediate_size: 0,
+    });
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(spec.label),
         layout: Some(&pipeline_layout),
@@ -132,7 +140,7 @@ pub(crate) fn pipeline(
         },
         primitive: wgpu::PrimitiveState {
             topology: spec.topology,
-            // Index strips end at u32::MAX (the lines' alternating strip).
+            // Index strips end at u32::MAX (the earlier strip's alternating strip).
             strip_index_format: (spec.topology == wgpu::PrimitiveTopology::TriangleStrip)
                 .then_some(wgpu::IndexFormat::Uint32),
             ..Default::default()

@@ -138,3 +138,32 @@ impl Gpu {
         self.lost.lock().unwrap_or_else(|poisoned| poisoned.into_inner()).clone()
     }
 }
+
+/// Runs `create`, an allocation of `size` bytes for `what`, in an out-of-memory error scope:
+/// a device that cannot hold it answers with [`Error::TooLarge`] naming the size and the
+/// device's largest buffer, not with wgpu's panicking default handler. Natively wgpu answers
+/// at once; a web page cannot wait for the answer, so there the allocation is not checked.
+pub(crate) fn allocating<T>(
+    device: &wgpu::Device,
+    what: &str,
+    size: u64,
+    create: impl FnOnce() -> T,
+) -> Result<T, Error> {
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        let scope = device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let value = create();
+        match pollster::block_on(scope.pop()) {
+            None => Ok(value),
+            Some(error) => Err(Error::TooLarge(format!(
+                "{what}: {size} bytes do not fit the device's memory (its largest buffer: {} bytes): {error}",
+                device.limits().max_buffer_size
+            ))),
+        }
+    }
+    #[cfg(target_arch = "wasm32")]
+    {
+        let _ = (device, what, size);
+        Ok(create())
+    }
+}

@@ -122,20 +122,7 @@ fn map_read(device: &wgpu::Device, buffer: &wgpu::Buffer) -> Result<(), Error> {
 
 /// Copies `buffer` (created with `COPY_SRC`) to the CPU and waits for it.
 pub fn read_buffer(device: &wgpu::Device, queue: &wgpu::Queue, buffer: &wgpu::Buffer) -> Result<Vec<u8>, Error> {
-    let staging = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("lineao::readback"),
-        size: buffer.size(),
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
-    let mut encoder =
-        device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::readback") });
-    encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
-    queue.submit([encoder.finish()]);
-    map_read(device, &staging)?;
-    let bytes = staging.slice(..).get_mapped_range().map_err(|e| Error::Gpu(e.to_string()))?.to_vec();
-    staging.unmap();
-    Ok(bytes)
+    pollster::block_on(read_buffer_async(device, queue, buffer))
 }
 
 /// A small buffer read back without waiting: [`LateReadback::copy`] records a copy into it and
@@ -201,4 +188,53 @@ impl LateReadback {
         device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| Error::Gpu(e.to_string()))?;
         self.try_take(device)
     }
+}
+
+/// [`read_buffer`] as a future, for hosts that must not block (the web: the page's event loop
+/// maps the buffer). Natively it waits for the device before it returns.
+pub async fn read_buffer_async(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    buffer: &wgpu::Buffer,
+) -> Result<Vec<u8>, Error> {
+    use std::sync::{Arc, Mutex};
+    use std::task::{Poll, Waker};
+    let staging = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("lineao::readback"),
+        size: buffer.size(),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder =
+        device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::readback") });
+    encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
+    // The mapping's answer and whoever waits for it.
+    type Answer = (Option<Result<(), wgpu::BufferAsyncError>>, Option<Waker>);
+    let answer: Arc<Mutex<Answer>> = Arc::new(Mutex::new((None, None)));
+    let sender = answer.clone();
+    encoder.map_buffer_on_submit(&staging, wgpu::MapMode::Read, .., move |result| {
+        let mut state = sender.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        state.0 = Some(result);
+        if let Some(waker) = state.1.take() {
+            waker.wake();
+        }
+    });
+    queue.submit([encoder.finish()]);
+    #[cfg(not(target_arch = "wasm32"))]
+    device.poll(wgpu::PollType::wait_indefinitely()).map_err(|e| Error::Gpu(e.to_string()))?;
+    let result = std::future::poll_fn(|cx| {
+        let mut state = answer.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        match state.0.take() {
+            Some(result) => Poll::Ready(result),
+            None => {
+                state.1 = Some(cx.waker().clone());
+                Poll::Pending
+            }
+        }
+    })
+    .await;
+    result.map_err(|e| Error::Gpu(format!("reading back: {e}")))?;
+    let bytes = staging.slice(..).get_mapped_range().map_err(|e| Error::Gpu(e.to_string()))?.to_vec();
+    staging.unmap();
+    Ok(bytes)
 }

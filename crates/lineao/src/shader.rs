@@ -9,6 +9,7 @@ use std::borrow::Cow;
 /// The WGSL files of the shared passes (under `shaders/`), by path relative to that folder;
 /// each method's are in its folder and its registry entry ([`crate::method::MethodInfo::shaders`]).
 const SHARED: &[(&str, &str)] = &[
+    ("shared/clusters.wgsl", include_str!("../shaders/shared/clusters.wgsl")),
     ("shared/cone.wgsl", include_str!("../shaders/shared/cone.wgsl")),
     ("shared/fullscreen.wgsl", include_str!("../shaders/shared/fullscreen.wgsl")),
     ("shared/gbuffer.wgsl", include_str!("../shaders/shared/gbuffer.wgsl")),
@@ -20,10 +21,12 @@ const SHARED: &[(&str, &str)] = &[
     ("shared/vo.wgsl", include_str!("../shaders/shared/vo.wgsl")),
     ("bilateral.wgsl", include_str!("../shaders/bilateral.wgsl")),
     ("composite.wgsl", include_str!("../shaders/composite.wgsl")),
+    ("line_geometry.wgsl", include_str!("../shaders/line_geometry.wgsl")),
     ("lines.wgsl", include_str!("../shaders/lines.wgsl")),
     ("meshes.wgsl", include_str!("../shaders/meshes.wgsl")),
     ("nd_from_depth.wgsl", include_str!("../shaders/nd_from_depth.wgsl")),
     ("nd_pyramid.wgsl", include_str!("../shaders/nd_pyramid.wgsl")),
+    ("strip.wgsl", include_str!("../shaders/strip.wgsl")),
     ("tubes.wgsl", include_str!("../shaders/tubes.wgsl")),
     ("volume_ao.wgsl", include_str!("../shaders/volume_ao.wgsl")),
 ];

@@ -277,7 +277,9 @@ fn curved_tubes_of_varying_radius_are_the_union_of_their_segments() {
         ("orthographic, per-vertex radii", orthographic, true),
     ] {
         let mut geometry = LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap();
-        let used: Vec<f32> = if varying { radii.clone() } else { vec![1.5; positions.len()] };
+        // The radii as the geometry stores them (f16), which the shader reads.
+        let stored: Vec<f32> = radii.iter().map(|&r| lineao::passes::lines::stored_radius(r)).collect();
+        let used: Vec<f32> = if varying { stored } else { vec![1.5; positions.len()] };
         if varying {
             let attributes = VertexAttributes { radius: Some(&radii), ..Default::default() };
             geometry.set_attributes(&gpu.device, &gpu.queue, &attributes).unwrap();
@@ -294,13 +296,14 @@ fn curved_tubes_of_varying_radius_are_the_union_of_their_segments() {
 }
 
 #[test]
-fn chunked_tubes_render_the_same() {
+fn paged_tubes_render_the_same() {
     let gpu = gpu();
     let (positions, offsets) = polylines(30, 0.2);
     let whole = LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap();
-    let options = GeometryOptions { chunk_bytes: 300 * 20, ..Default::default() };
+    // Pages of 96 points: each holds a few whole polylines.
+    let options = GeometryOptions { page_bytes: 96 * 8, ..Default::default() };
     let chunked = LineGeometry::with_options(&gpu.device, &gpu.queue, &positions, &offsets, options).unwrap();
-    assert!(chunked.chunk_count() > 10);
+    assert!(chunked.page_count() > 10, "{} pages", chunked.page_count());
     let (camera, _) = cameras_for_polylines();
     let a = render_tubes(&gpu, &whole, &camera, tubes(1.0), (160, 120));
     let b = render_tubes(&gpu, &chunked, &camera, tubes(1.0), (160, 120));

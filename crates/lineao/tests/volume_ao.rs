@@ -434,9 +434,9 @@ fn a_constant_visibility_gives_the_hemisphere_sky_in_closed_form() {
 fn attributes_split_with_the_strip_and_bad_attributes_are_errors() {
     let gpu = gpu();
     let (whole, _) = swept_polylines(&gpu, GeometryOptions::default());
-    // 40 polylines of 60 points: ~4 900 strip vertices in chunks of 400.
-    let (chunked, _) = swept_polylines(&gpu, GeometryOptions { chunk_bytes: 400 * 20, ..Default::default() });
-    assert!(chunked.chunk_count() > 10 && whole.chunk_count() == 1);
+    // 40 polylines of 60 points in pages of 120 points.
+    let (chunked, _) = swept_polylines(&gpu, GeometryOptions { page_bytes: 120 * 8, ..Default::default() });
+    assert!(chunked.page_count() == 20 && whole.page_count() == 1, "{} pages", chunked.page_count());
     let (camera, _) = cameras_for_polylines();
     let settings =
         ChainSettings { method: AoMethod::None, volume: Some(Default::default()), ..ChainSettings::default() };

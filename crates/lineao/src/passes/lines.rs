@@ -7,22 +7,21 @@
 //! normalized, facing the eye; normalized linear depth), the zoom map, the illuminated-lines
 //! specular and hardware depth.
 //!
-//! The geometry it draws — the strip, its buffers and the alternating strip — is
-//! `line_geometry.rs`'s.
+//! The geometry it draws — clusters its vertex shader pulls, and which of them may be drawn as
+//! the alternating strip — is `line_geometry`'s.
 
 use std::sync::atomic::{AtomicU32, Ordering};
 
 use crate::camera::FrameView;
 use crate::gbuffer::{self, GeometryBindings, GeometryUniform, Load, PipelineSpec};
 use crate::lighting::Lighting;
-use crate::line_geometry::LineGeometry;
+#[cfg(feature = "reference")]
+pub use crate::line_geometry::strip::{StripGeometry, StripRenderer};
 pub use crate::line_geometry::{
-    DEFAULT_CHUNK_BYTES, FLAG_UNIT, GeometryOptions, LineAttributes, LinePoint, VertexAttributes, VertexFlags,
+    CLUSTER_POINTS, ClusterRecord, DEFAULT_PAGE_BYTES, GeometryOptions, VertexAttributes, stored_radius,
     validate_offsets,
 };
-use crate::line_geometry::{
-    MAX_ALTERNATING_WIDTH_PX, MAX_TOLERANCE_PX, STRIP_ATTRIBUTES, attribute_layout, strip_layout,
-};
+use crate::line_geometry::{LineGeometry, MAX_ALTERNATING_WIDTH_PX, MAX_TOLERANCE_PX, Page, SIZE_CLASSES};
 use crate::settings::LineColor;
 use crate::targets::FrameTargets;
 use crate::timing::Span;
@@ -30,7 +29,7 @@ use crate::timing::Span;
 /// The most pixels one world unit can cover in `view` (at the near end of its depth range,
 /// off axis up to the viewport's corners): the Jacobian of (f x / z, f y / z) has norm at most
 /// f / z · √(1 + (x² + y²) / z²).
-fn max_px_per_world(view: &FrameView) -> f32 {
+pub(crate) fn max_px_per_world(view: &FrameView) -> f32 {
     if view.orthographic {
         return view.f_px;
     }
@@ -43,38 +42,35 @@ fn max_px_per_world(view: &FrameView) -> f32 {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum LineStyle {
     /// Screen-aligned quads of the chain's line width (the paper's fixed-width lines), from the
-    /// alternating strip where it stays within about half a pixel of the full one (see the
-    /// module documentation), else the full strip.
+    /// alternating strip where it stays within about half a pixel of the full one (see
+    /// `line_geometry`), else the full strip.
     #[default]
     Quads,
     /// Quads always from the full strip: both sides of every point.
     FullStrip,
-    /// The rasterizer's native 1-pixel lines (an indexed `LineList` over the same vertices),
+    /// The rasterizer's native 1-pixel lines (a `LineList` pulled from the same clusters),
     /// ignoring the line width: the cheapest way to put segments on screen, and the baseline
-    /// `lineao bench` measures quads against. Needs geometry uploaded with
-    /// [`GeometryOptions::native_lines`]; without it nothing is drawn.
+    /// `lineao bench` measures quads against.
     Native1px,
+}
+
+/// The pipelines of one output set: the full strip (or native lines) and the alternating strip.
+struct Pipelines {
+    full: wgpu::RenderPipeline,
+    alternating: Option<wgpu::RenderPipeline>,
 }
 
 /// Renders [`LineGeometry`] into the G-buffer of [`FrameTargets`].
 pub struct LineRenderer {
     style: LineStyle,
-    pipeline: wgpu::RenderPipeline,
-    /// With the geometry's attributes (the scalar's color), quads only.
-    attributes: Option<wgpu::RenderPipeline>,
-    /// Writing `octants` too: from the geometry's attributes, and fully visible for geometry
-    /// without them.
-    octants: Option<OctantPipelines>,
+    plain: Pipelines,
+    /// Writing `octants` too: the points' octant visibilities, fully visible where a page
+    /// holds none.
+    octants: Option<Pipelines>,
     bindings: GeometryBindings,
     /// The frame's [`max_px_per_world`] (f32 bits) when the alternating strip may be drawn
     /// (∞ otherwise), from [`LineRenderer::prepare`].
     px_per_world: AtomicU32,
-}
-
-/// The pipelines of a geometry pass that also writes the `octants` target.
-pub(crate) struct OctantPipelines {
-    pub attributes: wgpu::RenderPipeline,
-    pub visible: wgpu::RenderPipeline,
 }
 
 impl LineRenderer {
@@ -91,47 +87,45 @@ impl LineRenderer {
     /// per-vertex octant visibilities, interpolated ([`crate::passes::volume_ao`]); quads only.
     pub fn with_outputs(device: &wgpu::Device, style: LineStyle, octants: bool) -> LineRenderer {
         let bindings = GeometryBindings::new(device, "lineao::LineRenderer::bindings");
+        let page = crate::line_geometry::page_layout(device);
         let module = crate::shader::module(device, "lines.wgsl");
-        // Octants at 0 and 4, the scalar at 12 (the tubes' radius at 8 is skipped).
-        let octant_attributes = [
-            wgpu::VertexAttribute { format: wgpu::VertexFormat::Unorm8x4, offset: 0, shader_location: 2 },
-            wgpu::VertexAttribute { format: wgpu::VertexFormat::Unorm8x4, offset: 4, shader_location: 3 },
-            wgpu::VertexAttribute { format: wgpu::VertexFormat::Float32, offset: 12, shader_location: 5 },
-        ];
-        let strip = [Some(strip_layout(&STRIP_ATTRIBUTES))];
-        let with_attributes = [Some(strip_layout(&STRIP_ATTRIBUTES)), Some(attribute_layout(&octant_attributes))];
         let topology = match style {
             LineStyle::Quads | LineStyle::FullStrip => wgpu::PrimitiveTopology::TriangleStrip,
             LineStyle::Native1px => wgpu::PrimitiveTopology::LineList,
         };
-        let create = |label, vertex, fragment, buffers| {
+        let create = |label, vertex, fragment| {
             let octants = fragment == "fs_octants";
             gbuffer::pipeline(
                 device,
                 &bindings.layout,
-                PipelineSpec { label, module: &module, vertex, fragment, buffers, topology, octants },
+                PipelineSpec {
+                    label,
+                    groups: &[&page],
+                    module: &module,
+                    vertex,
+                    fragment,
+                    buffers: &[],
+                    topology,
+                    octants,
+                },
             )
         };
-        let vertex = match style {
-            LineStyle::Quads | LineStyle::FullStrip => "vs_main",
-            LineStyle::Native1px => "vs_native",
+        let plain = match style {
+            LineStyle::Native1px => {
+                Pipelines { full: create("lineao::LineRenderer::native", "vs_native", "fs_main"), alternating: None }
+            }
+            _ => Pipelines {
+                full: create("lineao::LineRenderer::full", "vs_full", "fs_main"),
+                alternating: (style == LineStyle::Quads)
+                    .then(|| create("lineao::LineRenderer::alternating", "vs_alternating", "fs_main")),
+            },
         };
-        let pipeline = create("lineao::LineRenderer::pipeline", vertex, "fs_main", &strip);
-        let quads = style != LineStyle::Native1px;
-        let attributes =
-            quads.then(|| create("lineao::LineRenderer::attributes", "vs_attributes", "fs_main", &with_attributes));
-        let octants = (octants && quads).then(|| OctantPipelines {
-            attributes: create("lineao::LineRenderer::octants", "vs_octants", "fs_octants", &with_attributes),
-            visible: create("lineao::LineRenderer::visible", "vs_visible", "fs_octants", &strip),
+        let octants = (octants && style != LineStyle::Native1px).then(|| Pipelines {
+            full: create("lineao::LineRenderer::full_octants", "vs_full_octants", "fs_octants"),
+            alternating: (style == LineStyle::Quads)
+                .then(|| create("lineao::LineRenderer::alternating_octants", "vs_alternating_octants", "fs_octants")),
         });
-        LineRenderer {
-            style,
-            pipeline,
-            attributes,
-            octants,
-            bindings,
-            px_per_world: AtomicU32::new(f32::INFINITY.to_bits()),
-        }
+        LineRenderer { style, plain, octants, bindings, px_per_world: AtomicU32::new(f32::INFINITY.to_bits()) }
     }
 
     /// Whether this renderer writes the `octants` target.
@@ -152,15 +146,22 @@ impl LineRenderer {
         self.px_per_world.store(scale.to_bits(), Ordering::Relaxed);
     }
 
-    /// Whether [`LineRenderer::encode`] draws `geometry` from the alternating strip in the frame
-    /// of the last [`LineRenderer::prepare`].
-    pub fn alternates(&self, geometry: &LineGeometry) -> bool {
+    /// Whether `page`'s straight clusters are drawn as the alternating strip in the frame of
+    /// the last [`LineRenderer::prepare`].
+    fn page_alternates(&self, page: &Page) -> bool {
         let scale = f32::from_bits(self.px_per_world.load(Ordering::Relaxed));
-        self.style == LineStyle::Quads && geometry.tolerance * scale <= MAX_TOLERANCE_PX
+        self.style == LineStyle::Quads && page.tolerance * scale <= MAX_TOLERANCE_PX
+    }
+
+    /// Whether [`LineRenderer::encode`] draws any of `geometry` as the alternating strip in the
+    /// frame of the last [`LineRenderer::prepare`].
+    pub fn alternates(&self, geometry: &LineGeometry) -> bool {
+        geometry.pages().iter().any(|page| self.page_alternates(page))
     }
 
     /// Draws `geometry` into the G-buffer, clearing it first or over earlier passes (`load`),
-    /// timed into `span` when given.
+    /// timed into `span` when given: per page, each size class of clusters with its vertex
+    /// count, the full strips first, then the alternating ones.
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -172,32 +173,30 @@ impl LineRenderer {
         // The octants too when both the pipelines and the target exist.
         let octants = self.octants.as_ref().filter(|_| targets.octants.is_some());
         let mut pass = gbuffer::begin(encoder, "lineao::LineRenderer", targets, load, octants.is_some(), span);
-        let attributes = geometry.has_attributes() && (octants.is_some() || self.attributes.is_some());
-        pass.set_pipeline(match (octants, &self.attributes) {
-            (Some(pipelines), _) if attributes => &pipelines.attributes,
-            (Some(pipelines), _) => &pipelines.visible,
-            (None, Some(pipeline)) if attributes => pipeline,
-            _ => &self.pipeline,
-        });
+        let pipelines = octants.unwrap_or(&self.plain);
         pass.set_bind_group(0, &self.bindings.group, &[]);
-        let alternates = self.alternates(geometry);
-        for chunk in &geometry.chunks {
-            pass.set_vertex_buffer(0, chunk.vertices.slice(..));
-            if let (true, Some(buffer)) = (attributes, &chunk.attributes) {
-                pass.set_vertex_buffer(1, buffer.slice(..));
+        for page in geometry.pages() {
+            pass.set_bind_group(1, &page.group, &[]);
+            let alternating = pipelines.alternating.as_ref().filter(|_| self.page_alternates(page));
+            // (class, vertices) of every non-empty range, full strips first.
+            let draws = page.classes.iter().enumerate().filter(|(_, range)| !range.is_empty());
+            let mut full = Vec::new();
+            let mut alternated = Vec::new();
+            for (class, range) in draws {
+                let segments = SIZE_CLASSES[class / 2];
+                let straight = class % 2 == 1;
+                match (self.style, alternating) {
+                    (LineStyle::Native1px, _) => full.push((2 * segments, range.clone())),
+                    (_, Some(_)) if straight => alternated.push((segments + 3, range.clone())),
+                    _ => full.push((2 * (segments + 1), range.clone())),
+                }
             }
-            match (self.style, &chunk.segments) {
-                (LineStyle::Quads, _) if alternates => {
-                    let (indices, count) = &chunk.alternating;
-                    pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
-                    pass.draw_indexed(0..*count, 0, 0..1);
+            for (pipeline, draws) in [(Some(&pipelines.full), full), (alternating, alternated)] {
+                let Some(pipeline) = pipeline.filter(|_| !draws.is_empty()) else { continue };
+                pass.set_pipeline(pipeline);
+                for (vertices, instances) in draws {
+                    pass.draw(0..vertices, instances);
                 }
-                (LineStyle::Quads | LineStyle::FullStrip, _) => pass.draw(0..chunk.count, 0..1),
-                (LineStyle::Native1px, Some((indices, count))) => {
-                    pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
-                    pass.draw_indexed(0..*count, 0, 0..1);
-                }
-                (LineStyle::Native1px, None) => {}
             }
         }
     }

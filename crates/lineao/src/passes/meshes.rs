@@ -103,6 +103,7 @@ impl MeshRenderer {
             device,
             &bindings.layout,
             PipelineSpec {
+                groups: &[],
                 label: "lineao::MeshRenderer::pipeline",
                 module: &module,
                 vertex: "vs_mesh",

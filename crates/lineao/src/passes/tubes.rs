@@ -13,28 +13,24 @@
 //! (`lineao bench`: the 2-triangle line strip is already most of a line frame). The billboards
 //! cost per pixel instead, with exact silhouettes, depth and normals at every zoom.
 //!
-//! No new buffers: the billboards are instances over [`LineGeometry`]'s strip, read with twice
-//! its stride so that instance k sees strip vertex 2k (a point's left vertex) and, through a
-//! second binding 40 bytes ahead, vertex 2k + 2 (the next point's). Instances that are no
-//! segment (joins, a run's last point) collapse to nothing. The strip's chunks start at even
-//! positions and overlap by two vertices, so each segment is an instance of exactly one chunk
-//! (the padding of two vertices keeps the second binding within bounds).
+//! No buffers of their own: the vertex shader pulls each segment from
+//! [`LineGeometry`]'s clusters (instance = a cluster, six vertices — two triangles — per
+//! segment, as many segments as the cluster's size class holds; those past its end lie
+//! outside the clip volume), so tubes and lines share one copy of the points.
 //!
 //! LineAO on tubes takes r0 = 1.5 · z(P) · t_s (paper Eq. 16, t_s = 2 · radius in zoom units).
 
 use crate::camera::FrameView;
 use crate::gbuffer::{self, GeometryBindings, GeometryUniform, Load, PipelineSpec};
 use crate::lighting::Lighting;
-use crate::line_geometry::{ATTRIBUTE_SIZE, LineGeometry, POINT_SIZE};
+use crate::line_geometry::{LineGeometry, SIZE_CLASSES};
 use crate::settings::LineColor;
 use crate::targets::FrameTargets;
 use crate::timing::Span;
 
 /// Renders [`LineGeometry`] as tubes into the G-buffer of [`FrameTargets`].
 pub struct TubeRenderer {
-    /// Without and with the geometry's attributes.
-    plain: wgpu::RenderPipeline,
-    attributes: wgpu::RenderPipeline,
+    pipeline: wgpu::RenderPipeline,
     octants: bool,
     bindings: GeometryBindings,
 }
@@ -44,48 +40,23 @@ impl TubeRenderer {
     /// visibilities along each segment ([`crate::passes::volume_ao`]).
     pub fn new(device: &wgpu::Device, octants: bool) -> TubeRenderer {
         let bindings = GeometryBindings::new(device, "lineao::TubeRenderer::bindings");
+        let page = crate::line_geometry::page_layout(device);
         let module = crate::shader::module(device, "tubes.wgsl");
-        let point = |a, t| wgpu::vertex_attr_array![a => Float32x3, t => Snorm16x4];
-        let (at_a, at_b) = (point(0, 1), point(2, 3));
-        let attribute =
-            |lo, hi, r, s| wgpu::vertex_attr_array![lo => Unorm8x4, hi => Unorm8x4, r => Float32, s => Float32];
-        let (attr_a, attr_b) = (attribute(4, 5, 6, 10), attribute(7, 8, 9, 11));
-        let instance = |stride, attributes| {
-            Some(wgpu::VertexBufferLayout {
-                array_stride: stride,
-                step_mode: wgpu::VertexStepMode::Instance,
-                attributes,
-            })
-        };
-        let segments = [instance(2 * POINT_SIZE, &at_a[..]), instance(2 * POINT_SIZE, &at_b[..])];
-        let with_attributes = [
-            segments[0].clone(),
-            segments[1].clone(),
-            instance(2 * ATTRIBUTE_SIZE, &attr_a[..]),
-            instance(2 * ATTRIBUTE_SIZE, &attr_b[..]),
-        ];
-        let fragment = if octants { "fs_tube_octants" } else { "fs_tube" };
-        let create = |label, vertex, buffers| {
-            gbuffer::pipeline(
-                device,
-                &bindings.layout,
-                PipelineSpec {
-                    label,
-                    module: &module,
-                    vertex,
-                    fragment,
-                    buffers,
-                    topology: wgpu::PrimitiveTopology::TriangleStrip,
-                    octants,
-                },
-            )
-        };
-        TubeRenderer {
-            plain: create("lineao::TubeRenderer::pipeline", "vs_tube", &segments),
-            attributes: create("lineao::TubeRenderer::attributes", "vs_tube_attributes", &with_attributes),
-            octants,
-            bindings,
-        }
+        let pipeline = gbuffer::pipeline(
+            device,
+            &bindings.layout,
+            PipelineSpec {
+                label: "lineao::TubeRenderer::pipeline",
+                groups: &[&page],
+                module: &module,
+                vertex: "vs_tube",
+                fragment: if octants { "fs_tube_octants" } else { "fs_tube" },
+                buffers: &[],
+                topology: wgpu::PrimitiveTopology::TriangleList,
+                octants,
+            },
+        );
+        TubeRenderer { pipeline, octants, bindings }
     }
 
     /// Whether this renderer writes the `octants` target.
@@ -117,17 +88,13 @@ impl TubeRenderer {
     ) {
         let octants = self.octants && targets.octants.is_some();
         let mut pass = gbuffer::begin(encoder, "lineao::TubeRenderer", targets, load, octants, span);
-        let attributes = geometry.has_attributes();
-        pass.set_pipeline(if attributes { &self.attributes } else { &self.plain });
+        pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &self.bindings.group, &[]);
-        for (vertices, count, extra) in geometry.chunk_buffers() {
-            pass.set_vertex_buffer(0, vertices.slice(..));
-            pass.set_vertex_buffer(1, vertices.slice(2 * POINT_SIZE..));
-            if let (true, Some(buffer)) = (attributes, extra) {
-                pass.set_vertex_buffer(2, buffer.slice(..));
-                pass.set_vertex_buffer(3, buffer.slice(2 * ATTRIBUTE_SIZE..));
+        for page in geometry.pages() {
+            pass.set_bind_group(1, &page.group, &[]);
+            for (class, range) in page.classes.iter().enumerate().filter(|(_, r)| !r.is_empty()) {
+                pass.draw(0..6 * SIZE_CLASSES[class / 2], range.clone());
             }
-            pass.draw(0..4, 0..count / 2);
         }
     }
 }

@@ -1,0 +1,140 @@
+// Polylines as clusters, pulled by the vertex shader (`lineao::line_geometry`, whose clusters
+// module lays them out): every point once, 16 bits per axis on its cluster's own grid; a
+// cluster's strip also draws the next cluster's first point, decoded with that cluster's grid,
+// so joins between clusters are exact. Bind group 1 is one page of clusters.
+
+// Keep in sync with `lineao::line_geometry::ClusterRecord`.
+struct Cluster {
+    origin: vec3<f32>,
+    scale: f32,
+    first: u32,
+    // Bits 0–7: point count; 8: the run goes on before it; 9: after it; 10: straight.
+    flags: u32,
+    previous: u32,
+    next: u32,
+}
+
+// Keep in sync with `lineao::line_geometry::PageUniform`.
+struct ClusterPage {
+    // Which attribute arrays hold data: 1 octants, 2 scalars, 4 radii.
+    attributes: u32,
+    _pad0: u32,
+    _pad1: u32,
+    _pad2: u32,
+}
+
+const CLUSTER_COUNT: u32 = 0xffu;
+const JOINS_PREVIOUS: u32 = 0x100u;
+const JOINS_NEXT: u32 = 0x200u;
+const HAS_OCTANTS: u32 = 1u;
+const HAS_SCALARS: u32 = 2u;
+const HAS_RADII: u32 = 4u;
+
+// x | y << 16 per point; z two points to a word.
+@group(1) @binding(0) var<storage, read> cluster_xy: array<u32>;
+@group(1) @binding(1) var<storage, read> cluster_z: array<u32>;
+@group(1) @binding(2) var<storage, read> clusters: array<Cluster>;
+// Per point, where the page has them: eight octant visibilities as unorm8, the colormap's
+// scalar, the tube radius as f16 (two to a word; 0 = the frame's).
+@group(1) @binding(3) var<storage, read> cluster_octants: array<vec2<u32>>;
+@group(1) @binding(4) var<storage, read> cluster_scalars: array<f32>;
+@group(1) @binding(5) var<storage, read> cluster_radii: array<u32>;
+@group(1) @binding(6) var<uniform> cluster_page: ClusterPage;
+
+// Point `i` of the page on the grid of cluster `c` (its own, or for the next cluster's first
+// point, the next's).
+fn decode_point(i: u32, c: Cluster) -> vec3<f32> {
+    let xy = cluster_xy[i];
+    let z = (cluster_z[i >> 1u] >> ((i & 1u) << 4u)) & 0xffffu;
+    let q = vec3<f32>(f32(xy & 0xffffu), f32(xy >> 16u), f32(z));
+    return fma(q, vec3<f32>(c.scale), c.origin);
+}
+
+// A point of a cluster's strip: where it is, its unit vertex tangent (the central difference
+// of its neighbours, else a one-sided one, else +x), and its index in the page.
+struct PulledPoint {
+    position: vec3<f32>,
+    tangent: vec3<f32>,
+    index: u32,
+}
+
+// The points a cluster's strip draws: its own, and the next cluster's first when its run goes on.
+fn drawn_points(c: Cluster) -> u32 {
+    return (c.flags & CLUSTER_COUNT) + select(0u, 1u, (c.flags & JOINS_NEXT) != 0u);
+}
+
+// Point `k` (< drawn_points) of cluster `c` with its vertex tangent.
+fn pulled_point(c: Cluster, k: u32) -> PulledPoint {
+    let count = c.flags & CLUSTER_COUNT;
+    let joins_next = (c.flags & JOINS_NEXT) != 0u;
+    let i = c.first + k;
+    var after = c;
+    if joins_next {
+        after = clusters[c.next];
+    }
+    // The next cluster's first point is on its grid.
+    var owner = c;
+    if k >= count {
+        owner = after;
+    }
+    let p = decode_point(i, owner);
+    var previous = p;
+    if k > 0u {
+        previous = decode_point(i - 1u, c);
+    } else if (c.flags & JOINS_PREVIOUS) != 0u {
+        previous = decode_point(i - 1u, clusters[c.previous]);
+    }
+    var next = p;
+    if k + 1u < count {
+        next = decode_point(i + 1u, c);
+    } else if joins_next {
+        // The next cluster's first or second point (clusters hold at least two).
+        next = decode_point(i + 1u, after);
+    }
+    var t = next - previous;
+    if dot(t, t) == 0.0 {
+        t = next - p;
+    }
+    if dot(t, t) == 0.0 {
+        t = p - previous;
+    }
+    if dot(t, t) == 0.0 {
+        t = vec3<f32>(1.0, 0.0, 0.0);
+    }
+    return PulledPoint(p, normalize(t), i);
+}
+
+fn point_scalar(i: u32) -> f32 {
+    if (cluster_page.attributes & HAS_SCALARS) == 0u {
+        return 0.0;
+    }
+    return cluster_scalars[i];
+}
+
+// The tube radius at point `i`; 0 where the page holds none (the frame's then).
+fn point_radius(i: u32) -> f32 {
+    if (cluster_page.attributes & HAS_RADII) == 0u {
+        return 0.0;
+    }
+    return positive_f16((cluster_radii[i >> 1u] >> ((i & 1u) << 4u)) & 0xffffu);
+}
+
+// A non-negative half-precision float's bits as f32 (by hand: `unpack2x16float` needs a
+// capability some backends lack).
+fn positive_f16(h: u32) -> f32 {
+    let exponent = (h >> 10u) & 0x1fu;
+    let mantissa = h & 0x3ffu;
+    if exponent == 0u {
+        return f32(mantissa) * exp2(-24.0);
+    }
+    return bitcast<f32>(((exponent + 112u) << 23u) | (mantissa << 13u));
+}
+
+// Octants 0–3 and 4–7 of point `i`; all visible where the page holds none.
+fn point_octants(i: u32) -> array<vec4<f32>, 2> {
+    if (cluster_page.attributes & HAS_OCTANTS) == 0u {
+        return array<vec4<f32>, 2>(vec4<f32>(1.0), vec4<f32>(1.0));
+    }
+    let packed = cluster_octants[i];
+    return array<vec4<f32>, 2>(unpack4x8unorm(packed.x), unpack4x8unorm(packed.y));
+}
