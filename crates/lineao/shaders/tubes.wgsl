@@ -83,8 +83,10 @@ fn tube_vertex(corner: u32, a_world: PulledPoint, b_world: PulledPoint, ra: f32,
     let end = (corner & 2u) != 0u;
     let side = select(-1.0, 1.0, (corner & 1u) != 0u);
     let pixel = select(pa - along * reach_a, pb + along * reach_b, end) + across * side;
-    // Back to clip space at the nearer end's depth: the fragment shader writes the true depth.
-    let near_clip = select(clip_b, clip_a, clip_a.z / clip_a.w < clip_b.z / clip_b.w);
+    // Back to clip space at the solid's nearest depth (the nearer end sphere's front): the
+    // fragment shader writes the true depth, never nearer.
+    let front = min(-a.z - ra, -b.z - rb);
+    let near_clip = frame.proj * vec4<f32>(0.0, 0.0, -max(front, 1e-6), 1.0);
     let ndc = (pixel / frame.viewport - 0.5) * vec2<f32>(2.0, -2.0);
     out.clip = vec4<f32>(ndc, clamp(near_clip.z / near_clip.w, 0.0, 1.0), 1.0);
     let near = frame.inv_proj * vec4<f32>(ndc, 0.0, 1.0);
@@ -211,7 +213,12 @@ struct TubeFragmentOctants {
     @location(4) octants: vec2<u32>,
 }
 
+// The hit is never nearer than the billboard's depth (the solid's front), so where the device
+// can take that promise (`wgpu::Features::SHADER_EARLY_DEPTH_TEST`) the tube renderer puts
+// `@early_depth_test(greater_equal)` on the fragment entries: hidden fragments are dropped before
+// they are shaded, though the shader writes its depth.
 @fragment
+//@conservative_depth
 fn fs_tube(in: TubeOut) -> TubeFragment {
     let h = tube_hit(in);
     let g = h.gbuffer;
@@ -219,6 +226,7 @@ fn fs_tube(in: TubeOut) -> TubeFragment {
 }
 
 @fragment
+//@conservative_depth
 fn fs_tube_octants(in: TubeOut) -> TubeFragmentOctants {
     let h = tube_hit(in);
     let g = with_octants(

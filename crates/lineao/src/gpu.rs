@@ -106,9 +106,12 @@ impl Gpu {
         Gpu { instance, adapter, device, queue, lost }
     }
 
-    /// What lineao asks of an adapter: its own limits, plus timestamp queries when offered.
+    /// What lineao asks of an adapter: its own limits, plus timestamp queries and early depth
+    /// tests before a shader that writes its depth (the tubes') when offered.
     pub fn device_descriptor(adapter: &wgpu::Adapter) -> wgpu::DeviceDescriptor<'static> {
-        let wanted = wgpu::Features::TIMESTAMP_QUERY | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS;
+        let wanted = wgpu::Features::TIMESTAMP_QUERY
+            | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS
+            | wgpu::Features::SHADER_EARLY_DEPTH_TEST;
         wgpu::DeviceDescriptor {
             label: Some("lineao::Gpu::device"),
             required_features: adapter.features() & wanted,

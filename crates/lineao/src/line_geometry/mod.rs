@@ -154,11 +154,7 @@ impl PageAttributes {
     }
 
     fn with_arrays(octants: bool, scalar: bool, radius: bool) -> PageAttributes {
-        PageAttributes {
-            octants: octants.then(Vec::new),
-            scalar: scalar.then(Vec::new),
-            radius: radius.then(Vec::new),
-        }
+        PageAttributes { octants: octants.then(Vec::new), scalar: scalar.then(Vec::new), radius: radius.then(Vec::new) }
     }
 
     /// Appends the attributes of points `from..from + len` of `a` (as stored: unorm8 octants,

@@ -41,7 +41,11 @@ impl TubeRenderer {
     pub fn new(device: &wgpu::Device, octants: bool) -> TubeRenderer {
         let bindings = GeometryBindings::new(device, "lineao::TubeRenderer::bindings");
         let page = crate::line_geometry::page_layout(device);
-        let module = crate::shader::module(device, "tubes.wgsl");
+        // The depth test before shading where the device takes the shader's promise that its
+        // depth is never nearer than the billboard's (`tubes.wgsl`).
+        let early = device.features().contains(wgpu::Features::SHADER_EARLY_DEPTH_TEST);
+        let promise = if early { "@early_depth_test(greater_equal)" } else { "" };
+        let module = crate::shader::module_with(device, "tubes.wgsl", &[("//@conservative_depth", promise)]);
         let pipeline = gbuffer::pipeline(
             device,
             &bindings.layout,
