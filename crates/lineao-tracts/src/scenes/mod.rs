@@ -8,6 +8,11 @@
 //!   like the LineAO paper's Fig. 3 (where the depth falloff δ(l) matters).
 //! - `vortex`: streamlines of a flow around a pair of counter-rotating, gently bent vortex tubes
 //!   with an axial jet, integrated with RK4.
+//! - `wholebrain`: a whole-brain tractogram of any size (association, projection and
+//!   commissural bundles and U-fibres in two hemispheres, 20–200 mm at 1 mm steps), made
+//!   streamline by streamline ([`wholebrain`]).
+
+pub mod wholebrain;
 
 use glam::Vec3;
 use rand_core::{Rng, SeedableRng};
@@ -39,22 +44,27 @@ pub enum SceneKind {
     Bundles,
     Spiral,
     Vortex,
+    WholeBrain,
 }
 
 impl SceneKind {
-    pub const ALL: [SceneKind; 3] = [SceneKind::Bundles, SceneKind::Spiral, SceneKind::Vortex];
+    pub const ALL: [SceneKind; 4] = [SceneKind::Bundles, SceneKind::Spiral, SceneKind::Vortex, SceneKind::WholeBrain];
 
     pub fn name(self) -> &'static str {
         match self {
             SceneKind::Bundles => "bundles",
             SceneKind::Spiral => "spiral",
             SceneKind::Vortex => "vortex",
+            SceneKind::WholeBrain => "wholebrain",
         }
     }
 
     /// The vertex count of the scene when none is requested.
     pub fn default_vertices(self) -> usize {
-        400_000
+        match self {
+            SceneKind::WholeBrain => 1_000_000,
+            _ => 400_000,
+        }
     }
 
     /// Builds the scene with about `vertices` vertices (at least a few streamlines).
@@ -64,6 +74,12 @@ impl SceneKind {
             SceneKind::Bundles => bundles(&mut rng, vertices),
             SceneKind::Spiral => spiral(&mut rng, vertices),
             SceneKind::Vortex => vortex(&mut rng, vertices),
+            SceneKind::WholeBrain => {
+                let brain = wholebrain::WholeBrain::new(seed, vertices as u64);
+                let tractogram = brain.tractogram(0..brain.streamlines());
+                let view = ViewHint::for_tractogram(&tractogram);
+                (tractogram, view)
+            }
         };
         Scene { kind: self, tractogram, view }
     }
@@ -75,7 +91,7 @@ impl std::str::FromStr for SceneKind {
         SceneKind::ALL
             .into_iter()
             .find(|k| k.name() == s)
-            .ok_or_else(|| format!("unknown scene '{s}' (expected one of: bundles, spiral, vortex)"))
+            .ok_or_else(|| format!("unknown scene '{s}' (expected one of: bundles, spiral, vortex, wholebrain)"))
     }
 }
 
@@ -151,6 +167,12 @@ fn framed(tractogram: &Tractogram, from: Vec3, up: Vec3, fov_y_deg: f32) -> View
         .map(|p| Vec3::from_array(*p).distance(centre))
         .filter(|d| d.is_finite())
         .fold(1.0f32, f32::max);
+    framing(centre, radius, from, up, fov_y_deg)
+}
+
+/// Camera looking at the sphere (`centre`, `radius` ≥ 1) from direction `from`, filling the frame.
+fn framing(centre: Vec3, radius: f32, from: Vec3, up: Vec3, fov_y_deg: f32) -> ViewHint {
+    let radius = radius.max(1.0);
     let distance = 0.9 * radius / (fov_y_deg.to_radians() * 0.5).tan();
     ViewHint {
         eye: (centre + from.normalize() * distance).to_array(),
@@ -161,12 +183,21 @@ fn framed(tractogram: &Tractogram, from: Vec3, up: Vec3, fov_y_deg: f32) -> View
     }
 }
 
+/// Where a tractogram is seen from: the left, a little anterior and superior.
+const TRACTOGRAM_VIEW: Vec3 = Vec3::new(-1.0, 0.35, 0.3);
+
 impl ViewHint {
     /// The default view of a loaded tractogram in RAS+ mm: from the left, a little anterior and
     /// superior (most association bundles run anterior–posterior and show best sagittally),
     /// superior up, 1 mm per zoom unit.
     pub fn for_tractogram(tractogram: &Tractogram) -> ViewHint {
-        framed(tractogram, Vec3::new(-1.0, 0.35, 0.3), Vec3::Z, 35.0)
+        framed(tractogram, TRACTOGRAM_VIEW, Vec3::Z, 35.0)
+    }
+
+    /// [`ViewHint::for_tractogram`] of streamlines whose bounding sphere (around their box's
+    /// centre) is `centre`, `radius`: for one streamed in, whose points are not kept.
+    pub fn for_sphere(centre: [f32; 3], radius: f32) -> ViewHint {
+        framing(Vec3::from_array(centre), radius, TRACTOGRAM_VIEW, Vec3::Z, 35.0)
     }
 }
 
