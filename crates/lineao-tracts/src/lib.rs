@@ -32,6 +32,7 @@ mod input;
 mod load;
 pub mod mesh;
 pub mod scenes;
+mod stream;
 mod tractogram;
 
 pub use error::{Error, ErrorKind};
@@ -39,4 +40,5 @@ pub use input::{Progress, ProgressFn};
 pub use load::{Compression, Format, LoadOptions, Loaded, load, load_from_bytes, load_with, parse_as, save};
 pub use mesh::{TriangleMesh, load_mesh};
 pub use scenes::{Scene, SceneKind, ViewHint};
+pub use stream::{ChunkDecoder, ChunkSink, Streamed, load_chunked};
 pub use tractogram::{Bounds, Field, Group, IDENTITY, Tractogram, VoxelSpace};

@@ -203,7 +203,7 @@ fn load_from<R: Read + Seek>(
 }
 
 /// Content first; the name only decides between text formats that look alike.
-fn detect(head: &[u8], path: &Path) -> Parse<Format> {
+pub(crate) fn detect(head: &[u8], path: &Path) -> Parse<Format> {
     if trk::sniff(head) {
         return Ok(Format::Trk);
     }

@@ -42,7 +42,7 @@ pub(crate) fn sniff(head: &[u8]) -> Option<bool> {
     }
 }
 
-fn read_header(r: &mut Reader) -> Parse<Header> {
+pub(crate) fn read_header(r: &mut Reader) -> Parse<Header> {
     let magic_at = r.offset();
     let magic = r.line(MAX_HEADER_LINE, "the magic line 'mrtrix tracks'")?.unwrap_or_default();
     let magic = String::from_utf8_lossy(magic);
@@ -98,7 +98,7 @@ fn read_header(r: &mut Reader) -> Parse<Header> {
 }
 
 /// `datatype` → (bytes per value, byte order).
-fn datatype(header: &Header, at: u64) -> Parse<(usize, Endian)> {
+pub(crate) fn datatype(header: &Header, at: u64) -> Parse<(usize, Endian)> {
     match header.get("datatype").map(str::trim) {
         Some("Float32LE") => Ok((4, Endian::Little)),
         Some("Float32BE") => Ok((4, Endian::Big)),
@@ -115,25 +115,7 @@ pub(crate) fn read(r: &mut Reader, size_hint: Option<u64>) -> Parse<(Tractogram,
     let header_end = r.offset();
     let (width, endian) = datatype(&header, header_end)?;
     // `file: . OFFSET`: the data may start anywhere after the header; seek, don't assume.
-    let data_at = match header.get("file") {
-        None => header_end,
-        Some(file) => {
-            let mut parts = file.split_whitespace();
-            let (Some("."), Some(offset), None) = (parts.next(), parts.next(), parts.next()) else {
-                return bad(header_end, format!("'file: . OFFSET' (data in this file), found 'file: {file}'"));
-            };
-            let Ok(offset) = offset.parse::<u64>() else {
-                return bad(header_end, format!("a byte offset after 'file: .', found '{offset}'"));
-            };
-            if offset < header_end {
-                return bad(
-                    header_end,
-                    format!("a data offset at or after the header's end ({header_end}), found {offset}"),
-                );
-            }
-            offset
-        }
-    };
+    let data_at = data_offset(&header, header_end)?;
     r.skip(data_at - header_end, "the padding before the data offset")?;
 
     let layout = (width, header.scalars);
@@ -184,6 +166,35 @@ pub(crate) fn read(r: &mut Reader, size_hint: Option<u64>) -> Parse<(Tractogram,
     Ok((t, header.scalars))
 }
 
+/// What a file that ends inside an element of `element` bytes lacks.
+pub(crate) fn truncated_element(element: usize, scalars: bool) -> String {
+    let what = if scalars { "element" } else { "point" };
+    format!("a whole {element}-byte {what} (the file ends inside one)")
+}
+
+/// The `file: . OFFSET` of a header ending at `header_end`: where the data starts.
+pub(crate) fn data_offset(header: &Header, header_end: u64) -> Parse<u64> {
+    match header.get("file") {
+        None => Ok(header_end),
+        Some(file) => {
+            let mut parts = file.split_whitespace();
+            let (Some("."), Some(offset), None) = (parts.next(), parts.next(), parts.next()) else {
+                return bad(header_end, format!("'file: . OFFSET' (data in this file), found 'file: {file}'"));
+            };
+            let Ok(offset) = offset.parse::<u64>() else {
+                return bad(header_end, format!("a byte offset after 'file: .', found '{offset}'"));
+            };
+            if offset < header_end {
+                return bad(
+                    header_end,
+                    format!("a data offset at or after the header's end ({header_end}), found {offset}"),
+                );
+            }
+            Ok(offset)
+        }
+    }
+}
+
 /// Decodes the triplets in `bytes[..got]` in place (point w goes to bytes 12w..12w + 12, never
 /// ahead of the triplet being read) until an Inf or the end; returns the number of points.
 /// `data_at` is the file offset of `bytes[0]`, for errors.
@@ -214,7 +225,7 @@ fn in_place(
         at += element;
     }
     if at < got {
-        return bad(data_at + at as u64, format!("a whole {element}-byte point (the file ends inside one)"));
+        return bad(data_at + at as u64, truncated_element(element, false));
     }
     if *offsets.last().unwrap() != kept as u64 {
         offsets.push(kept as u64);
@@ -242,7 +253,7 @@ fn stream(
         }
         if piece.len() % element != 0 {
             let at = piece_at + (piece.len() / element * element) as u64;
-            return bad(at, format!("a whole {element}-byte element (the file ends inside one)"));
+            return bad(at, truncated_element(element, scalars));
         }
         for e in piece.chunks_exact(element) {
             let x = decode(e);

@@ -27,8 +27,8 @@ pub(crate) fn sniff(head: &[u8]) -> bool {
     head.starts_with(b"TRACK")
 }
 
-struct Header {
-    endian: Endian,
+pub(crate) struct Header {
+    pub(crate) endian: Endian,
     dims: [u32; 3],
     voxel_sizes: [f32; 3],
     scalars: Vec<(String, usize)>,
@@ -37,10 +37,10 @@ struct Header {
     n_properties: usize,
     vox_to_ras: [[f64; 4]; 4],
     voxel_order: String,
-    n_count: u64,
+    pub(crate) n_count: u64,
 }
 
-fn parse_header(h: &[u8]) -> Parse<Header> {
+pub(crate) fn parse_header(h: &[u8]) -> Parse<Header> {
     let endian = if Endian::Little.i32(&h[996..]) == HEADER_SIZE as i32 {
         Endian::Little
     } else if Endian::Big.i32(&h[996..]) == HEADER_SIZE as i32 {
@@ -228,11 +228,8 @@ fn mul(a: &[[f64; 4]; 4], b: &[[f64; 4]; 4]) -> [[f64; 4]; 4] {
 pub(crate) fn read(r: &mut Reader, size_hint: Option<u64>) -> Parse<Tractogram> {
     let h = parse_header(r.take(HEADER_SIZE, "a 1000-byte TrackVis header")?)?;
     let mut t = Tractogram::new();
-    let mut scalar_fields: Vec<Field> =
-        h.scalars.iter().map(|(n, c)| Field { name: n.clone(), columns: *c, values: Vec::new() }).collect();
-    let mut property_fields: Vec<Field> =
-        h.properties.iter().map(|(n, c)| Field { name: n.clone(), columns: *c, values: Vec::new() }).collect();
-    let mut decoder = Decoder::new(&h, &mut scalar_fields, &mut property_fields);
+    let (mut scalar_fields, mut property_fields) = h.fields();
+    let mut decoder = Decoder::new(&h);
     match size_hint {
         // A plain file: read the body into the points' storage and decode in place (a point's
         // 12 bytes never overtake the 4 + 12 n bytes of its streamline's record).
@@ -257,14 +254,14 @@ pub(crate) fn read(r: &mut Reader, size_hint: Option<u64>) -> Parse<Tractogram> 
                     for p in 0..n as usize {
                         let s = at + p * decoder.record;
                         let xyz: [u8; 12] = bytes[s..s + 12].try_into().unwrap();
-                        decoder.scalars(&bytes[s + 12..s + decoder.record]);
+                        decoder.scalars(&bytes[s + 12..s + decoder.record], &mut scalar_fields);
                         let point = decoder.point(&xyz);
                         bytes[12 * kept..12 * kept + 12].copy_from_slice(bytemuck::bytes_of(&point));
                         kept += 1;
                     }
                 }
                 at += n as usize * decoder.record;
-                decoder.properties(&bytes[at..]);
+                decoder.properties(&bytes[at..], &mut property_fields);
                 at += 4 * h.n_properties;
                 t.offsets.push(kept as u64);
             }
@@ -284,36 +281,50 @@ pub(crate) fn read(r: &mut Reader, size_hint: Option<u64>) -> Parse<Tractogram> 
                     let k = left.min(per_piece);
                     let piece = r.take(k * decoder.record, &format!("{n} points of {} bytes", decoder.record))?;
                     for p in piece.chunks_exact(decoder.record) {
-                        decoder.scalars(&p[12..]);
+                        decoder.scalars(&p[12..], &mut scalar_fields);
                         t.positions.push(decoder.point(p[..12].try_into().unwrap()));
                     }
                     left -= k;
                 }
-                decoder.properties(r.take(4 * h.n_properties, "the streamline's properties")?);
+                let properties = r.take(4 * h.n_properties, "the streamline's properties")?;
+                decoder.properties(properties, &mut property_fields);
                 t.offsets.push(t.positions.len() as u64);
             }
         }
     }
     t.vertex_fields = scalar_fields;
     t.streamline_fields = property_fields;
-    t.space = Some(VoxelSpace { affine: h.vox_to_ras, dimensions: h.dims, voxel_sizes: Some(h.voxel_sizes) });
+    t.space = Some(h.space());
     Ok(t)
 }
 
-/// Turns point records into RAS+ points (and scalar rows), property records into rows.
-struct Decoder<'a> {
-    endian: Endian,
-    to_ras: [[f32; 4]; 3],
-    record: usize,
-    n_scalars: usize,
-    n_properties: usize,
-    row: Vec<f32>,
-    scalars: &'a mut [Field],
-    properties: &'a mut [Field],
+impl Header {
+    pub(crate) fn space(&self) -> VoxelSpace {
+        VoxelSpace { affine: self.vox_to_ras, dimensions: self.dims, voxel_sizes: Some(self.voxel_sizes) }
+    }
+
+    /// Empty fields for the scalars (per vertex) and properties (per streamline).
+    pub(crate) fn fields(&self) -> (Vec<Field>, Vec<Field>) {
+        let empty = |names: &[(String, usize)]| {
+            names.iter().map(|(n, c)| Field { name: n.clone(), columns: *c, values: Vec::new() }).collect()
+        };
+        (empty(&self.scalars), empty(&self.properties))
+    }
 }
 
-impl<'a> Decoder<'a> {
-    fn new(h: &Header, scalars: &'a mut [Field], properties: &'a mut [Field]) -> Decoder<'a> {
+/// Turns point records into RAS+ points (and scalar rows), property records into rows.
+pub(crate) struct Decoder {
+    endian: Endian,
+    to_ras: [[f32; 4]; 3],
+    /// Bytes of one point record.
+    pub(crate) record: usize,
+    n_scalars: usize,
+    pub(crate) n_properties: usize,
+    row: Vec<f32>,
+}
+
+impl Decoder {
+    pub(crate) fn new(h: &Header) -> Decoder {
         let m = voxmm_to_ras(h);
         Decoder {
             endian: h.endian,
@@ -323,13 +334,11 @@ impl<'a> Decoder<'a> {
             n_scalars: h.n_scalars,
             n_properties: h.n_properties,
             row: vec![0.0; h.n_scalars.max(h.n_properties)],
-            scalars,
-            properties,
         }
     }
 
     /// Bytes a streamline of `n` points needs after its count; rejects negative counts.
-    fn record_bytes(&self, n: i32, offset: u64) -> Parse<usize> {
+    pub(crate) fn record_bytes(&self, n: i32, offset: u64) -> Parse<usize> {
         if n < 0 {
             return bad(offset, format!("a non-negative point count, found {n}"));
         }
@@ -338,7 +347,7 @@ impl<'a> Decoder<'a> {
 
     /// voxmm → RAS+ for one point record's first 12 bytes.
     #[inline(always)]
-    fn point(&self, p: &[u8; 12]) -> [f32; 3] {
+    pub(crate) fn point(&self, p: &[u8; 12]) -> [f32; 3] {
         let word = |i: usize| {
             let w = u32::from_le_bytes([p[4 * i], p[4 * i + 1], p[4 * i + 2], p[4 * i + 3]]);
             f32::from_bits(if self.endian == Endian::Big { w.swap_bytes() } else { w })
@@ -374,22 +383,23 @@ impl<'a> Decoder<'a> {
         kept
     }
 
-    /// The scalars that follow a point's coordinates.
-    fn scalars(&mut self, p: &[u8]) {
+    /// The scalars that follow a point's coordinates, appended to `fields`.
+    pub(crate) fn scalars(&mut self, p: &[u8], fields: &mut [Field]) {
         if self.n_scalars > 0 {
             for (s, x) in self.row[..self.n_scalars].iter_mut().enumerate() {
                 *x = self.endian.f32(&p[4 * s..]);
             }
-            split_row(&self.row[..self.n_scalars], self.scalars);
+            split_row(&self.row[..self.n_scalars], fields);
         }
     }
 
-    fn properties(&mut self, p: &[u8]) {
+    /// A streamline's properties, appended to `fields`.
+    pub(crate) fn properties(&mut self, p: &[u8], fields: &mut [Field]) {
         if self.n_properties > 0 {
             for (s, x) in self.row[..self.n_properties].iter_mut().enumerate() {
                 *x = self.endian.f32(&p[4 * s..]);
             }
-            split_row(&self.row[..self.n_properties], self.properties);
+            split_row(&self.row[..self.n_properties], fields);
         }
     }
 }

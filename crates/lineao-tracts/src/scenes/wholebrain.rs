@@ -282,8 +282,13 @@ mod tests {
         assert!((120.0..160.0).contains(&extent[0]) && (140.0..190.0).contains(&extent[1]), "{extent:?}");
         assert!((110.0..170.0).contains(&extent[2]), "{extent:?}");
         // Consecutive points 1 mm apart.
-        let steps: Vec<f32> = whole.positions.windows(2).take(5000).map(|w| Vec3::from(w[0]).distance(Vec3::from(w[1]))).collect();
-        let median = { let mut s = steps.clone(); s.sort_by(f32::total_cmp); s[s.len() / 2] };
+        let steps: Vec<f32> =
+            whole.positions.windows(2).take(5000).map(|w| Vec3::from(w[0]).distance(Vec3::from(w[1]))).collect();
+        let median = {
+            let mut s = steps.clone();
+            s.sort_by(f32::total_cmp);
+            s[s.len() / 2]
+        };
         assert!((0.8..1.3).contains(&median), "step {median}");
     }
 }
