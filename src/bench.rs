@@ -9,7 +9,9 @@
 //! The bench's own passes are the geometry and what every method shares:
 //! - `lines`; `lines-native-1px`: the same segments as the rasterizer's native 1-px `LineList`;
 //!   `lines-full-strip`: the same lines always from the full strip (both sides of every point),
-//!   against which `lines` shows what its alternating strip saves;
+//!   against which `lines` shows what its alternating strip saves; `lines-strip`: the same
+//!   lines from the strip of earlier versions (a vertex buffer of 40 bytes a point and an index
+//!   buffer: what the clusters replaced, timed in the same run);
 //! - `nd-pyramid`, `composite`; `bilateral`: the separable bilateral blur (radius 4), which can
 //!   follow any method;
 //! - `tubes`: the same streamlines as ray-cast tubes of radius 0.5 mm (against `lines`);
@@ -55,7 +57,7 @@ use lineao::method::{BenchPass, Stage};
 use lineao::passes::Load;
 use lineao::passes::bilateral::Bilateral;
 use lineao::passes::composite::Composite;
-use lineao::passes::lines::{GeometryOptions, LineRenderer, LineStyle};
+use lineao::passes::lines::{LineRenderer, LineStyle};
 use lineao::passes::nd_from_depth::{HostConfig, HostInputs, NdFromDepth};
 use lineao::passes::nd_pyramid::NdPyramid;
 use lineao::passes::tubes::TubeRenderer;
@@ -80,6 +82,8 @@ struct Passes {
     lines: LineRenderer,
     lines_native: LineRenderer,
     lines_full: LineRenderer,
+    /// The strip of earlier versions and its renderer (`lines-strip`), when selected.
+    strip: Option<(lineao::passes::lines::StripGeometry, lineao::passes::lines::StripRenderer)>,
     pyramid: NdPyramid,
     composite: Composite,
     bilateral: Bilateral,
@@ -115,7 +119,8 @@ impl Passes {
         settings: &ChainSettings,
         targets: &FrameTargets,
         view: &FrameView,
-        scene: std::sync::Arc<lineao::RayScene>,
+        scene: Option<std::sync::Arc<lineao::RayScene>>,
+        strip: Option<lineao::passes::lines::StripGeometry>,
     ) -> Result<Passes> {
         let (device, queue) = (&gpu.device, &gpu.queue);
         let format = wgpu::TextureFormat::Rgba8UnormSrgb;
@@ -123,6 +128,11 @@ impl Passes {
             lines: LineRenderer::new(device),
             lines_native: LineRenderer::with_style(device, LineStyle::Native1px),
             lines_full: LineRenderer::with_style(device, LineStyle::FullStrip),
+            strip: strip.map(|geometry| {
+                let mut renderer = lineao::passes::lines::StripRenderer::new(device, false);
+                renderer.prepare(queue, view, settings);
+                (geometry, renderer)
+            }),
             pyramid: NdPyramid::new(device),
             composite: Composite::new(device, format),
             bilateral: Bilateral::new(device),
@@ -146,7 +156,7 @@ impl Passes {
             let Some(mut stage) = pass.stage(method, device, &first) else { continue };
             // The one stage that traces the scene.
             if let Some(tracer) = (stage.as_mut() as &mut dyn std::any::Any).downcast_mut::<RayTracedAo>() {
-                tracer.set_scene(Some(scene.clone()));
+                tracer.set_scene(scene.clone());
             }
             if let Some(span) = pass.spans.iter().find(|span| !stage.spans(&first).contains(span)) {
                 anyhow::bail!("bench pass {}: its stage records no span '{span}' with these settings", pass.name);
@@ -184,6 +194,11 @@ impl Passes {
             "lines" => self.lines.encode(encoder, targets, geometry, Load::Clear(background), span),
             "lines-native-1px" => self.lines_native.encode(encoder, targets, geometry, Load::Clear(background), span),
             "lines-full-strip" => self.lines_full.encode(encoder, targets, geometry, Load::Clear(background), span),
+            "lines-strip" => {
+                if let Some((strip, renderer)) = &self.strip {
+                    renderer.encode(encoder, targets, strip, Load::Clear(background), span);
+                }
+            }
             "nd-pyramid" => self.pyramid.encode(encoder, targets, span),
             "composite" => self.composite.encode(encoder, &self.output.view, span),
             "bilateral" => self.bilateral.encode(encoder, targets, span),
@@ -216,9 +231,37 @@ fn summary(name: &str, on: &str, mut ms: Vec<f64>) -> serde_json::Value {
     json!({"name": name, "on": on, "ms_median": median, "ms_min": ms[0], "ms_max": ms[ms.len() - 1]})
 }
 
+/// The passes that need the scene's points on the CPU: the earlier strip is built from them,
+/// the ray tracers' BVH and object-space AO's volumes too.
+fn needs_points(name: &str) -> bool {
+    name == "lines-strip" || name.starts_with("ray") || crate::cli::CPU_PASSES.contains(&name)
+}
+
 pub fn run(args: &BenchArgs) -> Result<()> {
     let source = crate::source::Source::Scene { kind: args.scene, vertices: args.vertices, seed: args.seed };
-    let scene = source.load(None)?;
+    let selected = |name: &str| args.passes.is_empty() || args.passes.iter().any(|p| p == name);
+    let all = gpu_passes();
+    let points = all.iter().chain(crate::cli::CPU_PASSES.iter()).any(|p| selected(p) && needs_points(p));
+    let gpu = Gpu::headless()?;
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    // The scene streamed onto the GPU as a file would be (the whole brain chunk by chunk on all
+    // cores), its points kept only where a selected pass needs them.
+    let start = Instant::now();
+    let keep = crate::source::Keep { points, ..Default::default() };
+    let scene = crate::source::Lines::stream(&source, &keep, None, device, queue)?;
+    let load_ms = start.elapsed().as_secs_f64() * 1e3;
+    let geometry = &scene.geometry;
+    let bytes_per_vertex = geometry.gpu_bytes() as f64 / geometry.vertices.max(1) as f64;
+    eprintln!(
+        "lineao: {} with {} streamlines, {} vertices made and uploaded in {load_ms:.0} ms: {} clusters in {} page(s), \
+         {:.2} bytes a vertex on the GPU",
+        scene.name,
+        geometry.streamlines,
+        geometry.vertices,
+        geometry.clusters(),
+        geometry.page_count(),
+        bytes_per_vertex
+    );
     // LineAO as the preset sets it; SSAO, VO and the rest keep the papers' values (their
     // presets' reach and strength do not change what a pass costs; their sample counts do).
     let papers = ChainSettings {
@@ -232,10 +275,6 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         camera.projection = Projection::Perspective { fov_y_deg };
     }
     crate::render::validate_camera(&camera)?;
-    let gpu = Gpu::headless()?;
-    let (device, queue) = (&gpu.device, &gpu.queue);
-    let options = GeometryOptions { bounded_staging: true, ..Default::default() };
-    let geometry = LineGeometry::with_options(device, queue, &scene.tracts.positions, &scene.tracts.offsets, options)?;
     let bounds = geometry.bounds.context("the scene has no finite points")?;
 
     // The chain decides the guard band; the passes below share one G-buffer with every target
@@ -247,28 +286,41 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let tractogram = &scene.tracts;
     let ray_geometry =
         lineao::RayGeometry { positions: &tractogram.positions, offsets: &tractogram.offsets, ..Default::default() };
-    let ray_scene = std::sync::Arc::new(lineao::RayScene::new(device, queue, &ray_geometry)?);
-    let passes = Passes::new(&gpu, &settings, targets, &view, ray_scene.clone())?;
-    let all = gpu_passes();
+    let tracing = all.iter().any(|p| selected(p) && p.starts_with("ray"));
+    let ray_scene = match tracing {
+        true => Some(std::sync::Arc::new(lineao::RayScene::new(device, queue, &ray_geometry)?)),
+        false => None,
+    };
+    let strip = match selected("lines-strip") {
+        true => {
+            Some(lineao::passes::lines::StripGeometry::new(device, queue, &tractogram.positions, &tractogram.offsets)?)
+        }
+        false => None,
+    };
+    let strip_bytes = strip.as_ref().map(|s| s.gpu_bytes() as f64 / geometry.vertices.max(1) as f64);
+    let passes = Passes::new(&gpu, &settings, targets, &view, ray_scene.clone(), strip)?;
+    eprintln!(
+        "lineao: lines: {:.1} % of the clusters drawn as the alternating strip in this view",
+        100.0 * passes.lines.alternating_share(geometry)
+    );
     let timer = if args.no_timestamps { None } else { PassTimer::new(device, queue, &all) };
 
     let mut times: Vec<Vec<f64>> = vec![Vec::new(); all.len()];
     // `lines` last among the line passes, so the G-buffer the later passes read is the chain's.
-    let first = ["lines-native-1px", "lines-full-strip"];
+    let first = ["lines-native-1px", "lines-full-strip", "lines-strip"];
     let order = first.into_iter().chain(all.iter().copied().filter(|p| !first.contains(p)));
     // The G-buffer and pyramid every later pass reads, also when `--passes` leaves them out.
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::bench") });
-    passes.encode("lines", 0, &mut encoder, targets, &geometry, None);
-    passes.encode("nd-pyramid", 0, &mut encoder, targets, &geometry, None);
+    passes.encode("lines", 0, &mut encoder, targets, geometry, None);
+    passes.encode("nd-pyramid", 0, &mut encoder, targets, geometry, None);
     queue.submit([encoder.finish()]);
-    let selected = |name: &str| args.passes.is_empty() || args.passes.iter().any(|p| p == name);
     for frame in 0..args.warmup + args.frames {
         for name in order.clone().filter(|name| selected(name)) {
             let mut encoder =
                 device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::bench") });
             encoder.push_debug_group(name);
             let span = timer.as_ref().and_then(|t| t.span(name));
-            passes.encode(name, frame, &mut encoder, targets, &geometry, span);
+            passes.encode(name, frame, &mut encoder, targets, geometry, span);
             encoder.pop_debug_group();
             if let Some(timer) = &timer {
                 timer.resolve(&mut encoder);
@@ -308,7 +360,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         }
         passes.push(summary("bvh-upload", "cpu", ms));
     }
-    if selected("raytraced-1spp") {
+    if let (true, Some(ray_scene)) = (selected("raytraced-1spp"), &ray_scene) {
         let geometry_pixels = lineao::verify::read_rgba(device, queue, &targets.nd[0])?
             .data
             .iter()
@@ -332,6 +384,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         "height": args.height,
         "scene": scene.name,
         "vertices": geometry.vertices,
+        "gpu_bytes_per_vertex": bytes_per_vertex,
+        "strip_bytes_per_vertex": strip_bytes,
+        "load_ms": load_ms,
         "frames": args.frames,
         "timestamps": timer.is_some(),
         "passes": passes,
@@ -475,6 +530,8 @@ fn print_table(report: &serde_json::Value, passes: &[serde_json::Value]) {
         ("lineao", "lineao-tap-floor"),
         ("lines", "lines-native-1px"),
         ("lines-full-strip", "lines-native-1px"),
+        ("lines", "lines-strip"),
+        ("tubes", "lines"),
         ("lineao-chain", "ssao-16-chain"),
         ("lineao-level", "lineao"),
         ("lineao-chain-level", "ssao-16-chain"),

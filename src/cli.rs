@@ -196,8 +196,17 @@ pub struct BenchLoadArgs {
 // The passes `lineao bench --passes` names (its vocabulary, so the CLI needs nothing of the
 // bench itself).
 /// The bench's own GPU passes: the geometry and what every method shares.
-const OWN_GPU_PASSES: [&str; 8] =
-    ["lines", "lines-native-1px", "lines-full-strip", "nd-pyramid", "composite", "bilateral", "tubes", "nd-from-depth"];
+const OWN_GPU_PASSES: [&str; 9] = [
+    "lines",
+    "lines-native-1px",
+    "lines-full-strip",
+    "lines-strip",
+    "nd-pyramid",
+    "composite",
+    "bilateral",
+    "tubes",
+    "nd-from-depth",
+];
 
 /// The GPU passes of one run: the bench's own, then every method's from the registry
 /// ([`lineao::method::BenchPass`]), in its order.

@@ -204,7 +204,9 @@ pub fn run(args: &ScoreArgs) -> Result<()> {
         source.source.scene = scene;
         source
     };
-    let mut sources: Vec<RenderArgs> = lineao_tracts::SceneKind::ALL.iter().map(|&kind| scene(kind)).collect();
+    // The scenes the default preset was fitted on (the whole brain came later).
+    use lineao_tracts::SceneKind::{Bundles, Spiral, Vortex};
+    let mut sources: Vec<RenderArgs> = [Bundles, Spiral, Vortex].into_iter().map(scene).collect();
     let files = real_files(&args.data);
     eprintln!(
         "lineao: fitting on {} scenes and {} tractograms from {}",
@@ -216,7 +218,7 @@ pub fn run(args: &ScoreArgs) -> Result<()> {
     let families = families(base.style.line_width);
     let mut views: Vec<View> = Vec::new();
     for source in &sources {
-        let mut session = Session::open(source)?;
+        let mut session = Session::open_with_points(source)?;
         let home = session.camera;
         let real = source.file.is_some();
         let bundle = TruthSettings {

@@ -297,6 +297,7 @@ fn bench_json_is_the_contract() {
         "lines",
         "lines-native-1px",
         "lines-full-strip",
+        "lines-strip",
         "nd-pyramid",
         "lineao",
         "lineao-tap-floor",
@@ -324,7 +325,11 @@ fn bench_json_is_the_contract() {
     ];
     expected.sort_unstable();
     assert_eq!(sorted, expected);
-    assert_eq!(names[..4], ["lines", "lines-native-1px", "lines-full-strip", "nd-pyramid"]);
+    assert_eq!(names[..5], ["lines", "lines-native-1px", "lines-full-strip", "lines-strip", "nd-pyramid"]);
+    // The line geometry's bytes a vertex on the GPU: the clusters' and the earlier strip's.
+    let (clusters, strip) =
+        (report["gpu_bytes_per_vertex"].as_f64().unwrap(), report["strip_bytes_per_vertex"].as_f64().unwrap());
+    assert!(clusters <= 8.0 && strip > 40.0, "{clusters} and {strip} bytes a vertex");
     for p in passes {
         let cpu_pass =
             ["density-256", "sweep-256", "variance-volume-256", "bvh-build-1m", "raytraced-cpu-64", "bvh-upload"]

@@ -143,8 +143,11 @@ fn every_pass_on_every_scene() {
 #[test]
 fn the_comparison_images() {
     let dir = common::scratch("snapshots-compare");
+    // The whole brain's passes are pinned above; its grid (a million points through every
+    // method, the CPU ones included) would cost CI more than it tells.
+    let scenes = SceneKind::ALL.iter().filter(|&&k| k != SceneKind::WholeBrain);
     let mut runs: Vec<(String, Vec<&str>)> =
-        SceneKind::ALL.iter().map(|k| (format!("{}_grid", k.name()), vec!["--scene", k.name(), "--grid"])).collect();
+        scenes.map(|k| (format!("{}_grid", k.name()), vec!["--scene", k.name(), "--grid"])).collect();
     runs.push(("bundles_compare_lineao_ssao".into(), vec!["--scene", "bundles", "--compare", "lineao,ssao"]));
     let mut failures = Vec::new();
     for (name, extra) in &runs {

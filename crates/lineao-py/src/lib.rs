@@ -19,7 +19,7 @@ use lineao_session::args::RenderArgs;
 use lineao_session::kwargs::KwargError;
 use lineao_session::render::Session;
 use lineao_session::source::Loaded;
-use lineao_tracts::{Field, Group, Tractogram, ViewHint, VoxelSpace};
+use lineao_tracts::{Field, Group, Tractogram, VoxelSpace};
 use numpy::ndarray::{Array2, Array3};
 use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::create_exception;
@@ -405,16 +405,17 @@ impl Renderer {
                     if !tracts.positions.iter().flatten().any(|c| c.is_finite()) {
                         return Err(PyValueError::new_err(format!("{name} has no finite points")));
                     }
-                    let hint = ViewHint::for_tractogram(&tracts);
-                    Session::with_loaded(&args, Loaded { name, tracts, hint }).map_err(render_error)
+                    // Framed as a file of the same streamlines is (by their bounds on the GPU).
+                    Session::with_loaded(&args, Loaded { name, tracts, hint: None }).map_err(render_error)
                 })?
             }
-            _ => py.detach(|| Session::open(&args)).map_err(|e| {
-                match e.downcast::<lineao_session::source::SourceError>() {
-                    Ok(lineao_session::source::SourceError::Load(load)) => load_error(py, load),
-                    Ok(other) => render_error(other.into()),
-                    Err(e) => render_error(e),
-                }
+            // Later frames may ask for any method: the points stay.
+            _ => py.detach(|| Session::open_with_points(&args)).map_err(|e| match e
+                .downcast::<lineao_session::source::SourceError>()
+            {
+                Ok(lineao_session::source::SourceError::Load(load)) => load_error(py, load),
+                Ok(other) => render_error(other.into()),
+                Err(e) => render_error(e),
             })?,
         };
         Ok(Renderer { session, chains: Vec::new(), opened: args })

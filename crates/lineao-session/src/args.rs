@@ -813,9 +813,21 @@ pub struct InfoArgs {
 /// `lineao convert`'s arguments.
 #[derive(Args, Debug)]
 pub struct ConvertArgs {
+    /// Any file `lineao info` reads (with `--scene`: the file to write).
     pub input: PathBuf,
     /// .tck, .trk or .trx.
-    pub output: PathBuf,
+    #[arg(required_unless_present = "scene")]
+    pub output: Option<PathBuf>,
+    /// Write a built-in scene instead of converting a file: a whole-brain tractogram of any
+    /// size (`--scene wholebrain --vertices 50000000 brain.tck`) without a 10 GB download.
+    #[arg(long, value_parser = parse_scene)]
+    pub scene: Option<SceneKind>,
+    /// The scene's approximate vertex count [default: the scene's].
+    #[arg(long, requires = "scene")]
+    pub vertices: Option<usize>,
+    /// The scene's seed.
+    #[arg(long, default_value_t = 1, requires = "scene")]
+    pub seed: u64,
 }
 
 /// `lineao render ARGS…` as the command line parses it (`argv` from the program's name on).

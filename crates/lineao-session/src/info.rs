@@ -71,21 +71,25 @@ pub fn run(args: &InfoArgs) -> Result<()> {
 }
 
 pub fn convert(args: &ConvertArgs) -> Result<()> {
-    let loaded = load(&args.input)?;
-    let dropped = lineao_tracts::save(&loaded.tractogram, &args.output)?;
+    let (input, output, tractogram) = match (args.scene, &args.output) {
+        (Some(kind), None) => {
+            let vertices = args.vertices.unwrap_or(kind.default_vertices());
+            let name = format!("{} ({vertices} vertices, seed {})", kind.name(), args.seed);
+            (name, &args.input, kind.build(args.seed, vertices).tractogram)
+        }
+        (None, Some(output)) => (args.input.display().to_string(), output, load(&args.input)?.tractogram),
+        (Some(_), Some(_)) => anyhow::bail!("convert --scene KIND takes the file to write alone"),
+        (None, None) => unreachable!("clap requires OUTPUT without --scene"),
+    };
+    let dropped = lineao_tracts::save(&tractogram, output)?;
     if !dropped.is_empty() {
-        eprintln!(
-            "lineao: warning: {} cannot hold these fields, left out: {}",
-            args.output.display(),
-            dropped.join(", ")
-        );
+        eprintln!("lineao: warning: {} cannot hold these fields, left out: {}", output.display(), dropped.join(", "));
     }
     eprintln!(
-        "lineao: {} ({} streamlines, {} vertices) -> {}",
-        args.input.display(),
-        loaded.tractogram.streamlines(),
-        loaded.tractogram.vertices(),
-        args.output.display()
+        "lineao: {input} ({} streamlines, {} vertices) -> {}",
+        tractogram.streamlines(),
+        tractogram.vertices(),
+        output.display()
     );
     Ok(())
 }

@@ -19,7 +19,7 @@ use lineao_tracts::scenes::ViewHint;
 
 use crate::args::{ColorArg, GeometryArg, Method, RenderArgs, SkyArg, VolumeNormal};
 use crate::label::Rgba8;
-use crate::source::{AttributeKey, Lines, Loaded, Source, submit_frame, vertex_field};
+use crate::source::{AttributeKey, Keep, Lines, Loaded, Source, submit_frame, vertex_field};
 
 /// The sky of object-space AO: open, or lit from the world axis nearest to the camera's `up`.
 pub fn sky(args: &RenderArgs, up: Vec3) -> Sky {
@@ -235,9 +235,20 @@ pub struct Session {
 }
 
 impl Session {
-    /// Loads the file (or builds the scene) and the surfaces, checks the camera, and uploads
-    /// the geometry.
+    /// Streams the file (or makes the scene) onto the GPU and loads the surfaces; the points
+    /// stay on the CPU only where a panel asked for needs them there (object-space AO, the ray
+    /// tracers): a whole-brain file is never held whole as f32.
     pub fn open(args: &RenderArgs) -> Result<Session> {
+        Self::open_keeping(args, needs_points(args))
+    }
+
+    /// [`Session::open`] keeping the points on the CPU whatever the panels: for later frames
+    /// of any method (Python's `Renderer`) and the truth (`score`).
+    pub fn open_with_points(args: &RenderArgs) -> Result<Session> {
+        Self::open_keeping(args, true)
+    }
+
+    fn open_keeping(args: &RenderArgs, points: bool) -> Result<Session> {
         let source = match &args.file {
             Some(path) => Source::File(path.clone()),
             None => Source::Scene {
@@ -246,27 +257,31 @@ impl Session {
                 seed: args.source.seed,
             },
         };
-        Session::with_loaded(args, source.load_on_terminal()?)
+        let surfaces = load_surfaces(args)?;
+        let base = base_attributes(args);
+        let gpu = Gpu::headless()?;
+        let keep = Keep { points, scalar: base.scalar.clone(), radius: base.radius.clone() };
+        let bar = match &source {
+            Source::File(path) => crate::source::progress_bar(path),
+            _ => None,
+        };
+        let mut report = |p: lineao_tracts::Progress| {
+            if let Some(bar) = &bar {
+                bar.set_position(p.bytes);
+            }
+            std::ops::ControlFlow::Continue(())
+        };
+        let lines = Lines::stream(&source, &keep, Some(&mut report), &gpu.device, &gpu.queue);
+        if let Some(bar) = &bar {
+            bar.finish_and_clear();
+        }
+        Self::assemble(args, lines?, surfaces, base, gpu)
     }
 
     /// [`Session::open`] on streamlines already in memory (the Python package's).
     pub fn with_loaded(args: &RenderArgs, loaded: Loaded) -> Result<Session> {
-        let camera = camera(args, &loaded.hint)?;
-        let sky = sky(args, camera.up);
-        let surfaces = args
-            .style
-            .surfaces
-            .iter()
-            .map(|path| lineao_tracts::load_mesh(path).map_err(anyhow::Error::from))
-            .collect::<Result<Vec<_>>>()?;
-        let base = AttributeKey {
-            scalar: match &args.style.color {
-                ColorArg::Field(field) => Some(field.clone()),
-                _ => None,
-            },
-            radius: args.style.tube_radius_field.clone(),
-            volume: None,
-        };
+        let surfaces = load_surfaces(args)?;
+        let base = base_attributes(args);
         // The fields exist, before any GPU work.
         for field in base.scalar.iter().chain(&base.radius) {
             vertex_field(&loaded.name, &loaded.tracts, field)?;
@@ -274,13 +289,27 @@ impl Session {
         let gpu = Gpu::headless()?;
         let mut lines = Lines::new(loaded, &gpu.device, &gpu.queue)?;
         lines.hold((&gpu.device, &gpu.queue), &base, || {})?;
+        Self::assemble(args, lines, surfaces, base, gpu)
+    }
+
+    /// The session of `lines` on the GPU with the surfaces: the camera, the bounds of both.
+    fn assemble(
+        args: &RenderArgs,
+        lines: Lines,
+        surfaces: Vec<lineao_tracts::TriangleMesh>,
+        base: AttributeKey,
+        gpu: Gpu,
+    ) -> Result<Session> {
+        let camera = camera(args, &lines.hint)?;
+        let sky = sky(args, camera.up);
         let meshes = surfaces
             .iter()
             .map(|m| MeshGeometry::new(&gpu.device, &gpu.queue, &m.positions, &m.normals, &m.indices))
             .collect::<Result<Vec<_>, _>>()?;
         let lines_bounds = lines.geometry.bounds.expect("checked at upload");
         let bounds = meshes.iter().filter_map(|m| m.bounds).fold(lines_bounds, |b, m| b.union(&m));
-        let points = lines.tracts.positions.iter().chain(surfaces.iter().flat_map(|m| &m.positions));
+        let corners = lines.geometry.corners().map(|(lo, hi)| [lo.to_array(), hi.to_array()]);
+        let points = corners.iter().flatten().chain(surfaces.iter().flat_map(|m| &m.positions));
         let longest_side = longest_side(points);
         Ok(Session {
             lines,
@@ -310,10 +339,11 @@ impl Session {
         }
     }
 
-    /// What the truth is traced against.
-    pub fn truth_scene(&self) -> crate::truth::Scene<'_> {
+    /// What the truth is traced against (the session keeps the points for a method that
+    /// traces them).
+    pub fn truth_scene(&self) -> Result<crate::truth::Scene<'_>> {
         let radii = self.base.radius.as_deref().and_then(|field| self.lines.field(field).ok());
-        crate::truth::Scene { tracts: &self.lines.tracts, surfaces: &self.surfaces, radii }
+        Ok(crate::truth::Scene { tracts: self.lines.points()?, surfaces: &self.surfaces, radii })
     }
 }
 
@@ -504,14 +534,14 @@ impl Session {
         if let Some(scene) = self.ray_scene.get() {
             return Ok(scene.clone());
         }
-        let scene = std::sync::Arc::new(crate::truth::ray_scene(&self.gpu, &self.truth_scene())?);
+        let scene = std::sync::Arc::new(crate::truth::ray_scene(&self.gpu, &self.truth_scene()?)?);
         Ok(self.ray_scene.get_or_init(|| scene).clone())
     }
 
     /// The truth on `chain`'s last frame, with a line on stderr saying what it cost.
     pub fn trace(&self, chain: &AoChain, settings: &lineao::truth::TruthSettings) -> Result<lineao::truth::Truth> {
         let start = std::time::Instant::now();
-        let bvh = crate::truth::bvh(chain, &self.truth_scene())?;
+        let bvh = crate::truth::bvh(chain, &self.truth_scene()?)?;
         let built = start.elapsed().as_secs_f64();
         let truth = crate::truth::trace(&self.gpu, chain, &bvh, settings)?;
         let seconds = start.elapsed().as_secs_f64() - built;
@@ -531,6 +561,35 @@ impl Session {
         );
         Ok(truth)
     }
+}
+
+/// The context surfaces of `--surface`.
+fn load_surfaces(args: &RenderArgs) -> Result<Vec<lineao_tracts::TriangleMesh>> {
+    args.style.surfaces.iter().map(|path| lineao_tracts::load_mesh(path).map_err(anyhow::Error::from)).collect()
+}
+
+/// The attributes every panel has: the scalar of `--color field:NAME`, the radii of
+/// `--tube-radius-field`.
+fn base_attributes(args: &RenderArgs) -> AttributeKey {
+    AttributeKey {
+        scalar: match &args.style.color {
+            ColorArg::Field(field) => Some(field.clone()),
+            _ => None,
+        },
+        radius: args.style.tube_radius_field.clone(),
+        volume: None,
+    }
+}
+
+/// Whether a panel `args` asks for needs the streamlines on the CPU: object-space AO (its
+/// volumes are made there) and the ray tracers (their BVH is built there).
+fn needs_points(args: &RenderArgs) -> bool {
+    let methods = match (args.shown.compare, args.shown.grid) {
+        (Some(pair), _) => pair.to_vec(),
+        (None, true) => grid_methods(),
+        (None, false) => vec![args.shown.method],
+    };
+    methods.iter().any(|m| m.volume.is_some() || m.screen == AoMethod::RayTraced)
 }
 
 /// The longest side of the axis-aligned box around the finite `points` (0 without any).

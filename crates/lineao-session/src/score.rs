@@ -271,7 +271,7 @@ fn srgb(v: f32) -> f32 {
 pub fn run(args: &ScoreArgs) -> Result<()> {
     let render = &args.render;
     let methods = if args.methods.is_empty() { ScoreMethod::all() } else { args.methods.clone() };
-    let session = Session::open(render)?;
+    let session = Session::open_with_points(render)?;
     let report = score(&session, render, &methods, args.bundle_distance)?;
     let truth = &report.truth;
     if args.json {

@@ -1,15 +1,18 @@
 //! What every command renders from, shared by `render`, `score`, `bench` and the viewer's
 //! worker: a source (a built-in scene or a file) loaded with progress into streamlines and a
-//! view hint, with one set of error texts; and one frame of a chain recorded, submitted and read
-//! back.
+//! view hint, or streamed chunk by chunk onto the GPU without keeping its points
+//! ([`Lines::stream`]), with one set of error texts; and one frame of a chain recorded,
+//! submitted and read back.
 
 use std::path::PathBuf;
 
-use lineao::passes::lines::VertexAttributes;
+use std::ops::ControlFlow;
+
+use lineao::passes::lines::{GeometryOptions, VertexAttributes};
 use lineao::passes::meshes::MeshGeometry;
 use lineao::volume::{VertexVisibility, VolumeAoOptions};
 use lineao::{AoChain, Camera, LineGeometry};
-use lineao_tracts::{Progress, SceneKind, Tractogram, ViewHint};
+use lineao_tracts::{Field, Progress, SceneKind, Tractogram, ViewHint};
 
 /// Why a source could not be shown, with the source named.
 #[derive(Debug, thiserror::Error)]
@@ -30,6 +33,10 @@ pub enum SourceError {
     NoField { name: String, field: String, available: String },
     #[error("{name}: per-vertex field '{field}' has {columns} columns, not 1")]
     FieldColumns { name: String, field: String, columns: usize },
+    /// A session streamed without keeping the points was asked for something that needs them
+    /// on the CPU (a bug of the session: it decides what to keep from what it will draw).
+    #[error("{0}: its points were streamed to the GPU and not kept on the CPU")]
+    PointsNotKept(String),
 }
 
 type Result<T> = std::result::Result<T, SourceError>;
@@ -53,12 +60,16 @@ pub enum Source {
 }
 
 /// A loaded source: its name (the scene's, or the file's path), its streamlines and the
-/// camera it suggests.
+/// camera it suggests (`None`: frame the streamlines, [`ViewHint::for_sphere`] of their
+/// bounds once on the GPU).
 pub struct Loaded {
     pub name: String,
     pub tracts: Tractogram,
-    pub hint: ViewHint,
+    pub hint: Option<ViewHint>,
 }
+
+/// Points a chunk of a streamed source holds (about): 12 MB of f32 points.
+pub const CHUNK_VERTICES: usize = 1 << 20;
 
 impl Source {
     /// [`Source::load`] with a progress bar on a terminal ([`progress_bar`]): the CLI's.
@@ -76,13 +87,69 @@ impl Source {
         loaded
     }
 
+    /// The name a loaded source goes by: the scene's, or the file's path.
+    pub fn name(&self) -> String {
+        match self {
+            Source::Scene { kind, .. } => kind.name().to_string(),
+            Source::File(path) => path.display().to_string(),
+            Source::Bytes { name, .. } => name.clone(),
+        }
+    }
+
+    /// Hands the source's streamlines to `sink` in chunks of about [`CHUNK_VERTICES`] points
+    /// as they are read (files: [`lineao_tracts::load_chunked`]) or made (the whole brain,
+    /// streamline by streamline, on all cores; the other scenes are built whole), reporting the
+    /// bytes read to `progress`. Returns the camera a built-in scene suggests.
+    pub fn stream(
+        &self,
+        progress: Option<lineao_tracts::ProgressFn<'_>>,
+        sink: &mut dyn FnMut(Tractogram) -> ControlFlow<()>,
+    ) -> Result<Option<ViewHint>> {
+        match self {
+            Source::Scene { kind: SceneKind::WholeBrain, vertices, seed } => {
+                whole_brain_in_chunks(*seed, *vertices as u64, sink);
+                Ok(None)
+            }
+            Source::Scene { kind, vertices, seed } => {
+                let scene = kind.build(*seed, *vertices);
+                let _ = sink(scene.tractogram);
+                Ok(Some(scene.view))
+            }
+            Source::File(path) => {
+                let streamed = lineao_tracts::load_chunked(path, &Default::default(), CHUNK_VERTICES, progress, sink)?;
+                if !streamed.has_points {
+                    let path = path.display().to_string();
+                    let format = streamed.format.map_or("tsf", |f| f.name());
+                    return Err(SourceError::ValuesWithoutPoints { path, format });
+                }
+                Ok(None)
+            }
+            Source::Bytes { name, bytes } => {
+                let mut decoder = lineao_tracts::ChunkDecoder::new(
+                    name,
+                    &Default::default(),
+                    Some(bytes.len() as u64),
+                    CHUNK_VERTICES,
+                    sink,
+                );
+                decoder.push(bytes)?;
+                let streamed = decoder.finish()?;
+                if !streamed.has_points {
+                    let format = streamed.format.map_or("tsf", |f| f.name());
+                    return Err(SourceError::ValuesWithoutPoints { path: name.clone(), format });
+                }
+                Ok(None)
+            }
+        }
+    }
+
     /// Builds the scene or loads the file, reporting the bytes read to `progress` (files only).
     /// A file of values without points (a .tsf) is an error that says what to render instead.
     pub fn load(&self, progress: Option<lineao_tracts::ProgressFn<'_>>) -> Result<Loaded> {
         match self {
             Source::Scene { kind, vertices, seed } => {
                 let scene = kind.build(*seed, *vertices);
-                Ok(Loaded { name: kind.name().to_string(), tracts: scene.tractogram, hint: scene.view })
+                Ok(Loaded { name: kind.name().to_string(), tracts: scene.tractogram, hint: Some(scene.view) })
             }
             Source::File(path) => {
                 let loaded = lineao_tracts::load_with(path, &Default::default(), progress)?;
@@ -90,28 +157,73 @@ impl Source {
                     let path = path.display().to_string();
                     return Err(SourceError::ValuesWithoutPoints { path, format: loaded.format.name() });
                 }
-                let hint = ViewHint::for_tractogram(&loaded.tractogram);
-                Ok(Loaded { name: path.display().to_string(), tracts: loaded.tractogram, hint })
+                Ok(Loaded { name: path.display().to_string(), tracts: loaded.tractogram, hint: None })
             }
             Source::Bytes { name, bytes } => {
                 let loaded = lineao_tracts::load_from_bytes(bytes, name, &Default::default())?;
                 if !loaded.tractogram.has_points() {
                     return Err(SourceError::ValuesWithoutPoints { path: name.clone(), format: loaded.format.name() });
                 }
-                let hint = ViewHint::for_tractogram(&loaded.tractogram);
-                Ok(Loaded { name: name.clone(), tracts: loaded.tractogram, hint })
+                Ok(Loaded { name: name.clone(), tracts: loaded.tractogram, hint: None })
             }
         }
     }
 }
 
-/// `tracts` (of the source `name`) on the GPU; an error naming it when no point is finite. The
-/// CLI and the viewer's worker own their devices, so they bound the staging memory (peak: the
-/// strip plus one buffer) by waiting after each buffer.
+/// The whole brain of `seed` with about `vertices` points, in chunks of about
+/// [`CHUNK_VERTICES`] made on all cores (in order: a chunk goes when it and those before are
+/// made).
+fn whole_brain_in_chunks(seed: u64, vertices: u64, sink: &mut dyn FnMut(Tractogram) -> ControlFlow<()>) {
+    let brain = lineao_tracts::scenes::wholebrain::WholeBrain::new(seed, vertices);
+    let per_chunk = (CHUNK_VERTICES as f64 / lineao_tracts::scenes::wholebrain::MEAN_POINTS) as u64;
+    let chunks = brain.streamlines().div_ceil(per_chunk);
+    let range = |k: u64| k * per_chunk..((k + 1) * per_chunk).min(brain.streamlines());
+    #[cfg(target_arch = "wasm32")]
+    for k in 0..chunks {
+        if sink(brain.tractogram(range(k))).is_break() {
+            return;
+        }
+    }
+    #[cfg(not(target_arch = "wasm32"))]
+    {
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get()) as u64;
+        let mut k = 0;
+        while k < chunks {
+            let batch: Vec<Tractogram> = std::thread::scope(|scope| {
+                let handles: Vec<_> = (k..(k + threads).min(chunks))
+                    .map(|j| {
+                        let brain = &brain;
+                        scope.spawn(move || brain.tractogram(range(j)))
+                    })
+                    .collect();
+                handles.into_iter().map(|h| h.join().expect("a chunk of the whole brain")).collect()
+            });
+            k += batch.len() as u64;
+            for chunk in batch {
+                if sink(chunk).is_break() {
+                    return;
+                }
+            }
+        }
+    }
+}
+
+/// How a session uploads its lines: waiting after each page (the CLI and the viewer's worker own
+/// their devices, so staging memory stays one page), pages of 4 M points (what is staged at
+/// once: 28 MB), and the alternating strip's tolerance a hundredth of a millimetre (files and
+/// the built-in scenes are in mm), whatever the chunks: a file streamed and the same
+/// streamlines uploaded whole from memory draw the same pixels.
+fn geometry_options() -> GeometryOptions {
+    GeometryOptions { bounded_staging: true, page_bytes: 32 << 20, tolerance: Some(0.01), ..Default::default() }
+}
+
+/// `tracts` (of the source `name`) on the GPU, as a stream of it would be; an error naming it
+/// when no point is finite.
 pub fn upload(name: &str, tracts: &Tractogram, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<LineGeometry> {
-    let options = lineao::passes::lines::GeometryOptions { bounded_staging: true, ..Default::default() };
-    let geometry = LineGeometry::with_options(device, queue, &tracts.positions, &tracts.offsets, options)
-        .map_err(|source| SourceError::Gpu { name: name.to_string(), source })?;
+    let gpu = |source| SourceError::Gpu { name: name.to_string(), source };
+    let mut geometry = LineGeometry::empty(device, geometry_options()).map_err(gpu)?;
+    geometry.append(device, queue, &tracts.positions, &tracts.offsets).map_err(gpu)?;
+    geometry.finish(device, queue).map_err(gpu)?;
     if geometry.bounds.is_none() {
         return Err(SourceError::NoFinitePoints(name.to_string()));
     }
@@ -211,18 +323,105 @@ impl AttributeKey {
 /// worker).
 pub struct Lines {
     pub name: String,
+    /// The streamlines on the CPU: kept where something needs them there (object-space AO, the
+    /// truth, the ray tracer's scene, the viewer's previews), else only their per-vertex
+    /// fields that colour the lines (`tracts.positions` empty, `points_kept` false).
     pub tracts: Tractogram,
+    points_kept: bool,
     pub hint: ViewHint,
     pub geometry: LineGeometry,
     pub volumes: VolumeCache,
     held: AttributeKey,
 }
 
+/// What a stream keeps on the CPU beside the GPU's geometry.
+#[derive(Clone, Debug, Default)]
+pub struct Keep {
+    /// Every point, offset and field (a tractogram as [`Source::load`] gives it).
+    pub points: bool,
+    /// The per-vertex field the lines are coloured by, uploaded with each chunk and kept for
+    /// its colour range (one f32 a vertex).
+    pub scalar: Option<String>,
+    /// The per-vertex field that gives tubes their radii, uploaded with each chunk.
+    pub radius: Option<String>,
+}
+
 impl Lines {
     /// `loaded` uploaded ([`upload`]).
     pub fn new(Loaded { name, tracts, hint }: Loaded, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Lines> {
         let geometry = upload(&name, &tracts, device, queue)?;
-        Ok(Lines { name, tracts, hint, geometry, volumes: VolumeCache::default(), held: AttributeKey::default() })
+        let hint = hint.unwrap_or_else(|| framing(&geometry));
+        Ok(Lines {
+            name,
+            tracts,
+            points_kept: true,
+            hint,
+            geometry,
+            volumes: VolumeCache::default(),
+            held: AttributeKey::default(),
+        })
+    }
+
+    /// `source` streamed onto the GPU chunk by chunk as it is read, keeping on the CPU only
+    /// what `keep` asks for; `progress` hears of the bytes read. The chunks of a file are never
+    /// all in memory at once unless `keep.points`.
+    pub fn stream(
+        source: &Source,
+        keep: &Keep,
+        progress: Option<lineao_tracts::ProgressFn<'_>>,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+    ) -> Result<Lines> {
+        let name = source.name();
+        let gpu = |source| SourceError::Gpu { name: name.clone(), source };
+        let mut geometry = LineGeometry::empty(device, geometry_options()).map_err(gpu)?;
+        let mut kept = Tractogram::new();
+        let mut failed: Option<SourceError> = None;
+        let fields = [keep.scalar.as_deref(), keep.radius.as_deref()];
+        let mut sink = |chunk: Tractogram| {
+            if !chunk.has_points() {
+                failed = Some(SourceError::ValuesWithoutPoints { path: name.clone(), format: "tsf" });
+                return ControlFlow::Break(());
+            }
+            let values = |field: Option<&str>| field.map(|f| vertex_field(&name, &chunk, f)).transpose();
+            let attributes = match (values(fields[0]), values(fields[1])) {
+                (Ok(scalar), Ok(radius)) => VertexAttributes { scalar, radius, octants: None },
+                (Err(e), _) | (_, Err(e)) => {
+                    failed = Some(e);
+                    return ControlFlow::Break(());
+                }
+            };
+            if let Err(source) = geometry.append_with(device, queue, &chunk.positions, &chunk.offsets, &attributes) {
+                failed = Some(SourceError::Gpu { name: name.clone(), source });
+                return ControlFlow::Break(());
+            }
+            append(&mut kept, chunk, keep);
+            ControlFlow::Continue(())
+        };
+        let streamed = source.stream(progress, &mut sink);
+        if let Some(error) = failed {
+            return Err(error);
+        }
+        let hint = streamed?;
+        geometry.finish(device, queue).map_err(gpu)?;
+        if geometry.bounds.is_none() {
+            return Err(SourceError::NoFinitePoints(name));
+        }
+        let hint = hint.unwrap_or_else(|| framing(&geometry));
+        Ok(Lines {
+            name,
+            tracts: kept,
+            points_kept: keep.points,
+            hint,
+            geometry,
+            volumes: VolumeCache::default(),
+            held: AttributeKey { scalar: keep.scalar.clone(), radius: keep.radius.clone(), volume: None },
+        })
+    }
+
+    /// The streamlines on the CPU, when the session kept them.
+    pub fn points(&self) -> Result<&Tractogram> {
+        if self.points_kept { Ok(&self.tracts) } else { Err(SourceError::PointsNotKept(self.name.clone())) }
     }
 
     /// The values of the per-vertex field `field` (one column).
@@ -233,7 +432,14 @@ impl Lines {
     /// The object-space AO `wanted` asks for, computed on first use (after `computing` is told).
     pub fn visibility(&mut self, wanted: &AttributeKey, computing: impl FnOnce()) -> Result<Option<&VertexVisibility>> {
         match &wanted.volume {
-            Some(options) => Ok(Some(self.volumes.get(&self.tracts, options, computing)?)),
+            Some(options) => {
+                let tracts = if self.points_kept {
+                    &self.tracts
+                } else {
+                    return Err(SourceError::PointsNotKept(self.name.clone()));
+                };
+                Ok(Some(self.volumes.get(tracts, options, computing)?))
+            }
             None => Ok(None),
         }
     }
@@ -248,6 +454,9 @@ impl Lines {
     ) -> Result<()> {
         if wanted.is_empty() || self.held == *wanted {
             return Ok(());
+        }
+        if !self.points_kept {
+            return Err(SourceError::PointsNotKept(self.name.clone()));
         }
         let Lines { name, tracts, geometry, volumes, .. } = self;
         let octants = match &wanted.volume {
@@ -277,4 +486,38 @@ pub fn vertex_field<'t>(name: &str, tracts: &'t Tractogram, field: &str) -> Resu
         return Err(SourceError::FieldColumns { name, field, columns: found.columns });
     }
     Ok(&found.values)
+}
+
+/// The camera that frames `geometry` (uploaded, so its bounds are known) as a loaded tractogram
+/// is framed.
+fn framing(geometry: &LineGeometry) -> ViewHint {
+    let bounds = geometry.bounds.expect("checked after the upload");
+    ViewHint::for_sphere(bounds.center.to_array(), bounds.radius)
+}
+
+/// Adds `chunk` to what a stream keeps: everything with `keep.points`, else the fields named.
+fn append(kept: &mut Tractogram, chunk: Tractogram, keep: &Keep) {
+    let base = kept.offsets.last().copied().unwrap_or(0);
+    if kept.offsets.is_empty() {
+        kept.offsets.push(0);
+        let wanted =
+            |f: &&Field| keep.points || [&keep.scalar, &keep.radius].iter().any(|k| k.as_deref() == Some(&*f.name));
+        let empty = |f: &Field| Field { name: f.name.clone(), columns: f.columns, values: Vec::new() };
+        kept.vertex_fields = chunk.vertex_fields.iter().filter(wanted).map(empty).collect();
+        if keep.points {
+            kept.streamline_fields = chunk.streamline_fields.iter().map(empty).collect();
+        }
+    }
+    for field in &mut kept.vertex_fields {
+        if let Some(from) = chunk.vertex_fields.iter().find(|f| f.name == field.name) {
+            field.values.extend_from_slice(&from.values);
+        }
+    }
+    if keep.points {
+        kept.positions.extend_from_slice(&chunk.positions);
+        kept.offsets.extend(chunk.offsets[1..].iter().map(|o| o + base));
+        for (field, from) in kept.streamline_fields.iter_mut().zip(&chunk.streamline_fields) {
+            field.values.extend_from_slice(&from.values);
+        }
+    }
 }

@@ -3,8 +3,9 @@
 //
 // The vertex shader pulls each strip vertex from the clusters (`shared/clusters.wgsl`):
 // instance = a cluster, vertex = a position along its strip, which takes every point twice
-// (left, right) — the full strip — or, for straight clusters drawn from afar, one side per
-// point by turns (the alternating strip; `lineao::line_geometry` has the tolerance argument).
+// (left, right) — the full strip — or, drawn from afar, one side per point by turns but both
+// sides of bent points (the alternating strip; `lineao::line_geometry` has the tolerance
+// argument).
 // It pushes the point half a line width sideways, perpendicular to the screen direction of its
 // *vertex* tangent, so consecutive segments share their join corners exactly: joins without
 // gaps or overlaps. Vertices past a cluster's strip repeat its last one and then collapse to
@@ -77,16 +78,41 @@ fn full_strip(v: u32, drawn: u32) -> StripPosition {
     return StripPosition(select(-1, i32(drawn) - 1, v == 2u * drawn), -1.0);
 }
 
-// The alternating strip: both sides of the first point, then one side per point by turns,
-// both sides of the last (L0 R0 L1 R2 L3 … for sides L, R).
-fn alternating_strip(v: u32, drawn: u32) -> StripPosition {
+// The first vertex of point k in the alternating strip of a cluster whose bent inner points are
+// `bent` (point j at bit j − 1): one vertex a point, two for the first point and each bent one.
+fn alternating_start(k: u32, bent: u32) -> u32 {
+    if k == 0u {
+        return 0u;
+    }
+    return k + 1u + countOneBits(bent & ((1u << (k - 1u)) - 1u));
+}
+
+// The alternating strip: both sides of the first point, then one side per point by turns, both
+// sides of bent points and of the last (L0 R0 L1 R2 L3 … for sides L, R, where nothing bends).
+// The point of vertex v is the last whose first vertex is at most v: a binary search over the
+// mask's prefix counts (a cluster draws at most 25 points: five steps).
+fn alternating_strip(v: u32, drawn: u32, bent: u32) -> StripPosition {
     let side = select(1.0, -1.0, (v & 1u) != 0u);
-    if v <= drawn + 1u {
+    let vertices = alternating_start(drawn - 1u, bent) + 2u;
+    if v < vertices && bent == 0u {
         return StripPosition(i32(clamp(v, 1u, drawn) - 1u), side);
     }
-    // The repeat of the last vertex (v = drawn + 1), then the collapsed ones.
-    let last = select(1.0, -1.0, ((drawn + 1u) & 1u) != 0u);
-    return StripPosition(select(-1, i32(drawn) - 1, v == drawn + 2u), last);
+    if v < vertices {
+        var lo = 0u;
+        var hi = drawn - 1u;
+        while lo < hi {
+            let mid = (lo + hi + 1u) >> 1u;
+            if alternating_start(mid, bent) <= v {
+                lo = mid;
+            } else {
+                hi = mid - 1u;
+            }
+        }
+        return StripPosition(i32(lo), side);
+    }
+    // The repeat of the last vertex, then the collapsed ones.
+    let last = select(1.0, -1.0, ((vertices - 1u) & 1u) != 0u);
+    return StripPosition(select(-1, i32(drawn) - 1, v == vertices), last);
 }
 
 // A vertex that collapses with every other past its strip's end.
@@ -96,22 +122,24 @@ fn collapsed() -> VsOut {
     return out;
 }
 
-fn strip_vertex(cluster: u32, at: StripPosition) -> VsOut {
+fn strip_vertex(c: Cluster, at: StripPosition) -> VsOut {
     if at.point < 0 {
         return collapsed();
     }
-    let q = pulled_point(clusters[cluster], u32(at.point));
+    let q = pulled_point(c, u32(at.point));
     return line_vertex(q.position, q.tangent, at.side, point_scalar(q.index));
 }
 
 @vertex
 fn vs_full(@builtin(vertex_index) v: u32, @builtin(instance_index) cluster: u32) -> VsOut {
-    return strip_vertex(cluster, full_strip(v, drawn_points(clusters[cluster])));
+    let c = clusters[cluster];
+    return strip_vertex(c, full_strip(v, drawn_points(c)));
 }
 
 @vertex
 fn vs_alternating(@builtin(vertex_index) v: u32, @builtin(instance_index) cluster: u32) -> VsOut {
-    return strip_vertex(cluster, alternating_strip(v, drawn_points(clusters[cluster])));
+    let c = clusters[cluster];
+    return strip_vertex(c, alternating_strip(v, drawn_points(c), c.flags >> BENT_SHIFT));
 }
 
 // Native 1-px lines (a `LineList`: segment v / 2 of the cluster): the rasterizer's own thin
@@ -130,10 +158,9 @@ fn vs_native(@builtin(vertex_index) v: u32, @builtin(instance_index) cluster: u3
     return line_vertex(q.position, q.tangent, 0.0, point_scalar(q.index));
 }
 
-fn with_point_octants(b: VsOut, cluster: u32, at: StripPosition) -> VsOutOctants {
+fn with_point_octants(b: VsOut, c: Cluster, at: StripPosition) -> VsOutOctants {
     var octants = array<vec4<f32>, 2>(vec4<f32>(1.0), vec4<f32>(1.0));
     if at.point >= 0 {
-        let c = clusters[cluster];
         octants = point_octants(c.first + u32(at.point));
     }
     return VsOutOctants(b.clip, b.view_pos, b.view_tangent, b.color, octants[0], octants[1]);
@@ -142,14 +169,16 @@ fn with_point_octants(b: VsOut, cluster: u32, at: StripPosition) -> VsOutOctants
 // The strips with the points' octant visibilities (object-space AO), for `fs_octants`.
 @vertex
 fn vs_full_octants(@builtin(vertex_index) v: u32, @builtin(instance_index) cluster: u32) -> VsOutOctants {
-    let at = full_strip(v, drawn_points(clusters[cluster]));
-    return with_point_octants(strip_vertex(cluster, at), cluster, at);
+    let c = clusters[cluster];
+    let at = full_strip(v, drawn_points(c));
+    return with_point_octants(strip_vertex(c, at), c, at);
 }
 
 @vertex
 fn vs_alternating_octants(@builtin(vertex_index) v: u32, @builtin(instance_index) cluster: u32) -> VsOutOctants {
-    let at = alternating_strip(v, drawn_points(clusters[cluster]));
-    return with_point_octants(strip_vertex(cluster, at), cluster, at);
+    let c = clusters[cluster];
+    let at = alternating_strip(v, drawn_points(c), c.flags >> BENT_SHIFT);
+    return with_point_octants(strip_vertex(c, at), c, at);
 }
 
 @fragment

@@ -8,7 +8,8 @@ struct Cluster {
     origin: vec3<f32>,
     scale: f32,
     first: u32,
-    // Bits 0–7: point count; 8: the run goes on before it; 9: after it; 10: straight.
+    // Bits 0–4: point count; 5: the run goes on before it; 6: after it; 8–31: which inner
+    // points are bent (take both sides in the alternating strip), inner point k at bit 7 + k.
     flags: u32,
     previous: u32,
     next: u32,
@@ -23,9 +24,10 @@ struct ClusterPage {
     _pad2: u32,
 }
 
-const CLUSTER_COUNT: u32 = 0xffu;
-const JOINS_PREVIOUS: u32 = 0x100u;
-const JOINS_NEXT: u32 = 0x200u;
+const CLUSTER_COUNT: u32 = 0x1fu;
+const JOINS_PREVIOUS: u32 = 0x20u;
+const JOINS_NEXT: u32 = 0x40u;
+const BENT_SHIFT: u32 = 8u;
 const HAS_OCTANTS: u32 = 1u;
 const HAS_SCALARS: u32 = 2u;
 const HAS_RADII: u32 = 4u;
@@ -63,16 +65,31 @@ fn drawn_points(c: Cluster) -> u32 {
     return (c.flags & CLUSTER_COUNT) + select(0u, 1u, (c.flags & JOINS_NEXT) != 0u);
 }
 
-// Point `k` (< drawn_points) of cluster `c` with its vertex tangent.
+// Point `k` (< drawn_points) of cluster `c` with its vertex tangent. Its neighbours across a
+// cluster border are decoded on their clusters' grids (the next one's is read only for the
+// last two points).
 fn pulled_point(c: Cluster, k: u32) -> PulledPoint {
     let count = c.flags & CLUSTER_COUNT;
-    let joins_next = (c.flags & JOINS_NEXT) != 0u;
     let i = c.first + k;
+    if k + 1u < count {
+        // Inside the cluster (its first point's previous may be the previous cluster's last).
+        let p = decode_point(i, c);
+        let next = decode_point(i + 1u, c);
+        var previous = p;
+        if k > 0u {
+            previous = decode_point(i - 1u, c);
+        } else if (c.flags & JOINS_PREVIOUS) != 0u {
+            previous = decode_point(i - 1u, clusters[c.previous]);
+        }
+        return PulledPoint(p, vertex_tangent(previous, p, next), i);
+    }
+    // The cluster's last point, or the next cluster's first (on that cluster's grid), whose
+    // next is the next cluster's first or second (clusters hold at least two).
     var after = c;
+    let joins_next = (c.flags & JOINS_NEXT) != 0u;
     if joins_next {
         after = clusters[c.next];
     }
-    // The next cluster's first point is on its grid.
     var owner = c;
     if k >= count {
         owner = after;
@@ -85,12 +102,15 @@ fn pulled_point(c: Cluster, k: u32) -> PulledPoint {
         previous = decode_point(i - 1u, clusters[c.previous]);
     }
     var next = p;
-    if k + 1u < count {
-        next = decode_point(i + 1u, c);
-    } else if joins_next {
-        // The next cluster's first or second point (clusters hold at least two).
+    if joins_next {
         next = decode_point(i + 1u, after);
     }
+    return PulledPoint(p, vertex_tangent(previous, p, next), i);
+}
+
+// The unit vertex tangent at `p` between `previous` and `next` (which repeat `p` at a run's
+// ends): the central difference, else a one-sided one, else +x.
+fn vertex_tangent(previous: vec3<f32>, p: vec3<f32>, next: vec3<f32>) -> vec3<f32> {
     var t = next - previous;
     if dot(t, t) == 0.0 {
         t = next - p;
@@ -101,7 +121,7 @@ fn pulled_point(c: Cluster, k: u32) -> PulledPoint {
     if dot(t, t) == 0.0 {
         t = vec3<f32>(1.0, 0.0, 0.0);
     }
-    return PulledPoint(p, normalize(t), i);
+    return normalize(t);
 }
 
 fn point_scalar(i: u32) -> f32 {

@@ -1,7 +1,7 @@
 //! Polylines as **clusters**, the form the GPU holds them in: each point once, 6 bytes.
 //!
 //! A polyline is cut at non-finite points into *runs* (≥ 2 finite points joined by segments),
-//! and each run into clusters of at most [`CLUSTER_POINTS`] consecutive points (never one: a
+//! and each run into clusters of at most [`CLUSTER_POINTS`] (24) consecutive points (never one: a
 //! remainder of one point makes the cluster before it one shorter). A cluster's points are
 //! quantized to 16 bits per axis on a grid of its own — origin the corner of its points' box,
 //! step `scale` = the box's longest side / 65535 — so a decoded point lies within
@@ -18,38 +18,46 @@
 //! The vertex shader *pulls* (`shaders/shared/clusters.wgsl`): instance = cluster, vertex =
 //! a position along its strip, so no strip and no index buffer exist. A draw gives every
 //! instance the same vertex count, so clusters are sorted by **size class** (the segments they
-//! draw: ≤ 2, 4, 8, 16, 32) and each class is drawn with its own count; vertices past a
-//! cluster's end collapse onto its last one (zero-area triangles the rasterizer drops).
+//! draw: ≤ 3, 6, 12, 24) and each class is drawn with its own count; vertices past a cluster's
+//! end collapse onto its last one (zero-area triangles the rasterizer drops).
 //!
-//! **Straight clusters** may be drawn as the alternating strip (one vertex per point, sides by
-//! turns; `strip.rs` has the tolerance argument): a cluster is straight when none of its inner
-//! points lies farther than the tolerance τ from the chord of its neighbours or turns its
-//! tangent more than 20° from theirs. Others always take both sides of every point. Each
-//! size class is two ranges of the sorted records, bent then straight.
+//! **The alternating strip** (the module above has the tolerance argument) takes one side per
+//! point but both sides of a cluster's ends and of its *bent* inner points — those farther than
+//! the tolerance τ from the chord of their neighbours, or whose tangent turns more than 20°
+//! from a neighbour's. A record holds its bent points as a mask; the vertex shader finds the
+//! point of strip vertex v by a binary search over the mask's prefix counts. Within a size
+//! class, records are sorted by how many of their points are bent, in five **bend classes**
+//! (none, up to an eighth, a quarter, half, all of the class's segments), each drawn with the
+//! vertex count its most bent cluster needs.
 
 use std::ops::Range;
 
 use glam::Vec3;
 
-/// The most points of one cluster.
-pub const CLUSTER_POINTS: u32 = 32;
+/// The most points of one cluster (the mask of its bent inner points fits in 24 bits of its
+/// record).
+pub const CLUSTER_POINTS: u32 = 24;
 
 /// The size classes: a cluster of class `c` draws at most `c` segments.
-pub(crate) const SIZE_CLASSES: [u32; 5] = [2, 4, 8, 16, 32];
+pub(crate) const SIZE_CLASSES: [u32; 4] = [3, 6, 12, 24];
 
-/// Draw ranges per page: each size class, bent and straight.
-pub(crate) const DRAW_CLASSES: usize = 2 * SIZE_CLASSES.len();
+/// The bend classes of a size class of `s` segments: at most `BEND_CLASSES[i] · s / 8` bent
+/// inner points (none, an eighth, a quarter, half, all).
+pub(crate) const BEND_CLASSES: [u32; 5] = [0, 1, 2, 4, 8];
+
+/// Draw ranges of a page: every bend class of every size class.
+pub(crate) const DRAW_CLASSES: usize = SIZE_CLASSES.len() * BEND_CLASSES.len();
 
 /// The bits of [`ClusterRecord::flags`]. Keep in sync with `shaders/shared/clusters.wgsl`.
 pub(crate) mod flags {
-    /// The cluster's own points (2..=255).
-    pub const COUNT: u32 = 0xff;
+    /// The cluster's own points (2..=24).
+    pub const COUNT: u32 = 0x1f;
     /// Its run goes on before it: its first point's previous neighbour is `previous`'s last.
-    pub const JOINS_PREVIOUS: u32 = 1 << 8;
+    pub const JOINS_PREVIOUS: u32 = 1 << 5;
     /// Its run goes on after it: it also draws `next`'s first point.
-    pub const JOINS_NEXT: u32 = 1 << 9;
-    /// It may be drawn as the alternating strip.
-    pub const STRAIGHT: u32 = 1 << 10;
+    pub const JOINS_NEXT: u32 = 1 << 6;
+    /// Bits 8–31: inner point k (1 ≤ k ≤ 24 of the strip) is bent at bit 7 + k.
+    pub const BENT_SHIFT: u32 = 8;
 }
 
 /// One cluster on the GPU. Keep in sync with `Cluster` in `shaders/shared/clusters.wgsl`.
@@ -80,8 +88,14 @@ impl ClusterRecord {
         self.count() + (self.flags & flags::JOINS_NEXT != 0) as u32
     }
 
-    pub fn is_straight(&self) -> bool {
-        self.flags & flags::STRAIGHT != 0
+    /// How many of its inner points are bent (take both sides in the alternating strip).
+    pub fn bent(&self) -> u32 {
+        (self.flags >> flags::BENT_SHIFT).count_ones()
+    }
+
+    /// Vertices of its alternating strip: one a point, both sides of its ends and bent points.
+    pub fn alternating_vertices(&self) -> u32 {
+        self.drawn() + 2 + self.bent()
     }
 
     /// A quantized point back in world units, as the shaders compute it.
@@ -107,9 +121,29 @@ fn size_class(segments: u32) -> usize {
     SIZE_CLASSES.iter().position(|&c| segments <= c).expect("clusters draw at most CLUSTER_POINTS segments")
 }
 
-/// Index of the draw range of a record: its size class's, bent (even) or straight (odd).
+/// The draw class of a record: its size class's bend class.
 fn draw_class(record: &ClusterRecord) -> usize {
-    2 * size_class(record.drawn() - 1) + record.is_straight() as usize
+    let size = size_class(record.drawn() - 1);
+    let bent = record.bent();
+    let bend = BEND_CLASSES.iter().position(|&b| bent * 8 <= b * SIZE_CLASSES[size]).expect("at most all points");
+    size * BEND_CLASSES.len() + bend
+}
+
+/// The alternating strip's vertex count of draw class `class` (its most bent cluster's).
+pub(crate) fn alternating_vertices(class: usize) -> u32 {
+    let segments = SIZE_CLASSES[class / BEND_CLASSES.len()];
+    let bent = (BEND_CLASSES[class % BEND_CLASSES.len()] * segments / 8).min(segments - 1);
+    segments + 3 + bent
+}
+
+/// The full strip's vertex count of draw class `class`.
+pub(crate) fn full_vertices(class: usize) -> u32 {
+    2 * (SIZE_CLASSES[class / BEND_CLASSES.len()] + 1)
+}
+
+/// The segments a cluster of draw class `class` draws at most.
+pub(crate) fn class_segments(class: usize) -> u32 {
+    SIZE_CLASSES[class / BEND_CLASSES.len()]
 }
 
 /// The unit vertex tangent of run point `k`: the central difference of its neighbours, else
@@ -128,17 +162,18 @@ pub(crate) fn vertex_tangent(run: &[[f32; 3]], k: usize) -> Vec3 {
 /// The cosine of the largest turn between neighbouring tangents a straight cluster allows (20°).
 pub(crate) const MAX_TURN_COS: f32 = 0.9397;
 
-/// Whether run point `k` (0 < k < len − 1) needs both sides in a strip of tolerance `tolerance`:
-/// it lies farther than that from the chord of its neighbours, or its tangent turns more than
-/// 20° from theirs.
-pub(crate) fn bends(run: &[[f32; 3]], tangents: &[Vec3], k: usize, tolerance: f32) -> bool {
+/// How far run point `k` (0 < k < len − 1) lies from the chord of its neighbours (world
+/// units): what skipping one of its sides moves an edge by; infinite where its tangent turns
+/// more than 20° from a neighbour's.
+pub(crate) fn deviation(run: &[[f32; 3]], tangents: &[Vec3], k: usize) -> f32 {
+    if tangents[k].dot(tangents[k - 1]) < MAX_TURN_COS || tangents[k].dot(tangents[k + 1]) < MAX_TURN_COS {
+        return f32::INFINITY;
+    }
     let (a, p, b) = (Vec3::from_array(run[k - 1]), Vec3::from_array(run[k]), Vec3::from_array(run[k + 1]));
     let chord = b - a;
     let t =
         if chord.length_squared() > 0.0 { ((p - a).dot(chord) / chord.length_squared()).clamp(0.0, 1.0) } else { 0.0 };
-    p.distance(a + t * chord) > tolerance
-        || tangents[k].dot(tangents[k - 1]) < MAX_TURN_COS
-        || tangents[k].dot(tangents[k + 1]) < MAX_TURN_COS
+    p.distance(a + t * chord)
 }
 
 /// The sizes of the clusters a run of `len` ≥ 2 points is cut into: `per` (≥ 3) each, the last
@@ -179,7 +214,7 @@ pub(crate) struct PageBuilder {
     pub z: Vec<u16>,
     pub records: Vec<ClusterRecord>,
     pub runs: Vec<RunMap>,
-    /// The largest tolerance a straight cluster of this page was judged with.
+    /// The largest tolerance a point of this page was judged bent with.
     pub tolerance: f32,
     /// The box of its input points (min, max).
     pub corners: Option<(Vec3, Vec3)>,
@@ -196,7 +231,7 @@ impl PageBuilder {
     }
 
     /// Appends a run of ≥ 2 finite points (input vertex `input` first), cut into clusters of at
-    /// most `per_cluster` points; straight clusters judged with `tolerance` (world units).
+    /// most `per_cluster` points, its points bent beyond `tolerance` (world units) marked.
     pub fn add_run(&mut self, run: &[[f32; 3]], input: u64, per_cluster: usize, tolerance: f32) {
         debug_assert!(run.len() >= 2 && run.iter().all(|p| p.iter().all(|c| c.is_finite())));
         let page_first = self.xy.len() as u32;
@@ -228,18 +263,18 @@ impl PageBuilder {
             }
             let joins_next = i + 1 < sizes.len();
             let drawn = count + joins_next as usize;
-            // Inner points of the strip: run points start + 1 ..= start + drawn − 2.
-            let straight = (start + 1..start + drawn - 1).all(|k| !bends(run, &self.tangents, k, tolerance));
+            // Inner points of the strip: run points start + 1 ..= start + drawn − 2, the k-th
+            // at bit 7 + k.
+            let bent = (1..drawn - 1)
+                .filter(|&k| deviation(run, &self.tangents, start + k) > tolerance)
+                .fold(0u32, |mask, k| mask | 1 << (flags::BENT_SHIFT + k as u32 - 1));
             let index = first_record + i as u32;
-            let mut bits = count as u32;
+            let mut bits = count as u32 | bent;
             if i > 0 {
                 bits |= flags::JOINS_PREVIOUS;
             }
             if joins_next {
                 bits |= flags::JOINS_NEXT;
-            }
-            if straight {
-                bits |= flags::STRAIGHT;
             }
             self.records.push(ClusterRecord {
                 origin: min.to_array(),
@@ -338,7 +373,8 @@ pub(crate) fn runs<'a>(positions: &'a [[f32; 3]], offsets: &'a [u64]) -> impl It
 mod tests {
     use super::*;
 
-    fn build(polylines: &[Vec<[f32; 3]>], per: usize, tolerance: f32) -> PageData {
+    fn build(polylines: &[Vec<[f32; 3]>], per: usize) -> PageData {
+        let tolerance = 1e-3;
         let mut page = PageBuilder::default();
         let mut input = 0u64;
         for line in polylines {
@@ -389,7 +425,7 @@ mod tests {
                     [at + size * a.cos(), at + size * a.sin(), at + size * (2.0 * s - 1.0)]
                 })
                 .collect();
-            let page = build(std::slice::from_ref(&line), 32, 0.0);
+            let page = build(std::slice::from_ref(&line), 24);
             let decoded = page.decoded();
             for r in &page.records {
                 let own = &line[r.first as usize..(r.first + r.count()) as usize];
@@ -410,20 +446,24 @@ mod tests {
 
     #[test]
     fn records_sort_into_classes_and_keep_their_neighbours() {
-        // Runs of 70 (32 + 32 + 6), 3 and 33 (31 + 2) points, a zigzag among them.
+        // Runs of 70 (24 + 24 + 22), 3 and 25 (23 + 2) points, a zigzag among them.
         let line = |n: usize, zig: bool| -> Vec<[f32; 3]> {
             (0..n).map(|i| [i as f32, if zig && i % 2 == 1 { 1.0 } else { 0.0 }, 0.0]).collect()
         };
-        let page = build(&[line(70, false), line(3, false), line(33, true)], 32, 1e-3);
+        let page = build(&[line(70, false), line(3, false), line(25, true)], 24);
         assert_eq!(page.records.len(), 3 + 1 + 2);
         for (class, range) in page.classes.iter().enumerate() {
             for r in &page.records[range.start as usize..range.end as usize] {
                 assert_eq!(draw_class(r), class);
             }
+            for r in &page.records[range.start as usize..range.end as usize] {
+                assert!(r.alternating_vertices() <= alternating_vertices(class), "{r:?} in class {class}");
+                assert!(2 * r.drawn() <= full_vertices(class), "{r:?} in class {class}");
+            }
         }
         // Following `next` from each run's first cluster visits its points in order.
         let decoded = page.decoded();
-        for (first, len) in [(0u32, 70u32), (70, 3), (73, 33)] {
+        for (first, len) in [(0u32, 70u32), (70, 3), (73, 25)] {
             let mut c = page.records.iter().position(|r| r.first == first).unwrap();
             let mut seen = 0;
             loop {
@@ -438,10 +478,10 @@ mod tests {
             }
             assert_eq!(seen, len);
         }
-        // The straight runs' clusters are straight, the zigzag's are not (but for its last
-        // two points, which have no inner point).
+        // The straight runs' clusters have no bent point; every inner point of the zigzag's is.
         for r in &page.records {
-            assert_eq!(r.is_straight(), r.first < 73 || r.drawn() == 2, "{r:?}");
+            let inner = r.drawn() - 2;
+            assert_eq!(r.bent(), if r.first < 73 { 0 } else { inner }, "{r:?}");
         }
         // The 3-point run's middle point, 1 of its 2 units across: within half a step.
         assert!((decoded[71][0] - 1.0).abs() <= 2.0 / 65535.0 && decoded[71][1] == 0.0, "{:?}", decoded[71]);

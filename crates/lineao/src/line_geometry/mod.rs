@@ -16,12 +16,12 @@
 //! ends): one vertex and one triangle per segment. Its left edge then runs from L1 to L3, past
 //! where L2 would be: straight lines come out exact, a bend at point i moves the skipped edge
 //! by about the distance δ_i of P_i from the chord P_(i−1) P_(i+1), and the turn of the tangents
-//! shifts the offsets. So a cluster is *straight* only where every inner point has δ_i within a
-//! tolerance τ (world units, a fixed share of the geometry's bounding radius) and turns its
-//! tangent by at most 20° from its neighbours'; a page draws its straight clusters alternating
-//! only where τ times the most pixels a world unit can cover in the frame is at most a quarter
-//! pixel and lines are at most 8 px wide: every edge within about half a pixel of the full
-//! strip's. Zoomed in closer, and for bent clusters, the full strip is drawn.
+//! shifts the offsets. So a point keeps both sides where δ_i exceeds a tolerance τ (world
+//! units: [`GeometryOptions::tolerance`], by default a fixed share of the geometry's bounding
+//! radius) or its tangent turns more than 20° from a neighbour's, and a frame uses the
+//! alternating strip only where τ times the most pixels a world unit can cover in it is at most
+//! a quarter pixel and lines are at most 8 px wide: every edge within about half a pixel of the
+//! full strip's. Zoomed in closer, the full strip is drawn.
 
 mod clusters;
 #[cfg(feature = "reference")]
@@ -34,7 +34,7 @@ use glam::Vec3;
 use crate::Error;
 use crate::camera::Bounds;
 pub use clusters::{CLUSTER_POINTS, ClusterRecord};
-pub(crate) use clusters::{DRAW_CLASSES, SIZE_CLASSES};
+pub(crate) use clusters::{DRAW_CLASSES, alternating_vertices, class_segments, full_vertices};
 use clusters::{PageAttributes, PageBuilder, PageData, RECORD_SIZE, RunMap};
 
 /// Default upper bound of one page's largest buffer (its octant visibilities, 8 bytes a
@@ -74,13 +74,19 @@ pub fn stored_radius(radius: f32) -> f32 {
 }
 
 /// How [`LineGeometry`] is uploaded.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GeometryOptions {
     /// Upper bound of a page's largest buffer in bytes, further capped by the device's buffer
     /// and storage-binding limits: how many points one bind group holds.
     pub page_bytes: u64,
     /// The most points of a cluster (3 to [`CLUSTER_POINTS`]).
     pub cluster_points: u32,
+    /// How far (world units) a point may lie from the chord of its neighbours and still take
+    /// one side in the alternating strip (τ; see the module documentation). `None`: a fixed
+    /// share of the bounding radius — the geometry's for [`LineGeometry::with_options`], the
+    /// box's so far for [`LineGeometry::append`], which then depends on how the chunks fall; a
+    /// host that appends chunks and wants the same pixels however they fall sets it.
+    pub tolerance: Option<f32>,
     /// Wait for the device after each page, so that each page's staging copy is freed before
     /// the next is made. It waits for whatever the device is doing, so a host's render loop
     /// leaves it off (the default: uploads never wait); a tool loading a huge file on its own
@@ -90,7 +96,12 @@ pub struct GeometryOptions {
 
 impl Default for GeometryOptions {
     fn default() -> Self {
-        GeometryOptions { page_bytes: DEFAULT_PAGE_BYTES, cluster_points: CLUSTER_POINTS, bounded_staging: false }
+        GeometryOptions {
+            page_bytes: DEFAULT_PAGE_BYTES,
+            cluster_points: CLUSTER_POINTS,
+            tolerance: None,
+            bounded_staging: false,
+        }
     }
 }
 
@@ -203,9 +214,9 @@ pub(crate) fn page_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
 /// One page of clusters on the GPU.
 pub(crate) struct Page {
     pub group: wgpu::BindGroup,
-    /// The records of each draw class ([`SIZE_CLASSES`], bent then straight).
+    /// The records of each draw class (size and bend class).
     pub classes: [Range<u32>; DRAW_CLASSES],
-    /// The tolerance its straight clusters were judged with (world units).
+    /// The largest tolerance τ its bent points were marked with (world units).
     pub tolerance: f32,
     pub records: u32,
     points: u32,
@@ -273,9 +284,9 @@ impl LineGeometry {
     ) -> Result<LineGeometry, Error> {
         validate_offsets(offsets, positions.len())?;
         let mut geometry = Self::empty(device, options)?;
-        // The exact sphere first: it sets the strips' tolerance as the stream's box would.
+        // The exact sphere first: it sets the strips' tolerance as a stream's box would.
         let bounds = Bounds::of_points(positions);
-        geometry.bounds = bounds;
+        geometry.corners = Bounds::corners_of(positions);
         geometry.append_runs(device, queue, positions, offsets, &VertexAttributes::default(), bounds)?;
         geometry.flush(device, queue)?;
         geometry.bounds = bounds;
@@ -348,19 +359,21 @@ impl LineGeometry {
                 "every chunk appended to a geometry carries the same attributes".to_string(),
             ));
         }
-        // The box so far, this chunk's included, gives the strips' tolerance.
         if let Some((lo, hi)) = Bounds::corners_of(positions) {
             let (a, b) = self.corners.unwrap_or((lo, hi));
             self.corners = Some((a.min(lo), b.max(hi)));
         }
-        let sphere = self.corners.map(|(lo, hi)| Bounds { center: (lo + hi) * 0.5, radius: (hi - lo).length() * 0.5 });
+        // Until `finish`: the sphere around the box (which also gives the strips' tolerance).
+        let sphere = self
+            .corners
+            .map(|(lo, hi)| Bounds { center: (lo + hi) * 0.5, radius: ((hi - lo).length() * 0.5).max(1e-6) });
         self.append_runs(device, queue, positions, offsets, attributes, sphere)?;
-        self.bounds = sphere.map(|b| Bounds { radius: b.radius.max(1e-6), ..b });
+        self.bounds = sphere;
         Ok(())
     }
 
     /// Cuts the polylines into runs and adds them to the pending page, uploading it whenever
-    /// it is full; `bounds` sets the tolerance of the alternating strip.
+    /// it is full; `bounds` sets the strips' tolerance unless the options do.
     fn append_runs(
         &mut self,
         device: &wgpu::Device,
@@ -370,7 +383,8 @@ impl LineGeometry {
         attributes: &VertexAttributes,
         bounds: Option<Bounds>,
     ) -> Result<(), Error> {
-        let tolerance = bounds.map_or(0.0, |b| b.radius * TOLERANCE_PER_RADIUS);
+        let tolerance =
+            self.options.tolerance.unwrap_or_else(|| bounds.map_or(0.0, |b| b.radius * TOLERANCE_PER_RADIUS));
         let per_cluster = self.options.cluster_points as usize;
         let base = self.vertices as u64;
         if self.vertices == 0 && !attributes.is_empty() {
@@ -551,6 +565,11 @@ impl LineGeometry {
             page.group = group;
         }
         settle(device, queue, self.options.bounded_staging)
+    }
+
+    /// The corners (min, max) of the box around every finite point appended.
+    pub fn corners(&self) -> Option<(Vec3, Vec3)> {
+        self.corners
     }
 
     /// Whether every page holds per-vertex attributes.

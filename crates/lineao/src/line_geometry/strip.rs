@@ -9,8 +9,8 @@
 
 use glam::Vec3;
 
-use super::clusters::{bends, runs, vertex_tangent};
-use super::{MAX_ALTERNATING_WIDTH_PX, MAX_TOLERANCE_PX, TOLERANCE_PER_RADIUS, validate_offsets};
+use super::clusters::{deviation, runs, vertex_tangent};
+use super::{MAX_ALTERNATING_WIDTH_PX, MAX_TOLERANCE_PX, validate_offsets};
 use crate::Error;
 use crate::camera::{Bounds, FrameView};
 use crate::gbuffer::{self, GeometryBindings, GeometryUniform, Load, PipelineSpec};
@@ -28,6 +28,9 @@ struct StripVertex {
 }
 
 const VERTEX_SIZE: u64 = std::mem::size_of::<StripVertex>() as u64;
+/// τ over the bounding radius: a view that shows the whole bounding sphere across 2 000 px
+/// covers about 2 000 / (2 radius) px per world unit, so τ is about 0.12 px there.
+const TOLERANCE_PER_RADIUS: f32 = 1.0 / 8192.0;
 /// Ends an index strip; the next index starts a new one.
 const RESTART: u32 = u32::MAX;
 
@@ -56,6 +59,8 @@ impl StripGeometry {
         use wgpu::util::DeviceExt;
         validate_offsets(offsets, positions.len())?;
         let bounds = Bounds::of_points(positions);
+        // A point keeps both sides where it lies farther than τ, a fixed share of the
+        // bounding radius, from its neighbours' chord (or turns sharply).
         let tolerance = bounds.map_or(0.0, |b| b.radius * TOLERANCE_PER_RADIUS);
         let mut vertices: Vec<StripVertex> = Vec::new();
         let mut indices: Vec<u32> = Vec::new();
@@ -86,7 +91,7 @@ impl StripGeometry {
             };
             for k in 0..run.len() {
                 side(k, &mut indices);
-                if k == 0 || k + 1 == run.len() || bends(run, &tangents, k, tolerance) {
+                if k == 0 || k + 1 == run.len() || deviation(run, &tangents, k) > tolerance {
                     side(k, &mut indices);
                 }
             }

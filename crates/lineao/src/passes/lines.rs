@@ -21,7 +21,9 @@ pub use crate::line_geometry::{
     CLUSTER_POINTS, ClusterRecord, DEFAULT_PAGE_BYTES, GeometryOptions, VertexAttributes, stored_radius,
     validate_offsets,
 };
-use crate::line_geometry::{LineGeometry, MAX_ALTERNATING_WIDTH_PX, MAX_TOLERANCE_PX, Page, SIZE_CLASSES};
+use crate::line_geometry::{
+    LineGeometry, MAX_ALTERNATING_WIDTH_PX, MAX_TOLERANCE_PX, Page, alternating_vertices, class_segments, full_vertices,
+};
 use crate::settings::LineColor;
 use crate::targets::FrameTargets;
 use crate::timing::Span;
@@ -146,8 +148,8 @@ impl LineRenderer {
         self.px_per_world.store(scale.to_bits(), Ordering::Relaxed);
     }
 
-    /// Whether `page`'s straight clusters are drawn as the alternating strip in the frame of
-    /// the last [`LineRenderer::prepare`].
+    /// Whether `page` is drawn as the alternating strip in the frame of the last
+    /// [`LineRenderer::prepare`].
     fn page_alternates(&self, page: &Page) -> bool {
         let scale = f32::from_bits(self.px_per_world.load(Ordering::Relaxed));
         self.style == LineStyle::Quads && page.tolerance * scale <= MAX_TOLERANCE_PX
@@ -159,9 +161,16 @@ impl LineRenderer {
         geometry.pages().iter().any(|page| self.page_alternates(page))
     }
 
+    /// The share of `geometry`'s clusters drawn as the alternating strip in the frame of the
+    /// last [`LineRenderer::prepare`].
+    pub fn alternating_share(&self, geometry: &LineGeometry) -> f64 {
+        let drawn: u32 = geometry.pages().iter().filter(|p| self.page_alternates(p)).map(|p| p.records).sum();
+        drawn as f64 / geometry.clusters().max(1) as f64
+    }
+
     /// Draws `geometry` into the G-buffer, clearing it first or over earlier passes (`load`),
-    /// timed into `span` when given: per page, each size class of clusters with its vertex
-    /// count, the full strips first, then the alternating ones.
+    /// timed into `span` when given: per page, each draw class of clusters with its vertex
+    /// count (the alternating strip's where the frame allows it, else the full strip's).
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -178,17 +187,13 @@ impl LineRenderer {
         for page in geometry.pages() {
             pass.set_bind_group(1, &page.group, &[]);
             let alternating = pipelines.alternating.as_ref().filter(|_| self.page_alternates(page));
-            // (class, vertices) of every non-empty range, full strips first.
-            let draws = page.classes.iter().enumerate().filter(|(_, range)| !range.is_empty());
-            let mut full = Vec::new();
-            let mut alternated = Vec::new();
-            for (class, range) in draws {
-                let segments = SIZE_CLASSES[class / 2];
-                let straight = class % 2 == 1;
+            // (vertices, instances) of every non-empty draw class, full strips first.
+            let (mut full, mut alternated) = (Vec::new(), Vec::new());
+            for (class, range) in page.classes.iter().enumerate().filter(|(_, range)| !range.is_empty()) {
                 match (self.style, alternating) {
-                    (LineStyle::Native1px, _) => full.push((2 * segments, range.clone())),
-                    (_, Some(_)) if straight => alternated.push((segments + 3, range.clone())),
-                    _ => full.push((2 * (segments + 1), range.clone())),
+                    (LineStyle::Native1px, _) => full.push((2 * class_segments(class), range.clone())),
+                    (_, Some(_)) => alternated.push((alternating_vertices(class), range.clone())),
+                    (_, None) => full.push((full_vertices(class), range.clone())),
                 }
             }
             for (pipeline, draws) in [(Some(&pipelines.full), full), (alternating, alternated)] {

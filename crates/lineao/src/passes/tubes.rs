@@ -23,7 +23,7 @@
 use crate::camera::FrameView;
 use crate::gbuffer::{self, GeometryBindings, GeometryUniform, Load, PipelineSpec};
 use crate::lighting::Lighting;
-use crate::line_geometry::{LineGeometry, SIZE_CLASSES};
+use crate::line_geometry::{LineGeometry, class_segments};
 use crate::settings::LineColor;
 use crate::targets::FrameTargets;
 use crate::timing::Span;
@@ -97,7 +97,7 @@ impl TubeRenderer {
         for page in geometry.pages() {
             pass.set_bind_group(1, &page.group, &[]);
             for (class, range) in page.classes.iter().enumerate().filter(|(_, r)| !r.is_empty()) {
-                pass.draw(0..6 * SIZE_CLASSES[class / 2], range.clone());
+                pass.draw(0..6 * class_segments(class), range.clone());
             }
         }
     }
