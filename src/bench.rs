@@ -248,7 +248,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     // cores), its points kept only where a selected pass needs them.
     let start = Instant::now();
     let keep = crate::source::Keep { points, ..Default::default() };
-    let scene = crate::source::Lines::stream(&source, &keep, None, device, queue)?;
+    let scene = crate::source::Lines::stream(&source, &keep, None, &gpu)?;
     let load_ms = start.elapsed().as_secs_f64() * 1e3;
     let geometry = &scene.geometry;
     let bytes_per_vertex = geometry.gpu_bytes() as f64 / geometry.vertices.max(1) as f64;

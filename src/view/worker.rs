@@ -346,7 +346,7 @@ fn load(gpu: &Gpu, source: &Source, send: &dyn Fn(FromWorker)) -> Result<(Scene,
     let start = web_time::Instant::now();
     let loaded = source.load(Some(&mut report)).map_err(|e| format!("{e:#}"))?;
     let load_ms = start.elapsed().as_secs_f64() * 1e3;
-    let lines = Lines::new(loaded, &gpu.device, &gpu.queue).map_err(|e| format!("{e:#}"))?;
+    let lines = Lines::new(loaded, gpu).map_err(|e| format!("{e:#}"))?;
     let upload_ms = start.elapsed().as_secs_f64() * 1e3 - load_ms;
     let fields = lines
         .tracts

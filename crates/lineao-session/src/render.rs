@@ -271,7 +271,7 @@ impl Session {
             }
             std::ops::ControlFlow::Continue(())
         };
-        let lines = Lines::stream(&source, &keep, Some(&mut report), &gpu.device, &gpu.queue);
+        let lines = Lines::stream(&source, &keep, Some(&mut report), &gpu);
         if let Some(bar) = &bar {
             bar.finish_and_clear();
         }
@@ -287,7 +287,7 @@ impl Session {
             vertex_field(&loaded.name, &loaded.tracts, field)?;
         }
         let gpu = Gpu::headless()?;
-        let mut lines = Lines::new(loaded, &gpu.device, &gpu.queue)?;
+        let mut lines = Lines::new(loaded, &gpu)?;
         lines.hold((&gpu.device, &gpu.queue), &base, || {})?;
         Self::assemble(args, lines, surfaces, base, gpu)
     }
