@@ -220,7 +220,13 @@ impl WholeBrain {
         let t1 = 1.0 - 0.06 * uniform(&mut rng);
         let (s0, s1) = (t0 * total, t1 * total);
         let points = ((s1 - s0).round() as usize).max(2) + 1;
-        let across = (symmetric(&mut rng), symmetric(&mut rng), symmetric(&mut rng));
+        // A place in the bundle's round cross-section (uniform in the unit ball).
+        let across = loop {
+            let v = Vec3::new(symmetric(&mut rng), symmetric(&mut rng), symmetric(&mut rng));
+            if v.length_squared() <= 1.0 {
+                break v;
+            }
+        };
         let (wander, phase) = (0.6 + 0.6 * uniform(&mut rng), std::f32::consts::TAU * uniform(&mut rng));
         let family = template.family;
         let mut k = 0usize;
@@ -239,7 +245,7 @@ impl WholeBrain {
                 _ => (2.0 * t - 1.0).powi(2),
             };
             let width = template.core + (template.ends - template.core) * end;
-            let offset = Vec3::new(across.0, across.1, across.2) * width
+            let offset = across * width
                 + Vec3::new((phase + 0.09 * s).sin(), (phase * 1.7 + 0.07 * s).cos(), (phase * 0.6 + 0.05 * s).sin())
                     * wander;
             out.push((centre + offset).to_array());
