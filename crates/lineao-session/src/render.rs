@@ -260,7 +260,7 @@ impl Session {
         let surfaces = load_surfaces(args)?;
         let base = base_attributes(args);
         let gpu = Gpu::headless()?;
-        let keep = Keep { points, scalar: base.scalar.clone(), radius: base.radius.clone() };
+        let keep = Keep { points, scalar: base.scalar.clone(), radius: base.radius.clone(), fields: false };
         let bar = match &source {
             Source::File(path) => crate::source::progress_bar(path),
             _ => None,

@@ -37,6 +37,9 @@ pub enum SourceError {
     /// on the CPU (a bug of the session: it decides what to keep from what it will draw).
     #[error("{0}: its points were streamed to the GPU and not kept on the CPU")]
     PointsNotKept(String),
+    /// A file read as it arrived, whose bytes were not kept, cannot be read again.
+    #[error("{0} was read as it arrived and not kept: open it again to use this")]
+    NotReadable(String),
 }
 
 type Result<T> = std::result::Result<T, SourceError>;
@@ -57,6 +60,83 @@ pub enum Source {
         name: String,
         bytes: std::sync::Arc<[u8]>,
     },
+    /// A file's bytes as they arrive (the web page reading a dropped file or a download in
+    /// pieces), under its name: the viewer decodes and draws them as they come, and keeps none.
+    Feed {
+        name: String,
+        feed: SharedFeed,
+    },
+}
+
+/// Bytes arriving from outside, pushed by their reader and taken by their decoder.
+#[derive(Debug, Default)]
+pub struct Feed {
+    pieces: std::collections::VecDeque<Vec<u8>>,
+    /// Bytes pushed so far, taken so far, and of how many (when known).
+    pub received: u64,
+    pub taken: u64,
+    pub total: Option<u64>,
+    /// The most bytes its decoder keeps to read the file again (for what needs every point on
+    /// the CPU); past them it keeps none.
+    pub keep_bytes: u64,
+    ended: bool,
+    failed: Option<String>,
+}
+
+impl Feed {
+    /// The next piece of the file.
+    pub fn push(&mut self, piece: Vec<u8>) {
+        self.received += piece.len() as u64;
+        self.pieces.push_back(piece);
+    }
+
+    /// The file has ended.
+    pub fn end(&mut self) {
+        self.ended = true;
+    }
+
+    /// Reading failed: the load fails with `message`.
+    pub fn fail(&mut self, message: String) {
+        self.failed = Some(message);
+    }
+
+    /// The next pieces that have arrived, about `bytes` of them (at least one piece when there
+    /// is one: a decoder's step takes a bounded share however fast the file arrives); whether
+    /// the file has ended with them; and a failure.
+    pub fn take(&mut self, bytes: usize) -> (Vec<Vec<u8>>, bool, Option<String>) {
+        let mut taken = Vec::new();
+        let mut size = 0;
+        while size < bytes
+            && let Some(piece) = self.pieces.pop_front()
+        {
+            size += piece.len();
+            taken.push(piece);
+        }
+        self.taken += size as u64;
+        (taken, self.ended && self.pieces.is_empty(), self.failed.take())
+    }
+}
+
+/// A [`Feed`] shared by its reader and its decoder; two are equal when they are the same feed.
+#[derive(Clone, Debug)]
+pub struct SharedFeed(pub std::sync::Arc<std::sync::Mutex<Feed>>);
+
+impl PartialEq for SharedFeed {
+    fn eq(&self, other: &SharedFeed) -> bool {
+        std::sync::Arc::ptr_eq(&self.0, &other.0)
+    }
+}
+
+impl SharedFeed {
+    /// A feed of `total` bytes when known, of which its decoder keeps up to `keep_bytes`.
+    pub fn new(total: Option<u64>, keep_bytes: u64) -> SharedFeed {
+        let feed = Feed { total, keep_bytes, ..Feed::default() };
+        SharedFeed(std::sync::Arc::new(std::sync::Mutex::new(feed)))
+    }
+
+    pub fn lock(&self) -> std::sync::MutexGuard<'_, Feed> {
+        self.0.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
+    }
 }
 
 /// A loaded source: its name (the scene's, or the file's path), its streamlines and the
@@ -76,7 +156,7 @@ impl Source {
     pub fn load_on_terminal(&self) -> Result<Loaded> {
         let bar = match self {
             Source::File(path) => progress_bar(path),
-            Source::Scene { .. } | Source::Bytes { .. } => None,
+            Source::Scene { .. } | Source::Bytes { .. } | Source::Feed { .. } => None,
         };
         let Some(bar) = bar else { return self.load(None) };
         let loaded = self.load(Some(&mut |p: Progress| {
@@ -92,7 +172,7 @@ impl Source {
         match self {
             Source::Scene { kind, .. } => kind.name().to_string(),
             Source::File(path) => path.display().to_string(),
-            Source::Bytes { name, .. } => name.clone(),
+            Source::Bytes { name, .. } | Source::Feed { name, .. } => name.clone(),
         }
     }
 
@@ -124,6 +204,7 @@ impl Source {
                 }
                 Ok(None)
             }
+            Source::Feed { name, .. } => Err(SourceError::NotReadable(name.clone())),
             Source::Bytes { name, bytes } => {
                 let mut decoder = lineao_tracts::ChunkDecoder::new(
                     name,
@@ -159,6 +240,7 @@ impl Source {
                 }
                 Ok(Loaded { name: path.display().to_string(), tracts: loaded.tractogram, hint: None })
             }
+            Source::Feed { name, .. } => Err(SourceError::NotReadable(name.clone())),
             Source::Bytes { name, bytes } => {
                 let loaded = lineao_tracts::load_from_bytes(bytes, name, &Default::default())?;
                 if !loaded.tractogram.has_points() {
@@ -333,6 +415,8 @@ pub struct Lines {
     /// fields that colour the lines (`tracts.positions` empty, `points_kept` false).
     pub tracts: Tractogram,
     points_kept: bool,
+    /// What a stream keeps of each chunk.
+    keep: Keep,
     pub hint: ViewHint,
     pub geometry: LineGeometry,
     pub volumes: VolumeCache,
@@ -349,6 +433,8 @@ pub struct Keep {
     pub scalar: Option<String>,
     /// The per-vertex field that gives tubes their radii, uploaded with each chunk.
     pub radius: Option<String>,
+    /// Every one-column per-vertex field (the viewer colours by any of them).
+    pub fields: bool,
 }
 
 impl Lines {
@@ -360,6 +446,7 @@ impl Lines {
             name,
             tracts,
             points_kept: true,
+            keep: Keep { points: true, ..Keep::default() },
             hint,
             geometry,
             volumes: VolumeCache::default(),
@@ -376,52 +463,98 @@ impl Lines {
         progress: Option<lineao_tracts::ProgressFn<'_>>,
         on: &lineao::Gpu,
     ) -> Result<Lines> {
-        let (device, queue) = (&on.device, &on.queue);
-        let name = source.name();
-        let gpu = |source| SourceError::Gpu { name: name.clone(), source };
-        let mut geometry = LineGeometry::empty(device, geometry_options(on)).map_err(gpu)?;
-        let mut kept = Tractogram::new();
+        let mut lines = Lines::empty(source.name(), keep, on)?;
         let mut failed: Option<SourceError> = None;
-        let fields = [keep.scalar.as_deref(), keep.radius.as_deref()];
-        let mut sink = |chunk: Tractogram| {
-            if !chunk.has_points() {
-                failed = Some(SourceError::ValuesWithoutPoints { path: name.clone(), format: "tsf" });
-                return ControlFlow::Break(());
+        let mut sink = |chunk: Tractogram| match lines.append_chunk(chunk, on) {
+            Ok(()) => ControlFlow::Continue(()),
+            Err(e) => {
+                failed = Some(e);
+                ControlFlow::Break(())
             }
-            let values = |field: Option<&str>| field.map(|f| vertex_field(&name, &chunk, f)).transpose();
-            let attributes = match (values(fields[0]), values(fields[1])) {
-                (Ok(scalar), Ok(radius)) => VertexAttributes { scalar, radius, octants: None },
-                (Err(e), _) | (_, Err(e)) => {
-                    failed = Some(e);
-                    return ControlFlow::Break(());
-                }
-            };
-            if let Err(source) = geometry.append_with(device, queue, &chunk.positions, &chunk.offsets, &attributes) {
-                failed = Some(SourceError::Gpu { name: name.clone(), source });
-                return ControlFlow::Break(());
-            }
-            append(&mut kept, chunk, keep);
-            ControlFlow::Continue(())
         };
         let streamed = source.stream(progress, &mut sink);
         if let Some(error) = failed {
             return Err(error);
         }
         let hint = streamed?;
-        geometry.finish(device, queue).map_err(gpu)?;
-        if geometry.bounds.is_none() {
-            return Err(SourceError::NoFinitePoints(name));
-        }
-        let hint = hint.unwrap_or_else(|| framing(&geometry));
+        lines.finish(hint, on)?;
+        Ok(lines)
+    }
+
+    /// Lines named `name` with nothing on the GPU yet, to [`Lines::append_chunk`] to: a source
+    /// streamed chunk by chunk (the viewer draws what has arrived between chunks), keeping on the
+    /// CPU what `keep` asks for.
+    pub fn empty(name: String, keep: &Keep, on: &lineao::Gpu) -> Result<Lines> {
+        let geometry = LineGeometry::empty(&on.device, geometry_options(on))
+            .map_err(|source| SourceError::Gpu { name: name.clone(), source })?;
         Ok(Lines {
             name,
-            tracts: kept,
+            tracts: Tractogram::new(),
             points_kept: keep.points,
-            hint,
+            keep: keep.clone(),
+            hint: ViewHint::for_sphere([0.0; 3], 1.0),
             geometry,
             volumes: VolumeCache::default(),
             held: AttributeKey { scalar: keep.scalar.clone(), radius: keep.radius.clone(), volume: None },
         })
+    }
+
+    /// Appends a chunk of whole streamlines: onto the GPU (with the attributes the lines hold),
+    /// and what the lines keep of it on the CPU. What has not filled a page yet is drawn after
+    /// [`LineGeometry::flush`].
+    pub fn append_chunk(&mut self, chunk: Tractogram, on: &lineao::Gpu) -> Result<()> {
+        if !chunk.has_points() {
+            return Err(SourceError::ValuesWithoutPoints { path: self.name.clone(), format: "tsf" });
+        }
+        let name = &self.name;
+        let values = |field: &Option<String>| field.as_deref().map(|f| vertex_field(name, &chunk, f)).transpose();
+        let attributes =
+            VertexAttributes { scalar: values(&self.held.scalar)?, radius: values(&self.held.radius)?, octants: None };
+        self.geometry
+            .append_with(&on.device, &on.queue, &chunk.positions, &chunk.offsets, &attributes)
+            .map_err(|source| SourceError::Gpu { name: name.clone(), source })?;
+        append(&mut self.tracts, chunk, &self.keep);
+        Ok(())
+    }
+
+    /// The end of a stream: the geometry flushed with its exact bounds, and the camera `hint`
+    /// suggests (else one framing the bounds). An error where no point was finite.
+    pub fn finish(&mut self, hint: Option<ViewHint>, on: &lineao::Gpu) -> Result<()> {
+        pollster::block_on(self.finish_async(hint, on))
+    }
+
+    /// [`Lines::finish`] as a future (a web page's device answers the bounds' readback only
+    /// once the page's event loop runs).
+    pub async fn finish_async(&mut self, hint: Option<ViewHint>, on: &lineao::Gpu) -> Result<()> {
+        let name = &self.name;
+        self.geometry
+            .finish_async(&on.device, &on.queue)
+            .await
+            .map_err(|source| SourceError::Gpu { name: name.clone(), source })?;
+        if self.geometry.bounds.is_none() {
+            return Err(SourceError::NoFinitePoints(name.clone()));
+        }
+        self.hint = hint.unwrap_or_else(|| framing(&self.geometry));
+        Ok(())
+    }
+
+    /// Whether the streamlines are kept on the CPU.
+    pub fn points_kept(&self) -> bool {
+        self.points_kept
+    }
+
+    /// Reads `source` (what these lines were streamed from) again for its points, which a
+    /// method that works on the CPU needs (object-space AO, the ray tracer's BVH).
+    pub fn load_points(&mut self, source: &Source) -> Result<()> {
+        if self.points_kept {
+            return Ok(());
+        }
+        let loaded = source.load(None)?;
+        (self.tracts.positions, self.tracts.offsets) = (loaded.tracts.positions, loaded.tracts.offsets);
+        self.tracts.streamline_fields = loaded.tracts.streamline_fields;
+        self.tracts.vertex_fields = loaded.tracts.vertex_fields;
+        self.points_kept = true;
+        Ok(())
     }
 
     /// The streamlines on the CPU, when the session kept them.
@@ -460,7 +593,8 @@ impl Lines {
         if wanted.is_empty() || self.held == *wanted {
             return Ok(());
         }
-        if !self.points_kept {
+        // Object-space AO works on the points; the fields are kept without them.
+        if wanted.volume.is_some() && !self.points_kept {
             return Err(SourceError::PointsNotKept(self.name.clone()));
         }
         let Lines { name, tracts, geometry, volumes, .. } = self;
@@ -505,8 +639,11 @@ fn append(kept: &mut Tractogram, chunk: Tractogram, keep: &Keep) {
     let base = kept.offsets.last().copied().unwrap_or(0);
     if kept.offsets.is_empty() {
         kept.offsets.push(0);
-        let wanted =
-            |f: &&Field| keep.points || [&keep.scalar, &keep.radius].iter().any(|k| k.as_deref() == Some(&*f.name));
+        let wanted = |f: &&Field| {
+            keep.points
+                || (keep.fields && f.columns == 1)
+                || [&keep.scalar, &keep.radius].iter().any(|k| k.as_deref() == Some(&*f.name))
+        };
         let empty = |f: &Field| Field { name: f.name.clone(), columns: f.columns, values: Vec::new() };
         kept.vertex_fields = chunk.vertex_fields.iter().filter(wanted).map(empty).collect();
         if keep.points {

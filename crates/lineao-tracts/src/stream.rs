@@ -49,6 +49,9 @@ pub struct Streamed {
 /// Where a chunk goes; `Break` stops the load (which then fails with [`ErrorKind::Cancelled`]).
 pub type ChunkSink<'a> = &'a mut dyn FnMut(Tractogram) -> ControlFlow<()>;
 
+/// A sink a [`ChunkDecoder`] owns (a decoder kept between pushes holds its own).
+type OwnedSink<'s> = Box<dyn FnMut(Tractogram) -> ControlFlow<()> + 's>;
+
 /// Bytes kept before the format is known (as many as detection looks at).
 const SNIFF: usize = 4096;
 /// The largest `.tck` header we wait for before giving up on its END line.
@@ -129,7 +132,7 @@ struct Chunker<'s> {
     streamlines: u64,
     vertices: u64,
     /// `None` once its decoder is finished.
-    sink: Option<ChunkSink<'s>>,
+    sink: Option<OwnedSink<'s>>,
     cancelled: bool,
     /// Empty fields of every chunk (trk scalars and properties, the tsf's values).
     vertex_fields: Vec<Field>,
@@ -137,7 +140,7 @@ struct Chunker<'s> {
 }
 
 impl<'s> Chunker<'s> {
-    fn new(chunk_vertices: usize, sink: Option<ChunkSink<'s>>) -> Chunker<'s> {
+    fn new(chunk_vertices: usize, sink: Option<OwnedSink<'s>>) -> Chunker<'s> {
         Chunker {
             chunk_vertices: chunk_vertices.max(1),
             current: Tractogram::new(),
@@ -233,7 +236,7 @@ impl<'s> ChunkDecoder<'s> {
         options: &LoadOptions,
         size_hint: Option<u64>,
         chunk_vertices: usize,
-        sink: ChunkSink<'s>,
+        sink: impl FnMut(Tractogram) -> ControlFlow<()> + 's,
     ) -> Self {
         let body = Body {
             received: 0,
@@ -241,7 +244,7 @@ impl<'s> ChunkDecoder<'s> {
             pending: Vec::new(),
             pending_at: 0,
             format: Decoding::Detecting,
-            chunk: Chunker::new(chunk_vertices, Some(sink)),
+            chunk: Chunker::new(chunk_vertices, Some(Box::new(sink))),
             error: None,
             name: name.to_string(),
             detected: None,
@@ -732,7 +735,7 @@ fn whole_in_chunks(
     sink: ChunkSink<'_>,
 ) -> Result<Streamed, Error> {
     let loaded = crate::load_with(path, options, progress)?;
-    let mut chunker = Chunker::new(chunk_vertices, Some(sink));
+    let mut chunker = Chunker::new(chunk_vertices, Some(Box::new(sink)));
     chunker.split(&loaded.tractogram);
     if chunker.cancelled {
         return Err(ErrorKind::Cancelled.at(path));
