@@ -95,9 +95,20 @@ pub struct App {
     orbit: Option<[f32; 3]>,
     pub dataset: Option<Dataset>,
     loading: Option<Loading>,
+    /// The camera that framed a dataset while it arrived: framed again once all of it has,
+    /// unless moved since.
+    framed: Option<OrbitCamera>,
+    /// Milliseconds from opening the dataset to its first part on the GPU.
+    pub first_picture: Option<f64>,
+    /// When the dataset was asked for, and how long until its first picture was on screen.
+    opened_at: Option<Instant>,
+    pub first_frame_ms: Option<f64>,
     /// What the render thread is busy with besides rendering (object-space AO).
     busy: Option<String>,
     pub error: Option<String>,
+    /// The error is the dataset's (its file ended in an error): it stays while the camera moves
+    /// over what was drawn, where a frame's error goes with the next view.
+    load_failed: bool,
     /// The last view sent to the render thread, and the frame on screen.
     pub requested: Option<View>,
     pub shown: Option<Box<Frame>>,
@@ -160,8 +171,13 @@ impl App {
             orbit: options.orbit,
             dataset: None,
             loading: None,
+            framed: None,
+            first_picture: None,
+            opened_at: None,
+            first_frame_ms: None,
             busy: None,
             error: None,
+            load_failed: false,
             requested: None,
             shown: None,
             frames_received: 0,
@@ -209,6 +225,7 @@ impl App {
     pub fn show_loading(&mut self, name: &str, bytes: u64, total: Option<u64>) {
         if self.loading.as_ref().is_none_or(|l| l.name != name) {
             (self.dataset, self.shown, self.requested, self.error, self.busy) = (None, None, None, None, None);
+            self.load_failed = false;
         }
         self.loading = Some(Loading { name: name.to_string(), bytes, total });
     }
@@ -217,11 +234,13 @@ impl App {
     pub fn load(&mut self, source: Source) {
         let name = match &source {
             Source::Scene { kind, .. } => format!("scene {}", kind.name()),
-            Source::File(path) => path.display().to_string(),
-            Source::Bytes { name, .. } => name.clone(),
+            source => source.name(),
         };
         self.loading = Some(Loading { name, bytes: 0, total: None });
         (self.dataset, self.shown, self.requested, self.error, self.busy) = (None, None, None, None, None);
+        self.load_failed = false;
+        (self.camera, self.framed, self.first_picture, self.first_frame_ms) = (None, None, None, None);
+        self.opened_at = Some(Instant::now());
         self.send(ToWorker::Load(source));
     }
 
@@ -284,11 +303,13 @@ impl App {
             && self.shown.as_ref().map(|f| &f.view) == self.requested.as_ref()
     }
 
-    /// Shows `message` as a failure (and ends a load in progress).
+    /// Shows `message` as a failure (and ends a load in progress; what it drew stays on screen).
     pub fn fail(&mut self, message: String) {
-        if self.loading.take().is_some() {
+        let loading = self.loading.take().is_some();
+        if loading && self.shown.is_none() {
             (self.dataset, self.shown) = (None, None);
         }
+        self.load_failed |= loading;
         self.busy = None;
         self.outcome.lock().expect("not poisoned").error = Some(message.clone());
         self.error = Some(message);
@@ -303,13 +324,36 @@ impl App {
                     }
                 }
                 FromWorker::Loaded(dataset) => {
-                    self.loading = None;
-                    let mut camera = OrbitCamera::from_hint(&dataset.hint);
-                    camera.orthographic = self.orthographic;
-                    if let Some(orbit) = self.orbit {
-                        camera.set_orbit_values(orbit);
+                    if dataset.complete {
+                        self.loading = None;
                     }
-                    self.camera = Some(camera);
+                    // The camera frames what has arrived, and again all of it once it is there
+                    // unless it was moved meanwhile.
+                    let reframe = match (&self.camera, &self.framed) {
+                        (None, _) => true,
+                        (Some(camera), Some(framed)) => camera == framed,
+                        (Some(_), None) => false,
+                    };
+                    if reframe {
+                        let mut camera = OrbitCamera::from_hint(&dataset.hint);
+                        camera.orthographic = self.orthographic;
+                        if let Some(orbit) = self.orbit {
+                            camera.set_orbit_values(orbit);
+                        }
+                        self.framed = (!dataset.complete).then_some(camera);
+                        self.camera = Some(camera);
+                    }
+                    if self.dataset.is_none() || !dataset.complete {
+                        self.first_picture.get_or_insert(dataset.first_ms);
+                    }
+                    if dataset.complete {
+                        let first = self.first_frame_ms.map_or("none yet".into(), |ms| format!("{ms:.0} ms"));
+                        eprintln!(
+                            "lineao: view: {}: {} vertices; the first on the GPU after {:.0} ms, the first picture \
+                             after {first}, all on the GPU after {:.0} ms",
+                            dataset.name, dataset.vertices, dataset.first_ms, dataset.load_ms
+                        );
+                    }
                     self.controls.set_zoom_unit(dataset.hint.zoom_unit);
                     if let ColorMode::Field(name) = &self.controls.color
                         && !dataset.fields.iter().any(|(f, _)| f == name)
@@ -318,8 +362,11 @@ impl App {
                     }
                     self.dataset = Some(dataset);
                 }
-                FromWorker::Frame(frame) if self.loading.is_none() => {
+                FromWorker::Frame(frame) if self.dataset.is_some() => {
                     self.busy = None;
+                    if self.first_frame_ms.is_none() {
+                        self.first_frame_ms = self.opened_at.map(|t| t.elapsed().as_secs_f64() * 1e3);
+                    }
                     self.frames_received += 1;
                     if let Backend::Inline { render_state, ids, .. } = &mut self.backend {
                         let mut renderer = render_state.renderer.write();
@@ -387,7 +434,9 @@ impl App {
         let size = ((rect.width() * ppp).round().max(1.0) as u32, (rect.height() * ppp).round().max(1.0) as u32);
         let Some(view) = self.view(size) else { return };
         if self.requested.as_ref() != Some(&view) {
-            self.error = None;
+            if !self.load_failed {
+                self.error = None;
+            }
             self.requested = Some(view.clone());
             self.send(ToWorker::Render(view));
         }

@@ -13,6 +13,7 @@
 pub mod app;
 pub mod camera;
 pub mod controls;
+mod loading;
 #[cfg(test)]
 mod tests;
 pub mod worker;

@@ -232,6 +232,23 @@ fn a_real_file_opens_and_a_bad_one_says_why() {
     assert!(harness.state().dataset.is_none() && harness.state().shown.is_none());
     harness.get_by_label(&error);
 
+    // A large file cut short in its data: drawn as it arrives, then the error naming the file
+    // and its byte beside what was drawn, which stays (and answers the camera).
+    let brain = lineao_tracts::scenes::wholebrain::WholeBrain::new(1, 4_000_000);
+    let whole = dir.join("whole.tck");
+    lineao_tracts::save(&brain.tractogram(0..brain.streamlines()), &whole).unwrap();
+    let bytes = std::fs::read(&whole).unwrap();
+    let cut = dir.join("cut.tck");
+    std::fs::write(&cut, &bytes[..bytes.len() * 9 / 10 + 5]).unwrap();
+    harness.state_mut().load(Source::File(cut.clone()));
+    settle(&mut harness);
+    let app = harness.state();
+    let error = app.error.clone().expect("an error");
+    assert!(error.contains("cut.tck") && error.contains("at byte"), "{error}");
+    let dataset = app.dataset.as_ref().expect("what arrived before the error");
+    assert!(dataset.vertices > 1_000_000 && !dataset.complete, "{} vertices", dataset.vertices);
+    assert!(non_background(&app.shown.as_ref().expect("a frame").images[0]) > 0.05);
+
     // Dropping a good file onto the window opens it.
     #[derive(Debug)]
     struct Dropped(PathBuf);

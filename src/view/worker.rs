@@ -3,7 +3,10 @@
 //! long LineAO submission would hold up every window frame behind it. Here the window keeps
 //! drawing and answering input while frames render; finished frames come back as RGBA images.
 //!
-//! Requests are coalesced: only the newest view is rendered, and a load drops pending renders.
+//! Requests are coalesced: only the newest view is rendered. A load opens its source as it
+//! arrives ([`super::loading`]): each step reads and uploads a little, and the newest view is
+//! drawn again whenever more of the data is on the GPU, so the first picture comes within a
+//! second whatever the file's size and the window stays interactive.
 //! While the camera moves the app asks for *preview* frames: every k-th streamline (at most
 //! [`PREVIEW_VERTICES`] vertices) at half resolution — visibly coarser, and replaced by the full
 //! frame as soon as the camera rests.
@@ -24,14 +27,14 @@ use std::sync::Arc;
 use std::sync::mpsc::{Receiver, Sender, TryRecvError};
 
 use lineao::Camera;
-use lineao::LineGeometry;
 use lineao::method::raytraced::RayProgress;
 use lineao::passes::lines::VertexAttributes;
 use lineao::timing::PassTime;
 use lineao::volume::VolumeAoOptions;
 use lineao::{AoChain, AoMethod, ChainSettings, Gpu, LineColor, RayScene};
-use lineao_tracts::{Tractogram, ViewHint};
+use lineao_tracts::ViewHint;
 
+use super::loading::{Opening, Preview, Step};
 pub use crate::source::Source;
 use crate::source::{AttributeKey, Lines, submit_frame};
 
@@ -64,18 +67,24 @@ pub enum ToWorker {
     Render(View),
 }
 
-/// What the app learns about a loaded dataset.
+/// What the app learns about a loaded dataset: first when part of it is on screen, then when
+/// all of it is (`complete`).
 #[derive(Clone, Debug)]
 pub struct Dataset {
     pub name: String,
     pub streamlines: usize,
     pub vertices: usize,
+    /// Whether the whole dataset is loaded (else what has arrived).
+    pub complete: bool,
+    /// Whether its source can be read again for the points (a file read as it arrived past
+    /// what its page keeps cannot: the methods that work on the CPU are then unavailable).
+    pub readable: bool,
     pub hint: ViewHint,
     /// One-column per-vertex fields, with their 2nd–98th percentile ranges.
     pub fields: Vec<(String, [f32; 2])>,
-    /// Milliseconds to parse the file (or build the scene), and to put it on the GPU.
+    /// Milliseconds to the first picture's data on the GPU, and to all of it.
+    pub first_ms: f64,
     pub load_ms: f64,
-    pub upload_ms: f64,
 }
 
 /// Where a worker's frames go.
@@ -140,9 +149,11 @@ pub enum FromWorker {
 struct Scene {
     /// Full detail, with its attributes and object-space AO.
     lines: Lines,
-    preview: Option<Preview>,
+    preview: Preview,
     /// The ray tracer's scene of the full detail, built when a panel first traces rays.
     rays: Option<Arc<RayScene>>,
+    /// Where the lines came from: read again for their points where a method needs them.
+    source: Source,
 }
 
 /// A panel's chain, the ray scene it was given (its generation) and its geometry pixels.
@@ -153,13 +164,6 @@ struct PanelChain {
     geometry_pixels: usize,
 }
 
-/// Every k-th streamline: its geometry, and which full-detail vertices it keeps.
-struct Preview {
-    geometry: LineGeometry,
-    kept: Vec<usize>,
-    attributes: AttributeKey,
-}
-
 /// The renderer behind the viewer: the loaded dataset on the GPU, a chain per panel, and the
 /// picture in progress. The native app runs it on its render thread ([`run`]); the web page
 /// steps it on its own thread.
@@ -167,6 +171,12 @@ pub struct Worker {
     gpu: Gpu,
     output: Output,
     scene: Option<Scene>,
+    /// A dataset being opened, drawn as it arrives.
+    opening: Option<Opening>,
+    /// Whether the app was told of the dataset being opened.
+    announced: bool,
+    /// The newest view asked for, drawn again as more of a dataset arrives.
+    last_view: Option<View>,
     chains: Vec<PanelChain>,
     /// [`Output::Textures`]: each panel's texture.
     textures: Vec<lineao::targets::Target>,
@@ -192,17 +202,28 @@ pub const TIMED_REPEATS: u32 = 3;
 
 impl Worker {
     pub fn new(gpu: Gpu, output: Output) -> Worker {
-        Worker { gpu, output, scene: None, chains: Vec::new(), textures: Vec::new(), continuing: None, timing: None }
+        Worker {
+            gpu,
+            output,
+            scene: None,
+            opening: None,
+            announced: false,
+            last_view: None,
+            chains: Vec::new(),
+            textures: Vec::new(),
+            continuing: None,
+            timing: None,
+        }
     }
 
     pub fn gpu(&self) -> &Gpu {
         &self.gpu
     }
 
-    /// Whether a picture is still accumulating, or a frame's times are awaited (so a step has
-    /// work without commands).
+    /// Whether a picture is still accumulating, a dataset still arriving, or a frame's times
+    /// are awaited (so a step has work without commands).
     pub fn continuing(&self) -> bool {
-        self.continuing.is_some() || self.timing.is_some()
+        self.continuing.is_some() || self.timing.is_some() || self.opening.is_some()
     }
 
     /// Reads the awaited frame's times without waiting; `true` once every panel's are in (or
@@ -240,7 +261,7 @@ impl Worker {
     pub async fn step_async(&mut self, mut pending: Vec<ToWorker>, send: &dyn Fn(FromWorker)) {
         // Nothing asked: the awaited times, then (a few times) the same view again.
         let mut repeats = 0;
-        if pending.is_empty() && self.continuing.is_none() {
+        if pending.is_empty() && self.continuing.is_none() && self.opening.is_none() {
             if !self.poll_times() {
                 return;
             }
@@ -258,30 +279,97 @@ impl Worker {
             pending.iter().rposition(|c| matches!(c, ToWorker::Render(_))).filter(|&r| last_load.is_none_or(|l| r > l));
         if let Some(l) = last_load {
             let ToWorker::Load(source) = &pending[l] else { unreachable!() };
-            (self.scene, self.continuing) = (None, None);
+            (self.scene, self.continuing, self.opening, self.announced) = (None, None, None, false);
             for panel in &mut self.chains {
                 // The old dataset's BVH is freed now, not when the next one replaces it.
                 panel.chain.set_ray_scene(&gpu.device, None);
                 panel.scene = None;
             }
-            match load(gpu, source, send) {
-                Ok((loaded, dataset)) => {
-                    self.scene = Some(loaded);
-                    send(FromWorker::Loaded(dataset));
-                }
+            match Opening::start(source.clone(), gpu) {
+                Ok(opening) => self.opening = Some(opening),
                 Err(e) => send(FromWorker::Error(e)),
+            }
+        }
+        // A dataset arriving: a step of reading, and once part of it is on the GPU, the newest
+        // view drawn again.
+        let mut more = false;
+        if let Some(opening) = &mut self.opening {
+            send(FromWorker::Progress { bytes: opening.progress.0, total: opening.progress.1 });
+            // The GPU's memory is the limit of what arrives: a page's device says so only to an
+            // error scope, which it answers once the page's event loop runs.
+            let scope = gpu.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+            let stepped = match opening.step(gpu) {
+                Ok(Step::Read) => opening.finish(gpu).await.map(|()| Step::Read),
+                other => other,
+            };
+            let stepped = match scope.pop().await {
+                None => stepped,
+                Some(error) => Err(format!(
+                    "{}: the GPU's memory is full after {} points ({} MB of lines on the GPU): {error}",
+                    opening.lines.name,
+                    opening.lines.geometry.vertices,
+                    opening.lines.geometry.gpu_bytes() >> 20
+                )),
+            };
+            match stepped {
+                Ok(Step::Reading { drawn }) => {
+                    if drawn && !self.announced {
+                        self.announced = true;
+                        send(FromWorker::Loaded(dataset(&opening.lines, opening, false)));
+                    }
+                    more = drawn;
+                }
+                Ok(Step::Read) => {
+                    let opening = self.opening.take().expect("opening");
+                    send(FromWorker::Loaded(dataset(&opening.lines, &opening, true)));
+                    let (lines, preview, source) = opening.into_parts();
+                    self.scene = Some(Scene { lines, preview, rays: None, source });
+                    more = true;
+                }
+                Err(e) => {
+                    // What was drawn before the error stays (the file's error is shown beside it).
+                    let mut opening = self.opening.take().expect("opening");
+                    if opening.drawn() {
+                        // All that arrived goes on screen, and the counts are its counts (a
+                        // flush that fails, the GPU's memory full, leaves what was drawn).
+                        let _ = opening.flush(gpu);
+                        send(FromWorker::Loaded(dataset(&opening.lines, &opening, false)));
+                        let (lines, preview, source) = opening.into_parts();
+                        self.scene = Some(Scene { lines, preview, rays: None, source });
+                    }
+                    send(FromWorker::Error(e));
+                }
             }
         }
         let view = match render {
             Some(r) => {
                 let ToWorker::Render(view) = pending.swap_remove(r) else { unreachable!() };
                 self.timing = None;
+                self.last_view = Some(view.clone());
                 Some(view)
             }
+            None if pending.is_empty() && more => self.last_view.clone(),
             None if pending.is_empty() => self.continuing.take(),
             None => None,
         };
-        if let (Some(view), Some(scene)) = (view, self.scene.as_mut()) {
+        // While a dataset arrives its frames are previews (every k-th streamline of what has
+        // arrived, at half resolution): a frame of all of it would cost more than reading it.
+        let view = match (view, self.opening.is_some()) {
+            (Some(view), true) => Some(View { preview: true, ..view }),
+            (view, _) => view,
+        };
+        let scene = match (&mut self.scene, &mut self.opening) {
+            (Some(scene), _) => Some(SceneRef {
+                lines: &mut scene.lines,
+                preview: &mut scene.preview,
+                rays: &mut scene.rays,
+                source: &scene.source,
+                opening: false,
+            }),
+            (None, Some(opening)) if opening.drawn() => Some(opening.scene()),
+            _ => None,
+        };
+        if let (Some(view), Some(scene)) = (view, scene) {
             self.continuing = None;
             let outputs = (self.output, &mut self.textures);
             match render_frame(gpu, scene, &mut self.chains, outputs, &view, send).await {
@@ -338,16 +426,8 @@ pub fn run(rx: Receiver<ToWorker>, tx: Sender<FromWorker>, repaint: impl Fn() + 
     }
 }
 
-fn load(gpu: &Gpu, source: &Source, send: &dyn Fn(FromWorker)) -> Result<(Scene, Dataset), String> {
-    let mut report = |p: lineao_tracts::Progress| {
-        send(FromWorker::Progress { bytes: p.bytes, total: p.total });
-        std::ops::ControlFlow::Continue(())
-    };
-    let start = web_time::Instant::now();
-    let loaded = source.load(Some(&mut report)).map_err(|e| format!("{e:#}"))?;
-    let load_ms = start.elapsed().as_secs_f64() * 1e3;
-    let lines = Lines::new(loaded, gpu).map_err(|e| format!("{e:#}"))?;
-    let upload_ms = start.elapsed().as_secs_f64() * 1e3 - load_ms;
+/// What the app is told of `lines`, being opened (`complete`: all of it is on the GPU).
+fn dataset(lines: &Lines, opening: &Opening, complete: bool) -> Dataset {
     let fields = lines
         .tracts
         .vertex_fields
@@ -356,27 +436,41 @@ fn load(gpu: &Gpu, source: &Source, send: &dyn Fn(FromWorker)) -> Result<(Scene,
         .map(|f| (f.name.clone(), crate::render::percentile_range(&f.values)))
         .collect();
     let (streamlines, vertices) = (lines.geometry.streamlines, lines.geometry.vertices);
-    let dataset =
-        Dataset { name: lines.name.clone(), streamlines, vertices, hint: lines.hint, fields, load_ms, upload_ms };
-    let scene = Scene { lines, preview: None, rays: None };
-    Ok((scene, dataset))
+    // While the data arrives, a camera that frames what has arrived.
+    let hint = match complete {
+        true => lines.hint,
+        false => {
+            let bounds = lines.geometry.bounds.expect("part of it is on the GPU");
+            ViewHint::for_sphere(bounds.center.to_array(), bounds.radius)
+        }
+    };
+    let elapsed = opening.started.elapsed().as_secs_f64() * 1e3;
+    Dataset {
+        name: lines.name.clone(),
+        streamlines,
+        vertices,
+        complete,
+        readable: opening.held,
+        hint,
+        fields,
+        first_ms: opening.first_ms().unwrap_or(elapsed),
+        load_ms: elapsed,
+    }
 }
 
-/// Every `k`-th streamline of `tracts`, with the indices of the vertices kept.
-fn subset(tracts: &Tractogram, k: usize) -> (Vec<[f32; 3]>, Vec<u64>, Vec<usize>) {
-    let (mut positions, mut offsets, mut kept) = (Vec::new(), vec![0u64], Vec::new());
-    for range in tracts.offsets.windows(2).step_by(k) {
-        let (a, b) = (range[0] as usize, range[1] as usize);
-        positions.extend_from_slice(&tracts.positions[a..b]);
-        kept.extend(a..b);
-        offsets.push(positions.len() as u64);
-    }
-    (positions, offsets, kept)
+/// The parts of a scene a frame reads: the loaded one's, or those of one being opened.
+pub(super) struct SceneRef<'a> {
+    pub lines: &'a mut Lines,
+    pub preview: &'a mut Preview,
+    pub rays: &'a mut Option<Arc<RayScene>>,
+    pub source: &'a Source,
+    /// Still arriving: what needs every point on the CPU waits until it is all there.
+    pub opening: bool,
 }
 
 async fn render_frame(
     gpu: &Gpu,
-    scene: &mut Scene,
+    mut scene: SceneRef<'_>,
     chains: &mut Vec<PanelChain>,
     (output, textures): (Output, &mut Vec<lineao::targets::Target>),
     view: &View,
@@ -386,12 +480,6 @@ async fn render_frame(
     let (d, q) = (&gpu.device, &gpu.queue);
     let preview = view.preview && scene.lines.geometry.vertices > PREVIEW_VERTICES;
     let size = if preview { ((view.size.0 / 2).max(1), (view.size.1 / 2).max(1)) } else { view.size };
-    if preview && scene.preview.is_none() {
-        let k = scene.lines.geometry.vertices.div_ceil(PREVIEW_VERTICES);
-        let (positions, offsets, kept) = subset(&scene.lines.tracts, k);
-        let geometry = LineGeometry::new(d, q, &positions, &offsets).map_err(|e| e.to_string())?;
-        scene.preview = Some(Preview { geometry, kept, attributes: AttributeKey::default() });
-    }
     let bounds = scene.lines.geometry.bounds.expect("checked at load");
     let format = wgpu::TextureFormat::Rgba8UnormSrgb;
     let readback = output == Output::Readback;
@@ -411,8 +499,27 @@ async fn render_frame(
     let (mut images, mut views, mut times, mut rays) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     for (i, panel) in view.panels.iter().enumerate() {
         let panel_start = web_time::Instant::now();
+        let mut settings = panel.settings.clone();
+        // What works on the CPU needs every point there: read again once all has arrived (while
+        // it arrives, such a panel shows the lines alone).
+        let cpu = panel.volume.is_some() || settings.method == AoMethod::RayTraced;
+        let volume = match (cpu, scene.opening) {
+            (true, true) => {
+                settings.method = AoMethod::None;
+                settings.volume = None;
+                None
+            }
+            (true, false) => {
+                if !scene.lines.points_kept() {
+                    send(FromWorker::Busy(format!("reading {} again for its points …", scene.lines.name)));
+                    scene.lines.load_points(scene.source).map_err(|e| format!("{e:#}"))?;
+                }
+                panel.volume.clone()
+            }
+            (false, _) => None,
+        };
         // The geometry's attributes this panel needs: the scalar's field and object-space AO.
-        let wanted = AttributeKey { scalar: view.scalar_field.clone(), radius: None, volume: panel.volume.clone() };
+        let wanted = AttributeKey { scalar: view.scalar_field.clone(), radius: None, volume };
         let busy = || {
             if let Some(options) = &wanted.volume {
                 send(FromWorker::Busy(format!("computing {} …", options.method.name())));
@@ -423,7 +530,7 @@ async fn render_frame(
         // into the settings, its octants into the attributes below.
         let sky = scene.lines.visibility(&wanted, busy).map_err(error)?.map(|v| v.sky);
         let geometry = if preview {
-            let p = scene.preview.as_mut().expect("made above");
+            let p = &mut *scene.preview;
             if p.attributes != wanted && (wanted.scalar.is_some() || wanted.volume.is_some()) {
                 let lines = &mut scene.lines;
                 let scalars = match &wanted.scalar {
@@ -444,7 +551,6 @@ async fn render_frame(
             scene.lines.hold((d, q), &wanted, || {}).map_err(error)?;
             &scene.lines.geometry
         };
-        let mut settings = panel.settings.clone();
         if let (Some(sky), Some(volume)) = (sky, &mut settings.volume) {
             volume.sky = sky;
         }
@@ -473,7 +579,7 @@ async fn render_frame(
                     };
                     let rays = lineao::RayScene::new(d, q, &geometry).map_err(|e| e.to_string())?;
                     let rays = Arc::new(rays);
-                    scene.rays.insert(rays).clone()
+                    scene.rays.get_or_insert(rays).clone()
                 }
             };
             let panel = &mut chains[i];
