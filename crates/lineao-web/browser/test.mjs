@@ -4,14 +4,14 @@
 //   OUT/<case>/<panel>/  the frame read back (lineao-web-check compares it with the CPU reference)
 //   OUT/results.json     statuses, counts and times;  OUT/*.png  screenshots.
 //
-// usage: node test.mjs BASE_URL OUT LINEAO_BIN DATA_DIR
+// usage: node test.mjs BASE_URL OUT LINEAO_BIN DATA_DIR WHOLE_BRAIN_TCK (served as wholebrain.tck)
 import { chromium } from 'playwright-core';
 import { execFileSync } from 'node:child_process';
 import fs from 'node:fs';
 import path from 'node:path';
 import assert from 'node:assert/strict';
 
-const [base, out, lineao, data] = process.argv.slice(2);
+const [base, out, lineao, data, WHOLE_BRAIN] = process.argv.slice(2);
 const STROKE = 'niivue+niivue/packages/niivue/demos/images/stroke.trk.gz';
 const SMALL = 'niivue+niivue/packages/niivue/demos/images/tract.SLF1_R.tck';
 const results = {};
@@ -93,6 +93,8 @@ async function drop(name, bytes) {
 }
 
 async function check(name, fn) {
+  // LINEAO_WEB_ONLY=text: only the checks whose name holds it (while working on one).
+  if (process.env.LINEAO_WEB_ONLY && !name.includes(process.env.LINEAO_WEB_ONLY)) return;
   const start = Date.now();
   try {
     await fn();
@@ -183,14 +185,43 @@ await check('a file dropped on the page opens; a bad one is an error, and the pa
   assert.equal(status.vertices, info(STROKE).vertices);
 });
 
-await check('a URL that fails: the HTTP status; a file over the limit: refused by its size', async () => {
+await check('a file arrives in pieces: drawn while it loads, kept by the page only up to hold=', async () => {
+  // A whole brain of 2 M points (23 MB) written by `lineao convert --scene wholebrain`; the page
+  // keeps at most 1 MiB of it (hold=1): it is decoded and drawn as it arrives, as a file over
+  // the page's memory would be, and nothing of it is held.
+  const expected = JSON.parse(execFileSync(lineao, ['info', '--json', WHOLE_BRAIN], { encoding: 'utf8' }));
+  const start = Date.now();
+  await page.goto(`${base}/?url=wholebrain.tck&hold=1`);
+  let drawnWhileLoading = false;
+  let status;
+  const seen = [];
+  for (;;) {
+    if (crashes.length) throw new Error(`the page crashed: ${crashes.join('; ')}`);
+    status = await page.evaluate(() => window.lineaoStatus);
+    const key = status && `${status.state} complete=${status.complete} frames=${status.frames}`;
+    if (key && !seen.at(-1)?.endsWith(key)) seen.push(`${Date.now() - start} ms: ${key}`);
+    if (status && status.complete === false && status.frames > 0) drawnWhileLoading = true;
+    if (status && ['ready', 'error'].includes(status.state)) break;
+    if (Date.now() - start > 600_000) throw new Error(`still ${JSON.stringify(status)}`);
+    await new Promise((r) => setTimeout(r, 100));
+  }
+  assert.equal(status.state, 'ready', status.message);
+  assert.equal(status.streamlines, expected.streamlines);
+  assert.equal(status.vertices, expected.vertices);
+  assert.equal(status.complete, true);
+  assert.equal(status.readable, false, 'a file past hold= is not kept');
+  assert.ok(drawnWhileLoading, `frames were drawn before the file had all arrived: ${seen.join('; ')}`);
+  results.streamed = { status, ms: Date.now() - start };
+});
+
+await check('a URL that fails: the HTTP status; a file read whole over the limit: refused by its size', async () => {
   let { status } = await open('?url=data/no-such-file.trk');
   assert.equal(status.state, 'error');
   assert.match(status.message, /HTTP 404/, status.message);
   results.missing = status.message;
-  ({ status } = await open('?url=too-large.trk'));
+  ({ status } = await open('?url=too-large.trx'));
   assert.equal(status.state, 'error');
-  assert.match(status.message, /too-large\.trk: \d+ MiB is more than this page can hold/, status.message);
+  assert.match(status.message, /too-large\.trx: \d+ MiB is more than this page can hold/, status.message);
   results.tooLarge = status.message;
   ({ status } = await open('?method=lineoa'));
   assert.equal(status.state, 'error');

@@ -4,8 +4,9 @@
 //!
 //! - [`query`]: the page's URL as `lineao view`'s options (`?url=`, `?scene=`, methods,
 //!   preset, camera), and the link of a view.
-//! - `page` (wasm32 only): the runner; files dropped, picked or fetched with progress and a
-//!   size limit; `window.lineaoStatus`; the AO and ND maps read back for tests.
+//! - `page` (wasm32 only): the runner; files dropped, picked or fetched and drawn as they
+//!   arrive (a size limit only for the formats read whole); `window.lineaoStatus`; the AO and
+//!   ND maps read back for tests.
 //! - [`check`]: natively, a page's read-back maps against lineao's CPU reference.
 //!
 //! `scripts/web.sh` builds the bundle (`target/web/`) and serves it; `scripts/test-web.sh`
@@ -16,13 +17,24 @@ pub mod check;
 mod page;
 pub mod query;
 
-/// The largest file the page reads: a page's WebAssembly memory is at most 4 GiB, and a file's
-/// points need about as much again as its bytes (decompressed, parsed and staged for the GPU).
+/// The largest file of a format read whole (TRX, VTK, VTP, DSI Studio, glTF, OBJ) the page
+/// reads: a page's WebAssembly memory is at most 4 GiB, and such a file's points need about as
+/// much again as its bytes. A .tck, .tsf or .trk (gzip or not) is decoded as it arrives and
+/// has no such limit (the page keeps at most this much of it, to read it again). Also the
+/// default of the URL's `hold`.
 pub const MAX_FILE_BYTES: u64 = 1 << 30;
 
-/// The refusal of a file of `bytes` bytes, before anything is allocated for it.
+/// Whether the page decodes a file named `name` as it arrives (by its extension, `.gz` aside).
+pub fn streamed(name: &str) -> bool {
+    let name = name.to_ascii_lowercase();
+    let name = name.strip_suffix(".gz").unwrap_or(&name);
+    [".tck", ".tsf", ".trk"].iter().any(|ext| name.ends_with(ext))
+}
+
+/// The refusal of a file of `bytes` bytes, before anything is allocated for it: a format read
+/// whole, over [`MAX_FILE_BYTES`].
 pub fn too_large(name: &str, bytes: u64) -> Option<String> {
-    (bytes > MAX_FILE_BYTES).then(|| {
+    (bytes > MAX_FILE_BYTES && !streamed(name)).then(|| {
         let mib = |b: u64| b as f64 / (1 << 20) as f64;
         format!(
             "{name}: {:.0} MiB is more than this page can hold (at most {:.0} MiB a file): open it with `lineao view`",
@@ -36,8 +48,12 @@ pub fn too_large(name: &str, bytes: u64) -> Option<String> {
 mod tests {
     #[test]
     fn files_over_the_limit_are_refused_by_size() {
-        assert_eq!(super::too_large("a.trk", super::MAX_FILE_BYTES), None);
-        let message = super::too_large("big.trk", 3 << 30).unwrap();
-        assert!(message.contains("big.trk: 3072 MiB") && message.contains("at most 1024 MiB"), "{message}");
+        assert_eq!(super::too_large("a.trx", super::MAX_FILE_BYTES), None);
+        let message = super::too_large("big.trx", 3 << 30).unwrap();
+        assert!(message.contains("big.trx: 3072 MiB") && message.contains("at most 1024 MiB"), "{message}");
+        // What is decoded as it arrives has no limit.
+        for name in ["big.trk", "big.tck.gz", "big.TSF"] {
+            assert_eq!(super::too_large(name, 3 << 30), None, "{name}");
+        }
     }
 }

@@ -1,8 +1,10 @@
 //! The page: eframe's web runner on WebGPU running the native viewer's [`App`] with its worker
-//! on this thread ([`App::inline`]); files from a drop, the file input or `?url=`, read in
-//! chunks with progress and refused by size before anything is allocated; `window.lineaoStatus`
-//! and [`readback`] for tests. `web/index.html` loads it and says what to do where WebGPU is
-//! missing.
+//! on this thread ([`App::inline`]); files from a drop, the file input or `?url=`, handed to the
+//! worker piece by piece as they are read ([`Source::Feed`]): a .tck, .tsf or .trk (gzip or
+//! not) is decoded and drawn as it arrives, whatever its size — the GPU's memory is the limit —
+//! while the formats read whole are refused by size before anything is allocated;
+//! `window.lineaoStatus` and [`readback`] for tests. `web/index.html` loads it and says what to
+//! do where WebGPU is missing.
 
 use std::cell::RefCell;
 use std::sync::{Arc, OnceLock};
@@ -11,7 +13,7 @@ use eframe::egui_wgpu::{WgpuSetup, WgpuSetupCreateNew};
 use js_sys::{Array, Float32Array, Object, Promise, Reflect, Uint8Array};
 use lineao::method::ssao::SsaoStage;
 use lineao::readback::TextureData;
-use lineao_cli::source::Source;
+use lineao_cli::source::{SharedFeed, Source};
 use lineao_cli::view::App;
 use wasm_bindgen::JsCast;
 use wasm_bindgen::prelude::*;
@@ -20,17 +22,41 @@ use wasm_bindgen_futures::JsFuture;
 use crate::check::Meta;
 use crate::query::{self, LinkSource};
 
-/// What arrives from outside the UI frame: files read by futures, tests' requests.
+/// What arrives from outside the UI frame: files being read by futures, tests' requests.
 enum Inbound {
-    Progress { name: String, bytes: u64, total: Option<u64> },
-    Loaded { name: String, bytes: Arc<[u8]>, from_url: bool },
+    Progress {
+        name: String,
+        bytes: u64,
+        total: Option<u64>,
+    },
+    /// A file whose pieces its reader pushes into `feed`.
+    Open {
+        name: String,
+        feed: SharedFeed,
+        from_url: bool,
+    },
     Failed(String),
-    Readback { panel: usize, resolve: js_sys::Function, reject: js_sys::Function },
+    Readback {
+        panel: usize,
+        resolve: js_sys::Function,
+        reject: js_sys::Function,
+    },
 }
 
 thread_local! {
     static INBOX: RefCell<Vec<Inbound>> = const { RefCell::new(Vec::new()) };
     static CONTEXT: RefCell<Option<egui::Context>> = const { RefCell::new(None) };
+    /// The most bytes of a file the page keeps to read it again (the URL's `hold`).
+    static HOLD_BYTES: std::cell::Cell<u64> = const { std::cell::Cell::new(crate::MAX_FILE_BYTES) };
+}
+
+/// Asks the UI for a frame (a piece of a file arrived).
+fn repaint() {
+    CONTEXT.with(|ctx| {
+        if let Some(ctx) = &*ctx.borrow() {
+            ctx.request_repaint();
+        }
+    });
 }
 
 fn post(message: Inbound) {
@@ -63,13 +89,13 @@ pub async fn start(canvas_id: String, adapter: String) -> Result<(), JsValue> {
         .ok_or_else(|| format!("no canvas '{canvas_id}'"))?;
     let page = query::parse(&window.location().search()?).map_err(|e| JsValue::from(js_sys::Error::new(&e)))?;
     let mut options = lineao_cli::view::options(&page.view);
+    HOLD_BYTES.with(|h| h.set(page.hold_bytes));
     if let Some(url) = &page.url {
         options.source = None;
         let url = url.clone();
         wasm_bindgen_futures::spawn_local(async move {
-            match fetch(&url).await {
-                Ok(bytes) => post(Inbound::Loaded { name: url, bytes, from_url: true }),
-                Err(e) => post(Inbound::Failed(e)),
+            if let Err(e) = fetch(&url).await {
+                post(Inbound::Failed(e));
             }
         });
     }
@@ -127,11 +153,10 @@ pub fn open_file(file: web_sys::File) {
     if let Some(message) = crate::too_large(&name, size) {
         return post(Inbound::Failed(message));
     }
+    let feed = SharedFeed::new(Some(size), HOLD_BYTES.with(|h| h.get()));
+    post(Inbound::Open { name: name.clone(), feed: feed.clone(), from_url: false });
     wasm_bindgen_futures::spawn_local(async move {
-        match read_stream(&name, file.stream(), Some(size)).await {
-            Ok(bytes) => post(Inbound::Loaded { name, bytes, from_url: false }),
-            Err(e) => post(Inbound::Failed(e)),
-        }
+        read_stream(&name, file.stream(), &feed).await;
     });
 }
 
@@ -151,7 +176,8 @@ fn pick_file() {
 }
 
 /// Fetches `url` (relative to the page) in chunks, with progress.
-async fn fetch(url: &str) -> Result<Arc<[u8]>, String> {
+/// Fetches `url` into a feed the viewer opens.
+async fn fetch(url: &str) -> Result<(), String> {
     post(Inbound::Progress { name: url.to_string(), bytes: 0, total: None });
     let window = web_sys::window().ok_or("no window")?;
     let response = JsFuture::from(window.fetch_with_str(url))
@@ -166,33 +192,39 @@ async fn fetch(url: &str) -> Result<Arc<[u8]>, String> {
         return Err(message);
     }
     let body = response.body().ok_or_else(|| format!("{url}: the response has no body"))?;
-    read_stream(url, body, total).await
+    let feed = SharedFeed::new(total, HOLD_BYTES.with(|h| h.get()));
+    post(Inbound::Open { name: url.to_string(), feed: feed.clone(), from_url: true });
+    read_stream(url, body, &feed).await;
+    Ok(())
 }
 
-/// Reads `stream` to its end, telling the progress, refusing more than
-/// [`crate::MAX_FILE_BYTES`].
-async fn read_stream(name: &str, stream: web_sys::ReadableStream, total: Option<u64>) -> Result<Arc<[u8]>, String> {
+/// Reads `stream` to its end into `feed`, a piece at a time as the browser hands them over;
+/// a format read whole is refused past [`crate::MAX_FILE_BYTES`].
+async fn read_stream(name: &str, stream: web_sys::ReadableStream, feed: &SharedFeed) {
     let reader: web_sys::ReadableStreamDefaultReader = stream.get_reader().unchecked_into();
-    let capacity = total.unwrap_or(0).min(crate::MAX_FILE_BYTES) as usize;
-    let mut bytes = Vec::new();
-    bytes.try_reserve_exact(capacity).map_err(|_| crate::too_large(name, u64::MAX).unwrap_or_default())?;
+    let mut read = 0u64;
     loop {
-        let chunk =
-            JsFuture::from(reader.read()).await.map_err(|e| format!("{name}: cannot read: {}", js_message(&e)))?;
+        let chunk = match JsFuture::from(reader.read()).await {
+            Ok(chunk) => chunk,
+            Err(e) => return feed.lock().fail(format!("{name}: cannot read: {}", js_message(&e))),
+        };
         if Reflect::get(&chunk, &"done".into()).ok().and_then(|d| d.as_bool()).unwrap_or(true) {
             break;
         }
-        let value: Uint8Array = Reflect::get(&chunk, &"value".into()).map_err(|e| js_message(&e))?.unchecked_into();
-        let (start, length) = (bytes.len(), value.length() as usize);
-        if let Some(message) = crate::too_large(name, (start + length) as u64) {
+        let value: Uint8Array = match Reflect::get(&chunk, &"value".into()) {
+            Ok(value) => value.unchecked_into(),
+            Err(e) => return feed.lock().fail(js_message(&e)),
+        };
+        read += value.length() as u64;
+        if let Some(message) = crate::too_large(name, read) {
             let _ = reader.cancel();
-            return Err(message);
+            return feed.lock().fail(message);
         }
-        bytes.resize(start + length, 0);
-        value.copy_to(&mut bytes[start..]);
-        post(Inbound::Progress { name: name.to_string(), bytes: bytes.len() as u64, total });
+        feed.lock().push(value.to_vec());
+        repaint();
     }
-    Ok(bytes.into())
+    feed.lock().end();
+    repaint();
 }
 
 /// A texture being copied back: its buffer and layout, and whether the mapping finished.
@@ -230,9 +262,9 @@ impl eframe::App for Page {
         for message in INBOX.with(|inbox| std::mem::take(&mut *inbox.borrow_mut())) {
             match message {
                 Inbound::Progress { name, bytes, total } => self.app.show_loading(&name, bytes, total),
-                Inbound::Loaded { name, bytes, from_url } => {
+                Inbound::Open { name, feed, from_url } => {
                     self.source = if from_url { LinkSource::Url(name.clone()) } else { LinkSource::None };
-                    self.app.load(Source::Bytes { name, bytes });
+                    self.app.load(Source::Feed { name, feed });
                 }
                 Inbound::Failed(message) => self.app.fail(message),
                 Inbound::Readback { panel, resolve, reject } => self.requests.push((panel, resolve, reject)),
@@ -366,7 +398,10 @@ impl Page {
             "streamlines": app.dataset.as_ref().map(|d| d.streamlines),
             "vertices": app.dataset.as_ref().map(|d| d.vertices),
             "loadMs": app.dataset.as_ref().map(|d| d.load_ms),
-            "uploadMs": app.dataset.as_ref().map(|d| d.upload_ms),
+            "firstMs": app.dataset.as_ref().map(|d| d.first_ms),
+            "firstPictureMs": app.first_frame_ms,
+            "complete": app.dataset.as_ref().map(|d| d.complete),
+            "readable": app.dataset.as_ref().map(|d| d.readable),
             "method": methods.join(" | "),
             "methods": methods,
             "adapter": self.adapter,

@@ -16,6 +16,9 @@ use lineao_cli::cli::ViewArgs;
 pub struct PageArgs {
     pub url: Option<String>,
     pub view: ViewArgs,
+    /// `hold=MIB`: the most of a file the page keeps to read it again (for the methods that
+    /// work on every point on the CPU); default [`crate::MAX_FILE_BYTES`].
+    pub hold_bytes: u64,
 }
 
 #[derive(Parser, Debug)]
@@ -31,11 +34,15 @@ const NOT_IN_A_PAGE: [&str; 3] = ["screenshot", "frames", "size"];
 /// Parses a URL's query string (`search`, with or without its `?`).
 pub fn parse(search: &str) -> Result<PageArgs, String> {
     let query = search.strip_prefix('?').unwrap_or(search);
-    let (mut url, mut args) = (None, Vec::new());
+    let (mut url, mut args, mut hold_bytes) = (None, Vec::new(), crate::MAX_FILE_BYTES);
     for (key, value) in form_urlencoded::parse(query.as_bytes()) {
         match &*key {
             "url" if value.is_empty() => return Err("url= needs a file's address".into()),
             "url" => url = Some(value.into_owned()),
+            "hold" => {
+                let mib: u64 = value.parse().map_err(|_| format!("hold= takes MiB, a whole number, got '{value}'"))?;
+                hold_bytes = mib << 20;
+            }
             key if NOT_IN_A_PAGE.contains(&key) => return Err(format!("'{key}' is not an option of the web page")),
             key if key.starts_with('-') || key.is_empty() => return Err(format!("'{key}' is not an option")),
             key => {
@@ -62,7 +69,7 @@ pub fn parse(search: &str) -> Result<PageArgs, String> {
     if methods.iter().any(|m| m.volume.is_some()) {
         return Err(format!("the page's URL: {}", lineao_cli::view::controls::WEB_LEAVES_OUT));
     }
-    Ok(PageArgs { url, view })
+    Ok(PageArgs { url, view, hold_bytes })
 }
 
 /// The query string of a view: the source and the options a link keeps (methods, preset,
