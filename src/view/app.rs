@@ -215,6 +215,11 @@ impl App {
         self.loading.is_some()
     }
 
+    /// Bytes read of how many, while a dataset loads.
+    pub fn progress(&self) -> Option<(u64, Option<u64>)> {
+        self.loading.as_ref().map(|l| (l.bytes, l.total))
+    }
+
     /// The message on screen for a failure, if any.
     pub fn error(&self) -> Option<&str> {
         self.error.as_deref()

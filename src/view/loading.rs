@@ -22,10 +22,14 @@ use web_time::Instant;
 use super::worker::{PREVIEW_VERTICES, Source};
 use crate::source::{CHUNK_VERTICES, Keep, Lines, SourceError};
 
-/// How long a step reads and uploads before it lets the worker draw and listen.
+/// How long a step reads and uploads before it lets the worker draw and listen, at least; a
+/// step reads as long as the time between steps (what the frames and the window took), up to
+/// [`STEP_MOST_MS`], so that the reading has half the time however slow the frames are.
 const STEP_BUDGET_MS: f64 = 60.0;
-/// How often what has arrived is drawn (a flush of the geometry's pending page), after the first
-/// chunk, which is drawn at once.
+const STEP_MOST_MS: f64 = 500.0;
+/// How much reading passes between two draws of what has arrived (a flush of the geometry's
+/// pending page), after the first chunk, which is drawn at once: at least this, and three times
+/// what the last draw took (a page on SwiftShader draws a preview in about a second).
 const FLUSH_EVERY_MS: f64 = 400.0;
 /// Bytes read from a file at a time.
 const READ_BYTES: usize = 4 << 20;
@@ -83,7 +87,13 @@ pub struct Opening {
     hint: Option<lineao_tracts::ViewHint>,
     /// Streamlines seen (the preview's count).
     streamlines: usize,
-    last_flush: Option<Instant>,
+    /// Whether anything was drawn yet; the reading since the last draw (ms); the time between
+    /// the steps after the last draw (what drawing it took); when the last step ended.
+    flushed: bool,
+    read_since_flush: f64,
+    draw_ms: f64,
+    after_flush: bool,
+    last_step_end: Option<Instant>,
     first_ms: Option<f64>,
     /// Whether the source can be read again for its points (a feed's bytes were kept).
     pub held: bool,
@@ -163,7 +173,11 @@ impl Opening {
             chunks,
             hint: None,
             streamlines: 0,
-            last_flush: None,
+            flushed: false,
+            read_since_flush: 0.0,
+            draw_ms: 0.0,
+            after_flush: false,
+            last_step_end: None,
             first_ms: None,
             held: true,
             rays: None,
@@ -177,8 +191,13 @@ impl Opening {
     /// and the source, where it came as a feed with its bytes kept, becomes those bytes.
     pub fn step(&mut self, gpu: &Gpu) -> Result<Step, String> {
         let start = Instant::now();
+        let gap = self.last_step_end.map_or(0.0, |t| (start - t).as_secs_f64() * 1e3);
+        if std::mem::take(&mut self.after_flush) {
+            self.draw_ms = gap;
+        }
+        let budget = gap.clamp(STEP_BUDGET_MS, STEP_MOST_MS);
         let mut ended = false;
-        while start.elapsed().as_secs_f64() * 1e3 < STEP_BUDGET_MS && !ended {
+        while start.elapsed().as_secs_f64() * 1e3 < budget && !ended {
             ended = self.read(gpu)?;
             self.append_chunks(gpu)?;
             if matches!(self.input, Input::Feed { .. })
@@ -189,13 +208,16 @@ impl Opening {
                 break;
             }
         }
+        self.read_since_flush += start.elapsed().as_secs_f64() * 1e3;
+        self.last_step_end = Some(Instant::now());
         if ended {
             return Ok(Step::Read);
         }
-        let due = self.last_flush.is_none_or(|t| t.elapsed().as_secs_f64() * 1e3 >= FLUSH_EVERY_MS);
+        let due = !self.flushed || self.read_since_flush >= FLUSH_EVERY_MS.max(3.0 * self.draw_ms);
         let arrived = self.lines.geometry.vertices > 0;
         if due && arrived {
             self.flush(gpu)?;
+            self.after_flush = true;
             return Ok(Step::Reading { drawn: true });
         }
         Ok(Step::Reading { drawn: false })
@@ -220,7 +242,7 @@ impl Opening {
     pub fn flush(&mut self, gpu: &Gpu) -> Result<(), String> {
         self.lines.geometry.flush(&gpu.device, &gpu.queue).map_err(|e| e.to_string())?;
         self.preview.geometry.flush(&gpu.device, &gpu.queue).map_err(|e| e.to_string())?;
-        self.last_flush = Some(Instant::now());
+        (self.flushed, self.read_since_flush) = (true, 0.0);
         self.first_ms.get_or_insert(self.started.elapsed().as_secs_f64() * 1e3);
         Ok(())
     }
