@@ -137,6 +137,17 @@ impl SharedFeed {
     pub fn lock(&self) -> std::sync::MutexGuard<'_, Feed> {
         self.0.lock().unwrap_or_else(|poisoned| poisoned.into_inner())
     }
+
+    /// Bytes pushed and not yet taken by the decoder.
+    pub fn ahead(&self) -> u64 {
+        let feed = self.lock();
+        feed.received - feed.taken
+    }
+
+    /// Whether only its reader holds it: its load has ended (failed, or another began).
+    pub fn abandoned(&self) -> bool {
+        std::sync::Arc::strong_count(&self.0) == 1
+    }
 }
 
 /// A loaded source: its name (the scene's, or the file's path), its streamlines and the

@@ -20,9 +20,13 @@ pub mod query;
 /// The largest file of a format read whole (TRX, VTK, VTP, DSI Studio, glTF, OBJ) the page
 /// reads: a page's WebAssembly memory is at most 4 GiB, and such a file's points need about as
 /// much again as its bytes. A .tck, .tsf or .trk (gzip or not) is decoded as it arrives and
-/// has no such limit (the page keeps at most this much of it, to read it again). Also the
-/// default of the URL's `hold`.
+/// has no such limit.
 pub const MAX_FILE_BYTES: u64 = 1 << 30;
+
+/// The most of a streamed file the page keeps by default (the URL's `hold=MIB`), to read its
+/// points again for the ray tracer's BVH: about 22 M points, whose BVH (31 bytes a point) still
+/// fits beside them in the page's 4 GiB; a larger file is drawn and not kept.
+pub const HOLD_BYTES: u64 = 256 << 20;
 
 /// Whether the page decodes a file named `name` as it arrives (by its extension, `.gz` aside).
 pub fn streamed(name: &str) -> bool {

@@ -47,7 +47,7 @@ thread_local! {
     static INBOX: RefCell<Vec<Inbound>> = const { RefCell::new(Vec::new()) };
     static CONTEXT: RefCell<Option<egui::Context>> = const { RefCell::new(None) };
     /// The most bytes of a file the page keeps to read it again (the URL's `hold`).
-    static HOLD_BYTES: std::cell::Cell<u64> = const { std::cell::Cell::new(crate::MAX_FILE_BYTES) };
+    static HOLD: std::cell::Cell<u64> = const { std::cell::Cell::new(crate::HOLD_BYTES) };
 }
 
 /// Asks the UI for a frame (a piece of a file arrived).
@@ -89,7 +89,7 @@ pub async fn start(canvas_id: String, adapter: String) -> Result<(), JsValue> {
         .ok_or_else(|| format!("no canvas '{canvas_id}'"))?;
     let page = query::parse(&window.location().search()?).map_err(|e| JsValue::from(js_sys::Error::new(&e)))?;
     let mut options = lineao_cli::view::options(&page.view);
-    HOLD_BYTES.with(|h| h.set(page.hold_bytes));
+    HOLD.with(|h| h.set(page.hold_bytes));
     if let Some(url) = &page.url {
         options.source = None;
         let url = url.clone();
@@ -153,7 +153,7 @@ pub fn open_file(file: web_sys::File) {
     if let Some(message) = crate::too_large(&name, size) {
         return post(Inbound::Failed(message));
     }
-    let feed = SharedFeed::new(Some(size), HOLD_BYTES.with(|h| h.get()));
+    let feed = SharedFeed::new(Some(size), HOLD.with(|h| h.get()));
     post(Inbound::Open { name: name.clone(), feed: feed.clone(), from_url: false });
     wasm_bindgen_futures::spawn_local(async move {
         read_stream(&name, file.stream(), &feed).await;
@@ -175,8 +175,7 @@ fn pick_file() {
     }
 }
 
-/// Fetches `url` (relative to the page) in chunks, with progress.
-/// Fetches `url` into a feed the viewer opens.
+/// Fetches `url` (relative to the page) into a feed the viewer opens as it arrives.
 async fn fetch(url: &str) -> Result<(), String> {
     post(Inbound::Progress { name: url.to_string(), bytes: 0, total: None });
     let window = web_sys::window().ok_or("no window")?;
@@ -192,18 +191,28 @@ async fn fetch(url: &str) -> Result<(), String> {
         return Err(message);
     }
     let body = response.body().ok_or_else(|| format!("{url}: the response has no body"))?;
-    let feed = SharedFeed::new(total, HOLD_BYTES.with(|h| h.get()));
+    let feed = SharedFeed::new(total, HOLD.with(|h| h.get()));
     post(Inbound::Open { name: url.to_string(), feed: feed.clone(), from_url: true });
     read_stream(url, body, &feed).await;
     Ok(())
 }
 
-/// Reads `stream` to its end into `feed`, a piece at a time as the browser hands them over;
-/// a format read whole is refused past [`crate::MAX_FILE_BYTES`].
+/// Reads `stream` to its end into `feed`, a piece at a time as the browser hands them over,
+/// never more than [`READ_AHEAD_BYTES`] ahead of the decoder (a file arrives faster than it is
+/// decoded, and the page's memory is not to hold it); a format read whole is refused past
+/// [`crate::MAX_FILE_BYTES`].
 async fn read_stream(name: &str, stream: web_sys::ReadableStream, feed: &SharedFeed) {
     let reader: web_sys::ReadableStreamDefaultReader = stream.get_reader().unchecked_into();
     let mut read = 0u64;
     loop {
+        while feed.ahead() > READ_AHEAD_BYTES && !feed.abandoned() {
+            pause(20).await;
+        }
+        if feed.abandoned() {
+            // Its load ended (an error, another file opened): nobody reads on.
+            let _ = reader.cancel();
+            return;
+        }
         let chunk = match JsFuture::from(reader.read()).await {
             Ok(chunk) => chunk,
             Err(e) => return feed.lock().fail(format!("{name}: cannot read: {}", js_message(&e))),
@@ -225,6 +234,19 @@ async fn read_stream(name: &str, stream: web_sys::ReadableStream, feed: &SharedF
     }
     feed.lock().end();
     repaint();
+}
+
+/// How far the page reads a file ahead of its decoder.
+const READ_AHEAD_BYTES: u64 = 64 << 20;
+
+/// Resolves after `ms` milliseconds (the page's event loop runs meanwhile).
+async fn pause(ms: i32) {
+    let promise = Promise::new(&mut |resolve, _| {
+        if let Some(window) = web_sys::window() {
+            let _ = window.set_timeout_with_callback_and_timeout_and_arguments_0(&resolve, ms);
+        }
+    });
+    let _ = JsFuture::from(promise).await;
 }
 
 /// A texture being copied back: its buffer and layout, and whether the mapping finished.
@@ -401,6 +423,7 @@ impl Page {
             "firstMs": app.dataset.as_ref().map(|d| d.first_ms),
             "firstPictureMs": app.first_frame_ms,
             "complete": app.dataset.as_ref().map(|d| d.complete),
+            "bytesRead": app.progress().map(|p| p.0),
             "readable": app.dataset.as_ref().map(|d| d.readable),
             "method": methods.join(" | "),
             "methods": methods,

@@ -17,7 +17,7 @@ pub struct PageArgs {
     pub url: Option<String>,
     pub view: ViewArgs,
     /// `hold=MIB`: the most of a file the page keeps to read it again (for the methods that
-    /// work on every point on the CPU); default [`crate::MAX_FILE_BYTES`].
+    /// work on every point on the CPU); default [`crate::HOLD_BYTES`].
     pub hold_bytes: u64,
 }
 
@@ -34,7 +34,7 @@ const NOT_IN_A_PAGE: [&str; 3] = ["screenshot", "frames", "size"];
 /// Parses a URL's query string (`search`, with or without its `?`).
 pub fn parse(search: &str) -> Result<PageArgs, String> {
     let query = search.strip_prefix('?').unwrap_or(search);
-    let (mut url, mut args, mut hold_bytes) = (None, Vec::new(), crate::MAX_FILE_BYTES);
+    let (mut url, mut args, mut hold_bytes) = (None, Vec::new(), crate::HOLD_BYTES);
     for (key, value) in form_urlencoded::parse(query.as_bytes()) {
         match &*key {
             "url" if value.is_empty() => return Err("url= needs a file's address".into()),
