@@ -80,6 +80,8 @@ const TUBE_RADIUS: f32 = 0.5;
 /// geometry, the shared passes) and every method's from the registry ([`StagePass`]).
 struct Passes {
     lines: LineRenderer,
+    /// The lines culled on the GPU (`lines-culled`; `cull` times its compute alone).
+    lines_culled: LineRenderer,
     lines_native: LineRenderer,
     lines_full: LineRenderer,
     /// The strip of earlier versions and its renderer (`lines-strip`), when selected.
@@ -126,6 +128,7 @@ impl Passes {
         let format = wgpu::TextureFormat::Rgba8UnormSrgb;
         let mut passes = Passes {
             lines: LineRenderer::new(device),
+            lines_culled: LineRenderer::new(device).culled(device),
             lines_native: LineRenderer::with_style(device, LineStyle::Native1px),
             lines_full: LineRenderer::with_style(device, LineStyle::FullStrip),
             strip: strip.map(|geometry| {
@@ -145,7 +148,7 @@ impl Passes {
             queue: queue.clone(),
             output: Target::output(device, "lineao::bench::output", (view.width, view.height), format),
         };
-        for renderer in [&passes.lines, &passes.lines_native, &passes.lines_full] {
+        for renderer in [&passes.lines, &passes.lines_culled, &passes.lines_native, &passes.lines_full] {
             renderer.prepare(queue, view, settings.line_width_px, settings.line_color, &settings.lighting);
         }
         passes.tubes.prepare(queue, view, TUBE_RADIUS * view.zoom_unit, settings.line_color, &settings.lighting);
@@ -191,7 +194,9 @@ impl Passes {
     ) {
         let background = self.settings.background;
         match name {
-            "lines" => self.lines.encode(encoder, targets, geometry, Load::Clear(background), span),
+            "lines" | "lines-all" => self.lines.encode(encoder, targets, geometry, Load::Clear(background), span),
+            "lines-culled" => self.lines_culled.encode(encoder, targets, geometry, Load::Clear(background), span),
+            "cull" => self.lines_culled.encode_cull(encoder, targets, geometry, span),
             "lines-native-1px" => self.lines_native.encode(encoder, targets, geometry, Load::Clear(background), span),
             "lines-full-strip" => self.lines_full.encode(encoder, targets, geometry, Load::Clear(background), span),
             "lines-strip" => {
@@ -307,7 +312,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
 
     let mut times: Vec<Vec<f64>> = vec![Vec::new(); all.len()];
     // `lines` last among the line passes, so the G-buffer the later passes read is the chain's.
-    let first = ["lines-native-1px", "lines-full-strip", "lines-strip"];
+    let first = ["lines-native-1px", "lines-full-strip", "lines-strip", "lines-all", "lines-culled", "cull"];
     let order = first.into_iter().chain(all.iter().copied().filter(|p| !first.contains(p)));
     // The G-buffer and pyramid every later pass reads, also when `--passes` leaves them out.
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::bench") });
@@ -339,6 +344,23 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         }
     }
 
+    // What the culled lines drew in their last frame (they ran last among the line passes).
+    let (visible_pieces, visible_clusters) = match selected("lines-culled") || selected("cull") {
+        true => {
+            let (early, late) = passes.lines_culled.drawn_pieces(queue, geometry)?.unwrap_or_default();
+            let pieces = lineao::passes::cull::LineCull::pieces(geometry).max(1) as f64;
+            let clusters = passes.lines_culled.visible_clusters(queue, geometry)?.unwrap_or_default();
+            let share = ((early + late) as f64 / pieces, clusters as f64 / geometry.clusters().max(1) as f64);
+            eprintln!(
+                "lineao: lines-culled: {:.2} % of the {} pieces of 8 segments drawn, in {:.2} % of the clusters",
+                100.0 * share.0,
+                pieces,
+                100.0 * share.1
+            );
+            (Some(share.0), Some(share.1))
+        }
+        false => (None, None),
+    };
     let on = if timer.is_some() { "gpu" } else { "cpu" };
     let mut passes: Vec<_> =
         all.iter().zip(times).filter(|(name, _)| selected(name)).map(|(name, ms)| summary(name, on, ms)).collect();
@@ -386,6 +408,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         "vertices": geometry.vertices,
         "gpu_bytes_per_vertex": bytes_per_vertex,
         "strip_bytes_per_vertex": strip_bytes,
+        "visible_pieces": visible_pieces,
+        "visible_clusters": visible_clusters,
         "load_ms": load_ms,
         "frames": args.frames,
         "timestamps": timer.is_some(),
@@ -529,6 +553,8 @@ fn print_table(report: &serde_json::Value, passes: &[serde_json::Value]) {
     for (a, b) in [
         ("lineao", "lineao-tap-floor"),
         ("lines", "lines-native-1px"),
+        ("lines-culled", "lines-all"),
+        ("cull", "lines-all"),
         ("lines-full-strip", "lines-native-1px"),
         ("lines", "lines-strip"),
         ("tubes", "lines"),

@@ -63,6 +63,10 @@ pub struct ViewArgs {
     /// How lines are lit (as `render --line-shading`).
     #[arg(long, value_parser = named::<LineShading>(), default_value = "specular")]
     pub line_shading: LineShading,
+    /// Draw only the lines that can be seen, culled on the GPU against the last frame (`on`),
+    /// or every line (`off`).
+    #[arg(long, value_parser = parse_on_off, default_value = "on")]
+    pub cull: bool,
     /// Line color: `tangent`, R,G,B in [0, 1], or `field:NAME` (see `render --color`).
     #[arg(long, default_value = "tangent", value_parser = parse_color)]
     pub color: ColorArg,
@@ -196,12 +200,15 @@ pub struct BenchLoadArgs {
 // The passes `lineao bench --passes` names (its vocabulary, so the CLI needs nothing of the
 // bench itself).
 /// The bench's own GPU passes: the geometry and what every method shares.
-const OWN_GPU_PASSES: [&str; 9] = [
+const OWN_GPU_PASSES: [&str; 12] = [
     "lines",
     "lines-native-1px",
     "lines-full-strip",
     "lines-strip",
     "nd-pyramid",
+    "lines-all",
+    "lines-culled",
+    "cull",
     "composite",
     "bilateral",
     "tubes",

@@ -299,6 +299,9 @@ fn bench_json_is_the_contract() {
         "lines-full-strip",
         "lines-strip",
         "nd-pyramid",
+        "lines-all",
+        "lines-culled",
+        "cull",
         "lineao",
         "lineao-tap-floor",
         "composite",
@@ -330,6 +333,12 @@ fn bench_json_is_the_contract() {
     let (clusters, strip) =
         (report["gpu_bytes_per_vertex"].as_f64().unwrap(), report["strip_bytes_per_vertex"].as_f64().unwrap());
     assert!(clusters <= 8.0 && strip > 40.0, "{clusters} and {strip} bytes a vertex");
+    // The culled lines' last frame: a share of the pieces, in a share of the clusters.
+    let (pieces, culled) = (report["visible_pieces"].as_f64().unwrap(), report["visible_clusters"].as_f64().unwrap());
+    assert!(
+        0.0 < pieces && pieces <= 1.0 && 0.0 < culled && culled <= 1.0,
+        "{pieces} of the pieces in {culled} of the clusters"
+    );
     for p in passes {
         let cpu_pass =
             ["density-256", "sweep-256", "variance-volume-256", "bvh-build-1m", "raytraced-cpu-64", "bvh-upload"]

@@ -231,6 +231,8 @@ impl Controls {
         match self.geometry {
             Geometry::Lines => {
                 ui.add(egui::Slider::new(&mut p.chain.line_width_px, 0.5..=8.0).text("width (px)"));
+                ui.checkbox(&mut p.chain.cull, "draw only what is seen")
+                    .on_hover_text("cull hidden lines on the GPU against the last frame: the same picture, faster when lines hide lines");
                 ui.horizontal(|ui| {
                     ui.label("lit");
                     ui.selectable_value(&mut self.line_shading, LineShading::Specular, "specular")

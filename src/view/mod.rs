@@ -56,6 +56,7 @@ pub fn options(args: &ViewArgs) -> app::Options {
     controls.debug_view = args.debug_view;
     controls.timings = args.timings;
     controls.params.chain.raytraced.max_rays = args.rays;
+    controls.params.chain.cull = args.cull;
     app::Options {
         source: Some(source),
         controls,

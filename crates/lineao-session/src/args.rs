@@ -439,6 +439,20 @@ pub struct StyleArgs {
     #[arg(long, default_value = "1,1,1", value_parser = parse_vec3)]
     #[serde(deserialize_with = "crate::kwargs::vec3")]
     pub background: [f32; 3],
+    /// Draw only the lines that can be seen, culled on the GPU against the frame before (`on`),
+    /// or every line (`off`) [default: off: one picture has no frame before it, and culled
+    /// it costs the full strip and the tests; the viewer culls].
+    #[arg(long, value_parser = parse_on_off)]
+    pub cull: Option<bool>,
+}
+
+/// `on` or `off`.
+pub fn parse_on_off(s: &str) -> Result<bool, String> {
+    match s {
+        "on" => Ok(true),
+        "off" => Ok(false),
+        _ => Err(format!("expected on or off, got '{s}'")),
+    }
 }
 
 /// The camera (the rest from the scene).

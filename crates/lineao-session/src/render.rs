@@ -129,6 +129,7 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky, lon
         debug_view: args.image.debug_view,
         zoom_unit: args.camera.zoom_unit.unwrap_or(zoom_unit),
         guard_max_px: args.chain.guard_max,
+        cull: args.style.cull.unwrap_or(false),
     }
     .with_preset(args.shown.preset);
     // What the command line names explicitly wins over the preset.

@@ -158,6 +158,52 @@ fn vs_native(@builtin(vertex_index) v: u32, @builtin(instance_index) cluster: u3
     return line_vertex(q.position, q.tangent, 0.0, point_scalar(q.index));
 }
 
+// The pieces the cull found visible (`lineao::passes::cull`), cluster << 2 | piece, for
+// `vs_piece`: piece p of a cluster is the part of its full strip from point 8p to 8p + 8 (or
+// its end), the same triangles, so the culled lines draw the full strip's pixels exactly.
+@group(2) @binding(0) var<storage, read> visible_pieces: array<u32>;
+
+struct Piece {
+    cluster: Cluster,
+    at: StripPosition,
+}
+
+// Vertex `v` of instance `instance`: block v / PIECE_STRIDE is a listed piece's full strip and
+// then a repeat of its last vertex and of the next block's first, so that the blocks' triangles
+// are their own strips' (each block starts at an even vertex: the same vertex order in every
+// triangle) and those between them have zero area. Slots past the listed pieces hold pieces
+// listed before (or cluster 0's first): drawing more of the lines than the visible ones leaves
+// the same G-buffer.
+fn piece_vertex(v: u32, instance: u32) -> Piece {
+    let block = v / PIECE_STRIDE;
+    var k = v % PIECE_STRIDE;
+    var slot = instance * PIECES_PER_INSTANCE + block;
+    if k == PIECE_STRIDE - 1u && block + 1u < PIECES_PER_INSTANCE {
+        // The next block's first vertex.
+        slot += 1u;
+        k = 0u;
+    }
+    let entry = visible_pieces[min(slot, arrayLength(&visible_pieces) - 1u)];
+    let c = clusters[entry >> 2u];
+    let first = (entry & 3u) * PIECE_SEGMENTS;
+    let points = min(drawn_points(c) - first, PIECE_SEGMENTS + 1u);
+    // Its strip's last vertex (the repeat after it, or the end of the instance).
+    let at = full_strip(min(k, 2u * (PIECE_SEGMENTS + 1u) - 1u), points);
+    return Piece(c, StripPosition(select(-1, at.point + i32(first), at.point >= 0), at.side));
+}
+
+@vertex
+fn vs_piece(@builtin(vertex_index) v: u32, @builtin(instance_index) instance: u32) -> VsOut {
+    let piece = piece_vertex(v, instance);
+    return strip_vertex(piece.cluster, piece.at);
+}
+
+@vertex
+fn vs_piece_octants(@builtin(vertex_index) v: u32, @builtin(instance_index) instance: u32) -> VsOutOctants {
+    let piece = piece_vertex(v, instance);
+    return with_point_octants(strip_vertex(piece.cluster, piece.at), piece.cluster, piece.at);
+}
+
 fn with_point_octants(b: VsOut, c: Cluster, at: StripPosition) -> VsOutOctants {
     var octants = array<vec4<f32>, 2>(vec4<f32>(1.0), vec4<f32>(1.0));
     if at.point >= 0 {

@@ -84,8 +84,12 @@ pub(crate) struct GeometryBindings {
 impl GeometryBindings {
     pub fn new(device: &wgpu::Device, label: &str) -> GeometryBindings {
         use crate::binding::{self, Slot};
-        let layout =
-            binding::layout(device, label, wgpu::ShaderStages::VERTEX_FRAGMENT, &[Slot::Uniform, Slot::Uniform]);
+        let layout = binding::layout(
+            device,
+            label,
+            wgpu::ShaderStages::VERTEX_FRAGMENT | wgpu::ShaderStages::COMPUTE,
+            &[Slot::Uniform, Slot::Uniform],
+        );
         let frame = binding::uniform_buffer::<GeometryUniform>(device, label);
         let lighting = binding::uniform_buffer::<crate::lighting::LightingUniform>(device, label);
         let group = binding::group(device, label, &layout, &[frame.as_entire_binding(), lighting.as_entire_binding()]);

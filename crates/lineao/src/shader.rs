@@ -21,6 +21,8 @@ const SHARED: &[(&str, &str)] = &[
     ("shared/vo.wgsl", include_str!("../shaders/shared/vo.wgsl")),
     ("bilateral.wgsl", include_str!("../shaders/bilateral.wgsl")),
     ("composite.wgsl", include_str!("../shaders/composite.wgsl")),
+    ("cull.wgsl", include_str!("../shaders/cull.wgsl")),
+    ("depth_pyramid.wgsl", include_str!("../shaders/depth_pyramid.wgsl")),
     ("line_geometry.wgsl", include_str!("../shaders/line_geometry.wgsl")),
     ("lines.wgsl", include_str!("../shaders/lines.wgsl")),
     ("meshes.wgsl", include_str!("../shaders/meshes.wgsl")),

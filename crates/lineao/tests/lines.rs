@@ -568,20 +568,7 @@ fn gbuffer_of(
     let mut encoder = d.create_command_encoder(&Default::default());
     draw(&mut encoder, &targets);
     q.submit([encoder.finish()]);
-    let scalar = |texture| {
-        let image = lineao::verify::read_f32(d, q, texture).unwrap();
-        lineao::reference::NdImage {
-            width: image.width,
-            height: image.height,
-            data: image.data.iter().map(|&v| [v, 0.0, 0.0, 0.0]).collect(),
-        }
-    };
-    [
-        lineao::verify::read_rgba(d, q, &targets.color).unwrap(),
-        lineao::verify::read_rgba(d, q, &targets.nd[0]).unwrap(),
-        scalar(&targets.zoom),
-        scalar(&targets.depth),
-    ]
+    common::read_gbuffer(gpu, &targets)
 }
 
 /// Issue "whole-brain tractograms": the clusters draw the G-buffer the strip of earlier versions

@@ -31,6 +31,16 @@ const BENT_SHIFT: u32 = 8u;
 const HAS_OCTANTS: u32 = 1u;
 const HAS_SCALARS: u32 = 2u;
 const HAS_RADII: u32 = 4u;
+// The culled lines' unit (`lineao::passes::cull`): a piece of a cluster's strip, segments
+// 8p .. 8p + 7 of it (points 8p ..= 8p + 8), so a cluster has at most three.
+const PIECE_SEGMENTS: u32 = 8u;
+// The culled lines' draws take PIECES_PER_INSTANCE pieces an instance, each its full strip (its
+// points twice) and two vertices that join it to the next by zero-area triangles: many
+// instances of a few vertices each are slow on some GPUs (a whole brain's pieces on an H200).
+const PIECES_PER_INSTANCE: u32 = 8u;
+const PIECE_STRIDE: u32 = 2u * (PIECE_SEGMENTS + 1u) + 2u;
+// Clusters of a group (`lineao::line_geometry::GROUP_CLUSTERS`).
+const GROUP_CLUSTERS: u32 = 64u;
 
 // x | y << 16 per point; z two points to a word.
 @group(1) @binding(0) var<storage, read> cluster_xy: array<u32>;
@@ -42,6 +52,13 @@ const HAS_RADII: u32 = 4u;
 @group(1) @binding(4) var<storage, read> cluster_scalars: array<f32>;
 @group(1) @binding(5) var<storage, read> cluster_radii: array<u32>;
 @group(1) @binding(6) var<uniform> cluster_page: ClusterPage;
+// Per group of GROUP_CLUSTERS consecutive clusters (close in space), the box of every point
+// their strips draw, as decoded (the cull's first test).
+struct ClusterGroup {
+    lo: vec4<f32>,
+    hi: vec4<f32>,
+}
+@group(1) @binding(7) var<storage, read> cluster_groups: array<ClusterGroup>;
 
 // Point `i` of the page on the grid of cluster `c` (its own, or for the next cluster's first
 // point, the next's).

@@ -116,7 +116,7 @@ impl AoChain {
                 stages.select(&settings, None, device, || method::build(device, &settings));
                 stages
             },
-            lines: LineRenderer::with_outputs(device, LineStyle::Quads, settings.volume.is_some()),
+            lines: line_renderer(device, &settings),
             tubes: settings.tubes.as_ref().map(|_| TubeRenderer::new(device, settings.volume.is_some())),
             meshes: settings.surfaces.as_ref().map(|_| MeshRenderer::new(device, settings.volume.is_some())),
             bilateral: Bilateral::new(device),
@@ -155,9 +155,9 @@ impl AoChain {
         })
         .await?;
         let octants = settings.volume.is_some();
-        if octants != self.lines.writes_octants() {
-            // Writing octants or not is a matter of the geometry pipelines.
-            self.lines = LineRenderer::with_outputs(device, LineStyle::Quads, octants);
+        if octants != self.lines.writes_octants() || settings.cull != self.lines.culls() {
+            // Writing octants or not, culling or not, is a matter of the geometry pipelines.
+            self.lines = line_renderer(device, &settings);
             self.volume_ao = settings.volume.as_ref().map(|_| VolumeAo::new(device));
         }
         let tubes_match = match (&self.tubes, &settings.tubes) {
@@ -530,4 +530,11 @@ impl AoChain {
     pub fn frame_view(&self) -> Option<&FrameView> {
         self.view.as_ref()
     }
+}
+
+/// The chain's line renderer for `settings`: fixed-width quads, writing the octants with
+/// object-space AO, culled on the GPU with [`ChainSettings::cull`].
+fn line_renderer(device: &wgpu::Device, settings: &ChainSettings) -> LineRenderer {
+    let renderer = LineRenderer::with_outputs(device, LineStyle::Quads, settings.volume.is_some());
+    if settings.cull { renderer.culled(device) } else { renderer }
 }

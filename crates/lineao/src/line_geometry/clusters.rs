@@ -38,6 +38,14 @@ use glam::Vec3;
 /// record).
 pub const CLUSTER_POINTS: u32 = 24;
 
+/// Segments of a piece, the unit the line cull tests and draws (`passes::cull`); as
+/// `PIECE_SEGMENTS` in `shaders/shared/clusters.wgsl`.
+pub const PIECE_SEGMENTS: u32 = 8;
+
+/// Consecutive records of a page (close in space: they are sorted along a Morton curve within
+/// their class) the cull tests as one box first; as `GROUP_CLUSTERS` in `shaders/cull.wgsl`.
+pub const GROUP_CLUSTERS: usize = 64;
+
 /// The size classes: a cluster of class `c` draws at most `c` segments.
 pub(crate) const SIZE_CLASSES: [u32; 4] = [3, 6, 12, 24];
 
@@ -213,6 +221,9 @@ pub(crate) struct PageBuilder {
     pub xy: Vec<u32>,
     pub z: Vec<u16>,
     pub records: Vec<ClusterRecord>,
+    /// Per record, the box of the input points its strip draws (its own and the next
+    /// cluster's first).
+    pub boxes: Vec<(Vec3, Vec3)>,
     pub runs: Vec<RunMap>,
     /// The largest tolerance a point of this page was judged bent with.
     pub tolerance: f32,
@@ -276,6 +287,9 @@ impl PageBuilder {
             if joins_next {
                 bits |= flags::JOINS_NEXT;
             }
+            // The box of what its strip draws: its points and the next cluster's first.
+            let joined = run.get(start + count).filter(|_| joins_next).map(|p| Vec3::from_array(*p));
+            self.boxes.push(joined.map_or((min, max), |p| (min.min(p), max.max(p))));
             self.records.push(ClusterRecord {
                 origin: min.to_array(),
                 scale,
@@ -293,7 +307,19 @@ impl PageBuilder {
     /// their draw classes (their `previous`/`next` renumbered), and each class's range.
     pub fn finish(self) -> PageData {
         let mut order: Vec<u32> = (0..self.records.len() as u32).collect();
-        order.sort_by_key(|&i| draw_class(&self.records[i as usize]));
+        // Within a class along a Morton curve, so that a group of consecutive records is a
+        // small region of space (the cull tests groups first).
+        let (lo, hi) = self.corners.unwrap_or((Vec3::ZERO, Vec3::ONE));
+        let cell = 1023.0 / (hi - lo).max(Vec3::splat(f32::MIN_POSITIVE));
+        let morton = |(a, b): (Vec3, Vec3)| {
+            let q = (((a + b) * 0.5 - lo) * cell).clamp(Vec3::ZERO, Vec3::splat(1023.0)).as_uvec3();
+            (0..10).fold(0u32, |code, bit| {
+                code | ((q.x >> bit) & 1) << (3 * bit)
+                    | ((q.y >> bit) & 1) << (3 * bit + 1)
+                    | ((q.z >> bit) & 1) << (3 * bit + 2)
+            })
+        };
+        order.sort_by_key(|&i| (draw_class(&self.records[i as usize]), morton(self.boxes[i as usize])));
         let mut new_index = vec![0u32; order.len()];
         for (new, &old) in order.iter().enumerate() {
             new_index[old as usize] = new as u32;
@@ -322,7 +348,24 @@ impl PageBuilder {
             *range = start..end;
         }
         let z = self.z.chunks(2).map(|pair| pair[0] as u32 | (*pair.get(1).unwrap_or(&0) as u32) << 16).collect();
-        PageData { xy: self.xy, z, records, classes, runs: self.runs, tolerance: self.tolerance }
+        let groups = order
+            .chunks(GROUP_CLUSTERS)
+            .map(|members| {
+                let (lo, hi) = members.iter().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &old| {
+                    let r = &self.records[old as usize];
+                    // A decoded point lies within half a step of its input (on its own grid,
+                    // or the next cluster's for the joined point), and f32's rounding of it.
+                    let next = (r.flags & flags::JOINS_NEXT != 0).then(|| self.records[r.next as usize].scale);
+                    let step = Vec3::splat(r.scale.max(next.unwrap_or(0.0)));
+                    let (a, b) = self.boxes[old as usize];
+                    (lo.min(a - step), hi.max(b + step))
+                });
+                let ulps = |v: Vec3| v.abs() * (4.0 * f32::EPSILON);
+                let (lo, hi) = (lo - ulps(lo), hi + ulps(hi));
+                [lo.x, lo.y, lo.z, 0.0, hi.x, hi.y, hi.z, 0.0]
+            })
+            .collect();
+        PageData { xy: self.xy, z, records, groups, classes, runs: self.runs, tolerance: self.tolerance }
     }
 }
 
@@ -331,6 +374,9 @@ pub(crate) struct PageData {
     pub xy: Vec<u32>,
     pub z: Vec<u32>,
     pub records: Vec<ClusterRecord>,
+    /// Per group of [`GROUP_CLUSTERS`] consecutive records, the box (min, 0, max, 0) of
+    /// every point their strips draw, as decoded.
+    pub groups: Vec<[f32; 8]>,
     pub classes: [Range<u32>; DRAW_CLASSES],
     pub runs: Vec<RunMap>,
     pub tolerance: f32,

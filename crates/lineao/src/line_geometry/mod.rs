@@ -33,7 +33,7 @@ use glam::Vec3;
 
 use crate::Error;
 use crate::camera::Bounds;
-pub use clusters::{CLUSTER_POINTS, ClusterRecord};
+pub use clusters::{CLUSTER_POINTS, ClusterRecord, GROUP_CLUSTERS, PIECE_SEGMENTS};
 pub(crate) use clusters::{DRAW_CLASSES, alternating_vertices, class_segments, full_vertices};
 use clusters::{PageAttributes, PageBuilder, PageData, RECORD_SIZE, RunMap};
 
@@ -199,7 +199,7 @@ pub(crate) struct PageUniform {
 }
 
 /// The bind group layout of a page (group 1 of the line and tube pipelines): the points, the
-/// records, the three attribute arrays and the page's uniform.
+/// records, the three attribute arrays, the page's uniform and the boxes of its groups of clusters.
 pub(crate) fn page_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     use crate::binding::Slot::{Storage, Uniform};
     let visibility = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::COMPUTE;
@@ -207,7 +207,7 @@ pub(crate) fn page_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
         device,
         "lineao::LineGeometry::page",
         visibility,
-        &[Storage, Storage, Storage, Storage, Storage, Storage, Uniform],
+        &[Storage, Storage, Storage, Storage, Storage, Storage, Uniform, Storage],
     )
 }
 
@@ -219,11 +219,17 @@ pub(crate) struct Page {
     /// The largest tolerance τ its bent points were marked with (world units).
     pub tolerance: f32,
     pub records: u32,
+    /// Pieces of eight segments its clusters' strips have (the culled lines' unit).
+    pub pieces: u64,
+    /// Its culling state, made on its first culled frame.
+    pub cull: std::sync::OnceLock<crate::passes::cull::PageCull>,
     points: u32,
     runs: Vec<RunMap>,
-    xy: wgpu::Buffer,
-    z: wgpu::Buffer,
-    clusters: wgpu::Buffer,
+    pub xy: wgpu::Buffer,
+    pub z: wgpu::Buffer,
+    pub clusters: wgpu::Buffer,
+    /// Per group of consecutive clusters, the box of their points (the cull's first test).
+    pub groups: wgpu::Buffer,
     attributes: [Option<wgpu::Buffer>; 3],
     uniform: wgpu::Buffer,
 }
@@ -232,7 +238,9 @@ impl Page {
     /// Bytes of its buffers.
     fn bytes(&self) -> u64 {
         let attributes: u64 = self.attributes.iter().flatten().map(wgpu::Buffer::size).sum();
-        self.xy.size() + self.z.size() + self.clusters.size() + attributes + self.uniform.size()
+        let cull = self.cull.get().map_or(0, crate::passes::cull::PageCull::bytes);
+        let own = self.xy.size() + self.z.size() + self.clusters.size() + self.groups.size();
+        own + attributes + self.uniform.size() + cull
     }
 }
 
@@ -468,6 +476,7 @@ impl LineGeometry {
         let xy = buffer("lineao::LineGeometry::xy", bytemuck::cast_slice(&data.xy))?;
         let z = buffer("lineao::LineGeometry::z", bytemuck::cast_slice(&data.z))?;
         let clusters = buffer("lineao::LineGeometry::clusters", bytemuck::cast_slice(&data.records))?;
+        let groups = buffer("lineao::LineGeometry::groups", bytemuck::cast_slice(&data.groups))?;
         let attributes = self.attribute_buffers(device, queue, attributes)?;
         let uniform = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("lineao::LineGeometry::page"),
@@ -477,15 +486,18 @@ impl LineGeometry {
         });
         queue.write_buffer(&uniform, 0, bytemuck::bytes_of(&PageUniform { attributes: flags, _pad: [0; 3] }));
         Ok(Page {
-            group: self.bind_group(device, [&xy, &z, &clusters], &attributes, &uniform),
+            group: self.bind_group(device, [&xy, &z, &clusters, &groups], &attributes, &uniform),
             classes: data.classes,
             tolerance: data.tolerance,
             records: data.records.len() as u32,
+            pieces: data.records.iter().map(|r| r.drawn().saturating_sub(1).div_ceil(PIECE_SEGMENTS) as u64).sum(),
+            cull: std::sync::OnceLock::new(),
             points,
             runs: data.runs,
             xy,
             z,
             clusters,
+            groups,
             attributes,
             uniform,
         })
@@ -520,7 +532,7 @@ impl LineGeometry {
     fn bind_group(
         &self,
         device: &wgpu::Device,
-        [xy, z, clusters]: [&wgpu::Buffer; 3],
+        [xy, z, clusters, groups]: [&wgpu::Buffer; 4],
         attributes: &[Option<wgpu::Buffer>; 3],
         uniform: &wgpu::Buffer,
     ) -> wgpu::BindGroup {
@@ -537,6 +549,7 @@ impl LineGeometry {
                 scalars.as_ref().unwrap_or(&self.placeholder).as_entire_binding(),
                 radii.as_ref().unwrap_or(&self.placeholder).as_entire_binding(),
                 uniform.as_entire_binding(),
+                groups.as_entire_binding(),
             ],
         )
     }
@@ -558,7 +571,8 @@ impl LineGeometry {
             let flags = gathered.flags();
             let buffers = self.attribute_buffers(device, queue, gathered)?;
             let page = &self.pages[i];
-            let group = self.bind_group(device, [&page.xy, &page.z, &page.clusters], &buffers, &page.uniform);
+            let group =
+                self.bind_group(device, [&page.xy, &page.z, &page.clusters, &page.groups], &buffers, &page.uniform);
             queue.write_buffer(&page.uniform, 0, bytemuck::bytes_of(&PageUniform { attributes: flags, _pad: [0; 3] }));
             let page = &mut self.pages[i];
             page.attributes = buffers;

@@ -8,6 +8,8 @@ pub use crate::gbuffer::Load;
 
 pub mod bilateral;
 pub mod composite;
+pub mod cull;
+pub mod depth_pyramid;
 pub mod lines;
 pub mod meshes;
 pub mod nd_from_depth;

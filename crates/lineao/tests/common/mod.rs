@@ -324,3 +324,23 @@ pub fn unit_sphere_view() -> (Camera, Bounds) {
     };
     (camera, Bounds { center: glam::Vec3::ZERO, radius: 1.0 })
 }
+
+/// The G-buffer in `targets` (color, ND, zoom, hardware depth), read back; the scalar maps in
+/// the first channel.
+pub fn read_gbuffer(gpu: &Gpu, targets: &FrameTargets) -> [NdImage; 4] {
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let scalar = |texture| {
+        let image = read_f32(d, q, texture).unwrap();
+        NdImage {
+            width: image.width,
+            height: image.height,
+            data: image.data.iter().map(|&v| [v, 0.0, 0.0, 0.0]).collect(),
+        }
+    };
+    [
+        read_rgba(d, q, &targets.color).unwrap(),
+        read_rgba(d, q, &targets.nd[0]).unwrap(),
+        scalar(&targets.zoom),
+        scalar(&targets.depth),
+    ]
+}

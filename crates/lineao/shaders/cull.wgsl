@@ -1,0 +1,272 @@
+// Culling the lines' pieces against the view and the depth pyramid (`lineao::passes::cull`),
+// in two phases per frame. `early` lists the pieces visible in the last frame, which are drawn;
+// then the pyramid is built from the depth they left, and every piece is tested against it:
+// one whose fragments all lie behind what is drawn at each pixel they can cover, or outside
+// the view, is hidden, any other is visible, and the visible ones not drawn early are drawn
+// now. Each test is conservative, so the G-buffer is the one drawing every piece leaves.
+// `settle` tests the marked pieces again against the final depth, for the next frame.
+//
+// The tests run coarse to fine: `test_groups` tests each group of 64 clusters by its box
+// (close in space: a page sorts its clusters along a Morton curve) and lists the groups that
+// may be visible; `late` and `settle` run a workgroup per listed group and an invocation per
+// piece, so hidden groups cost one test and neighbouring invocations do the same work.
+//
+// A piece (segments 8p .. 8p + 7 of a cluster's strip) is visible where one of its segments
+// is, each bounded by its two points as the vertex shader computes them: its quads' corners are
+// the points pushed half a line width sideways on screen at the points' depth, so its fragments
+// lie within half a line width of the two points' box on screen and no nearer than the nearer
+// point (depth interpolates linearly on screen). A segment spans a few pixels: its box is
+// tight, and the pyramid is read at a fine level. A box in front of the eye projects within
+// its corners' projections, no nearer than its nearest corner.
+#import shared/clusters.wgsl
+#import shared/geometry.wgsl
+
+// Keep in sync with `lineao::passes::depth_pyramid::PyramidUniform`.
+struct Pyramid {
+    size: vec2<u32>,
+    levels: u32,
+    _pad: u32,
+    // Per level: first texel, width, height.
+    level: array<vec4<u32>, 16>,
+}
+
+@group(2) @binding(0) var<uniform> pyramid: Pyramid;
+@group(2) @binding(1) var<storage, read> pyramid_texels: array<f32>;
+
+// A page's state, in one buffer (a stage may bind 8 storage buffers, the WebGPU default):
+// words 0–3 the early draw's indirect arguments, 4–7 the late one's, 8 the groups listed for
+// `late` or `settle`, 9 and 10 the pieces listed for the early and the late draw (these 16
+// words zeroed before each frame); then per cluster a word, bit p set where piece p passed
+// the last test (`VISIBLE`); then the listed groups (`SEEN`).
+@group(3) @binding(0) var<storage, read_write> state: array<atomic<u32>>;
+// The pieces to draw (cluster << 2 | piece), the early phase's, then the late one's.
+@group(3) @binding(1) var<storage, read_write> pieces: array<u32>;
+// The indirect dispatch of `late` or `settle` (x, y, 1) and, in word 3, the groups listed for
+// it, as `test_groups` counts them (only bound there and in `size_dispatch`: a dispatch cannot
+// read its arguments from a buffer it binds). Zeroed before each listing.
+@group(3) @binding(2) var<storage, read_write> listing: array<atomic<u32>>;
+
+const VISIBLE: u32 = 16u;
+
+fn cluster_count() -> u32 {
+    return arrayLength(&clusters);
+}
+
+// Where listed group slot `slot` lies in `state`.
+fn seen_at(slot: u32) -> u32 {
+    return VISIBLE + cluster_count() + slot;
+}
+
+// Vertices of an instance of the culled lines (`lines.wgsl`'s `vs_piece`).
+const INSTANCE_VERTICES: u32 = PIECES_PER_INSTANCE * PIECE_STRIDE;
+// Workgroups per row of a direct dispatch (`lineao::passes::cull`'s ROW), 64 invocations each.
+const ROW: u32 = 32768u;
+// Workgroups per row of an indirect one.
+const DISPATCH_ROW: u32 = 65535u;
+// What the rasterizer's interpolation and the two computations of a point's depth may differ
+// by (about 16 steps of f32 near 1).
+const DEPTH_MARGIN: f32 = 2e-6;
+
+fn invocation(group: vec3<u32>, local: u32) -> u32 {
+    return (group.x + group.y * ROW) * 64u + local;
+}
+
+// Lists piece `entry` for draw `draw` (0 early, 1 late): its slot from the draw's piece count,
+// an instance more for every PIECES_PER_INSTANCE of them.
+fn append(draw: u32, entry: u32) {
+    let slot = atomicAdd(&state[9u + draw], 1u);
+    pieces[slot] = entry;
+    if slot % PIECES_PER_INSTANCE == 0u {
+        atomicAdd(&state[4u * draw + 1u], 1u);
+    }
+}
+
+@compute @workgroup_size(64)
+fn early(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let i = invocation(group, local);
+    if i == 0u {
+        atomicStore(&state[0], INSTANCE_VERTICES);
+        atomicStore(&state[4], INSTANCE_VERTICES);
+    }
+    if i >= cluster_count() {
+        return;
+    }
+    let bits = atomicLoad(&state[VISIBLE + i]);
+    for (var p = 0u; p < 3u; p++) {
+        if (bits & (1u << p)) != 0u {
+            append(0u, (i << 2u) | p);
+        }
+    }
+}
+
+// Lists the groups whose box may be visible; unmarks the pieces of the others.
+@compute @workgroup_size(64)
+fn test_groups(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let g = invocation(group, local);
+    let clusters_of_page = cluster_count();
+    if g * GROUP_CLUSTERS >= clusters_of_page {
+        return;
+    }
+    let box = cluster_groups[g];
+    if box_in_view_visible(box.lo.xyz, box.hi.xyz) {
+        atomicStore(&state[seen_at(atomicAdd(&listing[3], 1u))], g);
+        return;
+    }
+    for (var i = g * GROUP_CLUSTERS; i < min((g + 1u) * GROUP_CLUSTERS, clusters_of_page); i++) {
+        atomicStore(&state[VISIBLE + i], 0u);
+    }
+}
+
+// The indirect dispatch of the listed groups, a workgroup each (rows of 65 535).
+@compute @workgroup_size(1)
+fn size_dispatch() {
+    let listed = atomicLoad(&listing[3]);
+    atomicStore(&listing[0], min(listed, DISPATCH_ROW));
+    atomicStore(&listing[1], (listed + DISPATCH_ROW - 1u) / DISPATCH_ROW);
+    atomicStore(&listing[2], 1u);
+    atomicStore(&state[8], listed);
+}
+
+// The piece of invocation `local` of workgroup `group` (a listed group's slot): (cluster,
+// piece, first, last) with last < first where there is none.
+fn listed_piece(group: vec3<u32>, local: u32) -> vec4<u32> {
+    let slot = group.x + group.y * DISPATCH_ROW;
+    let none = vec4<u32>(0u, 0u, 1u, 0u);
+    if slot >= atomicLoad(&state[8]) {
+        return none;
+    }
+    let i = atomicLoad(&state[seen_at(slot)]) * GROUP_CLUSTERS + local / 3u;
+    if i >= cluster_count() {
+        return none;
+    }
+    let p = local % 3u;
+    let drawn = drawn_points(clusters[i]);
+    let first = p * PIECE_SEGMENTS;
+    return vec4<u32>(i, p, first, min(first + PIECE_SEGMENTS, drawn - 1u));
+}
+
+// Whether cluster `i`'s piece of mark `bit` is marked visible.
+fn marked(i: u32, bit: u32) -> bool {
+    return (atomicLoad(&state[VISIBLE + i]) & bit) != 0u;
+}
+
+// An invocation per piece of a listed group: marks it visible or not, and lists the visible
+// ones the early draw did not draw.
+@compute @workgroup_size(192)
+fn late(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let piece = listed_piece(group, local);
+    if piece.w <= piece.z {
+        return;
+    }
+    let bit = 1u << piece.y;
+    let before = marked(piece.x, bit);
+    if piece_visible(clusters[piece.x], piece.z, piece.w) {
+        atomicOr(&state[VISIBLE + piece.x], bit);
+        if !before {
+            append(1u, (piece.x << 2u) | piece.y);
+        }
+    } else if before {
+        atomicAnd(&state[VISIBLE + piece.x], ~bit);
+    }
+}
+
+// After the late draw, against the pyramid of the frame's final depth (and `test_groups` run
+// again): the pieces marked visible that the frame's lines hide after all are unmarked, so the
+// next frame's early phase draws only what this one shows (after a first frame or a cut, the
+// late phase marks all that passed against the early phase's depth).
+@compute @workgroup_size(192)
+fn settle(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let piece = listed_piece(group, local);
+    if piece.w <= piece.z {
+        return;
+    }
+    let bit = 1u << piece.y;
+    if marked(piece.x, bit) && !piece_visible(clusters[piece.x], piece.z, piece.w) {
+        atomicAnd(&state[VISIBLE + piece.x], ~bit);
+    }
+}
+
+// Whether strip points `first ..= last` of cluster `c` may leave a fragment in front of the
+// pyramid: whether one of their segments may.
+fn piece_visible(c: Cluster, first: u32, last: u32) -> bool {
+    let count = c.flags & CLUSTER_COUNT;
+    var previous = vec3<f32>(0.0);
+    for (var k = first; k <= last; k++) {
+        var owner = c;
+        if k >= count {
+            owner = clusters[c.next];
+        }
+        // As the vertex shader computes it.
+        let view_pos = frame.view * vec4<f32>(decode_point(c.first + k, owner), 1.0);
+        let clip = frame.proj * view_pos;
+        if clip.w <= 0.0 {
+            // Behind the eye: the rasterizer clips the piece, and its box says nothing.
+            return true;
+        }
+        let ndc = clip.xyz / clip.w;
+        if k > first && segment_visible(previous, ndc) {
+            return true;
+        }
+        previous = ndc;
+    }
+    return false;
+}
+
+// Whether what lies in the world box `lo`..`hi` may leave a fragment in front of the pyramid.
+fn box_in_view_visible(lo: vec3<f32>, hi: vec3<f32>) -> bool {
+    var ndc_lo = vec3<f32>(3.0e38);
+    var ndc_hi = vec3<f32>(-3.0e38);
+    for (var k = 0u; k < 8u; k++) {
+        let corner = select(lo, hi, vec3<bool>((k & 1u) != 0u, (k & 2u) != 0u, (k & 4u) != 0u));
+        let clip = frame.proj * (frame.view * vec4<f32>(corner, 1.0));
+        if clip.w <= 0.0 {
+            // Reaches behind the eye: no bound on screen.
+            return true;
+        }
+        let ndc = clip.xyz / clip.w;
+        ndc_lo = min(ndc_lo, ndc);
+        ndc_hi = max(ndc_hi, ndc);
+    }
+    return box_visible(ndc_lo, ndc_hi);
+}
+
+// Whether the segment between points at NDC `a` and `b` may leave a fragment in front of the
+// pyramid. Its two triangles' corners lie half a line width from `a` or `b` on screen, at
+// their depths.
+fn segment_visible(a: vec3<f32>, b: vec3<f32>) -> bool {
+    return box_visible(min(a, b), max(a, b));
+}
+
+// Whether what lies in the NDC box `lo`..`hi` (drawn half a line width wider) may leave a
+// fragment in front of the pyramid.
+fn box_visible(lo: vec3<f32>, hi: vec3<f32>) -> bool {
+    // Wholly in front of the near plane or beyond the far one: clipped.
+    if hi.z < 0.0 || lo.z > 1.0 {
+        return false;
+    }
+    // The pixels whose centres its quads can cover (a pixel more for rounding).
+    let size = vec2<f32>(pyramid.size);
+    let reach = 0.5 * frame.line_width_px + 1.0;
+    let top_left = vec2<f32>(lo.x * 0.5 + 0.5, 0.5 - hi.y * 0.5) * size - reach;
+    let bottom_right = vec2<f32>(hi.x * 0.5 + 0.5, 0.5 - lo.y * 0.5) * size + reach;
+    if any(bottom_right < vec2<f32>(0.0)) || any(top_left >= size) {
+        return false;
+    }
+    let a_px = vec2<u32>(clamp(floor(top_left), vec2<f32>(0.0), size - 1.0));
+    let b_px = vec2<u32>(clamp(floor(bottom_right), vec2<f32>(0.0), size - 1.0));
+    // The finest level where the rectangle spans at most 2 × 2 texels.
+    var l = 0u;
+    while l + 1u < pyramid.levels && any((b_px >> vec2<u32>(l)) - (a_px >> vec2<u32>(l)) > vec2<u32>(1u)) {
+        l++;
+    }
+    let level = pyramid.level[l];
+    let ta = a_px >> vec2<u32>(l);
+    let tb = b_px >> vec2<u32>(l);
+    var farthest = 0.0;
+    for (var y = ta.y; y <= tb.y; y++) {
+        for (var x = ta.x; x <= tb.x; x++) {
+            farthest = max(farthest, pyramid_texels[level.x + y * level.y + x]);
+        }
+    }
+    return lo.z <= farthest + DEPTH_MARGIN;
+}

@@ -1,0 +1,126 @@
+//! Culling on the GPU (`passes::cull`): the culled lines draw the G-buffer drawing every line
+//! (the full strip) draws — bit for bit, but where two fragments tie in depth and the order
+//! decides — from outside, inside, close up, orthographic and after a camera cut, on the first
+//! frame (nothing known visible) and the next (the early phase draws the last frame's pieces).
+
+mod common;
+
+use common::{gpu, is_geometry};
+use glam::Vec3;
+use lineao::passes::lines::{LineRenderer, LineStyle};
+use lineao::reference::NdImage;
+use lineao::targets::FrameTargets;
+use lineao::{Bounds, Camera, ChainSettings, FrameView, LineGeometry, Projection};
+
+const SIZE: (u32, u32) = (320, 240);
+/// A guard band as the chain's methods want one (the pyramid covers it too).
+const GUARD: u32 = 24;
+
+/// `count` smooth streamlines of 150 points wandering through a ball of radius 40: a small
+/// whole brain, many lines deep from every side.
+fn ball(count: usize) -> (Vec<[f32; 3]>, Vec<u64>) {
+    let mut state = 0x2545_f491_u64;
+    let mut random = move || {
+        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        ((state >> 33) as f32 / (1u64 << 31) as f32) * 2.0 - 1.0
+    };
+    let (mut positions, mut offsets) = (Vec::new(), vec![0u64]);
+    for _ in 0..count {
+        let mut p = Vec3::new(random(), random(), random()) * 30.0;
+        let mut d = Vec3::new(random(), random(), random()).normalize_or(Vec3::X);
+        for _ in 0..150 {
+            positions.push(p.to_array());
+            d = (d + 0.15 * Vec3::new(random(), random(), random())).normalize_or(Vec3::X);
+            // Turn back inside the ball.
+            if (p + d).length() > 40.0 {
+                d = (d - 0.5 * p.normalize()).normalize_or(Vec3::X);
+            }
+            p += d;
+        }
+        offsets.push(positions.len() as u64);
+    }
+    (positions, offsets)
+}
+
+fn bounds() -> Bounds {
+    Bounds { center: Vec3::ZERO, radius: 45.0 }
+}
+
+fn outside() -> Camera {
+    Camera {
+        eye: Vec3::new(30.0, 40.0, 120.0),
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        projection: Projection::Perspective { fov_y_deg: 45.0 },
+    }
+}
+
+/// The G-buffer (color, ND, zoom, hardware depth) `renderer` draws of `geometry` for `camera`.
+fn draw(gpu: &lineao::Gpu, renderer: &LineRenderer, geometry: &LineGeometry, camera: &Camera) -> [NdImage; 4] {
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let view = FrameView::new(camera, &bounds(), SIZE.0, SIZE.1, GUARD, 1.0);
+    let targets = FrameTargets::new(d, SIZE.0, SIZE.1, GUARD, 1);
+    let s = ChainSettings { line_width_px: 3.0, ..ChainSettings::default() };
+    renderer.prepare(q, &view, s.line_width_px, s.line_color, &s.lighting);
+    let mut encoder = d.create_command_encoder(&Default::default());
+    renderer.encode(&mut encoder, &targets, geometry, lineao::passes::Load::Clear(s.background), None);
+    q.submit([encoder.finish()]);
+    common::read_gbuffer(gpu, &targets)
+}
+
+/// Checks that `culled` equals `all` bit for bit but at ties (same depth, another line's
+/// values); returns (geometry pixels, ties).
+fn same_gbuffer(all: &[NdImage; 4], culled: &[NdImage; 4], case: &str) -> (usize, usize) {
+    let (mut geometry, mut ties) = (0, 0);
+    for i in 0..all[0].data.len() {
+        let depth = (all[3].data[i][0], culled[3].data[i][0]);
+        assert_eq!(depth.0.to_bits(), depth.1.to_bits(), "{case}: depth differs at pixel {i}: {depth:?}");
+        geometry += is_geometry(all[1].data[i]) as usize;
+        let equal = (0..3).all(|t| all[t].data[i].map(f32::to_bits) == culled[t].data[i].map(f32::to_bits));
+        ties += !equal as usize;
+    }
+    (geometry, ties)
+}
+
+#[test]
+fn culled_lines_draw_the_g_buffer_of_all_lines() {
+    let gpu = gpu();
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let (positions, offsets) = ball(8000);
+    let geometry = LineGeometry::new(d, q, &positions, &offsets).unwrap();
+    let all = LineRenderer::with_style(d, LineStyle::FullStrip);
+    let culled = LineRenderer::new(d).culled(d);
+    let pieces = lineao::passes::cull::LineCull::pieces(&geometry);
+    let inside = Camera { eye: Vec3::new(2.0, 1.0, 3.0), target: Vec3::new(30.0, 5.0, -10.0), ..outside() };
+    let close = Camera { eye: Vec3::new(10.0, 12.0, 40.0), target: Vec3::new(5.0, 5.0, 0.0), ..outside() };
+    let orthographic = Camera { projection: Projection::Orthographic { height: 95.0 }, ..outside() };
+    let cut = Camera { eye: Vec3::new(-110.0, -20.0, -40.0), ..outside() };
+    for (case, camera) in [
+        ("outside", outside()),
+        ("inside", inside),
+        ("close up", close),
+        ("orthographic", orthographic),
+        ("a camera cut", cut),
+    ] {
+        let expected = draw(&gpu, &all, &geometry, &camera);
+        // The first frame of a view (after the one before it), then the next.
+        for frame in ["first", "second"] {
+            let got = draw(&gpu, &culled, &geometry, &camera);
+            let (early, late) = culled.drawn_pieces(q, &geometry).unwrap().unwrap();
+            let (covered, ties) = same_gbuffer(&expected, &got, case);
+            println!(
+                "{case}, {frame} frame: drew {early} + {late} of {pieces} pieces ({:.1} %); {covered} geometry pixels, {ties} ties",
+                100.0 * (early + late) as f64 / pieces as f64
+            );
+            assert!(ties * 2000 <= covered, "{case}: {ties} of {covered} pixels differ at equal depth");
+            if frame == "second" {
+                assert!(late * 100 <= early, "{case}: a still camera draws what the last frame found visible");
+            }
+        }
+    }
+    // From outside most of the ball is hidden: a second frame draws well under half of it.
+    draw(&gpu, &culled, &geometry, &outside());
+    draw(&gpu, &culled, &geometry, &outside());
+    let (early, late) = culled.drawn_pieces(q, &geometry).unwrap().unwrap();
+    assert!((early + late) * 2 < pieces, "drew {early} + {late} of {pieces}");
+}
