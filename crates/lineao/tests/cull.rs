@@ -1,7 +1,8 @@
 //! Culling on the GPU (`passes::cull`): the culled lines draw the G-buffer drawing every line
 //! (the full strip) draws — bit for bit, but where two fragments tie in depth and the order
 //! decides — from outside, inside, close up, orthographic and after a camera cut, on the first
-//! frame (nothing known visible) and the next (the early phase draws the last frame's pieces).
+//! frame (nothing known visible) and the next (the early phase draws the last frame's pieces);
+//! and the GPU's marks after each frame are the CPU reference's (`lineao::reference::cull`).
 
 mod common;
 
@@ -15,6 +16,7 @@ use lineao::{Bounds, Camera, ChainSettings, FrameView, LineGeometry, Projection}
 const SIZE: (u32, u32) = (320, 240);
 /// A guard band as the chain's methods want one (the pyramid covers it too).
 const GUARD: u32 = 24;
+const LINE_WIDTH: f32 = 3.0;
 
 /// `count` smooth streamlines of 150 points wandering through a ball of radius 40: a small
 /// whole brain, many lines deep from every side.
@@ -60,7 +62,7 @@ fn draw(gpu: &lineao::Gpu, renderer: &LineRenderer, geometry: &LineGeometry, cam
     let (d, q) = (&gpu.device, &gpu.queue);
     let view = FrameView::new(camera, &bounds(), SIZE.0, SIZE.1, GUARD, 1.0);
     let targets = FrameTargets::new(d, SIZE.0, SIZE.1, GUARD, 1);
-    let s = ChainSettings { line_width_px: 3.0, ..ChainSettings::default() };
+    let s = ChainSettings { line_width_px: LINE_WIDTH, ..ChainSettings::default() };
     renderer.prepare(q, &view, s.line_width_px, s.line_color, &s.lighting);
     let mut encoder = d.create_command_encoder(&Default::default());
     renderer.encode(&mut encoder, &targets, geometry, lineao::passes::Load::Clear(s.background), None);
@@ -80,6 +82,46 @@ fn same_gbuffer(all: &[NdImage; 4], culled: &[NdImage; 4], case: &str) -> (usize
         ties += !equal as usize;
     }
     (geometry, ties)
+}
+
+/// Checks the GPU's marks after a frame against the CPU reference of the cull on the frame's
+/// final depth (`depth`): every piece the reference finds visible or hidden with a hundredth of a
+/// pixel and 1e-7 of depth to spare is marked so; the unsure ones are counted.
+fn same_marks_as_the_cpu_reference(
+    gpu: &lineao::Gpu,
+    renderer: &LineRenderer,
+    geometry: &LineGeometry,
+    camera: &Camera,
+    depth: &NdImage,
+    case: &str,
+) {
+    use lineao::reference::cull::{CullView, Slack, Verdict, marks};
+    let view = FrameView::new(camera, &bounds(), SIZE.0, SIZE.1, GUARD, 1.0);
+    let depth = lineao::reference::Image {
+        width: depth.width,
+        height: depth.height,
+        data: depth.data.iter().map(|d| d[0]).collect(),
+    };
+    let frame = CullView { view: view.view, proj: view.proj, size: view.banded_size(), line_width_px: LINE_WIDTH };
+    let pages = geometry.page_contents(&gpu.device, &gpu.queue).unwrap();
+    let expected = marks(&pages, &frame, &depth, Slack { px: 0.01, depth: 1e-7 });
+    let got = renderer.cull_marks(&gpu.queue, geometry).unwrap().unwrap();
+    let (mut pieces, mut unsure) = (0, 0);
+    for (page, (expected, got)) in expected.iter().zip(&got).enumerate() {
+        for (i, (verdicts, &bits)) in expected.iter().zip(got).enumerate() {
+            for (p, verdict) in verdicts.iter().enumerate() {
+                let marked = bits & (1 << p) != 0;
+                match verdict {
+                    Verdict::Visible => assert!(marked, "{case}: page {page} cluster {i} piece {p} is visible"),
+                    Verdict::Hidden => assert!(!marked, "{case}: page {page} cluster {i} piece {p} is hidden"),
+                    Verdict::Unsure => unsure += 1,
+                }
+                pieces += (*verdict != Verdict::Hidden) as usize;
+            }
+        }
+    }
+    println!("{case}: the CPU reference agrees on every sure piece; {unsure} unsure of {pieces} not hidden");
+    assert!(unsure * 100 <= pieces.max(100), "{case}: {unsure} pieces unsure");
 }
 
 #[test]
@@ -116,6 +158,7 @@ fn culled_lines_draw_the_g_buffer_of_all_lines() {
             if frame == "second" {
                 assert!(late * 100 <= early, "{case}: a still camera draws what the last frame found visible");
             }
+            same_marks_as_the_cpu_reference(&gpu, &culled, &geometry, &camera, &got[3], case);
         }
     }
     // From outside most of the ball is hidden: a second frame draws well under half of it.

@@ -631,6 +631,33 @@ impl LineGeometry {
         }
         Ok(out)
     }
+
+    /// Each page's cluster records, points (page order) and group boxes (min, max) as the GPU
+    /// holds them, read back: what the cull's CPU reference tests ([`crate::reference::cull`]).
+    #[cfg(feature = "reference")]
+    pub fn page_contents(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+    ) -> Result<Vec<crate::reference::cull::PageContents>, Error> {
+        let read = |buffer| pollster::block_on(crate::readback::read_buffer_async(device, queue, buffer));
+        self.pages
+            .iter()
+            .map(|page| {
+                let records: Vec<ClusterRecord> =
+                    bytemuck::cast_slice(&read(&page.clusters)?)[..page.records as usize].to_vec();
+                let groups = bytemuck::cast_slice::<u8, [f32; 8]>(&read(&page.groups)?)
+                    .iter()
+                    .map(|g| (Vec3::new(g[0], g[1], g[2]), Vec3::new(g[4], g[5], g[6])))
+                    .collect();
+                Ok(crate::reference::cull::PageContents {
+                    records,
+                    points: farthest::decode(device, queue, page)?,
+                    groups,
+                })
+            })
+            .collect()
+    }
 }
 
 /// A storage buffer holding `bytes` (words; at least one), written through the queue; an allocation

@@ -398,6 +398,21 @@ impl LineCull {
         Ok(visible)
     }
 
+    /// Each page's marks after the last frame recorded, a word per cluster (bit p: piece p
+    /// passed), read back (waits for the device): what the CPU reference checks.
+    pub fn marks(&self, queue: &wgpu::Queue, geometry: &LineGeometry) -> Result<Vec<Vec<u32>>, crate::Error> {
+        geometry
+            .pages()
+            .iter()
+            .map(|page| {
+                let Some(state) = page.cull.get() else { return Ok(vec![0; page.records as usize]) };
+                let bytes = pollster::block_on(crate::readback::read_buffer_async(&self.device, queue, &state.state))?;
+                Ok(bytemuck::cast_slice::<u8, u32>(&bytes)[STATE_HEADER_WORDS as usize..][..page.records as usize]
+                    .to_vec())
+            })
+            .collect()
+    }
+
     /// Pieces `geometry` has (what drawing everything would draw).
     pub fn pieces(geometry: &LineGeometry) -> u64 {
         geometry.pages().iter().map(|p| p.pieces).sum()

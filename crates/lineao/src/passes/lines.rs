@@ -213,6 +213,11 @@ impl LineRenderer {
         }
     }
 
+    /// Each page's marks after the last frame ([`LineCull::marks`]); none when it does not cull.
+    pub fn cull_marks(&self, queue: &wgpu::Queue, geometry: &LineGeometry) -> Result<Option<Vec<Vec<u32>>>, Error> {
+        self.culled.as_ref().map(|c| c.cull.marks(queue, geometry)).transpose()
+    }
+
     /// The clusters with a piece visible in the last frame (read back, waits for the device).
     pub fn visible_clusters(&self, queue: &wgpu::Queue, geometry: &LineGeometry) -> Result<Option<u64>, Error> {
         self.culled.as_ref().map(|c| c.cull.visible_clusters(queue, geometry)).transpose()

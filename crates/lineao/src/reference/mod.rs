@@ -7,6 +7,7 @@
 //! the two differ only by rounding inside the GPU (fused multiply-adds, `pow`, `sqrt`).
 
 mod bilateral;
+pub mod cull;
 pub mod tubes;
 mod volume_ao;
 

@@ -1,0 +1,176 @@
+//! The CPU reference of the line cull ([`crate::passes::cull`], `shaders/cull.wgsl`), line by
+//! line: the max-depth pyramid, the groups' boxes, the pieces' segments.
+//!
+//! After a frame the GPU's marks are exactly the pieces that pass against the pyramid of the
+//! frame's *final* depth: the late test marks what passes against the early depth, which is
+//! never nearer than the final one, so everything passing at the end passed then too, and the
+//! settling unmarks the rest. The reference recomputes that set from the depth read back. The
+//! GPU rounds its projections and the rasterizer's interpolation its own way, so each test is
+//! made twice — with the rectangle `slack` pixels narrower and the depth margin smaller, and
+//! with both larger — and a piece is *visible* where even the narrow test passes, *hidden*
+//! where even the wide one fails, else *unsure*: the GPU must agree on every sure one.
+
+use glam::{Mat4, Vec3, Vec4Swizzles};
+
+use super::Image;
+use crate::line_geometry::{ClusterRecord, GROUP_CLUSTERS, PIECE_SEGMENTS};
+
+/// One page as the GPU holds it ([`crate::LineGeometry::page_contents`]).
+pub struct PageContents {
+    pub records: Vec<ClusterRecord>,
+    /// Every point decoded on its cluster's grid, in page order.
+    pub points: Vec<[f32; 3]>,
+    /// Per group of 64 consecutive records, its box (min, max).
+    pub groups: Vec<(Vec3, Vec3)>,
+}
+
+/// The frame the cull tested against.
+pub struct CullView {
+    pub view: Mat4,
+    pub proj: Mat4,
+    /// The targets' guard-banded size.
+    pub size: (u32, u32),
+    pub line_width_px: f32,
+}
+
+/// What a test says once the GPU's rounding is allowed for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Verdict {
+    Visible,
+    Hidden,
+    Unsure,
+}
+
+/// How far the GPU may round: pixels of a rectangle's edges, and depth.
+#[derive(Clone, Copy, Debug)]
+pub struct Slack {
+    pub px: f32,
+    pub depth: f32,
+}
+
+/// `DEPTH_MARGIN` of `shaders/cull.wgsl`.
+const DEPTH_MARGIN: f32 = 2e-6;
+
+/// The max-depth pyramid of `depth`, level 0 first, down to 1 × 1 (`depth_pyramid.wgsl`).
+pub fn depth_pyramid(depth: &Image<f32>) -> Vec<Image<f32>> {
+    let mut levels = vec![depth.clone()];
+    while levels.last().is_some_and(|l| l.width > 1 || l.height > 1) {
+        let below = levels.last().expect("a level");
+        let (w, h) = (below.width.div_ceil(2), below.height.div_ceil(2));
+        let at = |x: usize, y: usize| below.data[y.min(below.height - 1) * below.width + x.min(below.width - 1)];
+        let data = (0..w * h)
+            .map(|i| {
+                let (x, y) = (2 * (i % w), 2 * (i / w));
+                at(x, y).max(at(x + 1, y)).max(at(x, y + 1)).max(at(x + 1, y + 1))
+            })
+            .collect();
+        levels.push(Image { width: w, height: h, data });
+    }
+    levels
+}
+
+/// Every piece's verdict (per page, per cluster, pieces 0–2; a piece a cluster lacks is
+/// hidden) for a frame of `view` whose final depth is `depth`.
+pub fn marks(pages: &[PageContents], view: &CullView, depth: &Image<f32>, slack: Slack) -> Vec<Vec<[Verdict; 3]>> {
+    let pyramid = depth_pyramid(depth);
+    let test = Tester { view, pyramid: &pyramid };
+    let both = |visible: &dyn Fn(f32, f32) -> bool| {
+        let (narrow, wide) = (visible(-slack.px, -slack.depth), visible(slack.px, slack.depth));
+        match (narrow, wide) {
+            (true, true) => Verdict::Visible,
+            (false, false) => Verdict::Hidden,
+            _ => Verdict::Unsure,
+        }
+    };
+    pages
+        .iter()
+        .map(|page| {
+            let groups: Vec<Verdict> =
+                page.groups.iter().map(|&(lo, hi)| both(&|px, d| test.world_box(lo, hi, px, d))).collect();
+            page.records
+                .iter()
+                .enumerate()
+                .map(|(i, c)| {
+                    std::array::from_fn(|p| {
+                        let drawn = c.drawn() as usize;
+                        let first = p * PIECE_SEGMENTS as usize;
+                        if first + 1 >= drawn {
+                            return Verdict::Hidden;
+                        }
+                        let last = (first + PIECE_SEGMENTS as usize).min(drawn - 1);
+                        let points: Vec<Vec3> =
+                            (first..=last).map(|k| Vec3::from_array(page.points[c.first as usize + k])).collect();
+                        let piece = both(&|px, d| test.piece(&points, px, d));
+                        match (groups[i / GROUP_CLUSTERS], piece) {
+                            (Verdict::Hidden, _) | (_, Verdict::Hidden) => Verdict::Hidden,
+                            (Verdict::Visible, Verdict::Visible) => Verdict::Visible,
+                            _ => Verdict::Unsure,
+                        }
+                    })
+                })
+                .collect()
+        })
+        .collect()
+}
+
+struct Tester<'a> {
+    view: &'a CullView,
+    pyramid: &'a [Image<f32>],
+}
+
+impl Tester<'_> {
+    /// `p` in NDC, none behind the eye.
+    fn project(&self, p: Vec3) -> Option<Vec3> {
+        let clip = self.view.proj * (self.view.view * p.extend(1.0));
+        (clip.w > 0.0).then(|| clip.xyz() / clip.w)
+    }
+
+    /// `box_in_view_visible`.
+    fn world_box(&self, lo: Vec3, hi: Vec3, px: f32, depth: f32) -> bool {
+        let (mut a, mut b) = (Vec3::splat(3.0e38), Vec3::splat(-3.0e38));
+        for k in 0..8 {
+            let corner = Vec3::select(glam::BVec3::new(k & 1 != 0, k & 2 != 0, k & 4 != 0), hi, lo);
+            let Some(ndc) = self.project(corner) else { return true };
+            (a, b) = (a.min(ndc), b.max(ndc));
+        }
+        self.ndc_box(a, b, px, depth)
+    }
+
+    /// `visible_segments` of `piece_visible`: whether one of the segments between `points` may.
+    fn piece(&self, points: &[Vec3], px: f32, depth: f32) -> bool {
+        let mut previous = None;
+        for &p in points {
+            let Some(ndc) = self.project(p) else { return true };
+            if previous.is_some_and(|q: Vec3| self.ndc_box(q.min(ndc), q.max(ndc), px, depth)) {
+                return true;
+            }
+            previous = Some(ndc);
+        }
+        false
+    }
+
+    /// `box_visible`, its rectangle `px` wider on each side and its margin `depth` larger.
+    fn ndc_box(&self, lo: Vec3, hi: Vec3, px: f32, depth: f32) -> bool {
+        if hi.z < 0.0 || lo.z > 1.0 {
+            return false;
+        }
+        let (w, h) = (self.view.size.0 as f32, self.view.size.1 as f32);
+        let reach = 0.5 * self.view.line_width_px + 1.0 + px;
+        let (x0, y0) = ((lo.x * 0.5 + 0.5) * w - reach, (0.5 - hi.y * 0.5) * h - reach);
+        let (x1, y1) = ((hi.x * 0.5 + 0.5) * w + reach, (0.5 - lo.y * 0.5) * h + reach);
+        if x1 < 0.0 || y1 < 0.0 || x0 >= w || y0 >= h {
+            return false;
+        }
+        let texel = |v: f32, most: f32| v.floor().clamp(0.0, most - 1.0) as usize;
+        let (ax, ay, bx, by) = (texel(x0, w), texel(y0, h), texel(x1, w), texel(y1, h));
+        let mut l = 0;
+        while l + 1 < self.pyramid.len() && ((bx >> l) - (ax >> l) > 1 || (by >> l) - (ay >> l) > 1) {
+            l += 1;
+        }
+        let level = &self.pyramid[l];
+        let farthest = ((ay >> l)..=(by >> l))
+            .flat_map(|y| ((ax >> l)..=(bx >> l)).map(move |x| level.data[y * level.width + x]))
+            .fold(0.0f32, f32::max);
+        lo.z <= farthest + DEPTH_MARGIN + depth
+    }
+}
