@@ -347,6 +347,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     // What the culled lines drew in their last frame (they ran last among the line passes).
     let (visible_pieces, visible_clusters) = match selected("lines-culled") || selected("cull") {
         true => {
+            if let Some(note) = passes.lines_culled.cull_note() {
+                eprintln!("lineao: lines-culled: {note}");
+            }
             let (early, late) = passes.lines_culled.drawn_pieces(queue, geometry)?.unwrap_or_default();
             let pieces = lineao::passes::cull::LineCull::pieces(geometry).max(1) as f64;
             let clusters = passes.lines_culled.visible_clusters(queue, geometry)?.unwrap_or_default();
