@@ -162,6 +162,8 @@ pub struct LineCull {
     pyramid_layout: wgpu::BindGroupLayout,
     state_layout: wgpu::BindGroupLayout,
     listing_layout: wgpu::BindGroupLayout,
+    /// The pyramid's bind group, made once for each pyramid (the targets' size).
+    pyramid_group: std::sync::Mutex<Option<(Arc<Built>, wgpu::BindGroup)>>,
     pieces_layout: wgpu::BindGroupLayout,
 }
 
@@ -210,6 +212,7 @@ impl LineCull {
             pyramid_layout,
             state_layout,
             listing_layout,
+            pyramid_group: std::sync::Mutex::new(None),
         }
     }
 
@@ -226,6 +229,24 @@ impl LineCull {
                 targets.size.0, targets.size.1
             )
         })
+    }
+
+    /// The bind group of pyramid `built` (made when the pyramid is).
+    fn pyramid_group(&self, built: &Arc<Built>) -> wgpu::BindGroup {
+        let mut cached = self.pyramid_group.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+        match cached.as_ref() {
+            Some((of, group)) if Arc::ptr_eq(of, built) => group.clone(),
+            _ => {
+                let group = binding::group(
+                    &self.device,
+                    "lineao::LineCull::pyramid",
+                    &self.pyramid_layout,
+                    &[built.uniform.as_entire_binding(), built.texels.as_entire_binding()],
+                );
+                *cached = Some((built.clone(), group.clone()));
+                group
+            }
+        }
     }
 
     /// `page`'s state, made on its first frame.
@@ -326,12 +347,7 @@ impl LineCull {
         pieces: &wgpu::ComputePipeline,
         span: Option<Span>,
     ) {
-        let pyramid = binding::group(
-            &self.device,
-            "lineao::LineCull::pyramid",
-            &self.pyramid_layout,
-            &[built.uniform.as_entire_binding(), built.texels.as_entire_binding()],
-        );
+        let pyramid = self.pyramid_group(built);
         for page in pages {
             encoder.clear_buffer(&self.state(page).listing, 0, None);
         }
