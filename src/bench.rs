@@ -15,6 +15,7 @@
 //! - `nd-pyramid`, `composite`; `bilateral`: the separable bilateral blur (radius 4), which can
 //!   follow any method;
 //! - `tubes`: the same streamlines as ray-cast tubes of radius 0.5 mm (against `lines`);
+//!   `tubes-culled`: the same tubes culled on the GPU, both phases (against `lines-culled`);
 //! - `nd-from-depth`: the ND and zoom maps derived from the G-buffer's depth, as from a host
 //!   renderer's (what embedding costs besides the method).
 //!
@@ -90,6 +91,8 @@ struct Passes {
     composite: Composite,
     bilateral: Bilateral,
     tubes: TubeRenderer,
+    /// The tubes culled on the GPU (`tubes-culled`, the chain's default for tubes).
+    tubes_culled: TubeRenderer,
     /// The ND and zoom maps from the G-buffer's own depth, as from a host's (whose bind group
     /// is made per frame, on the device).
     nd_from_depth: NdFromDepth,
@@ -140,6 +143,7 @@ impl Passes {
             composite: Composite::new(device, format),
             bilateral: Bilateral::new(device),
             tubes: TubeRenderer::new(device, false),
+            tubes_culled: TubeRenderer::new(device, false).culled(device),
             nd_from_depth: NdFromDepth::new(device, HostConfig::default()),
             stages: Vec::new(),
             settings: settings.clone(),
@@ -151,7 +155,9 @@ impl Passes {
         for renderer in [&passes.lines, &passes.lines_culled, &passes.lines_native, &passes.lines_full] {
             renderer.prepare(queue, view, settings.line_width_px, settings.line_color, &settings.lighting);
         }
-        passes.tubes.prepare(queue, view, TUBE_RADIUS * view.zoom_unit, settings.line_color, &settings.lighting);
+        for renderer in [&passes.tubes, &passes.tubes_culled] {
+            renderer.prepare(queue, view, TUBE_RADIUS * view.zoom_unit, settings.line_color, &settings.lighting);
+        }
         passes.nd_from_depth.prepare(queue, view);
         passes.pyramid.resize(device, targets);
         for (method, pass) in lineao::method::bench_passes() {
@@ -208,6 +214,7 @@ impl Passes {
             "composite" => self.composite.encode(encoder, &self.output.view, span),
             "bilateral" => self.bilateral.encode(encoder, targets, span),
             "tubes" => self.tubes.encode(encoder, targets, geometry, Load::Clear(background), span),
+            "tubes-culled" => self.tubes_culled.encode(encoder, targets, geometry, Load::Clear(background), span),
             "nd-from-depth" => {
                 let inputs = HostInputs { depth: &targets.depth.view, normals: None, color: None };
                 self.nd_from_depth.encode(&self.device, encoder, targets, &inputs, span);
@@ -344,26 +351,24 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         }
     }
 
-    // What the culled lines drew in their last frame (they ran last among the line passes).
-    let (visible_pieces, visible_clusters) = match selected("lines-culled") || selected("cull") {
-        true => {
-            if let Some(note) = passes.lines_culled.cull_note() {
-                eprintln!("lineao: lines-culled: {note}");
-            }
-            let (early, late) = passes.lines_culled.drawn_pieces(queue, geometry)?.unwrap_or_default();
-            let pieces = lineao::passes::cull::LineCull::pieces(geometry).max(1) as f64;
-            let clusters = passes.lines_culled.visible_clusters(queue, geometry)?.unwrap_or_default();
-            let share = ((early + late) as f64 / pieces, clusters as f64 / geometry.clusters().max(1) as f64);
-            eprintln!(
-                "lineao: lines-culled: {:.2} % of the {} pieces of 8 segments drawn, in {:.2} % of the clusters",
-                100.0 * share.0,
-                pieces,
-                100.0 * share.1
-            );
-            (Some(share.0), Some(share.1))
+    // What the culled lines and tubes drew in their last frame (they ran last among their
+    // passes).
+    let mut visible = (None, None);
+    for (name, renderer) in [("lines-culled", passes.lines_culled.cull()), ("tubes-culled", passes.tubes_culled.cull())]
+    {
+        let Some(culled) = renderer.filter(|_| selected(name) || (name == "lines-culled" && selected("cull"))) else {
+            continue;
+        };
+        if let Some(note) = culled.note() {
+            eprintln!("lineao: {name}: {note}");
         }
-        false => (None, None),
-    };
+        let counts = culled.counts(queue, geometry)?;
+        eprintln!("lineao: {name}: {counts}");
+        if name == "lines-culled" {
+            visible = (Some(counts.drawn_share()), Some(counts.visible_share()));
+        }
+    }
+    let (visible_pieces, visible_clusters) = visible;
     let on = if timer.is_some() { "gpu" } else { "cpu" };
     let mut passes: Vec<_> =
         all.iter().zip(times).filter(|(name, _)| selected(name)).map(|(name, ms)| summary(name, on, ms)).collect();
@@ -561,6 +566,8 @@ fn print_table(report: &serde_json::Value, passes: &[serde_json::Value]) {
         ("lines-full-strip", "lines-native-1px"),
         ("lines", "lines-strip"),
         ("tubes", "lines"),
+        ("tubes-culled", "lines-culled"),
+        ("tubes-culled", "tubes"),
         ("lineao-chain", "ssao-16-chain"),
         ("lineao-level", "lineao"),
         ("lineao-chain-level", "ssao-16-chain"),

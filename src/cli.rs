@@ -200,7 +200,7 @@ pub struct BenchLoadArgs {
 // The passes `lineao bench --passes` names (its vocabulary, so the CLI needs nothing of the
 // bench itself).
 /// The bench's own GPU passes: the geometry and what every method shares.
-const OWN_GPU_PASSES: [&str; 12] = [
+const OWN_GPU_PASSES: [&str; 13] = [
     "lines",
     "lines-native-1px",
     "lines-full-strip",
@@ -212,6 +212,7 @@ const OWN_GPU_PASSES: [&str; 12] = [
     "composite",
     "bilateral",
     "tubes",
+    "tubes-culled",
     "nd-from-depth",
 ];
 

@@ -314,6 +314,7 @@ fn bench_json_is_the_contract() {
         "vo-area-1",
         "bilateral",
         "tubes",
+        "tubes-culled",
         "nd-from-depth",
         "raytraced-1spp",
         "raytraced-start-1spp",

@@ -501,6 +501,9 @@ impl Session {
                 }
                 None => eprintln!("lineao: {label}: frame {wall_ms:.2} ms (CPU wall time: no timestamp queries)"),
             }
+            if let Some(counts) = chain.cull_counts(&gpu.queue, &self.lines.geometry)? {
+                eprintln!("lineao: {label}: cull: {counts}");
+            }
         }
         let truth = if panel.settings.method == AoMethod::RayTraced && args.truth.cpu {
             let truth = self.trace(&chain, &crate::truth::settings(args, self.longest_side))?;

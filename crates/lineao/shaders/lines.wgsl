@@ -12,6 +12,7 @@
 // one point: zero-area triangles.
 #import shared/clusters.wgsl
 #import shared/geometry.wgsl
+#import shared/pieces.wgsl
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
@@ -158,22 +159,16 @@ fn vs_native(@builtin(vertex_index) v: u32, @builtin(instance_index) cluster: u3
     return line_vertex(q.position, q.tangent, 0.0, point_scalar(q.index));
 }
 
-// The pieces the cull found visible (`lineao::passes::cull`), cluster << 2 | piece, for
-// `vs_piece`: piece p of a cluster is the part of its full strip from point 8p to 8p + 8 (or
-// its end), the same triangles, so the culled lines draw the full strip's pixels exactly.
-@group(2) @binding(0) var<storage, read> visible_pieces: array<u32>;
-
 struct Piece {
     cluster: Cluster,
     at: StripPosition,
 }
 
-// Vertex `v` of instance `instance`: block v / PIECE_STRIDE is a listed piece's full strip and
-// then a repeat of its last vertex and of the next block's first, so that the blocks' triangles
-// are their own strips' (each block starts at an even vertex: the same vertex order in every
-// triangle) and those between them have zero area. Slots past the listed pieces hold pieces
-// listed before (or cluster 0's first): drawing more of the lines than the visible ones leaves
-// the same G-buffer.
+// Vertex `v` of instance `instance`: block v / PIECE_STRIDE is a listed piece's full strip (the
+// same triangles as the cluster's full strip, so the culled lines draw its pixels exactly) and
+// then a repeat of its last vertex and of the next block's first, so that the blocks'
+// triangles are their own strips' (each block starts at an even vertex: the same vertex order
+// in every triangle) and those between them have zero area.
 fn piece_vertex(v: u32, instance: u32) -> Piece {
     let block = v / PIECE_STRIDE;
     var k = v % PIECE_STRIDE;
@@ -183,13 +178,10 @@ fn piece_vertex(v: u32, instance: u32) -> Piece {
         slot += 1u;
         k = 0u;
     }
-    let entry = visible_pieces[min(slot, arrayLength(&visible_pieces) - 1u)];
-    let c = clusters[entry >> 2u];
-    let first = (entry & 3u) * PIECE_SEGMENTS;
-    let points = min(drawn_points(c) - first, PIECE_SEGMENTS + 1u);
+    let piece = visible_piece(slot);
     // Its strip's last vertex (the repeat after it, or the end of the instance).
-    let at = full_strip(min(k, 2u * (PIECE_SEGMENTS + 1u) - 1u), points);
-    return Piece(c, StripPosition(select(-1, at.point + i32(first), at.point >= 0), at.side));
+    let at = full_strip(min(k, 2u * (PIECE_SEGMENTS + 1u) - 1u), piece.points);
+    return Piece(piece.cluster, StripPosition(select(-1, at.point + i32(piece.first), at.point >= 0), at.side));
 }
 
 @vertex

@@ -4,11 +4,14 @@
 // billboards at the joints each ray-cast their own segment and the depth test keeps the nearest
 // hit, so a polyline renders as the exact union of its segments' solids: seamless joints.
 // The vertex shader pulls the segments from the clusters (`shared/clusters.wgsl`): instance = a
-// cluster, six vertices (two triangles) per segment. `lineao::passes::tubes` documents it;
-// `lineao::reference::tubes` is the CPU side.
+// cluster, six vertices (two triangles) per segment; culled, instance = visible pieces
+// (`shared/pieces.wgsl`). `lineao::passes::tubes` documents it; `lineao::reference::tubes` is
+// the CPU side.
+#import shared/billboard.wgsl
 #import shared/clusters.wgsl
 #import shared/cone.wgsl
 #import shared/geometry.wgsl
+#import shared/pieces.wgsl
 
 struct TubeOut {
     @builtin(position) clip: vec4<f32>,
@@ -29,25 +32,6 @@ struct TubeOut {
     @location(10) ray_direction: vec3<f32>,
 }
 
-// A bound of the screen radius in pixels of a sphere of radius `r` at view position `p`:
-// r f / (d − r) at depth d, stretched by (|p| / d)² toward the image's edges (a sphere off the
-// optical axis projects to an ellipse).
-fn screen_radius(p: vec3<f32>, r: f32) -> f32 {
-    if is_orthographic() {
-        return r * frame.f_px;
-    }
-    let d = -p.z;
-    if d <= r * 1.0001 {
-        return 2.0 * max(frame.viewport.x, frame.viewport.y);
-    }
-    let stretch = dot(p, p) / (d * d);
-    return r * frame.f_px / (d - r) * stretch;
-}
-
-fn to_pixels(clip: vec4<f32>) -> vec2<f32> {
-    return (clip.xy / clip.w * vec2<f32>(0.5, -0.5) + 0.5) * frame.viewport;
-}
-
 // Corner `corner` (0..3 of the billboard: (−, −), (−, +), (+, −), (+, +)) of the segment from
 // `a` to `b` (world points with unit tangents `ta`, `tb`) of radii `ra`, `rb` (world units).
 fn tube_vertex(corner: u32, a_world: PulledPoint, b_world: PulledPoint, ra: f32, rb: f32) -> TubeOut {
@@ -66,29 +50,21 @@ fn tube_vertex(corner: u32, a_world: PulledPoint, b_world: PulledPoint, ra: f32,
     out.octants_b_lo = octants_b[0];
     out.octants_b_hi = octants_b[1];
     // An end behind the eye: a degenerate billboard (outside the clip volume).
-    if !is_orthographic() && (-a.z <= 0.0 || -b.z <= 0.0) {
+    if behind_eye(a) || behind_eye(b) {
         out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
         return out;
     }
-    // The billboard: the ends' disks on screen, hulled by a rectangle along the segment, one
-    // pixel wider all round.
-    let clip_a = frame.proj * vec4<f32>(a, 1.0);
-    let clip_b = frame.proj * vec4<f32>(b, 1.0);
-    let pa = to_pixels(clip_a);
-    let pb = to_pixels(clip_b);
-    let reach_a = screen_radius(a, ra) + 1.0;
-    let reach_b = screen_radius(b, rb) + 1.0;
-    let along = select(vec2<f32>(1.0, 0.0), normalize(pb - pa), distance(pa, pb) > 1e-6);
-    let across = vec2<f32>(-along.y, along.x) * max(reach_a, reach_b);
+    // The billboard (`shared/billboard.wgsl`): the ends' disks on screen, hulled by a rectangle
+    // along the segment, at the solid's nearest depth (the fragment shader writes the true
+    // depth, never nearer).
+    let bb = billboard(a, b, ra, rb);
+    let along = select(vec2<f32>(1.0, 0.0), normalize(bb.pb - bb.pa), distance(bb.pa, bb.pb) > 1e-6);
+    let across = vec2<f32>(-along.y, along.x) * max(bb.reach_a, bb.reach_b);
     let end = (corner & 2u) != 0u;
     let side = select(-1.0, 1.0, (corner & 1u) != 0u);
-    let pixel = select(pa - along * reach_a, pb + along * reach_b, end) + across * side;
-    // Back to clip space at the solid's nearest depth (the nearer end sphere's front): the
-    // fragment shader writes the true depth, never nearer.
-    let front = min(-a.z - ra, -b.z - rb);
-    let near_clip = frame.proj * vec4<f32>(0.0, 0.0, -max(front, 1e-6), 1.0);
+    let pixel = select(bb.pa - along * bb.reach_a, bb.pb + along * bb.reach_b, end) + across * side;
     let ndc = (pixel / frame.viewport - 0.5) * vec2<f32>(2.0, -2.0);
-    out.clip = vec4<f32>(ndc, clamp(near_clip.z / near_clip.w, 0.0, 1.0), 1.0);
+    out.clip = vec4<f32>(ndc, bb.depth, 1.0);
     let near = frame.inv_proj * vec4<f32>(ndc, 0.0, 1.0);
     let far = frame.inv_proj * vec4<f32>(ndc, 1.0, 1.0);
     out.ray_origin = near.xyz / near.w;
@@ -96,13 +72,10 @@ fn tube_vertex(corner: u32, a_world: PulledPoint, b_world: PulledPoint, ra: f32,
     return out;
 }
 
-// Vertex v of a cluster's tubes: segment v / 6, two triangles of its billboard's corners.
-// Segments past the cluster's end lie outside the clip volume.
-@vertex
-fn vs_tube(@builtin(vertex_index) v: u32, @builtin(instance_index) cluster: u32) -> TubeOut {
-    let c = clusters[cluster];
-    let segment = v / 6u;
-    if segment + 1u >= drawn_points(c) {
+// Corner `corner` (0..5: two triangles) of segment `segment` of cluster `c`'s strip, whose
+// points before `end` are drawn; a segment past them lies outside the clip volume.
+fn segment_vertex(c: Cluster, segment: u32, corner: u32, end: u32) -> TubeOut {
+    if segment + 1u >= end {
         var out: TubeOut;
         out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
         return out;
@@ -114,7 +87,24 @@ fn vs_tube(@builtin(vertex_index) v: u32, @builtin(instance_index) cluster: u32)
     let rb = point_radius(b.index);
     let radius_a = select(frame.tube_radius, ra, ra > 0.0);
     let radius_b = select(frame.tube_radius, rb, rb > 0.0);
-    return tube_vertex(corners[v % 6u], a, b, radius_a, radius_b);
+    return tube_vertex(corners[corner], a, b, radius_a, radius_b);
+}
+
+// Vertex v of a cluster's tubes: segment v / 6, two triangles of its billboard's corners.
+@vertex
+fn vs_tube(@builtin(vertex_index) v: u32, @builtin(instance_index) cluster: u32) -> TubeOut {
+    let c = clusters[cluster];
+    return segment_vertex(c, v / 6u, v % 6u, drawn_points(c));
+}
+
+// Vertex v of an instance of the culled tubes (`lineao::passes::cull`): PIECES_PER_INSTANCE
+// listed pieces, six vertices for each of a piece's segments.
+@vertex
+fn vs_tube_piece(@builtin(vertex_index) v: u32, @builtin(instance_index) instance: u32) -> TubeOut {
+    let per_piece = 6u * PIECE_SEGMENTS;
+    let piece = visible_piece(instance * PIECES_PER_INSTANCE + v / per_piece);
+    let k = v % per_piece;
+    return segment_vertex(piece.cluster, piece.first + k / 6u, k % 6u, piece.first + piece.points);
 }
 
 // The first hit of the ray ro + t rd (|rd| = 1) with the rounded cone between spheres (pa, ra)

@@ -246,7 +246,7 @@ pub struct ChainSettings {
     pub zoom_unit: f32,
     /// Upper bound of the guard band in pixels, whatever the method. Default 128.
     pub guard_max_px: u32,
-    /// Draw only the lines that can be seen, culled on the GPU against the last frame's depth
+    /// Draw only the lines (or tubes) that can be seen, culled on the GPU against the last frame's depth
     /// ([`crate::passes::cull`]): the full strip's G-buffer exactly, a fraction of the cost
     /// where lines hide lines (a whole brain) from the second frame of a view on. Default on:
     /// a chain draws frames one after another. A single picture has no frame before it, and

@@ -9,6 +9,7 @@ use std::borrow::Cow;
 /// The WGSL files of the shared passes (under `shaders/`), by path relative to that folder;
 /// each method's are in its folder and its registry entry ([`crate::method::MethodInfo::shaders`]).
 const SHARED: &[(&str, &str)] = &[
+    ("shared/billboard.wgsl", include_str!("../shaders/shared/billboard.wgsl")),
     ("shared/clusters.wgsl", include_str!("../shaders/shared/clusters.wgsl")),
     ("shared/cone.wgsl", include_str!("../shaders/shared/cone.wgsl")),
     ("shared/fullscreen.wgsl", include_str!("../shaders/shared/fullscreen.wgsl")),
@@ -17,6 +18,7 @@ const SHARED: &[(&str, &str)] = &[
     ("shared/lighting.wgsl", include_str!("../shaders/shared/lighting.wgsl")),
     ("shared/moments.wgsl", include_str!("../shaders/shared/moments.wgsl")),
     ("shared/nd.wgsl", include_str!("../shaders/shared/nd.wgsl")),
+    ("shared/pieces.wgsl", include_str!("../shaders/shared/pieces.wgsl")),
     ("shared/view.wgsl", include_str!("../shaders/shared/view.wgsl")),
     ("shared/vo.wgsl", include_str!("../shaders/shared/vo.wgsl")),
     ("bilateral.wgsl", include_str!("../shaders/bilateral.wgsl")),

@@ -19,7 +19,8 @@ struct Cluster {
 struct ClusterPage {
     // Which attribute arrays hold data: 1 octants, 2 scalars, 4 radii.
     attributes: u32,
-    _pad0: u32,
+    // The largest tube radius its points hold (0 where none: the frame's), for the cull.
+    max_radius: f32,
     _pad1: u32,
     _pad2: u32,
 }
@@ -40,7 +41,7 @@ const PIECE_SEGMENTS: u32 = 8u;
 const PIECES_PER_INSTANCE: u32 = 8u;
 const PIECE_STRIDE: u32 = 2u * (PIECE_SEGMENTS + 1u) + 2u;
 // Clusters of a group (`lineao::line_geometry::GROUP_CLUSTERS`).
-const GROUP_CLUSTERS: u32 = 64u;
+const GROUP_CLUSTERS: u32 = 16u;
 
 // x | y << 16 per point; z two points to a word.
 @group(1) @binding(0) var<storage, read> cluster_xy: array<u32>;

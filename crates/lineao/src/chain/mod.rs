@@ -117,7 +117,7 @@ impl AoChain {
                 stages
             },
             lines: line_renderer(device, &settings),
-            tubes: settings.tubes.as_ref().map(|_| TubeRenderer::new(device, settings.volume.is_some())),
+            tubes: tube_renderer(device, &settings),
             meshes: settings.surfaces.as_ref().map(|_| MeshRenderer::new(device, settings.volume.is_some())),
             bilateral: Bilateral::new(device),
             volume_ao: settings.volume.as_ref().map(|_| VolumeAo::new(device)),
@@ -161,12 +161,14 @@ impl AoChain {
             self.volume_ao = settings.volume.as_ref().map(|_| VolumeAo::new(device));
         }
         let tubes_match = match (&self.tubes, &settings.tubes) {
-            (Some(renderer), Some(_)) => renderer.writes_octants() == octants,
+            (Some(renderer), Some(_)) => {
+                renderer.writes_octants() == octants && renderer.cull().is_some() == settings.cull
+            }
             (None, None) => true,
             _ => false,
         };
         if !tubes_match {
-            self.tubes = settings.tubes.as_ref().map(|_| TubeRenderer::new(device, octants));
+            self.tubes = tube_renderer(device, &settings);
         }
         let meshes_match = match (&self.meshes, &settings.surfaces) {
             (Some(renderer), Some(_)) => renderer.writes_octants() == octants,
@@ -215,6 +217,21 @@ impl AoChain {
             self.timer = if enabled { PassTimer::new(device, queue, &method::pass_names()) } else { None };
         }
         self.timer.is_some()
+    }
+
+    /// What the cull drew of `geometry` in the last frame (lines, or tubes where the settings
+    /// ask for them), read back (waits for the device); `None` where it does not cull, or
+    /// cannot on this device.
+    pub fn cull_counts(
+        &self,
+        queue: &wgpu::Queue,
+        geometry: &LineGeometry,
+    ) -> Result<Option<crate::passes::cull::CullCounts>, Error> {
+        let culled = match &self.tubes {
+            Some(tubes) => tubes.cull(),
+            None => self.lines.cull(),
+        };
+        culled.filter(|c| c.note().is_none()).map(|c| c.counts(queue, geometry)).transpose()
     }
 
     /// GPU time of each pass of the last submitted frame (waits for it), or `None` when timing
@@ -537,4 +554,12 @@ impl AoChain {
 fn line_renderer(device: &wgpu::Device, settings: &ChainSettings) -> LineRenderer {
     let renderer = LineRenderer::with_outputs(device, LineStyle::Quads, settings.volume.is_some());
     if settings.cull { renderer.culled(device) } else { renderer }
+}
+
+/// The chain's tube renderer where `settings` asks for tubes: writing the octants with
+/// object-space AO, culled on the GPU with [`ChainSettings::cull`].
+fn tube_renderer(device: &wgpu::Device, settings: &ChainSettings) -> Option<TubeRenderer> {
+    settings.tubes.as_ref()?;
+    let renderer = TubeRenderer::new(device, settings.volume.is_some());
+    Some(if settings.cull { renderer.culled(device) } else { renderer })
 }

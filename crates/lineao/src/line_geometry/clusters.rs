@@ -44,7 +44,7 @@ pub const PIECE_SEGMENTS: u32 = 8;
 
 /// Consecutive records of a page (close in space: they are sorted along a Morton curve within
 /// their class) the cull tests as one box first; as `GROUP_CLUSTERS` in `shaders/cull.wgsl`.
-pub const GROUP_CLUSTERS: usize = 64;
+pub const GROUP_CLUSTERS: usize = 16;
 
 /// The size classes: a cluster of class `c` draws at most `c` segments.
 pub(crate) const SIZE_CLASSES: [u32; 4] = [3, 6, 12, 24];

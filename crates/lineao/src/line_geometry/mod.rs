@@ -184,6 +184,12 @@ impl PageAttributes {
         }
     }
 
+    /// The largest radius it holds, as stored (0 where none).
+    fn max_radius(&self) -> f32 {
+        let radii = self.radius.iter().flatten();
+        radii.map(|&bits| half::f16::from_bits(bits).to_f32()).fold(0.0, f32::max)
+    }
+
     /// Which arrays it holds, as the shaders' `attributes` bits.
     fn flags(&self) -> u32 {
         self.octants.is_some() as u32 | (self.scalar.is_some() as u32) << 1 | (self.radius.is_some() as u32) << 2
@@ -195,7 +201,15 @@ impl PageAttributes {
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub(crate) struct PageUniform {
     pub attributes: u32,
-    pub _pad: [u32; 3],
+    /// The largest tube radius its points hold (0 where none), for the tube cull's bound.
+    pub max_radius: f32,
+    pub _pad: [u32; 2],
+}
+
+impl PageUniform {
+    fn of(attributes: &PageAttributes) -> PageUniform {
+        PageUniform { attributes: attributes.flags(), max_radius: attributes.max_radius(), _pad: [0; 2] }
+    }
 }
 
 /// The bind group layout of a page (group 1 of the line and tube pipelines): the points, the
@@ -221,8 +235,9 @@ pub(crate) struct Page {
     pub records: u32,
     /// Pieces of eight segments its clusters' strips have (the culled lines' unit).
     pub pieces: u64,
-    /// Its culling state, made on its first culled frame.
-    pub cull: std::sync::OnceLock<crate::passes::cull::PageCull>,
+    /// Its culling state for lines and for tubes (each marks what it found visible),
+    /// made on its first culled frame.
+    pub cull: [std::sync::OnceLock<crate::passes::cull::PageCull>; 2],
     points: u32,
     runs: Vec<RunMap>,
     pub xy: wgpu::Buffer,
@@ -231,14 +246,14 @@ pub(crate) struct Page {
     /// Per group of consecutive clusters, the box of their points (the cull's first test).
     pub groups: wgpu::Buffer,
     attributes: [Option<wgpu::Buffer>; 3],
-    uniform: wgpu::Buffer,
+    pub uniform: wgpu::Buffer,
 }
 
 impl Page {
     /// Bytes of its buffers.
     fn bytes(&self) -> u64 {
         let attributes: u64 = self.attributes.iter().flatten().map(wgpu::Buffer::size).sum();
-        let cull = self.cull.get().map_or(0, crate::passes::cull::PageCull::bytes);
+        let cull: u64 = self.cull.iter().filter_map(|c| c.get()).map(crate::passes::cull::PageCull::bytes).sum();
         let own = self.xy.size() + self.z.size() + self.clusters.size() + self.groups.size();
         own + attributes + self.uniform.size() + cull
     }
@@ -471,7 +486,7 @@ impl LineGeometry {
         attributes: PageAttributes,
     ) -> Result<Page, Error> {
         let points = data.xy.len() as u32;
-        let flags = attributes.flags();
+        let page_uniform = PageUniform::of(&attributes);
         let buffer = |label: &str, bytes: &[u8]| storage_buffer(device, queue, label, bytes);
         let xy = buffer("lineao::LineGeometry::xy", bytemuck::cast_slice(&data.xy))?;
         let z = buffer("lineao::LineGeometry::z", bytemuck::cast_slice(&data.z))?;
@@ -484,14 +499,14 @@ impl LineGeometry {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        queue.write_buffer(&uniform, 0, bytemuck::bytes_of(&PageUniform { attributes: flags, _pad: [0; 3] }));
+        queue.write_buffer(&uniform, 0, bytemuck::bytes_of(&page_uniform));
         Ok(Page {
             group: self.bind_group(device, [&xy, &z, &clusters, &groups], &attributes, &uniform),
             classes: data.classes,
             tolerance: data.tolerance,
             records: data.records.len() as u32,
             pieces: data.records.iter().map(|r| r.drawn().saturating_sub(1).div_ceil(PIECE_SEGMENTS) as u64).sum(),
-            cull: std::sync::OnceLock::new(),
+            cull: Default::default(),
             points,
             runs: data.runs,
             xy,
@@ -568,12 +583,12 @@ impl LineGeometry {
         for i in 0..self.pages.len() {
             let page = &self.pages[i];
             let gathered = attributes.gather(&page.runs, 0);
-            let flags = gathered.flags();
+            let page_uniform = PageUniform::of(&gathered);
             let buffers = self.attribute_buffers(device, queue, gathered)?;
             let page = &self.pages[i];
             let group =
                 self.bind_group(device, [&page.xy, &page.z, &page.clusters, &page.groups], &buffers, &page.uniform);
-            queue.write_buffer(&page.uniform, 0, bytemuck::bytes_of(&PageUniform { attributes: flags, _pad: [0; 3] }));
+            queue.write_buffer(&page.uniform, 0, bytemuck::bytes_of(&page_uniform));
             let page = &mut self.pages[i];
             page.attributes = buffers;
             page.group = group;
@@ -836,5 +851,5 @@ fn records_and_the_page_uniform_match_their_wgsl_structs() {
         "Cluster",
         [origin, scale, first, flags, previous, next]
     );
-    crate::shader::assert_wgsl_layout!(PageUniform, "shared/clusters.wgsl", "ClusterPage", [attributes]);
+    crate::shader::assert_wgsl_layout!(PageUniform, "shared/clusters.wgsl", "ClusterPage", [attributes, max_radius]);
 }

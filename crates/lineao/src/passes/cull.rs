@@ -1,4 +1,4 @@
-//! **Culling the lines on the GPU**, exactly: only the pieces of streamline that can leave a
+//! **Culling the lines (and tubes) on the GPU**, exactly: only the pieces of streamline that can leave a
 //! fragment in front of what is already drawn are drawn. A whole brain seen from outside is a
 //! hairy surface hundreds of lines deep (`scripts/depth-complexity.py`: 225 fragments a
 //! covered pixel at 10 M points), and screen-space AO sees only the front one.
@@ -16,15 +16,17 @@
 //! 3. **late**: compute passes test every piece against the view and the pyramid, mark it
 //!    visible or not for the next frame, and list the visible ones not drawn early, which are
 //!    drawn over the first;
-//! 4. **settle**: the pyramid of the frame's final depth, and the pieces marked visible are
-//!    tested again against it, so that the next frame's early list holds only what this frame
-//!    shows (after a first frame or a cut, the late phase marks everything that passed against
-//!    the early depth: without this the second frame would draw nearly all again).
+//! 4. **settle**: the pyramid of the frame's final depth, and the pieces drawn (the only ones
+//!    marked visible) are tested again against it, so that the next frame's early list holds
+//!    only what this frame shows (after a first frame or a cut, the late phase marks everything
+//!    that passed against the early depth: without this the second frame would draw nearly all
+//!    again).
 //!
 //! **The tests** (`shaders/cull.wgsl`) run coarse to fine. A page's clusters lie along a
-//! Morton curve within their draw class, so 64 consecutive ones (a *group*) are a small region
-//! of space: `test_groups` tests each group's box (8 projected corners) and lists those that
-//! may be visible, clearing the marks of the others; then a workgroup per listed group runs an
+//! Morton curve within their draw class, so 16 consecutive ones (a *group*) are a small region
+//! of space: `test_groups` tests each group's box (8 projected corners, the pyramid read where
+//! the box spans at most 16 × 16 texels: a large box read coarsely nearly always passes) and
+//! lists those that may be visible, clearing the marks of the others; then a workgroup per listed group runs an
 //! invocation per piece, which tests the piece *segment by segment*. A segment's two triangles
 //! have their corners half a line width from its two points on screen, at those points' depths
 //! (the vertex shader pushes points sideways on screen only), so its fragments lie within half a
@@ -43,9 +45,15 @@
 //! and the order decides. A first frame, a camera cut or a resize costs one full draw (nothing
 //! was visible before, so the late phase draws all that passes against an empty pyramid).
 //!
-//! Each page keeps its state ([`PageCull`]): a word a cluster (its visible pieces), the list
-//! of pieces to draw (a word each), the listed groups and the indirect draws and dispatch:
-//! about 0.7 bytes a point, made on the page's first culled frame.
+//! **Tubes** ([`Shape::Tubes`], `crate::passes::tubes`) are culled the same way, piece by
+//! piece: a segment's fragments lie within its billboard (`shaders/shared/billboard.wgsl`: the
+//! end spheres' disks on screen hulled by a rectangle, at the depth of the solid's front, which
+//! the written depth is never nearer than), bounded for the largest radius the page's points
+//! hold (its uniform) or the frame's; a group's box grows by that radius.
+//!
+//! Each page keeps its state ([`PageCull`]), one for lines and one for tubes: a word a cluster
+//! (its visible pieces), the list of pieces to draw (a word each), the listed groups and the
+//! indirect draws and dispatch: about 1.3 bytes a point, made on the page's first culled frame.
 
 use std::sync::Arc;
 
@@ -72,6 +80,16 @@ const LISTING_BYTES: u64 = 16;
 fn dispatch_over(pass: &mut wgpu::ComputePass, count: u32) {
     let groups = count.div_ceil(WORKGROUP_INVOCATIONS);
     pass.dispatch_workgroups(groups.min(ROW), groups.div_ceil(ROW), 1);
+}
+
+/// What the culled pieces are drawn as: what bounds a segment's fragments.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shape {
+    /// Lines of the frame's width in pixels (`lines.wgsl`'s `vs_piece`).
+    Lines,
+    /// Ray-cast tubes (`tubes.wgsl`'s `vs_tube_piece`), bounded for the largest radius of a
+    /// page's points.
+    Tubes,
 }
 
 /// Which of a frame's two draws.
@@ -105,8 +123,9 @@ impl Phase {
 pub struct PageCull {
     /// The indirect draws (and, in the same buffer, the marks and the listed groups).
     pub(crate) state: wgpu::Buffer,
-    /// The visible pieces, read by the vertex shader (`lines.wgsl`'s group 2).
-    pub(crate) draw_group: wgpu::BindGroup,
+    /// The early and the late list of visible pieces, read by the vertex shader (group 2 of
+    /// `lines.wgsl`, `tubes.wgsl`).
+    draw_groups: [wgpu::BindGroup; 2],
     compute_group: wgpu::BindGroup,
     /// With the listed groups' dispatch (`test_groups`, `size_dispatch`).
     listing_group: wgpu::BindGroup,
@@ -117,25 +136,29 @@ pub struct PageCull {
 }
 
 impl PageCull {
+    /// The pieces `phase` draws, as the vertex shader reads them.
+    pub(crate) fn draw_group(&self, phase: Phase) -> &wgpu::BindGroup {
+        &self.draw_groups[phase as usize]
+    }
+
     /// Bytes of its buffers.
     pub fn bytes(&self) -> u64 {
         self.state.size() + self.pieces.size() + self.listing.size()
     }
 }
 
-/// The layout of the page's arrays the tests read: points, records and group boxes, at their
-/// bindings in `shaders/shared/clusters.wgsl`.
+/// The layout of what the tests read of a page: points, records, its uniform and the group
+/// boxes, at their bindings in `shaders/shared/clusters.wgsl`.
 fn geometry_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-    let entries = [0, 1, 2, 7].map(|binding| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only: true },
-            has_dynamic_offset: false,
-            min_binding_size: None,
+    let storage = wgpu::BufferBindingType::Storage { read_only: true };
+    let entries = [(0, storage), (1, storage), (2, storage), (6, wgpu::BufferBindingType::Uniform), (7, storage)].map(
+        |(binding, ty)| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
+            count: None,
         },
-        count: None,
-    });
+    );
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: Some("lineao::LineCull::geometry"),
         entries: &entries,
@@ -151,11 +174,13 @@ pub(crate) fn pieces_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
 /// The two-phase cull of [`LineGeometry`]'s pieces (see the module documentation).
 pub struct LineCull {
     device: wgpu::Device,
+    shape: Shape,
     pyramid: DepthPyramid,
     early: wgpu::ComputePipeline,
     test_groups: wgpu::ComputePipeline,
     size_dispatch: wgpu::ComputePipeline,
     late: wgpu::ComputePipeline,
+    size_settle: wgpu::ComputePipeline,
     settle: wgpu::ComputePipeline,
     /// A page's points, records and group boxes (`clusters.wgsl`'s bindings 0, 1, 2, 7).
     geometry_layout: wgpu::BindGroupLayout,
@@ -168,9 +193,9 @@ pub struct LineCull {
 }
 
 impl LineCull {
-    /// The cull of geometry drawn with `frame` (the line renderer's group 0: its frame
+    /// The cull of geometry drawn as `shape` with `frame` (the renderer's group 0: its frame
     /// uniform and lighting).
-    pub fn new(device: &wgpu::Device, frame: &wgpu::BindGroupLayout) -> LineCull {
+    pub fn new(device: &wgpu::Device, frame: &wgpu::BindGroupLayout, shape: Shape) -> LineCull {
         let label = "lineao::LineCull";
         let compute = wgpu::ShaderStages::COMPUTE;
         let pyramid_layout = binding::layout(device, label, compute, &[Slot::Uniform, Slot::Storage]);
@@ -182,6 +207,7 @@ impl LineCull {
         let listing_layout = binding::layout(device, label, compute, &state);
         let page = geometry_layout(device);
         let module = crate::shader::module(device, "cull.wgsl");
+        let constants = [("TUBES", (shape == Shape::Tubes) as u32 as f64)];
         let pipeline = |entry: &str, groups: &[Option<&wgpu::BindGroupLayout>]| {
             let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some(label),
@@ -193,7 +219,7 @@ impl LineCull {
                 layout: Some(&layout),
                 module: &module,
                 entry_point: Some(entry),
-                compilation_options: Default::default(),
+                compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
                 cache: None,
             })
         };
@@ -201,11 +227,13 @@ impl LineCull {
         let listing = [Some(frame), Some(&page), Some(&pyramid_layout), Some(&listing_layout)];
         LineCull {
             device: device.clone(),
+            shape,
             pyramid: DepthPyramid::new(device),
             early: pipeline("early", &[None, Some(&page), None, Some(&state_layout)]),
             test_groups: pipeline("test_groups", &listing),
             size_dispatch: pipeline("size_dispatch", &[None, None, None, Some(&listing_layout)]),
             late: pipeline("late", &all),
+            size_settle: pipeline("size_settle", &[None, None, None, Some(&listing_layout)]),
             settle: pipeline("settle", &all),
             pieces_layout: pieces_layout(device),
             geometry_layout: page,
@@ -251,7 +279,7 @@ impl LineCull {
 
     /// `page`'s state, made on its first frame.
     pub(crate) fn state<'p>(&self, page: &'p Page) -> &'p PageCull {
-        page.cull.get_or_init(|| {
+        page.cull[self.shape as usize].get_or_init(|| {
             let device = &self.device;
             let buffer = |label, size: u64, usage| {
                 device.create_buffer(&wgpu::BufferDescriptor {
@@ -269,8 +297,10 @@ impl LineCull {
                 4 * (STATE_HEADER_WORDS + clusters + groups),
                 wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
             );
-            let pieces =
-                buffer("lineao::LineCull::pieces", 4 * PIECES_PER_CLUSTER * clusters, wgpu::BufferUsages::empty());
+            // The early list, then the late one where a storage binding may start.
+            let align = u64::from(device.limits().min_storage_buffer_offset_alignment);
+            let list = (4 * PIECES_PER_CLUSTER * clusters).next_multiple_of(align);
+            let pieces = buffer("lineao::LineCull::pieces", 2 * list, wgpu::BufferUsages::empty());
             let listing = buffer(
                 "lineao::LineCull::listing",
                 LISTING_BYTES,
@@ -281,15 +311,18 @@ impl LineCull {
                 |layout, count: usize| binding::group(device, "lineao::LineCull::state", layout, &bound[..count]);
             let compute_group = group(&self.state_layout, 2);
             let listing_group = group(&self.listing_layout, 3);
-            let draw_group =
-                binding::group(device, "lineao::LineCull::pieces", &self.pieces_layout, &[pieces.as_entire_binding()]);
+            let draw_groups = [0, list].map(|offset| {
+                let list = wgpu::BufferBinding { buffer: &pieces, offset, size: wgpu::BufferSize::new(list) };
+                let list = wgpu::BindingResource::Buffer(list);
+                binding::group(device, "lineao::LineCull::pieces", &self.pieces_layout, &[list])
+            });
             let geometry = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("lineao::LineCull::geometry"),
                 layout: &self.geometry_layout,
-                entries: &[(0, &page.xy), (1, &page.z), (2, &page.clusters), (7, &page.groups)]
+                entries: &[(0, &page.xy), (1, &page.z), (2, &page.clusters), (6, &page.uniform), (7, &page.groups)]
                     .map(|(binding, buffer)| wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() }),
             });
-            PageCull { state, draw_group, compute_group, listing_group, geometry, pieces, listing }
+            PageCull { state, draw_groups, compute_group, listing_group, geometry, pieces, listing }
         })
     }
 
@@ -323,10 +356,10 @@ impl LineCull {
         }
         draw(encoder, Phase::Early, None);
         let built = self.pyramid.encode(encoder, &targets.depth, None);
-        self.test(encoder, pages, frame, &built, &self.late, None);
+        self.test(encoder, pages, frame, &built, &self.size_dispatch, &self.late, None);
         draw(encoder, Phase::Late, None);
         let built = self.pyramid.encode(encoder, &targets.depth, None);
-        self.test(encoder, pages, frame, &built, &self.settle, last);
+        self.test(encoder, pages, frame, &built, &self.size_settle, &self.settle, last);
     }
 
     fn compute_pass<'e>(&self, encoder: &'e mut wgpu::CommandEncoder, span: Option<Span>) -> wgpu::ComputePass<'e> {
@@ -336,27 +369,45 @@ impl LineCull {
         })
     }
 
-    /// One compute pass testing every page's groups against the pyramid `built`, then the
-    /// pieces of the listed groups with `pieces` (the late test or the settling).
+    /// A test against the pyramid `built`: every page's groups (the pieces of hidden ones
+    /// unmarked), then `size` (`size_dispatch`, `size_settle`) writes each page's indirect
+    /// dispatch of `pieces`: the late test of the listed groups' pieces, or the settling of the
+    /// pieces drawn.
+    #[allow(clippy::too_many_arguments)]
     fn test(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         pages: &[Page],
         frame: &wgpu::BindGroup,
         built: &Arc<Built>,
+        size: &wgpu::ComputePipeline,
         pieces: &wgpu::ComputePipeline,
         span: Option<Span>,
     ) {
         let pyramid = self.pyramid_group(built);
+        let (first, last) = Span::split(span);
+        self.test_groups(encoder, pages, frame, &pyramid, first);
+        self.size(encoder, pages, size);
+        self.dispatch_listed(encoder, pages, frame, &pyramid, pieces, last);
+    }
+
+    /// A pass testing every page's groups against `pyramid`, listing those that may be visible
+    /// and unmarking the pieces of the others. Separate passes follow it: on lavapipe,
+    /// dispatches within one pass did not see each other's writes.
+    fn test_groups(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        pages: &[Page],
+        frame: &wgpu::BindGroup,
+        pyramid: &wgpu::BindGroup,
+        span: Option<Span>,
+    ) {
         for page in pages {
             encoder.clear_buffer(&self.state(page).listing, 0, None);
         }
-        // Three passes: on lavapipe, dispatches within one pass did not see each other's
-        // writes.
-        let (first, last) = Span::split(span);
-        let mut pass = self.compute_pass(encoder, first);
+        let mut pass = self.compute_pass(encoder, span);
         pass.set_bind_group(0, frame, &[]);
-        pass.set_bind_group(2, &pyramid, &[]);
+        pass.set_bind_group(2, pyramid, &[]);
         pass.set_pipeline(&self.test_groups);
         for page in pages {
             let state = self.state(page);
@@ -364,19 +415,34 @@ impl LineCull {
             pass.set_bind_group(3, &state.listing_group, &[]);
             dispatch_over(&mut pass, page.records.div_ceil(GROUP_CLUSTERS as u32));
         }
-        drop(pass);
+    }
+
+    /// A pass of `size` (`size_dispatch` or `size_settle`) writing each page's indirect
+    /// dispatch.
+    fn size(&self, encoder: &mut wgpu::CommandEncoder, pages: &[Page], size: &wgpu::ComputePipeline) {
         let mut pass = self.compute_pass(encoder, None);
-        pass.set_pipeline(&self.size_dispatch);
+        pass.set_pipeline(size);
         for page in pages {
             let state = self.state(page);
             pass.set_bind_group(1, &state.geometry, &[]);
             pass.set_bind_group(3, &state.listing_group, &[]);
             pass.dispatch_workgroups(1, 1, 1);
         }
-        drop(pass);
-        let mut pass = self.compute_pass(encoder, last);
+    }
+
+    /// A pass of `pieces` (`late` or `settle`) over each page's indirect dispatch.
+    fn dispatch_listed(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        pages: &[Page],
+        frame: &wgpu::BindGroup,
+        pyramid: &wgpu::BindGroup,
+        pieces: &wgpu::ComputePipeline,
+        span: Option<Span>,
+    ) {
+        let mut pass = self.compute_pass(encoder, span);
         pass.set_bind_group(0, frame, &[]);
-        pass.set_bind_group(2, &pyramid, &[]);
+        pass.set_bind_group(2, pyramid, &[]);
         pass.set_pipeline(pieces);
         for page in pages {
             let state = self.state(page);
@@ -389,13 +455,20 @@ impl LineCull {
     /// The pieces each page drew in the last frame recorded, early and late, read back (waits
     /// for the device): what `--timings` and the bench report.
     pub fn drawn(&self, queue: &wgpu::Queue, geometry: &LineGeometry) -> Result<(u64, u64), crate::Error> {
-        let mut drawn = (0, 0);
+        let (early, late, _) = self.drawn_and_listed(queue, geometry)?;
+        Ok((early, late))
+    }
+
+    /// [`LineCull::drawn`] and the groups the late test listed.
+    fn drawn_and_listed(&self, queue: &wgpu::Queue, geometry: &LineGeometry) -> Result<(u64, u64, u64), crate::Error> {
+        let mut drawn = (0, 0, 0);
         for page in geometry.pages() {
-            let Some(state) = page.cull.get() else { continue };
+            let Some(state) = page.cull[self.shape as usize].get() else { continue };
             let bytes = pollster::block_on(crate::readback::read_buffer_async(&self.device, queue, &state.state))?;
             let words: &[u32] = bytemuck::cast_slice(&bytes);
             drawn.0 += words[9] as u64;
             drawn.1 += words[10] as u64;
+            drawn.2 += words[8] as u64;
         }
         Ok(drawn)
     }
@@ -405,7 +478,7 @@ impl LineCull {
     pub fn visible_clusters(&self, queue: &wgpu::Queue, geometry: &LineGeometry) -> Result<u64, crate::Error> {
         let mut visible = 0;
         for page in geometry.pages() {
-            let Some(state) = page.cull.get() else { continue };
+            let Some(state) = page.cull[self.shape as usize].get() else { continue };
             let bytes = pollster::block_on(crate::readback::read_buffer_async(&self.device, queue, &state.state))?;
             let marks =
                 &bytemuck::cast_slice::<u8, u32>(&bytes)[STATE_HEADER_WORDS as usize..][..page.records as usize];
@@ -421,7 +494,9 @@ impl LineCull {
             .pages()
             .iter()
             .map(|page| {
-                let Some(state) = page.cull.get() else { return Ok(vec![0; page.records as usize]) };
+                let Some(state) = page.cull[self.shape as usize].get() else {
+                    return Ok(vec![0; page.records as usize]);
+                };
                 let bytes = pollster::block_on(crate::readback::read_buffer_async(&self.device, queue, &state.state))?;
                 Ok(bytemuck::cast_slice::<u8, u32>(&bytes)[STATE_HEADER_WORDS as usize..][..page.records as usize]
                     .to_vec())
@@ -432,5 +507,156 @@ impl LineCull {
     /// Pieces `geometry` has (what drawing everything would draw).
     pub fn pieces(geometry: &LineGeometry) -> u64 {
         geometry.pages().iter().map(|p| p.pieces).sum()
+    }
+}
+
+/// A renderer's culled drawing: its [`LineCull`], the pipelines that draw the visible pieces
+/// (group 0 the renderer's frame, 1 the page, 2 its visible pieces), and why it draws
+/// everything after all, once a frame found out (a device whose storage bindings cannot hold
+/// the depth pyramid).
+pub struct Culled {
+    cull: LineCull,
+    plain: wgpu::RenderPipeline,
+    octants: Option<wgpu::RenderPipeline>,
+    note: std::sync::OnceLock<String>,
+}
+
+impl Culled {
+    /// The cull of `shape` for a renderer whose group 0 is `frame`; `create(label, fragment
+    /// outputs with octants)` makes a pipeline drawing the visible pieces, `octants` whether the
+    /// renderer writes them.
+    pub(crate) fn new(
+        device: &wgpu::Device,
+        frame: &wgpu::BindGroupLayout,
+        shape: Shape,
+        octants: bool,
+        create: impl Fn(bool) -> wgpu::RenderPipeline,
+    ) -> Culled {
+        Culled {
+            cull: LineCull::new(device, frame, shape),
+            plain: create(false),
+            octants: octants.then(|| create(true)),
+            note: std::sync::OnceLock::new(),
+        }
+    }
+
+    /// Why it draws everything though asked to cull, once a frame found it out.
+    pub fn note(&self) -> Option<&str> {
+        self.note.get().map(String::as_str)
+    }
+
+    /// Records a frame of `geometry` into `targets` as [`LineCull::encode`] does, its draws
+    /// with the pipelines (`octants`: the targets' octants too), the first loading the targets
+    /// as `load` says; `false`, recording nothing, when the device cannot cull into `targets`
+    /// (the renderer then draws everything).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &FrameTargets,
+        geometry: &LineGeometry,
+        frame: &wgpu::BindGroup,
+        label: &str,
+        load: Load,
+        octants: bool,
+        span: Option<Span>,
+    ) -> bool {
+        if let Some(reason) = self.cull.unsupported(targets) {
+            // Said once; every frame then draws everything.
+            self.note.get_or_init(|| reason);
+        }
+        if self.note.get().is_some() {
+            return false;
+        }
+        let pipeline = if octants { self.octants.as_ref() } else { Some(&self.plain) };
+        let pipeline = pipeline.expect("culled pipelines with octants where the renderer has them");
+        let draw = |encoder: &mut wgpu::CommandEncoder, phase: Phase, span| {
+            let mut pass = crate::gbuffer::begin(encoder, label, targets, phase.load(load), octants, span);
+            pass.set_pipeline(pipeline);
+            pass.set_bind_group(0, frame, &[]);
+            for page in geometry.pages() {
+                let state = self.cull.state(page);
+                pass.set_bind_group(1, &page.group, &[]);
+                pass.set_bind_group(2, state.draw_group(phase), &[]);
+                pass.draw_indirect(&state.state, phase.offset());
+            }
+        };
+        self.cull.encode(encoder, targets, geometry, frame, span, draw);
+        true
+    }
+
+    /// The cull's compute alone, as [`Culled::encode`] records it but for the draws (the
+    /// bench's `cull`).
+    pub(crate) fn encode_compute(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        targets: &FrameTargets,
+        geometry: &LineGeometry,
+        frame: &wgpu::BindGroup,
+        span: Option<Span>,
+    ) {
+        self.cull.encode(encoder, targets, geometry, frame, span, |_, _, _| {});
+    }
+
+    /// The cull itself (what it drew, its marks).
+    pub fn cull(&self) -> &LineCull {
+        &self.cull
+    }
+
+    /// What the last frame recorded drew of `geometry`, read back (waits for the device).
+    pub fn counts(&self, queue: &wgpu::Queue, geometry: &LineGeometry) -> Result<CullCounts, crate::Error> {
+        let (early, late, listed_groups) = self.cull.drawn_and_listed(queue, geometry)?;
+        Ok(CullCounts {
+            early,
+            late,
+            listed_groups,
+            groups: geometry.pages().iter().map(|p| p.records.div_ceil(GROUP_CLUSTERS as u32) as u64).sum(),
+            pieces: LineCull::pieces(geometry),
+            visible_clusters: self.cull.visible_clusters(queue, geometry)?,
+            clusters: geometry.clusters() as u64,
+        })
+    }
+}
+
+/// What a culled frame drew: pieces of eight segments drawn early and late of all the
+/// geometry has, and the clusters with a piece found visible.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CullCounts {
+    pub early: u64,
+    pub late: u64,
+    /// Groups of 16 clusters whose pieces the late test tested, of all.
+    pub listed_groups: u64,
+    pub groups: u64,
+    pub pieces: u64,
+    pub visible_clusters: u64,
+    pub clusters: u64,
+}
+
+impl CullCounts {
+    /// The share of the pieces drawn.
+    pub fn drawn_share(&self) -> f64 {
+        (self.early + self.late) as f64 / self.pieces.max(1) as f64
+    }
+
+    /// The share of the clusters found visible.
+    pub fn visible_share(&self) -> f64 {
+        self.visible_clusters as f64 / self.clusters.max(1) as f64
+    }
+}
+
+impl std::fmt::Display for CullCounts {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "drew {} + {} of {} pieces of 8 segments ({:.2} %), {:.2} % of the {} clusters visible; tested the \
+             pieces of {:.2} % of the groups",
+            self.early,
+            self.late,
+            self.pieces,
+            100.0 * self.drawn_share(),
+            100.0 * self.visible_share(),
+            self.clusters,
+            100.0 * self.listed_groups as f64 / self.groups.max(1) as f64
+        )
     }
 }

@@ -25,7 +25,7 @@ pub use crate::line_geometry::{
 use crate::line_geometry::{
     LineGeometry, MAX_ALTERNATING_WIDTH_PX, MAX_TOLERANCE_PX, Page, alternating_vertices, class_segments, full_vertices,
 };
-use crate::passes::cull::{LineCull, Phase};
+use crate::passes::cull::{Culled, Shape};
 use crate::settings::LineColor;
 use crate::targets::FrameTargets;
 use crate::timing::Span;
@@ -64,22 +64,12 @@ struct Pipelines {
     alternating: Option<wgpu::RenderPipeline>,
 }
 
-/// The culled lines' pipelines (the visible pieces' full strips) and their cull.
-struct Culled {
-    cull: LineCull,
-    plain: wgpu::RenderPipeline,
-    octants: Option<wgpu::RenderPipeline>,
-}
-
 /// Renders [`LineGeometry`] into the G-buffer of [`FrameTargets`].
 pub struct LineRenderer {
     style: LineStyle,
     plain: Pipelines,
-    /// Culling on the GPU ([`LineRenderer::culled`]).
+    /// Culling on the GPU ([`LineRenderer::culled`]): the visible pieces' full strips.
     culled: Option<Culled>,
-    /// Why it draws everything after all, once it found out (a device whose storage bindings
-    /// cannot hold the depth pyramid).
-    cull_note: std::sync::OnceLock<String>,
     /// Writing `octants` too: the points' octant visibilities, fully visible where a page
     /// holds none.
     octants: Option<Pipelines>,
@@ -146,7 +136,6 @@ impl LineRenderer {
             plain,
             octants,
             culled: None,
-            cull_note: std::sync::OnceLock::new(),
             bindings,
             px_per_world: AtomicU32::new(f32::INFINITY.to_bits()),
         }
@@ -159,33 +148,34 @@ impl LineRenderer {
         if self.style == LineStyle::Native1px || self.culled.is_some() {
             return self;
         }
-        let cull = LineCull::new(device, &self.bindings.layout);
         let page = crate::line_geometry::page_layout(device);
         let pieces = crate::passes::cull::pieces_layout(device);
         let module = crate::shader::module(device, "lines.wgsl");
-        let create = |label, vertex, fragment| {
+        let create = |octants: bool| {
+            let (vertex, fragment) = if octants { ("vs_piece_octants", "fs_octants") } else { ("vs_piece", "fs_main") };
             gbuffer::pipeline(
                 device,
                 &self.bindings.layout,
                 PipelineSpec {
-                    label,
+                    label: "lineao::LineRenderer::pieces",
                     groups: &[&page, &pieces],
                     module: &module,
                     vertex,
                     fragment,
                     buffers: &[],
                     topology: wgpu::PrimitiveTopology::TriangleStrip,
-                    octants: fragment == "fs_octants",
+                    octants,
                 },
             )
         };
-        let plain = create("lineao::LineRenderer::pieces", "vs_piece", "fs_main");
-        let octants = self
-            .octants
-            .is_some()
-            .then(|| create("lineao::LineRenderer::pieces_octants", "vs_piece_octants", "fs_octants"));
-        self.culled = Some(Culled { cull, plain, octants });
+        let culled = Culled::new(device, &self.bindings.layout, Shape::Lines, self.octants.is_some(), create);
+        self.culled = Some(culled);
         self
+    }
+
+    /// Its culling, where it culls.
+    pub fn cull(&self) -> Option<&Culled> {
+        self.culled.as_ref()
     }
 
     /// Whether it culls ([`LineRenderer::culled`]).
@@ -196,7 +186,7 @@ impl LineRenderer {
     /// Why it draws every line though asked to cull, once a frame found it out (the device's
     /// limits): what a front end shows once.
     pub fn cull_note(&self) -> Option<&str> {
-        self.cull_note.get().map(String::as_str)
+        self.culled.as_ref().and_then(Culled::note)
     }
 
     /// The cull's compute alone, as [`LineRenderer::encode`] records it but for the draws (the
@@ -209,25 +199,25 @@ impl LineRenderer {
         span: Option<Span>,
     ) {
         if let Some(culled) = &self.culled {
-            culled.cull.encode(encoder, targets, geometry, &self.bindings.group, span, |_, _, _| {});
+            culled.encode_compute(encoder, targets, geometry, &self.bindings.group, span);
         }
     }
 
-    /// Each page's marks after the last frame ([`LineCull::marks`]); none when it does not cull.
+    /// Each page's marks after the last frame ([`LineCull::marks`](crate::passes::cull::LineCull::marks)); none when it does not cull.
     pub fn cull_marks(&self, queue: &wgpu::Queue, geometry: &LineGeometry) -> Result<Option<Vec<Vec<u32>>>, Error> {
-        self.culled.as_ref().map(|c| c.cull.marks(queue, geometry)).transpose()
+        self.culled.as_ref().map(|c| c.cull().marks(queue, geometry)).transpose()
     }
 
     /// The clusters with a piece visible in the last frame (read back, waits for the device).
     pub fn visible_clusters(&self, queue: &wgpu::Queue, geometry: &LineGeometry) -> Result<Option<u64>, Error> {
-        self.culled.as_ref().map(|c| c.cull.visible_clusters(queue, geometry)).transpose()
+        self.culled.as_ref().map(|c| c.cull().visible_clusters(queue, geometry)).transpose()
     }
 
     /// The pieces of eight segments drawn in the last frame, early and late, of the
-    /// geometry's [`LineCull::pieces`], read back (waits for the device); none when it does
+    /// geometry's [`LineCull::pieces`](crate::passes::cull::LineCull::pieces), read back (waits for the device); none when it does
     /// not cull.
     pub fn drawn_pieces(&self, queue: &wgpu::Queue, geometry: &LineGeometry) -> Result<Option<(u64, u64)>, Error> {
-        self.culled.as_ref().map(|c| c.cull.drawn(queue, geometry)).transpose()
+        self.culled.as_ref().map(|c| c.cull().drawn(queue, geometry)).transpose()
     }
 
     /// Whether this renderer writes the `octants` target.
@@ -281,27 +271,10 @@ impl LineRenderer {
     ) {
         // The octants too when both the pipelines and the target exist.
         let octants = self.octants.as_ref().filter(|_| targets.octants.is_some());
-        let unsupported = self.culled.as_ref().and_then(|c| c.cull.unsupported(targets));
-        if let Some(reason) = unsupported {
-            // Said once; every frame then draws everything.
-            self.cull_note.get_or_init(|| reason);
-        }
-        if let Some(culled) = self.culled.as_ref().filter(|_| self.cull_note.get().is_none()) {
-            let pipeline = if octants.is_some() { culled.octants.as_ref() } else { Some(&culled.plain) };
-            let pipeline = pipeline.expect("culled pipelines with octants where the renderer has them");
-            let draw = |encoder: &mut wgpu::CommandEncoder, phase: Phase, span| {
-                let load = phase.load(load);
-                let mut pass = gbuffer::begin(encoder, "lineao::LineRenderer", targets, load, octants.is_some(), span);
-                pass.set_pipeline(pipeline);
-                pass.set_bind_group(0, &self.bindings.group, &[]);
-                for page in geometry.pages() {
-                    let state = culled.cull.state(page);
-                    pass.set_bind_group(1, &page.group, &[]);
-                    pass.set_bind_group(2, &state.draw_group, &[]);
-                    pass.draw_indirect(&state.state, phase.offset());
-                }
-            };
-            culled.cull.encode(encoder, targets, geometry, &self.bindings.group, span, draw);
+        let label = "lineao::LineRenderer";
+        let frame = &self.bindings.group;
+        let culled = self.culled.as_ref();
+        if culled.is_some_and(|c| c.encode(encoder, targets, geometry, frame, label, load, octants.is_some(), span)) {
             return;
         }
         let mut pass = gbuffer::begin(encoder, "lineao::LineRenderer", targets, load, octants.is_some(), span);

@@ -20,7 +20,7 @@ pub struct PageContents {
     pub records: Vec<ClusterRecord>,
     /// Every point decoded on its cluster's grid, in page order.
     pub points: Vec<[f32; 3]>,
-    /// Per group of 64 consecutive records, its box (min, max).
+    /// Per group of GROUP_CLUSTERS (16) consecutive records, its box (min, max).
     pub groups: Vec<(Vec3, Vec3)>,
 }
 
@@ -118,6 +118,11 @@ struct Tester<'a> {
     pyramid: &'a [Image<f32>],
 }
 
+/// Texels across at most where a group's box and a segment's read the pyramid (`GROUP_SPAN`,
+/// `SEGMENT_SPAN` in `cull.wgsl`).
+const GROUP_SPAN: usize = 16;
+const SEGMENT_SPAN: usize = 2;
+
 impl Tester<'_> {
     /// `p` in NDC, none behind the eye.
     fn project(&self, p: Vec3) -> Option<Vec3> {
@@ -133,7 +138,7 @@ impl Tester<'_> {
             let Some(ndc) = self.project(corner) else { return true };
             (a, b) = (a.min(ndc), b.max(ndc));
         }
-        self.ndc_box(a, b, px, depth)
+        self.ndc_box(a, b, px, depth, GROUP_SPAN)
     }
 
     /// `visible_segments` of `piece_visible`: whether one of the segments between `points` may.
@@ -141,7 +146,7 @@ impl Tester<'_> {
         let mut previous = None;
         for &p in points {
             let Some(ndc) = self.project(p) else { return true };
-            if previous.is_some_and(|q: Vec3| self.ndc_box(q.min(ndc), q.max(ndc), px, depth)) {
+            if previous.is_some_and(|q: Vec3| self.ndc_box(q.min(ndc), q.max(ndc), px, depth, SEGMENT_SPAN)) {
                 return true;
             }
             previous = Some(ndc);
@@ -149,8 +154,9 @@ impl Tester<'_> {
         false
     }
 
-    /// `box_visible`, its rectangle `px` wider on each side and its margin `depth` larger.
-    fn ndc_box(&self, lo: Vec3, hi: Vec3, px: f32, depth: f32) -> bool {
+    /// `box_visible`, its rectangle `px` wider on each side and its margin `depth` larger, read
+    /// at the finest level where it spans at most `span` texels across.
+    fn ndc_box(&self, lo: Vec3, hi: Vec3, px: f32, depth: f32, span: usize) -> bool {
         if hi.z < 0.0 || lo.z > 1.0 {
             return false;
         }
@@ -164,7 +170,7 @@ impl Tester<'_> {
         let texel = |v: f32, most: f32| v.floor().clamp(0.0, most - 1.0) as usize;
         let (ax, ay, bx, by) = (texel(x0, w), texel(y0, h), texel(x1, w), texel(y1, h));
         let mut l = 0;
-        while l + 1 < self.pyramid.len() && ((bx >> l) - (ax >> l) > 1 || (by >> l) - (ay >> l) > 1) {
+        while l + 1 < self.pyramid.len() && ((bx >> l) - (ax >> l) >= span || (by >> l) - (ay >> l) >= span) {
             l += 1;
         }
         let level = &self.pyramid[l];
