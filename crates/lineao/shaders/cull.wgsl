@@ -208,11 +208,12 @@ fn size_settle() {
     atomicStore(&listing[2], 1u);
 }
 
-// After the late draw, against the pyramid of the frame's final depth: the pieces drawn (the
-// only ones marked: the early list holds the marked ones, the late one those marked since) that
-// the frame's lines hide after all are unmarked, so the next frame's early phase draws only
-// what this one shows (after a first frame or a cut, the late phase marks all that passed
-// against the early phase's depth). A frame that drew few pieces late settles cheaply.
+// After the late draw, against the pyramid of the frame's final depth (and after
+// `test_groups`, which unmarks the pieces of hidden groups): the pieces drawn (the only ones
+// marked: the early list holds the marked ones, the late one those marked since) that the
+// frame's lines hide after all are unmarked, so the next frame's early phase draws only what
+// this one shows (after a first frame or a cut, the late phase marks all that passed against
+// the early phase's depth).
 @compute @workgroup_size(64)
 fn settle(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) local: u32) {
     let i = (group.x + group.y * DISPATCH_ROW) * 64u + local;

@@ -23,7 +23,7 @@
 //! segment bounded by its billboard for the largest radius of its page's points; the G-buffer
 //! of drawing every segment (`tests/cull.rs`). The billboards' fragments are shaded before the
 //! depth test where the device ignores the early-depth promise (lavapipe), so what the cull
-//! saves there is most of the frame: a whole brain of 10 M points seen from outside 68 s → 9.8 s.
+//! saves there is most of the frame: a whole brain of 10 M points seen from outside 68.6 s → 9.6 s.
 //!
 //! LineAO on tubes takes r0 = 1.5 · z(P) · t_s (paper Eq. 16, t_s = 2 · radius in zoom units).
 
@@ -43,7 +43,8 @@ pub struct TubeRenderer {
     bindings: GeometryBindings,
     /// Culling on the GPU ([`TubeRenderer::culled`]).
     culled: Option<Culled>,
-    /// The fragment shader's depth promise, as the pipelines are made with it.
+    /// `tubes.wgsl` with the fragment shader's depth promise where the device takes it (the
+    /// culled pipelines are made from it too).
     module: wgpu::ShaderModule,
 }
 
