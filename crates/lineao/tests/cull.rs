@@ -143,7 +143,7 @@ fn same_marks_as_the_cpu_reference(
     let frame = CullView { view: view.view, proj: view.proj, size: view.banded_size(), line_width_px: LINE_WIDTH };
     let pages = geometry.page_contents(&gpu.device, &gpu.queue).unwrap();
     let expected = marks(&pages, &frame, &depth, Slack { px: 0.01, depth: 1e-7 });
-    let got = renderer.cull_marks(&gpu.queue, geometry).unwrap().unwrap();
+    let got = renderer.cull().unwrap().cull().marks(&gpu.queue, geometry).unwrap();
     let (mut pieces, mut unsure) = (0, 0);
     for (page, (expected, got)) in expected.iter().zip(&got).enumerate() {
         for (i, (verdicts, &bits)) in expected.iter().zip(got).enumerate() {
@@ -176,7 +176,8 @@ fn culled_lines_draw_the_g_buffer_of_all_lines() {
         // The first frame of a view (after the one before it), then the next.
         for frame in ["first", "second"] {
             let got = draw(&gpu, &culled, &geometry, &camera);
-            let (early, late) = culled.drawn_pieces(q, &geometry).unwrap().unwrap();
+            let counts = culled.cull().unwrap().counts(q, &geometry).unwrap();
+            let (early, late) = (counts.early, counts.late);
             let (covered, ties) = same_gbuffer(&expected, &got, case);
             println!(
                 "{case}, {frame} frame: drew {early} + {late} of {pieces} pieces ({:.1} %); {covered} geometry pixels, {ties} ties",
@@ -192,7 +193,8 @@ fn culled_lines_draw_the_g_buffer_of_all_lines() {
     // From outside most of the ball is hidden: a second frame draws well under half of it.
     draw(&gpu, &culled, &geometry, &outside());
     draw(&gpu, &culled, &geometry, &outside());
-    let (early, late) = culled.drawn_pieces(q, &geometry).unwrap().unwrap();
+    let counts = culled.cull().unwrap().counts(q, &geometry).unwrap();
+    let (early, late) = (counts.early, counts.late);
     assert!((early + late) * 2 < pieces, "drew {early} + {late} of {pieces}");
 }
 
@@ -222,7 +224,8 @@ fn culled_tubes_draw_the_g_buffer_of_all_tubes() {
             let expected = draw_tubes(&gpu, &all, &geometry, &camera);
             for frame in ["first", "second"] {
                 let got = draw_tubes(&gpu, &culled, &geometry, &camera);
-                let (early, late) = culled.cull().unwrap().cull().drawn(q, &geometry).unwrap();
+                let counts = culled.cull().unwrap().counts(q, &geometry).unwrap();
+                let (early, late) = (counts.early, counts.late);
                 let (covered, ties) = same_gbuffer(&expected, &got, &case);
                 println!(
                     "{case}, {frame} frame: drew {early} + {late} of {pieces} pieces ({:.1} %); {covered} geometry pixels, {ties} ties",

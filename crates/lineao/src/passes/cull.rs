@@ -344,16 +344,10 @@ impl LineCull {
         for page in pages {
             encoder.clear_buffer(&self.state(page).state, 0, Some(4 * STATE_HEADER_WORDS));
         }
-        {
-            let mut pass = self.compute_pass(encoder, first);
-            pass.set_pipeline(&self.early);
-            for page in pages {
-                let state = self.state(page);
-                pass.set_bind_group(1, &state.geometry, &[]);
-                pass.set_bind_group(3, &state.compute_group, &[]);
-                dispatch_over(&mut pass, page.records);
-            }
-        }
+        self.over_pages(encoder, pages, None, &self.early, first, |pass, page, state| {
+            pass.set_bind_group(3, &state.compute_group, &[]);
+            dispatch_over(pass, page.records);
+        });
         draw(encoder, Phase::Early, None);
         let built = self.pyramid.encode(encoder, &targets.depth, None);
         self.test(encoder, pages, frame, &built, &self.size_dispatch, &self.late, None);
@@ -362,11 +356,32 @@ impl LineCull {
         self.test(encoder, pages, frame, &built, &self.size_settle, &self.settle, last);
     }
 
-    fn compute_pass<'e>(&self, encoder: &'e mut wgpu::CommandEncoder, span: Option<Span>) -> wgpu::ComputePass<'e> {
-        encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+    /// One compute pass of `pipeline` timed into `span`, with the frame and the pyramid bound
+    /// (`bound`) where it reads them, and each page's geometry; `dispatch` binds the page's state
+    /// and dispatches over it.
+    fn over_pages(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        pages: &[Page],
+        bound: Option<(&wgpu::BindGroup, &wgpu::BindGroup)>,
+        pipeline: &wgpu::ComputePipeline,
+        span: Option<Span>,
+        dispatch: impl Fn(&mut wgpu::ComputePass, &Page, &PageCull),
+    ) {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("lineao::LineCull"),
             timestamp_writes: crate::timing::compute_writes(span),
-        })
+        });
+        if let Some((frame, pyramid)) = bound {
+            pass.set_bind_group(0, frame, &[]);
+            pass.set_bind_group(2, pyramid, &[]);
+        }
+        pass.set_pipeline(pipeline);
+        for page in pages {
+            let state = self.state(page);
+            pass.set_bind_group(1, &state.geometry, &[]);
+            dispatch(&mut pass, page, state);
+        }
     }
 
     /// A test against the pyramid `built`: every page's groups (the pieces of hidden ones
@@ -385,123 +400,70 @@ impl LineCull {
         span: Option<Span>,
     ) {
         let pyramid = self.pyramid_group(built);
+        let bound = Some((frame, &pyramid));
         let (first, last) = Span::split(span);
-        self.test_groups(encoder, pages, frame, &pyramid, first);
-        self.size(encoder, pages, size);
-        self.dispatch_listed(encoder, pages, frame, &pyramid, pieces, last);
-    }
-
-    /// A pass testing every page's groups against `pyramid`, listing those that may be visible
-    /// and unmarking the pieces of the others. Separate passes follow it: on lavapipe,
-    /// dispatches within one pass did not see each other's writes.
-    fn test_groups(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        pages: &[Page],
-        frame: &wgpu::BindGroup,
-        pyramid: &wgpu::BindGroup,
-        span: Option<Span>,
-    ) {
         for page in pages {
             encoder.clear_buffer(&self.state(page).listing, 0, None);
         }
-        let mut pass = self.compute_pass(encoder, span);
-        pass.set_bind_group(0, frame, &[]);
-        pass.set_bind_group(2, pyramid, &[]);
-        pass.set_pipeline(&self.test_groups);
-        for page in pages {
-            let state = self.state(page);
-            pass.set_bind_group(1, &state.geometry, &[]);
+        // Separate passes: on lavapipe, dispatches within one pass did not see each other's
+        // writes.
+        self.over_pages(encoder, pages, bound, &self.test_groups, first, |pass, page, state| {
             pass.set_bind_group(3, &state.listing_group, &[]);
-            dispatch_over(&mut pass, page.records.div_ceil(GROUP_CLUSTERS as u32));
-        }
-    }
-
-    /// A pass of `size` (`size_dispatch` or `size_settle`) writing each page's indirect
-    /// dispatch.
-    fn size(&self, encoder: &mut wgpu::CommandEncoder, pages: &[Page], size: &wgpu::ComputePipeline) {
-        let mut pass = self.compute_pass(encoder, None);
-        pass.set_pipeline(size);
-        for page in pages {
-            let state = self.state(page);
-            pass.set_bind_group(1, &state.geometry, &[]);
+            dispatch_over(pass, page.records.div_ceil(GROUP_CLUSTERS as u32));
+        });
+        self.over_pages(encoder, pages, None, size, None, |pass, _, state| {
             pass.set_bind_group(3, &state.listing_group, &[]);
             pass.dispatch_workgroups(1, 1, 1);
-        }
-    }
-
-    /// A pass of `pieces` (`late` or `settle`) over each page's indirect dispatch.
-    fn dispatch_listed(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        pages: &[Page],
-        frame: &wgpu::BindGroup,
-        pyramid: &wgpu::BindGroup,
-        pieces: &wgpu::ComputePipeline,
-        span: Option<Span>,
-    ) {
-        let mut pass = self.compute_pass(encoder, span);
-        pass.set_bind_group(0, frame, &[]);
-        pass.set_bind_group(2, pyramid, &[]);
-        pass.set_pipeline(pieces);
-        for page in pages {
-            let state = self.state(page);
-            pass.set_bind_group(1, &state.geometry, &[]);
+        });
+        self.over_pages(encoder, pages, bound, pieces, last, |pass, _, state| {
             pass.set_bind_group(3, &state.compute_group, &[]);
             pass.dispatch_workgroups_indirect(&state.listing, 0);
-        }
+        });
     }
 
-    /// The pieces each page drew in the last frame recorded, early and late, read back (waits
-    /// for the device): what `--timings` and the bench report.
-    pub fn drawn(&self, queue: &wgpu::Queue, geometry: &LineGeometry) -> Result<(u64, u64), crate::Error> {
-        let (early, late, _) = self.drawn_and_listed(queue, geometry)?;
-        Ok((early, late))
-    }
-
-    /// [`LineCull::drawn`] and the groups the late test listed.
-    fn drawn_and_listed(&self, queue: &wgpu::Queue, geometry: &LineGeometry) -> Result<(u64, u64, u64), crate::Error> {
-        let mut drawn = (0, 0, 0);
-        for page in geometry.pages() {
-            let Some(state) = page.cull[self.shape as usize].get() else { continue };
+    /// Each page's state after the last frame recorded, read back (waits for the device): its
+    /// header words and its marks (none for a page not culled yet).
+    fn read_states(&self, queue: &wgpu::Queue, geometry: &LineGeometry) -> Result<Vec<Option<Vec<u32>>>, crate::Error> {
+        let read = |page: &Page| -> Result<_, crate::Error> {
+            let Some(state) = page.cull[self.shape as usize].get() else { return Ok(None) };
             let bytes = pollster::block_on(crate::readback::read_buffer_async(&self.device, queue, &state.state))?;
             let words: &[u32] = bytemuck::cast_slice(&bytes);
-            drawn.0 += words[9] as u64;
-            drawn.1 += words[10] as u64;
-            drawn.2 += words[8] as u64;
-        }
-        Ok(drawn)
+            Ok(Some(words[..(STATE_HEADER_WORDS + page.records as u64) as usize].to_vec()))
+        };
+        geometry.pages().iter().map(read).collect()
     }
 
-    /// The clusters with a piece marked visible after the last frame recorded, read back (waits
-    /// for the device).
-    pub fn visible_clusters(&self, queue: &wgpu::Queue, geometry: &LineGeometry) -> Result<u64, crate::Error> {
-        let mut visible = 0;
-        for page in geometry.pages() {
-            let Some(state) = page.cull[self.shape as usize].get() else { continue };
-            let bytes = pollster::block_on(crate::readback::read_buffer_async(&self.device, queue, &state.state))?;
-            let marks =
-                &bytemuck::cast_slice::<u8, u32>(&bytes)[STATE_HEADER_WORDS as usize..][..page.records as usize];
-            visible += marks.iter().filter(|&&bits| bits != 0).count() as u64;
+    /// What the last frame recorded drew of `geometry`, read back (waits for the device): what
+    /// `--timings` and the bench report.
+    pub fn counts(&self, queue: &wgpu::Queue, geometry: &LineGeometry) -> Result<CullCounts, crate::Error> {
+        let mut counts = CullCounts {
+            early: 0,
+            late: 0,
+            listed_groups: 0,
+            groups: geometry.pages().iter().map(|p| p.records.div_ceil(GROUP_CLUSTERS as u32) as u64).sum(),
+            pieces: LineCull::pieces(geometry),
+            visible_clusters: 0,
+            clusters: geometry.clusters() as u64,
+        };
+        for words in self.read_states(queue, geometry)?.into_iter().flatten() {
+            counts.early += words[9] as u64;
+            counts.late += words[10] as u64;
+            counts.listed_groups += words[8] as u64;
+            let marks = &words[STATE_HEADER_WORDS as usize..];
+            counts.visible_clusters += marks.iter().filter(|&&bits| bits != 0).count() as u64;
         }
-        Ok(visible)
+        Ok(counts)
     }
 
     /// Each page's marks after the last frame recorded, a word per cluster (bit p: piece p
     /// passed), read back (waits for the device): what the CPU reference checks.
     pub fn marks(&self, queue: &wgpu::Queue, geometry: &LineGeometry) -> Result<Vec<Vec<u32>>, crate::Error> {
-        geometry
-            .pages()
-            .iter()
-            .map(|page| {
-                let Some(state) = page.cull[self.shape as usize].get() else {
-                    return Ok(vec![0; page.records as usize]);
-                };
-                let bytes = pollster::block_on(crate::readback::read_buffer_async(&self.device, queue, &state.state))?;
-                Ok(bytemuck::cast_slice::<u8, u32>(&bytes)[STATE_HEADER_WORDS as usize..][..page.records as usize]
-                    .to_vec())
-            })
-            .collect()
+        let states = self.read_states(queue, geometry)?;
+        let marks = states.into_iter().zip(geometry.pages()).map(|(words, page)| match words {
+            Some(words) => words[STATE_HEADER_WORDS as usize..].to_vec(),
+            None => vec![0; page.records as usize],
+        });
+        Ok(marks.collect())
     }
 
     /// Pieces `geometry` has (what drawing everything would draw).
@@ -603,18 +565,9 @@ impl Culled {
         &self.cull
     }
 
-    /// What the last frame recorded drew of `geometry`, read back (waits for the device).
+    /// What the last frame recorded drew ([`LineCull::counts`]).
     pub fn counts(&self, queue: &wgpu::Queue, geometry: &LineGeometry) -> Result<CullCounts, crate::Error> {
-        let (early, late, listed_groups) = self.cull.drawn_and_listed(queue, geometry)?;
-        Ok(CullCounts {
-            early,
-            late,
-            listed_groups,
-            groups: geometry.pages().iter().map(|p| p.records.div_ceil(GROUP_CLUSTERS as u32) as u64).sum(),
-            pieces: LineCull::pieces(geometry),
-            visible_clusters: self.cull.visible_clusters(queue, geometry)?,
-            clusters: geometry.clusters() as u64,
-        })
+        self.cull.counts(queue, geometry)
     }
 }
 

@@ -12,7 +12,6 @@
 
 use std::sync::atomic::{AtomicU32, Ordering};
 
-use crate::Error;
 use crate::camera::FrameView;
 use crate::gbuffer::{self, GeometryBindings, GeometryUniform, Load, PipelineSpec};
 use crate::lighting::Lighting;
@@ -201,23 +200,6 @@ impl LineRenderer {
         if let Some(culled) = &self.culled {
             culled.encode_compute(encoder, targets, geometry, &self.bindings.group, span);
         }
-    }
-
-    /// Each page's marks after the last frame ([`LineCull::marks`](crate::passes::cull::LineCull::marks)); none when it does not cull.
-    pub fn cull_marks(&self, queue: &wgpu::Queue, geometry: &LineGeometry) -> Result<Option<Vec<Vec<u32>>>, Error> {
-        self.culled.as_ref().map(|c| c.cull().marks(queue, geometry)).transpose()
-    }
-
-    /// The clusters with a piece visible in the last frame (read back, waits for the device).
-    pub fn visible_clusters(&self, queue: &wgpu::Queue, geometry: &LineGeometry) -> Result<Option<u64>, Error> {
-        self.culled.as_ref().map(|c| c.cull().visible_clusters(queue, geometry)).transpose()
-    }
-
-    /// The pieces of eight segments drawn in the last frame, early and late, of the
-    /// geometry's [`LineCull::pieces`](crate::passes::cull::LineCull::pieces), read back (waits for the device); none when it does
-    /// not cull.
-    pub fn drawn_pieces(&self, queue: &wgpu::Queue, geometry: &LineGeometry) -> Result<Option<(u64, u64)>, Error> {
-        self.culled.as_ref().map(|c| c.cull().drawn(queue, geometry)).transpose()
     }
 
     /// Whether this renderer writes the `octants` target.
