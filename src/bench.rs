@@ -14,6 +14,10 @@
 //!   buffer: what the clusters replaced, timed in the same run);
 //! - `nd-pyramid`, `composite`; `bilateral`: the separable bilateral blur (radius 4), which can
 //!   follow any method;
+//! - `lines-all`: every cluster drawn (the alternating strip); `lines-culled`: the default path,
+//!   culled on the GPU at levels of detail (both phases, tests and draws); `lines-culled-exact`:
+//!   culled without levels of detail (the full strip's G-buffer); `cull`: the cull's compute
+//!   alone;
 //! - `tubes`: the same streamlines as ray-cast tubes of radius 0.5 mm (against `lines`);
 //!   `tubes-culled`: the same tubes culled on the GPU, both phases (against `lines-culled`);
 //! - `nd-from-depth`: the ND and zoom maps derived from the G-buffer's depth, as from a host
@@ -83,6 +87,8 @@ struct Passes {
     lines: LineRenderer,
     /// The lines culled on the GPU (`lines-culled`; `cull` times its compute alone).
     lines_culled: LineRenderer,
+    /// The same without levels of detail (`lines-culled-exact`): the full strip's G-buffer.
+    lines_culled_exact: LineRenderer,
     lines_native: LineRenderer,
     lines_full: LineRenderer,
     /// The strip of earlier versions and its renderer (`lines-strip`), when selected.
@@ -131,7 +137,8 @@ impl Passes {
         let format = wgpu::TextureFormat::Rgba8UnormSrgb;
         let mut passes = Passes {
             lines: LineRenderer::new(device),
-            lines_culled: LineRenderer::new(device).culled(device),
+            lines_culled: LineRenderer::new(device).culled(device, true),
+            lines_culled_exact: LineRenderer::new(device).culled(device, false),
             lines_native: LineRenderer::with_style(device, LineStyle::Native1px),
             lines_full: LineRenderer::with_style(device, LineStyle::FullStrip),
             strip: strip.map(|geometry| {
@@ -152,7 +159,9 @@ impl Passes {
             queue: queue.clone(),
             output: Target::output(device, "lineao::bench::output", (view.width, view.height), format),
         };
-        for renderer in [&passes.lines, &passes.lines_culled, &passes.lines_native, &passes.lines_full] {
+        for renderer in
+            [&passes.lines, &passes.lines_culled, &passes.lines_culled_exact, &passes.lines_native, &passes.lines_full]
+        {
             renderer.prepare(queue, view, settings.line_width_px, settings.line_color, &settings.lighting);
         }
         for renderer in [&passes.tubes, &passes.tubes_culled] {
@@ -202,6 +211,9 @@ impl Passes {
         match name {
             "lines" | "lines-all" => self.lines.encode(encoder, targets, geometry, Load::Clear(background), span),
             "lines-culled" => self.lines_culled.encode(encoder, targets, geometry, Load::Clear(background), span),
+            "lines-culled-exact" => {
+                self.lines_culled_exact.encode(encoder, targets, geometry, Load::Clear(background), span)
+            }
             "cull" => self.lines_culled.encode_cull(encoder, targets, geometry, span),
             "lines-native-1px" => self.lines_native.encode(encoder, targets, geometry, Load::Clear(background), span),
             "lines-full-strip" => self.lines_full.encode(encoder, targets, geometry, Load::Clear(background), span),
@@ -319,7 +331,15 @@ pub fn run(args: &BenchArgs) -> Result<()> {
 
     let mut times: Vec<Vec<f64>> = vec![Vec::new(); all.len()];
     // `lines` last among the line passes, so the G-buffer the later passes read is the chain's.
-    let first = ["lines-native-1px", "lines-full-strip", "lines-strip", "lines-all", "lines-culled", "cull"];
+    let first = [
+        "lines-native-1px",
+        "lines-full-strip",
+        "lines-strip",
+        "lines-all",
+        "lines-culled-exact",
+        "lines-culled",
+        "cull",
+    ];
     let order = first.into_iter().chain(all.iter().copied().filter(|p| !first.contains(p)));
     // The G-buffer and pyramid every later pass reads, also when `--passes` leaves them out.
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::bench") });
@@ -562,6 +582,7 @@ fn print_table(report: &serde_json::Value, passes: &[serde_json::Value]) {
         ("lineao", "lineao-tap-floor"),
         ("lines", "lines-native-1px"),
         ("lines-culled", "lines-all"),
+        ("lines-culled", "lines-culled-exact"),
         ("cull", "lines-all"),
         ("lines-full-strip", "lines-native-1px"),
         ("lines", "lines-strip"),

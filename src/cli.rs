@@ -67,6 +67,10 @@ pub struct ViewArgs {
     /// or every line (`off`).
     #[arg(long, value_parser = parse_on_off, default_value = "on")]
     pub cull: bool,
+    /// Where lines are culled, draw each visible piece at the coarsest level of detail within
+    /// half a pixel of it (`on`), or every point (`off`: the full strip exactly).
+    #[arg(long, value_parser = parse_on_off, default_value = "on")]
+    pub lod: bool,
     /// Line color: `tangent`, R,G,B in [0, 1], or `field:NAME` (see `render --color`).
     #[arg(long, default_value = "tangent", value_parser = parse_color)]
     pub color: ColorArg,
@@ -200,7 +204,7 @@ pub struct BenchLoadArgs {
 // The passes `lineao bench --passes` names (its vocabulary, so the CLI needs nothing of the
 // bench itself).
 /// The bench's own GPU passes: the geometry and what every method shares.
-const OWN_GPU_PASSES: [&str; 13] = [
+const OWN_GPU_PASSES: [&str; 14] = [
     "lines",
     "lines-native-1px",
     "lines-full-strip",
@@ -208,6 +212,7 @@ const OWN_GPU_PASSES: [&str; 13] = [
     "nd-pyramid",
     "lines-all",
     "lines-culled",
+    "lines-culled-exact",
     "cull",
     "composite",
     "bilateral",

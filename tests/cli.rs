@@ -301,6 +301,7 @@ fn bench_json_is_the_contract() {
         "nd-pyramid",
         "lines-all",
         "lines-culled",
+        "lines-culled-exact",
         "cull",
         "lineao",
         "lineao-tap-floor",

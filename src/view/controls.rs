@@ -233,6 +233,9 @@ impl Controls {
                 ui.add(egui::Slider::new(&mut p.chain.line_width_px, 0.5..=8.0).text("width (px)"));
                 ui.checkbox(&mut p.chain.cull, "draw only what is seen")
                     .on_hover_text("cull hidden lines on the GPU against the last frame: the same picture, faster when lines hide lines");
+                ui.add_enabled(p.chain.cull, egui::Checkbox::new(&mut p.chain.lod, "level of detail")).on_hover_text(
+                    "draw each visible piece of line with fewer points where that moves it by under half a pixel",
+                );
                 ui.horizontal(|ui| {
                     ui.label("lit");
                     ui.selectable_value(&mut self.line_shading, LineShading::Specular, "specular")
@@ -322,6 +325,7 @@ impl Controls {
             (DebugView::Zoom, "zoom map z(P)".into()),
         ];
         views.extend((0..levels).map(|k| (DebugView::Level(k), format!("pyramid level {k}"))));
+        views.push((DebugView::Pieces, "pieces: level of detail".into()));
         let current =
             views.iter().find(|(v, _)| *v == self.debug_view).map_or("final image".into(), |(_, l)| l.clone());
         egui::ComboBox::from_id_salt("debug-view").selected_text(current).show_ui(ui, |ui| {

@@ -35,6 +35,19 @@ def test_render_equals_the_command_line_pixel_for_pixel(lineao_bin, tmp_path):
     assert (expected[..., :3] < 200).any(axis=2).mean() > 0.02
 
 
+def test_cull_and_level_of_detail_are_the_command_lines(lineao_bin, tmp_path):
+    t = lineao.load(TRK)
+    for lod in (True, False):
+        image = lineao.render(t, cull=True, lod=lod, **SMALL)
+        expected = cli_render(
+            lineao_bin, tmp_path, TRK, "--cull", "on", "--lod", "on" if lod else "off", "--width", 320, "--height", 256
+        )
+        assert (image != expected).sum() == 0, lod
+    # Culled without levels of detail: the picture drawing every line leaves.
+    exact = lineao.render(t, cull=True, lod=False, **SMALL)
+    assert (exact != lineao.render(t, **SMALL)).any(axis=2).mean() < 0.001
+
+
 def test_settings_compare_and_grid_are_the_command_lines(lineao_bin, tmp_path):
     t = lineao.load(TRK)
     compare = lineao.render(t, compare=("lineao", "ssao"), preset="paper", s_h=4, **SMALL)

@@ -20,6 +20,11 @@
 // tight, and the pyramid is read at a fine level. A box in front of the eye projects within
 // its corners' projections, no nearer than its nearest corner.
 //
+// With `LOD` (lines only) each visible piece is drawn at the coarsest level of detail that
+// leaves it within LOD_PIXELS of its full strip on screen (`piece_level`): every 2nd, 4th or 8th
+// point of it kept, and its ends. The coarse pieces are listed from the back of their phase's
+// list and drawn with fewer vertices a piece (`lines.wgsl`'s `vs_piece_coarse`).
+//
 // With `TUBES` the pieces are drawn as tubes (`tubes.wgsl`): a segment is bounded by its
 // billboard (`shared/billboard.wgsl`) for the largest radius of the page's points, and a group
 // by its box grown by that radius; the billboard's depth is clamped into the depth range, so
@@ -30,6 +35,8 @@
 
 // Whether the pieces are drawn as tubes (`lineao::passes::cull::Shape`).
 override TUBES: bool = false;
+// Whether the pieces are drawn at a level of detail (`lineao::passes::cull::Lod`).
+override LOD: bool = false;
 
 // Keep in sync with `lineao::passes::depth_pyramid::PyramidUniform`.
 struct Pyramid {
@@ -44,13 +51,15 @@ struct Pyramid {
 @group(2) @binding(1) var<storage, read> pyramid_texels: array<f32>;
 
 // A page's state, in one buffer (a stage may bind 8 storage buffers, the WebGPU default):
-// words 0–3 the early draw's indirect arguments, 4–7 the late one's, 8 the groups listed for
-// `late`, 9 and 10 the pieces listed for the early and the late draw (these 16
-// words zeroed before each frame); then per cluster a word, bit p set where piece p passed
-// the last test (`VISIBLE`); then the listed groups (`SEEN`).
+// words 4d .. 4d + 3 the indirect arguments of draw d (`draw_of`: 0 early, 1 late, 2 and 3
+// their coarse pieces), 16 the groups listed for `late`, 17 + d the pieces listed for draw d
+// (these HEADER words zeroed before each frame); then per cluster a word (from `VISIBLE`):
+// bit p set where piece p passed the last test, bits LEVEL_SHIFT + 2p .. + 1 the level it was
+// drawn at (points kept: every 2^level-th); then the listed groups.
 @group(3) @binding(0) var<storage, read_write> state: array<atomic<u32>>;
-// The pieces to draw (cluster << 2 | piece): the early phase's list in the first half, the
-// late one's in the second (each draw binds its half).
+// The pieces to draw (`piece_entry`): the early phase's list in the first half, the late one's
+// in the second (each draw binds its half); in each, the full pieces from the front and the
+// coarse ones from the back (room for both padded to whole instances: `pad`).
 @group(3) @binding(1) var<storage, read_write> pieces: array<u32>;
 // The indirect dispatch of `late` (x, y, 1) and, in word 3, the groups listed for it, as
 // `test_groups` counts them; or `settle`'s (only bound there and in `size_dispatch` and
@@ -58,7 +67,15 @@ struct Pyramid {
 // each listing.
 @group(3) @binding(2) var<storage, read_write> listing: array<atomic<u32>>;
 
-const VISIBLE: u32 = 16u;
+const HEADER: u32 = 32u;
+const VISIBLE: u32 = HEADER;
+const LISTED_GROUPS: u32 = 16u;
+const LISTED_PIECES: u32 = 17u;
+const LEVEL_SHIFT: u32 = 3u;
+// How far a piece drawn at a coarser level may lie from its full strip on screen (pixels).
+const LOD_PIXELS: f32 = 0.5;
+// The coarsest level: every 8th point kept (a piece's ends).
+const LEVELS: u32 = 4u;
 // Texels across at most where a group's box reads the pyramid, and a segment's (a group's box
 // is large: read finer, it passes less often — at 10 M points 71 % of the groups of 16 for 91 %
 // at 2, for up to 256 reads a group).
@@ -79,10 +96,30 @@ fn seen_at(slot: u32) -> u32 {
     return VISIBLE + cluster_count() + slot;
 }
 
-// Vertices of an instance of the culled lines (`lines.wgsl`'s `vs_piece`: each piece's strip)
-// or tubes (`tubes.wgsl`'s `vs_tube_piece`: six vertices a segment).
-fn instance_vertices() -> u32 {
-    return PIECES_PER_INSTANCE * select(PIECE_STRIDE, 6u * PIECE_SEGMENTS, TUBES);
+// Vertices of an instance of draw `d`'s culled lines (`lines.wgsl`'s `vs_piece`: each piece's
+// strip, `vs_piece_coarse` at most every second point's) or tubes (`tubes.wgsl`'s
+// `vs_tube_piece`: six vertices a segment).
+fn instance_vertices(d: u32) -> u32 {
+    if TUBES {
+        return PIECES_PER_INSTANCE * 6u * PIECE_SEGMENTS;
+    }
+    return PIECES_PER_INSTANCE * select(PIECE_STRIDE, COARSE_PIECE_STRIDE, d >= 2u);
+}
+
+// The draw of a piece of phase `phase` (0 early, 1 late) drawn at `level`.
+fn draw_of(phase: u32, level: u32) -> u32 {
+    return phase + select(0u, 2u, level > 0u);
+}
+
+// A listed piece: its cluster, its level, which piece.
+fn piece_entry(cluster: u32, level: u32, p: u32) -> u32 {
+    return (cluster << 4u) | (level << 2u) | p;
+}
+
+// Where slot `slot` of draw `d`'s list lies in `pieces`.
+fn list_index(d: u32, slot: u32) -> u32 {
+    let start = (d & 1u) * late_list();
+    return select(start + slot, start + late_list() - 1u - slot, d >= 2u);
 }
 // Workgroups per row of a direct dispatch (`lineao::passes::cull`'s ROW), 64 invocations each.
 const ROW: u32 = 32768u;
@@ -96,22 +133,27 @@ fn invocation(group: vec3<u32>, local: u32) -> u32 {
     return (group.x + group.y * ROW) * 64u + local;
 }
 
-// Lists piece `entry` for draw `draw` (0 early, 1 late): its slot from the draw's piece count,
-// an instance more for every PIECES_PER_INSTANCE of them.
-fn append(draw: u32, entry: u32) {
-    let slot = atomicAdd(&state[9u + draw], 1u);
-    pieces[draw * late_list() + slot] = entry;
+// Lists piece `p` of cluster `cluster` at `level` for phase `phase` (0 early, 1 late): its
+// slot from its draw's piece count, an instance more for every PIECES_PER_INSTANCE of them.
+fn append(phase: u32, cluster: u32, level: u32, p: u32) {
+    let d = draw_of(phase, level);
+    let slot = atomicAdd(&state[LISTED_PIECES + d], 1u);
+    pieces[list_index(d, slot)] = piece_entry(cluster, level, p);
     if slot % PIECES_PER_INSTANCE == 0u {
-        atomicAdd(&state[4u * draw + 1u], 1u);
+        atomicAdd(&state[4u * d + 1u], 1u);
     }
+}
+
+// The level piece `p` of a cluster whose mark is `bits` was drawn at.
+fn marked_level(bits: u32, p: u32) -> u32 {
+    return (bits >> (LEVEL_SHIFT + 2u * p)) & 3u;
 }
 
 @compute @workgroup_size(64)
 fn early(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) local: u32) {
     let i = invocation(group, local);
-    if i == 0u {
-        atomicStore(&state[0], instance_vertices());
-        atomicStore(&state[4], instance_vertices());
+    if i < 4u {
+        atomicStore(&state[4u * i], instance_vertices(i));
     }
     if i >= cluster_count() {
         return;
@@ -119,8 +161,21 @@ fn early(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_inde
     let bits = atomicLoad(&state[VISIBLE + i]);
     for (var p = 0u; p < 3u; p++) {
         if (bits & (1u << p)) != 0u {
-            append(0u, (i << 2u) | p);
+            // Marks a cull at levels of detail left say nothing to one without.
+            append(0u, i, select(0u, marked_level(bits, p), LOD), p);
         }
+    }
+}
+
+// After a listing: the slots of each draw's last instance past its pieces hold NO_PIECE, so
+// they draw nothing (`shared/pieces.wgsl`).
+@compute @workgroup_size(32)
+fn pad(@builtin(local_invocation_index) local: u32) {
+    let d = local / 8u;
+    let count = atomicLoad(&state[LISTED_PIECES + d]);
+    let slot = count + local % 8u;
+    if slot % PIECES_PER_INSTANCE != 0u && slot < late_list() {
+        pieces[list_index(d, slot)] = NO_PIECE;
     }
 }
 
@@ -151,7 +206,7 @@ fn size_dispatch() {
     atomicStore(&listing[0], min(listed, DISPATCH_ROW));
     atomicStore(&listing[1], (listed + DISPATCH_ROW - 1u) / DISPATCH_ROW);
     atomicStore(&listing[2], 1u);
-    atomicStore(&state[8], listed);
+    atomicStore(&state[LISTED_GROUPS], listed);
 }
 
 // The piece of invocation `local` of workgroup `group` (a listed group's slot): (cluster,
@@ -159,7 +214,7 @@ fn size_dispatch() {
 fn listed_piece(group: vec3<u32>, local: u32) -> vec4<u32> {
     let slot = group.x + group.y * DISPATCH_ROW;
     let none = vec4<u32>(0u, 0u, 1u, 0u);
-    if slot >= atomicLoad(&state[8]) {
+    if slot >= atomicLoad(&state[LISTED_GROUPS]) {
         return none;
     }
     let i = atomicLoad(&state[seen_at(slot)]) * GROUP_CLUSTERS + local / 3u;
@@ -178,7 +233,7 @@ fn marked(i: u32, bit: u32) -> bool {
 }
 
 // An invocation per piece of a listed group: marks it visible or not, and lists the visible
-// ones the early draw did not draw.
+// ones the early draw did not draw (in full: their level is found by `settle`).
 @compute @workgroup_size(48)
 fn late(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) local: u32) {
     let piece = listed_piece(group, local);
@@ -190,18 +245,26 @@ fn late(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
     if piece_visible(clusters[piece.x], piece.z, piece.w) {
         atomicOr(&state[VISIBLE + piece.x], bit);
         if !before {
-            append(1u, (piece.x << 2u) | piece.y);
+            append(1u, piece.x, 0u, piece.y);
         }
     } else if before {
-        atomicAnd(&state[VISIBLE + piece.x], ~bit);
+        atomicAnd(&state[VISIBLE + piece.x], ~(bit | level_bits(piece.y)));
     }
+}
+
+// The bits of a cluster's mark that hold piece `p`'s level.
+fn level_bits(p: u32) -> u32 {
+    return 3u << (LEVEL_SHIFT + 2u * p);
 }
 
 // The indirect dispatch of `settle`: an invocation per piece drawn, early and late (rows of
 // 65 535 workgroups of 64).
 @compute @workgroup_size(1)
 fn size_settle() {
-    let drawn = atomicLoad(&state[9]) + atomicLoad(&state[10]);
+    var drawn = 0u;
+    for (var d = 0u; d < 4u; d++) {
+        drawn += atomicLoad(&state[LISTED_PIECES + d]);
+    }
     let groups = (drawn + 63u) / 64u;
     atomicStore(&listing[0], min(groups, DISPATCH_ROW));
     atomicStore(&listing[1], (groups + DISPATCH_ROW - 1u) / DISPATCH_ROW);
@@ -213,26 +276,91 @@ fn size_settle() {
 // marked: the early list holds the marked ones, the late one those marked since) that the
 // frame's lines hide after all are unmarked, so the next frame's early phase draws only what
 // this one shows (after a first frame or a cut, the late phase marks all that passed against
-// the early phase's depth).
+// the early phase's depth); with `LOD`, at the level found here.
 @compute @workgroup_size(64)
 fn settle(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) local: u32) {
-    let i = (group.x + group.y * DISPATCH_ROW) * 64u + local;
-    let early = atomicLoad(&state[9]);
-    if i >= early + atomicLoad(&state[10]) {
+    var i = (group.x + group.y * DISPATCH_ROW) * 64u + local;
+    // Slot i of the four lists one after the other.
+    var d = 0u;
+    for (; d < 4u; d++) {
+        let count = atomicLoad(&state[LISTED_PIECES + d]);
+        if i < count {
+            break;
+        }
+        i -= count;
+    }
+    if d == 4u {
         return;
     }
-    let entry = pieces[select(late_list() + i - early, i, i < early)];
-    let cluster = entry >> 2u;
+    let entry = pieces[list_index(d, i)];
+    let cluster = entry >> 4u;
     let p = entry & 3u;
     let bit = 1u << p;
     if !marked(cluster, bit) {
         return;
     }
+    let c = clusters[cluster];
     let first = p * PIECE_SEGMENTS;
-    let last = min(first + PIECE_SEGMENTS, drawn_points(clusters[cluster]) - 1u);
-    if !piece_visible(clusters[cluster], first, last) {
-        atomicAnd(&state[VISIBLE + cluster], ~bit);
+    let last = min(first + PIECE_SEGMENTS, drawn_points(c) - 1u);
+    if !piece_visible(c, first, last) {
+        atomicAnd(&state[VISIBLE + cluster], ~(bit | level_bits(p)));
+    } else if LOD {
+        // The level the next frame draws it at (here, where only the pieces drawn are tested:
+        // in `late`, the invocations beside a visible piece would wait for it).
+        let level = piece_level(c, first, last);
+        atomicAnd(&state[VISIBLE + cluster], ~level_bits(p));
+        atomicOr(&state[VISIBLE + cluster], level << (LEVEL_SHIFT + 2u * p));
     }
+}
+
+// The coarsest level (< LEVELS) at which strip points `first ..= last` of cluster `c` lie within
+// LOD_PIXELS of their full strip on screen: where every 2^level-th point and the last are kept,
+// each dropped point lies within LOD_PIXELS of the segment between the kept ones around it
+// (its distance in view space, at the scale of the piece's nearest point), and the sideways
+// push at it turns by no more (half a line width times its tangent's distance from the
+// segment's direction). A kept point keeps its own tangent, so the strip's corners there, and
+// the joins to the next pieces, are the full strip's.
+fn piece_level(c: Cluster, first: u32, last: u32) -> u32 {
+    let count = c.flags & CLUSTER_COUNT;
+    var p: array<vec3<f32>, 9>;
+    let n = last - first + 1u;
+    var nearest = 3.0e38;
+    for (var k = 0u; k < n; k++) {
+        var owner = c;
+        if first + k >= count {
+            owner = clusters[c.next];
+        }
+        let view_pos = frame.view * vec4<f32>(decode_point(c.first + first + k, owner), 1.0);
+        let w = (frame.proj * view_pos).w;
+        if w <= 0.0 {
+            return 0u;
+        }
+        nearest = min(nearest, w);
+        p[k] = view_pos.xyz;
+    }
+    // Pixels a view-space unit spans at the nearest point.
+    let px = 0.5 * max(frame.proj[0][0] * frame.viewport.x, frame.proj[1][1] * frame.viewport.y) / nearest;
+    let half_width = 0.5 * frame.line_width_px;
+    for (var level = LEVELS - 1u; level > 0u; level--) {
+        let stride = 1u << level;
+        var fits = true;
+        for (var k = 1u; k + 1u < n && fits; k++) {
+            if k % stride == 0u {
+                continue;
+            }
+            let a = p[k - k % stride];
+            let b = p[min(k - k % stride + stride, n - 1u)];
+            let ab = b - a;
+            let t = clamp(dot(p[k] - a, ab) / max(dot(ab, ab), 1e-30), 0.0, 1.0);
+            let off_line = length(p[k] - (a + t * ab)) * px;
+            let turn = length(normalize(p[k + 1u] - p[k - 1u]) - normalize(ab)) * half_width;
+            fits = off_line + turn <= LOD_PIXELS;
+        }
+        if fits {
+            return level;
+        }
+    }
+    return 0u;
 }
 
 // Whether strip points `first ..= last` of cluster `c` may leave a fragment in front of the

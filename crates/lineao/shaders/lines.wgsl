@@ -162,38 +162,62 @@ fn vs_native(@builtin(vertex_index) v: u32, @builtin(instance_index) cluster: u3
 struct Piece {
     cluster: Cluster,
     at: StripPosition,
+    stride: u32,
 }
 
-// Vertex `v` of instance `instance`: block v / PIECE_STRIDE is a listed piece's full strip (the
-// same triangles as the cluster's full strip, so the culled lines draw its pixels exactly) and
-// then a repeat of its last vertex and of the next block's first, so that the blocks'
-// triangles are their own strips' (each block starts at an even vertex: the same vertex order
-// in every triangle) and those between them have zero area.
-fn piece_vertex(v: u32, instance: u32) -> Piece {
-    let block = v / PIECE_STRIDE;
-    var k = v % PIECE_STRIDE;
+// Vertex `v` of instance `instance` of the full (or `coarse`) pieces: block v / `stride` is a
+// listed piece's full strip through the points it keeps (the same triangles as the cluster's
+// full strip for a full piece, so the culled lines draw its pixels exactly; a kept point keeps
+// its own tangent, so a coarse piece's corners there are the full strip's) and then a repeat
+// of its last vertex and of the next block's first, so that the blocks' triangles are their own
+// strips' (each block starts at an even vertex: the same vertex order in every triangle) and
+// those between them have zero area. A piece keeping fewer points collapses the rest.
+fn piece_vertex(v: u32, instance: u32, coarse: bool) -> Piece {
+    let stride = select(PIECE_STRIDE, COARSE_PIECE_STRIDE, coarse);
+    let block = v / stride;
+    var k = v % stride;
     var slot = instance * PIECES_PER_INSTANCE + block;
-    if k == PIECE_STRIDE - 1u && block + 1u < PIECES_PER_INSTANCE {
+    if k == stride - 1u && block + 1u < PIECES_PER_INSTANCE {
         // The next block's first vertex.
         slot += 1u;
         k = 0u;
     }
-    let piece = visible_piece(slot);
+    let piece = visible_piece(slot, coarse);
     // Its strip's last vertex (the repeat after it, or the end of the instance).
-    let at = full_strip(min(k, 2u * (PIECE_SEGMENTS + 1u) - 1u), piece.points);
-    return Piece(piece.cluster, StripPosition(select(-1, at.point + i32(piece.first), at.point >= 0), at.side));
+    let at = full_strip(min(k, stride - 3u), kept_points(piece));
+    let point = select(-1, i32(kept_point(piece, u32(max(at.point, 0)))), at.point >= 0);
+    return Piece(piece.cluster, StripPosition(point, at.side), piece.stride);
+}
+
+// A piece's strip vertex, colored by its level in color mode 3.
+fn piece_strip_vertex(piece: Piece) -> VsOut {
+    var out = strip_vertex(piece.cluster, piece.at);
+    if frame.color_mode == 3u {
+        out.color = piece_color(piece.stride);
+    }
+    return out;
 }
 
 @vertex
 fn vs_piece(@builtin(vertex_index) v: u32, @builtin(instance_index) instance: u32) -> VsOut {
-    let piece = piece_vertex(v, instance);
-    return strip_vertex(piece.cluster, piece.at);
+    return piece_strip_vertex(piece_vertex(v, instance, false));
 }
 
 @vertex
 fn vs_piece_octants(@builtin(vertex_index) v: u32, @builtin(instance_index) instance: u32) -> VsOutOctants {
-    let piece = piece_vertex(v, instance);
-    return with_point_octants(strip_vertex(piece.cluster, piece.at), piece.cluster, piece.at);
+    let piece = piece_vertex(v, instance, false);
+    return with_point_octants(piece_strip_vertex(piece), piece.cluster, piece.at);
+}
+
+@vertex
+fn vs_piece_coarse(@builtin(vertex_index) v: u32, @builtin(instance_index) instance: u32) -> VsOut {
+    return piece_strip_vertex(piece_vertex(v, instance, true));
+}
+
+@vertex
+fn vs_piece_coarse_octants(@builtin(vertex_index) v: u32, @builtin(instance_index) instance: u32) -> VsOutOctants {
+    let piece = piece_vertex(v, instance, true);
+    return with_point_octants(piece_strip_vertex(piece), piece.cluster, piece.at);
 }
 
 fn with_point_octants(b: VsOut, c: Cluster, at: StripPosition) -> VsOutOctants {

@@ -102,7 +102,7 @@ fn vs_tube(@builtin(vertex_index) v: u32, @builtin(instance_index) cluster: u32)
 @vertex
 fn vs_tube_piece(@builtin(vertex_index) v: u32, @builtin(instance_index) instance: u32) -> TubeOut {
     let per_piece = 6u * PIECE_SEGMENTS;
-    let piece = visible_piece(instance * PIECES_PER_INSTANCE + v / per_piece);
+    let piece = visible_piece(instance * PIECES_PER_INSTANCE + v / per_piece, false);
     let k = v % per_piece;
     return segment_vertex(piece.cluster, piece.first + k / 6u, k % 6u, piece.first + piece.points);
 }

@@ -43,6 +43,7 @@ impl GeometryUniform {
             LineColor::Tangent => (0, [0.0; 3]),
             LineColor::Constant(rgb) => (1, rgb),
             LineColor::Scalar { .. } => (2, [0.0; 3]),
+            LineColor::Pieces => (3, [0.0; 3]),
         };
         let (scalar_range, colormap) = match color {
             LineColor::Scalar { colormap, range } => ([range[0], range[1], 0.0, 0.0], colormap.table()),

@@ -155,6 +155,10 @@ pub enum DebugView {
     Zoom,
     /// Normals of pyramid level k.
     Level(u32),
+    /// The final image with each culled piece of line colored by the level of detail it is
+    /// drawn at ([`crate::passes::cull`]): blue every point, green every 2nd, orange every 4th,
+    /// red every 8th; lines drawn whole (not culled) and tubes gray.
+    Pieces,
 }
 
 impl DebugView {
@@ -166,6 +170,8 @@ impl DebugView {
             DebugView::Depth => (3, 0),
             DebugView::Zoom => (4, 0),
             DebugView::Level(k) => (5, k),
+            // The geometry's colors say it.
+            DebugView::Pieces => (0, 0),
         }
     }
 }
@@ -180,6 +186,8 @@ pub enum LineColor {
     Tangent,
     /// One linear RGB color.
     Constant([f32; 3]),
+    /// What the cull drew each piece as ([`DebugView::Pieces`], which sets it for the frame).
+    Pieces,
     /// The geometry's per-vertex scalar ([`crate::passes::lines::VertexAttributes::scalar`]:
     /// FA, curvature, a bundle index …) through `colormap`, `range` mapped to its ends (values
     /// beyond clamp). Geometry without scalars shows the colormap's low end.
@@ -252,6 +260,12 @@ pub struct ChainSettings {
     /// a chain draws frames one after another. A single picture has no frame before it, and
     /// culled it costs the full strip and the tests (`lineao render` turns it off).
     pub cull: bool,
+    /// Where it culls lines, draw each visible piece at the coarsest level of detail that lies
+    /// within half a pixel of it on screen ([`crate::passes::cull`]'s level of detail): fewer
+    /// vertices for lines seen from afar, a G-buffer that differs from the full strip's by
+    /// sub-pixel shifts. Off: the full strip exactly. Default on (but for the ray tracer:
+    /// [`ChainSettings::levels_of_detail`]).
+    pub lod: bool,
 }
 
 impl Default for ChainSettings {
@@ -263,6 +277,13 @@ impl Default for ChainSettings {
 }
 
 impl ChainSettings {
+    /// Whether the culled lines are drawn at levels of detail: [`ChainSettings::lod`], but never
+    /// for the GPU ray tracer, whose rays start on the G-buffer's lines and must find them
+    /// where the scene it traces has them.
+    pub fn levels_of_detail(&self) -> bool {
+        self.lod && self.method != AoMethod::RayTraced
+    }
+
     /// The papers' values for every setting (LineAO s_r 3, r0 1.5 × the line width, δ scale 1,
     /// strength 1; VO and SSAO spheres of 2 world units): `ChainSettings::default()` before the
     /// default preset is applied, and what [`Preset::Paper`] restores.
@@ -286,6 +307,7 @@ impl ChainSettings {
             zoom_unit: 1.0,
             guard_max_px: 128,
             cull: true,
+            lod: true,
         }
     }
 }

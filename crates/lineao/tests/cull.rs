@@ -169,7 +169,7 @@ fn culled_lines_draw_the_g_buffer_of_all_lines() {
     let (positions, offsets) = ball(8000);
     let geometry = LineGeometry::new(d, q, &positions, &offsets).unwrap();
     let all = LineRenderer::with_style(d, LineStyle::FullStrip);
-    let culled = LineRenderer::new(d).culled(d);
+    let culled = LineRenderer::new(d).culled(d, false);
     let pieces = lineao::passes::cull::LineCull::pieces(&geometry);
     for (case, camera) in cameras() {
         let expected = draw(&gpu, &all, &geometry, &camera);
@@ -239,6 +239,63 @@ fn culled_tubes_draw_the_g_buffer_of_all_tubes() {
                     assert!((early + late) * 2 < pieces, "{case}: drew {early} + {late} of {pieces}");
                 }
             }
+        }
+    }
+}
+
+/// The culled lines at levels of detail (`passes::cull`'s `LOD_PIXELS`): against every line's
+/// full strip, the same pixels covered but a few at the silhouette, and the front line's depth
+/// within half a pixel's width of the full strip's at nearly every pixel (elsewhere another
+/// line, shifted less than a pixel, is in front); and with fewer points drawn. The first frame
+/// after a cut is the full strip's.
+#[test]
+fn culled_lines_at_levels_of_detail_stay_within_half_a_pixel() {
+    let gpu = gpu();
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let (positions, offsets) = ball(8000);
+    let geometry = LineGeometry::new(d, q, &positions, &offsets).unwrap();
+    let all = LineRenderer::with_style(d, LineStyle::FullStrip);
+    let lod = LineRenderer::new(d).culled(d, true);
+    for (case, camera) in cameras() {
+        let view = FrameView::new(&camera, &bounds(), SIZE.0, SIZE.1, GUARD, 1.0);
+        let expected = draw(&gpu, &all, &geometry, &camera);
+        // The first frame after a cut draws every piece whole (the levels were found for
+        // another view); the second draws them at the levels found against this one.
+        let first = draw(&gpu, &lod, &geometry, &camera);
+        let counts = lod.cull().unwrap().counts(q, &geometry).unwrap();
+        assert_eq!(counts.coarse, 0, "{case}: the first frame after a cut draws every piece whole");
+        same_gbuffer(&expected, &first, case);
+        let got = draw(&gpu, &lod, &geometry, &camera);
+        let counts = lod.cull().unwrap().counts(q, &geometry).unwrap();
+        let (mut covered, mut coverage, mut far, mut identical) = (0usize, 0usize, 0usize, 0usize);
+        for i in 0..expected[0].data.len() {
+            let (a, b) = (is_geometry(expected[1].data[i]), is_geometry(got[1].data[i]));
+            covered += a as usize;
+            coverage += (a != b) as usize;
+            if !(a && b) {
+                continue;
+            }
+            identical += (0..4).all(|t| expected[t].data[i] == got[t].data[i]) as usize;
+            // Linear depth in world units, and half a pixel's width there.
+            let z = |nd: [f32; 4]| view.near + nd[3] * (view.far - view.near);
+            let (za, zb) = (z(expected[1].data[i]), z(got[1].data[i]));
+            let px = if view.orthographic { view.f_px } else { view.f_px / za };
+            far += ((za - zb).abs() > lineao::passes::cull::LOD_PIXELS / px) as usize;
+        }
+        let share = |n: usize| 100.0 * n as f64 / covered as f64;
+        println!(
+            "{case}: {:.1} % of {} pieces drawn coarser; of {covered} geometry pixels {:.2} % covered or not \
+             otherwise, {:.2} % identical, {:.2} % with another depth beyond half a pixel",
+            100.0 * counts.coarse as f64 / (counts.early + counts.late) as f64,
+            counts.early + counts.late,
+            share(coverage),
+            share(identical),
+            share(far),
+        );
+        assert!(coverage * 200 <= covered, "{case}: {coverage} of {covered} pixels covered otherwise");
+        assert!(far * 50 <= covered, "{case}: {far} of {covered} pixels at another depth");
+        if case == "outside" {
+            assert!(counts.coarse * 2 >= counts.early + counts.late, "{case}: {counts}");
         }
     }
 }

@@ -40,6 +40,10 @@ const PIECE_SEGMENTS: u32 = 8u;
 // instances of a few vertices each are slow on some GPUs (a whole brain's pieces on an H200).
 const PIECES_PER_INSTANCE: u32 = 8u;
 const PIECE_STRIDE: u32 = 2u * (PIECE_SEGMENTS + 1u) + 2u;
+// A coarse piece's (`lineao::passes::cull`'s level of detail): at most every second point.
+const COARSE_PIECE_STRIDE: u32 = 2u * (PIECE_SEGMENTS / 2u + 1u) + 2u;
+// A list slot that holds no piece.
+const NO_PIECE: u32 = 0xffffffffu;
 // Clusters of a group (`lineao::line_geometry::GROUP_CLUSTERS`).
 const GROUP_CLUSTERS: u32 = 16u;
 

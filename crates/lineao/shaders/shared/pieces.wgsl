@@ -1,22 +1,46 @@
 // The pieces the cull found visible (`lineao::passes::cull`), as the culled lines and tubes
-// draw them: cluster << 2 | piece, where piece p of a cluster is its strip's segments
-// 8p .. 8p + 7 (points 8p ..= 8p + 8, or to its end). Bind group 2 of their pipelines.
+// draw them: cluster << 4 | level << 2 | piece, where piece p of a cluster is its strip's
+// segments 8p .. 8p + 7 (points 8p ..= 8p + 8, or to its end), drawn keeping every
+// 2^level-th point of it and its last. A draw of full pieces reads its list from the front,
+// one of coarse pieces (level > 0) from the back. Bind group 2 of their pipelines.
 #import shared/clusters.wgsl
 
 @group(2) @binding(0) var<storage, read> visible_pieces: array<u32>;
 
-// A listed piece: its cluster, its first point in the cluster's strip and how many it draws.
+// A listed piece: its cluster, its first point in the cluster's strip, how many it spans, and
+// the stride of the points it keeps.
 struct VisiblePiece {
     cluster: Cluster,
     first: u32,
     points: u32,
+    stride: u32,
 }
 
-// The piece of slot `slot`. Slots past the listed pieces hold pieces listed before (or
-// cluster 0's first): drawing more of the lines than the visible ones leaves the same G-buffer.
-fn visible_piece(slot: u32) -> VisiblePiece {
-    let entry = visible_pieces[min(slot, arrayLength(&visible_pieces) - 1u)];
-    let c = clusters[entry >> 2u];
+// The piece of slot `slot` of the list of full (or `coarse`) pieces. Slots past the listed
+// pieces hold NO_PIECE (the cull pads the last instance), which spans no point: nothing drawn.
+fn visible_piece(slot: u32, coarse: bool) -> VisiblePiece {
+    let length = arrayLength(&visible_pieces);
+    var entry = NO_PIECE;
+    if slot < length {
+        entry = visible_pieces[select(slot, length - 1u - slot, coarse)];
+    }
+    if entry == NO_PIECE {
+        return VisiblePiece(clusters[0], 0u, 0u, 1u);
+    }
+    let c = clusters[entry >> 4u];
     let first = (entry & 3u) * PIECE_SEGMENTS;
-    return VisiblePiece(c, first, min(drawn_points(c) - first, PIECE_SEGMENTS + 1u));
+    return VisiblePiece(c, first, min(drawn_points(c) - first, PIECE_SEGMENTS + 1u), 1u << ((entry >> 2u) & 3u));
+}
+
+// How many points a piece keeps: every stride-th and its last.
+fn kept_points(piece: VisiblePiece) -> u32 {
+    if piece.points < 2u {
+        return piece.points;
+    }
+    return (piece.points + piece.stride - 2u) / piece.stride + 1u;
+}
+
+// The strip point of the piece's k-th kept point.
+fn kept_point(piece: VisiblePiece, k: u32) -> u32 {
+    return piece.first + min(k * piece.stride, piece.points - 1u);
 }

@@ -60,6 +60,7 @@ use crate::settings::{AoMethod, ChainSettings};
 use crate::stage::Stages;
 use crate::targets::FrameTargets;
 use crate::timing::{PassTime, PassTimer, Span};
+use crate::{DebugView, LineColor};
 
 pub use host::HostAo;
 pub use overlay::OverlayAo;
@@ -155,8 +156,11 @@ impl AoChain {
         })
         .await?;
         let octants = settings.volume.is_some();
-        if octants != self.lines.writes_octants() || settings.cull != self.lines.culls() {
-            // Writing octants or not, culling or not, is a matter of the geometry pipelines.
+        if octants != self.lines.writes_octants()
+            || settings.cull != self.lines.culls()
+            || (settings.cull && settings.levels_of_detail() != self.lines.lods())
+        {
+            // Writing octants or not, culling (at levels of detail) or not, is a matter of the geometry pipelines.
             self.lines = line_renderer(device, &settings);
             self.volume_ao = settings.volume.as_ref().map(|_| VolumeAo::new(device));
         }
@@ -370,9 +374,10 @@ impl AoChain {
             self.targets = Some(targets);
         }
         let targets = self.targets.as_ref()?;
+        let color = if s.debug_view == DebugView::Pieces { LineColor::Pieces } else { s.line_color };
         match (&self.tubes, &s.tubes) {
-            (Some(tubes), Some(t)) => tubes.prepare(queue, &view, t.radius_world, s.line_color, &s.lighting),
-            _ => self.lines.prepare(queue, &view, s.line_width_px, s.line_color, &s.lighting),
+            (Some(tubes), Some(t)) => tubes.prepare(queue, &view, t.radius_world, color, &s.lighting),
+            _ => self.lines.prepare(queue, &view, s.line_width_px, color, &s.lighting),
         }
         if let (Some(meshes), Some(surfaces)) = (&self.meshes, &s.surfaces) {
             meshes.prepare(queue, &view, surfaces.color, &s.lighting);
@@ -550,10 +555,11 @@ impl AoChain {
 }
 
 /// The chain's line renderer for `settings`: fixed-width quads, writing the octants with
-/// object-space AO, culled on the GPU with [`ChainSettings::cull`].
+/// object-space AO, culled on the GPU with [`ChainSettings::cull`] (at levels of detail with
+/// [`ChainSettings::lod`]).
 fn line_renderer(device: &wgpu::Device, settings: &ChainSettings) -> LineRenderer {
     let renderer = LineRenderer::with_outputs(device, LineStyle::Quads, settings.volume.is_some());
-    if settings.cull { renderer.culled(device) } else { renderer }
+    if settings.cull { renderer.culled(device, settings.levels_of_detail()) } else { renderer }
 }
 
 /// The chain's tube renderer where `settings` asks for tubes: writing the octants with

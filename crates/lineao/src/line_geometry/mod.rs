@@ -235,9 +235,9 @@ pub(crate) struct Page {
     pub records: u32,
     /// Pieces of eight segments its clusters' strips have (the culled lines' unit).
     pub pieces: u64,
-    /// Its culling state for lines and for tubes (each marks what it found visible),
-    /// made on its first culled frame.
-    pub cull: [std::sync::OnceLock<crate::passes::cull::PageCull>; 2],
+    /// Its culling state for lines, lines at levels of detail and tubes (each marks what it
+    /// found visible, and at which level), made on its first culled frame.
+    pub cull: [std::sync::OnceLock<crate::passes::cull::PageCull>; 3],
     points: u32,
     runs: Vec<RunMap>,
     pub xy: wgpu::Buffer,

@@ -45,13 +45,30 @@
 //! and the order decides. A first frame, a camera cut or a resize costs one full draw (nothing
 //! was visible before, so the late phase draws all that passes against an empty pyramid).
 //!
+//! **Level of detail** (lines, where asked: [`LineCull::new`]'s `lod`, the chain's default):
+//! the settling also picks for each piece drawn and still visible the coarsest level — every 2nd, 4th or 8th
+//! point kept, and its last — at which each dropped point lies within [`LOD_PIXELS`] of the
+//! segment between the kept points around it, on screen at the piece's nearest point, and the
+//! sideways push at it turns by no more (half a line width times how far its tangent turns from
+//! the segment's direction). Kept points keep their own tangents, so the strip's corners there
+//! and the joins between pieces are the full strip's. The level is kept with the piece's mark,
+//! and the next frame's early phase draws the piece at it (a piece seen first is drawn whole
+//! by the late phase; the settling tests a compact list, where the late test's invocations
+//! beside a visible piece would wait for it) — where the view is close to the one the levels
+//! were found for ([`LevelsView::holds`]: the same projection, the eye moved by under 5 % of
+//! the near distance, turned by under 0.05 rad); after a cut it draws every piece whole;
+//! coarse pieces are listed from the
+//! back of their phase's list and drawn with 12 vertices a piece instead of 20. Without it the
+//! G-buffer is the full strip's exactly.
+//!
 //! **Tubes** ([`Shape::Tubes`], `crate::passes::tubes`) are culled the same way, piece by
 //! piece: a segment's fragments lie within its billboard (`shaders/shared/billboard.wgsl`: the
 //! end spheres' disks on screen hulled by a rectangle, at the depth of the solid's front, which
 //! the written depth is never nearer than), bounded for the largest radius the page's points
 //! hold (its uniform) or the frame's; a group's box grows by that radius.
 //!
-//! Each page keeps its state ([`PageCull`]), one for lines and one for tubes: a word a cluster
+//! Each page keeps its state ([`PageCull`]), one for lines, lines at levels of detail and
+//! tubes each: a word a cluster
 //! (its visible pieces), the list of pieces to draw (a word each), the listed groups and the
 //! indirect draws and dispatch: about 1.3 bytes a point, made on the page's first culled frame.
 
@@ -70,9 +87,18 @@ const ROW: u32 = 32768;
 const WORKGROUP_INVOCATIONS: u32 = 64;
 /// Pieces a cluster has at most (24 segments of 8).
 pub const PIECES_PER_CLUSTER: u64 = 3;
-/// Words of a page's state before its marks: the indirect draws, early and late, the count of
-/// listed groups and of each draw's pieces (`state` in `shaders/cull.wgsl`).
-const STATE_HEADER_WORDS: u64 = 16;
+/// Words of a page's state before its marks: the four indirect draws (early and late, full and
+/// coarse pieces), the count of listed groups and of each draw's pieces (`state` in
+/// `shaders/cull.wgsl`).
+const STATE_HEADER_WORDS: u64 = 32;
+/// Where the count of listed groups lies in the state, and the counts of the draws' pieces.
+const LISTED_GROUPS: usize = 16;
+const LISTED_PIECES: usize = 17;
+/// How far from its full strip a piece drawn at a coarser level may lie on screen, in pixels
+/// (`LOD_PIXELS` in `shaders/cull.wgsl`).
+pub const LOD_PIXELS: f32 = 0.5;
+/// Bits of a cluster's mark that say which pieces are visible (the others: their levels).
+pub const MARK_VISIBLE: u32 = 0b111;
 /// Bytes of the listed groups' indirect dispatch and their count (`listing`).
 const LISTING_BYTES: u64 = 16;
 
@@ -110,12 +136,43 @@ impl Phase {
         }
     }
 
-    /// Where its indirect arguments lie in a page's draws buffer.
-    pub fn offset(self) -> u64 {
-        match self {
-            Phase::Early => 0,
-            Phase::Late => 16,
+    /// Where the indirect arguments of its draw of full (or `coarse`) pieces lie in a page's
+    /// state.
+    pub fn offset(self, coarse: bool) -> u64 {
+        16 * (self as u64 + 2 * coarse as u64)
+    }
+}
+
+/// The view a page's levels of detail were found for.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LevelsView {
+    view: glam::Mat4,
+    proj: glam::Mat4,
+    near: f32,
+    orthographic: bool,
+}
+
+impl LevelsView {
+    pub fn of(view: &crate::FrameView) -> LevelsView {
+        LevelsView { view: view.view, proj: view.proj, near: view.near, orthographic: view.orthographic }
+    }
+
+    /// Whether levels found for this view keep a frame of `now` within about their bound: the
+    /// same projection, and (perspective) the eye moved by under 5 % of the near distance —
+    /// what the nearest line's depth, and so its pixels per unit, changes by at most — and the
+    /// view direction turned by under 0.05 rad.
+    pub fn holds(&self, now: &LevelsView) -> bool {
+        if self.proj != now.proj {
+            return false;
         }
+        if self.orthographic {
+            // Orthographic: a unit spans the same pixels wherever it lies.
+            return true;
+        }
+        let (before, after) = (self.view.inverse(), now.view.inverse());
+        let moved = before.w_axis.truncate().distance(after.w_axis.truncate());
+        let turned = before.z_axis.truncate().angle_between(after.z_axis.truncate());
+        moved < 0.05 * self.near && turned < 0.05
     }
 }
 
@@ -133,6 +190,8 @@ pub struct PageCull {
     geometry: wgpu::BindGroup,
     pieces: wgpu::Buffer,
     listing: wgpu::Buffer,
+    /// The view its marks' levels of detail were found for.
+    levels_of: std::sync::Mutex<Option<LevelsView>>,
 }
 
 impl PageCull {
@@ -176,7 +235,14 @@ pub struct LineCull {
     device: wgpu::Device,
     shape: Shape,
     pyramid: DepthPyramid,
+    /// Whether it picks a level of detail for each piece.
+    lod: bool,
     early: wgpu::ComputePipeline,
+    /// `early` drawing every piece whole, after a cut (where it picks levels).
+    early_whole: wgpu::ComputePipeline,
+    /// The view of the frame being recorded ([`LineCull::set_view`]).
+    view: std::sync::Mutex<Option<LevelsView>>,
+    pad: wgpu::ComputePipeline,
     test_groups: wgpu::ComputePipeline,
     size_dispatch: wgpu::ComputePipeline,
     late: wgpu::ComputePipeline,
@@ -194,8 +260,8 @@ pub struct LineCull {
 
 impl LineCull {
     /// The cull of geometry drawn as `shape` with `frame` (the renderer's group 0: its frame
-    /// uniform and lighting).
-    pub fn new(device: &wgpu::Device, frame: &wgpu::BindGroupLayout, shape: Shape) -> LineCull {
+    /// uniform and lighting), picking a level of detail for each piece where `lod` (lines only).
+    pub fn new(device: &wgpu::Device, frame: &wgpu::BindGroupLayout, shape: Shape, lod: bool) -> LineCull {
         let label = "lineao::LineCull";
         let compute = wgpu::ShaderStages::COMPUTE;
         let pyramid_layout = binding::layout(device, label, compute, &[Slot::Uniform, Slot::Storage]);
@@ -207,8 +273,9 @@ impl LineCull {
         let listing_layout = binding::layout(device, label, compute, &state);
         let page = geometry_layout(device);
         let module = crate::shader::module(device, "cull.wgsl");
-        let constants = [("TUBES", (shape == Shape::Tubes) as u32 as f64)];
-        let pipeline = |entry: &str, groups: &[Option<&wgpu::BindGroupLayout>]| {
+        let lod = lod && shape == Shape::Lines;
+        let constants = |lod: bool| [("TUBES", (shape == Shape::Tubes) as u32 as f64), ("LOD", lod as u32 as f64)];
+        let pipeline_of = |entry: &str, groups: &[Option<&wgpu::BindGroupLayout>], lod: bool| {
             let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some(label),
                 bind_group_layouts: groups,
@@ -219,10 +286,14 @@ impl LineCull {
                 layout: Some(&layout),
                 module: &module,
                 entry_point: Some(entry),
-                compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants: &constants(lod),
+                    ..Default::default()
+                },
                 cache: None,
             })
         };
+        let pipeline = |entry: &str, groups: &[Option<&wgpu::BindGroupLayout>]| pipeline_of(entry, groups, lod);
         let all = [Some(frame), Some(&page), Some(&pyramid_layout), Some(&state_layout)];
         let listing = [Some(frame), Some(&page), Some(&pyramid_layout), Some(&listing_layout)];
         LineCull {
@@ -230,6 +301,10 @@ impl LineCull {
             shape,
             pyramid: DepthPyramid::new(device),
             early: pipeline("early", &[None, Some(&page), None, Some(&state_layout)]),
+            early_whole: pipeline_of("early", &[None, Some(&page), None, Some(&state_layout)], false),
+            view: Default::default(),
+            pad: pipeline("pad", &[None, None, None, Some(&state_layout)]),
+            lod,
             test_groups: pipeline("test_groups", &listing),
             size_dispatch: pipeline("size_dispatch", &[None, None, None, Some(&listing_layout)]),
             late: pipeline("late", &all),
@@ -279,7 +354,7 @@ impl LineCull {
 
     /// `page`'s state, made on its first frame.
     pub(crate) fn state<'p>(&self, page: &'p Page) -> &'p PageCull {
-        page.cull[self.shape as usize].get_or_init(|| {
+        page.cull[self.slot()].get_or_init(|| {
             let device = &self.device;
             let buffer = |label, size: u64, usage| {
                 device.create_buffer(&wgpu::BufferDescriptor {
@@ -297,9 +372,10 @@ impl LineCull {
                 4 * (STATE_HEADER_WORDS + clusters + groups),
                 wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
             );
-            // The early list, then the late one where a storage binding may start.
+            // The early list, then the late one where a storage binding may start; each with
+            // room for its full and its coarse pieces padded to whole instances.
             let align = u64::from(device.limits().min_storage_buffer_offset_alignment);
-            let list = (4 * PIECES_PER_CLUSTER * clusters).next_multiple_of(align);
+            let list = (4 * (PIECES_PER_CLUSTER * clusters + 16)).next_multiple_of(align);
             let pieces = buffer("lineao::LineCull::pieces", 2 * list, wgpu::BufferUsages::empty());
             let listing = buffer(
                 "lineao::LineCull::listing",
@@ -322,7 +398,16 @@ impl LineCull {
                 entries: &[(0, &page.xy), (1, &page.z), (2, &page.clusters), (6, &page.uniform), (7, &page.groups)]
                     .map(|(binding, buffer)| wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() }),
             });
-            PageCull { state, draw_groups, compute_group, listing_group, geometry, pieces, listing }
+            PageCull {
+                state,
+                draw_groups,
+                compute_group,
+                listing_group,
+                geometry,
+                pieces,
+                listing,
+                levels_of: Default::default(),
+            }
         })
     }
 
@@ -344,16 +429,54 @@ impl LineCull {
         for page in pages {
             encoder.clear_buffer(&self.state(page).state, 0, Some(4 * STATE_HEADER_WORDS));
         }
+        let view = *self.view.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
         self.over_pages(encoder, pages, None, &self.early, first, |pass, page, state| {
+            if self.lod {
+                let mut levels_of = state.levels_of.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+                let hold = matches!((*levels_of, view), (Some(then), Some(now)) if then.holds(&now));
+                pass.set_pipeline(if hold { &self.early } else { &self.early_whole });
+                // This frame's settling finds them for this view.
+                *levels_of = view;
+            }
             pass.set_bind_group(3, &state.compute_group, &[]);
             dispatch_over(pass, page.records);
         });
+        self.pad(encoder, pages);
         draw(encoder, Phase::Early, None);
         let built = self.pyramid.encode(encoder, &targets.depth, None);
         self.test(encoder, pages, frame, &built, &self.size_dispatch, &self.late, None);
+        self.pad(encoder, pages);
         draw(encoder, Phase::Late, None);
         let built = self.pyramid.encode(encoder, &targets.depth, None);
         self.test(encoder, pages, frame, &built, &self.size_settle, &self.settle, last);
+    }
+
+    /// Pads each page's lists to whole instances (`pad`).
+    fn pad(&self, encoder: &mut wgpu::CommandEncoder, pages: &[Page]) {
+        self.over_pages(encoder, pages, None, &self.pad, None, |pass, _, state| {
+            pass.set_bind_group(3, &state.compute_group, &[]);
+            pass.dispatch_workgroups(1, 1, 1);
+        });
+    }
+
+    /// Whether it picks a level of detail for each piece.
+    pub fn lod(&self) -> bool {
+        self.lod
+    }
+
+    /// The view of the frames it records next (the renderer's `prepare`): where it is not close
+    /// to the one a page's levels were found for, the early phase draws that page whole.
+    pub fn set_view(&self, view: &crate::FrameView) {
+        *self.view.lock().unwrap_or_else(|poisoned| poisoned.into_inner()) = Some(LevelsView::of(view));
+    }
+
+    /// Which of a page's culling states is its own: lines, lines at levels of detail, tubes.
+    fn slot(&self) -> usize {
+        match (self.shape, self.lod) {
+            (Shape::Lines, false) => 0,
+            (Shape::Lines, true) => 1,
+            (Shape::Tubes, _) => 2,
+        }
     }
 
     /// One compute pass of `pipeline` timed into `span`, with the frame and the pyramid bound
@@ -425,7 +548,7 @@ impl LineCull {
     /// header words and its marks (none for a page not culled yet).
     fn read_states(&self, queue: &wgpu::Queue, geometry: &LineGeometry) -> Result<Vec<Option<Vec<u32>>>, crate::Error> {
         let read = |page: &Page| -> Result<_, crate::Error> {
-            let Some(state) = page.cull[self.shape as usize].get() else { return Ok(None) };
+            let Some(state) = page.cull[self.slot()].get() else { return Ok(None) };
             let bytes = pollster::block_on(crate::readback::read_buffer_async(&self.device, queue, &state.state))?;
             let words: &[u32] = bytemuck::cast_slice(&bytes);
             Ok(Some(words[..(STATE_HEADER_WORDS + page.records as u64) as usize].to_vec()))
@@ -439,6 +562,7 @@ impl LineCull {
         let mut counts = CullCounts {
             early: 0,
             late: 0,
+            coarse: 0,
             listed_groups: 0,
             groups: geometry.pages().iter().map(|p| p.records.div_ceil(GROUP_CLUSTERS as u32) as u64).sum(),
             pieces: LineCull::pieces(geometry),
@@ -446,17 +570,19 @@ impl LineCull {
             clusters: geometry.clusters() as u64,
         };
         for words in self.read_states(queue, geometry)?.into_iter().flatten() {
-            counts.early += words[9] as u64;
-            counts.late += words[10] as u64;
-            counts.listed_groups += words[8] as u64;
+            let listed = |d: usize| words[LISTED_PIECES + d] as u64;
+            counts.early += listed(0) + listed(2);
+            counts.late += listed(1) + listed(3);
+            counts.coarse += listed(2) + listed(3);
+            counts.listed_groups += words[LISTED_GROUPS] as u64;
             let marks = &words[STATE_HEADER_WORDS as usize..];
-            counts.visible_clusters += marks.iter().filter(|&&bits| bits != 0).count() as u64;
+            counts.visible_clusters += marks.iter().filter(|&&bits| bits & MARK_VISIBLE != 0).count() as u64;
         }
         Ok(counts)
     }
 
     /// Each page's marks after the last frame recorded, a word per cluster (bit p: piece p
-    /// passed), read back (waits for the device): what the CPU reference checks.
+    /// passed; bits 3 + 2p and 4 + 2p: the level it was drawn at), read back (waits for the device): what the CPU reference checks.
     pub fn marks(&self, queue: &wgpu::Queue, geometry: &LineGeometry) -> Result<Vec<Vec<u32>>, crate::Error> {
         let states = self.read_states(queue, geometry)?;
         let marks = states.into_iter().zip(geometry.pages()).map(|(words, page)| match words {
@@ -478,28 +604,28 @@ impl LineCull {
 /// the depth pyramid).
 pub struct Culled {
     cull: LineCull,
-    plain: wgpu::RenderPipeline,
-    octants: Option<wgpu::RenderPipeline>,
+    /// The full pieces' pipeline, and the coarse ones' where it picks levels of detail.
+    plain: Vec<wgpu::RenderPipeline>,
+    octants: Option<Vec<wgpu::RenderPipeline>>,
     note: std::sync::OnceLock<String>,
 }
 
 impl Culled {
-    /// The cull of `shape` for a renderer whose group 0 is `frame`; `create(label, fragment
-    /// outputs with octants)` makes a pipeline drawing the visible pieces, `octants` whether the
-    /// renderer writes them.
+    /// The cull of `shape` for a renderer whose group 0 is `frame`, at levels of detail where
+    /// `lod`; `create(fragment outputs with octants, coarse)` makes a pipeline drawing the
+    /// visible full (or coarse) pieces, `octants` whether the renderer writes them.
     pub(crate) fn new(
         device: &wgpu::Device,
         frame: &wgpu::BindGroupLayout,
         shape: Shape,
+        lod: bool,
         octants: bool,
-        create: impl Fn(bool) -> wgpu::RenderPipeline,
+        create: impl Fn(bool, bool) -> wgpu::RenderPipeline,
     ) -> Culled {
-        Culled {
-            cull: LineCull::new(device, frame, shape),
-            plain: create(false),
-            octants: octants.then(|| create(true)),
-            note: std::sync::OnceLock::new(),
-        }
+        let cull = LineCull::new(device, frame, shape, lod);
+        let lists = if cull.lod { 2 } else { 1 };
+        let pipelines = |octants: bool| (0..lists).map(|list| create(octants, list == 1)).collect();
+        Culled { plain: pipelines(false), octants: octants.then(|| pipelines(true)), cull, note: Default::default() }
     }
 
     /// Why it draws everything though asked to cull, once a frame found it out.
@@ -530,17 +656,19 @@ impl Culled {
         if self.note.get().is_some() {
             return false;
         }
-        let pipeline = if octants { self.octants.as_ref() } else { Some(&self.plain) };
-        let pipeline = pipeline.expect("culled pipelines with octants where the renderer has them");
+        let pipelines = if octants { self.octants.as_ref() } else { Some(&self.plain) };
+        let pipelines = pipelines.expect("culled pipelines with octants where the renderer has them");
         let draw = |encoder: &mut wgpu::CommandEncoder, phase: Phase, span| {
             let mut pass = crate::gbuffer::begin(encoder, label, targets, phase.load(load), octants, span);
-            pass.set_pipeline(pipeline);
             pass.set_bind_group(0, frame, &[]);
-            for page in geometry.pages() {
-                let state = self.cull.state(page);
-                pass.set_bind_group(1, &page.group, &[]);
-                pass.set_bind_group(2, state.draw_group(phase), &[]);
-                pass.draw_indirect(&state.state, phase.offset());
+            for (list, pipeline) in pipelines.iter().enumerate() {
+                pass.set_pipeline(pipeline);
+                for page in geometry.pages() {
+                    let state = self.cull.state(page);
+                    pass.set_bind_group(1, &page.group, &[]);
+                    pass.set_bind_group(2, state.draw_group(phase), &[]);
+                    pass.draw_indirect(&state.state, phase.offset(list == 1));
+                }
             }
         };
         self.cull.encode(encoder, targets, geometry, frame, span, draw);
@@ -572,11 +700,13 @@ impl Culled {
 }
 
 /// What a culled frame drew: pieces of eight segments drawn early and late of all the
-/// geometry has, and the clusters with a piece found visible.
+/// geometry has (and of those, at a coarser level of detail), and the clusters with a piece
+/// found visible.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct CullCounts {
     pub early: u64,
     pub late: u64,
+    pub coarse: u64,
     /// Groups of 16 clusters whose pieces the late test tested, of all.
     pub listed_groups: u64,
     pub groups: u64,
@@ -601,12 +731,13 @@ impl std::fmt::Display for CullCounts {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "drew {} + {} of {} pieces of 8 segments ({:.2} %), {:.2} % of the {} clusters visible; tested the \
-             pieces of {:.2} % of the groups",
+            "drew {} + {} of {} pieces of 8 segments ({:.2} %; {:.1} % of them coarser), {:.2} % of the {} clusters \
+             visible; tested the pieces of {:.2} % of the groups",
             self.early,
             self.late,
             self.pieces,
             100.0 * self.drawn_share(),
+            100.0 * self.coarse as f64 / (self.early + self.late).max(1) as f64,
             100.0 * self.visible_share(),
             self.clusters,
             100.0 * self.listed_groups as f64 / self.groups.max(1) as f64

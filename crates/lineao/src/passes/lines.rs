@@ -141,17 +141,23 @@ impl LineRenderer {
     }
 
     /// This renderer drawing only the pieces of line that can be seen, found on the GPU each
-    /// frame ([`crate::passes::cull`]): the full strip's G-buffer, exactly. Native lines are
-    /// always drawn whole.
-    pub fn culled(mut self, device: &wgpu::Device) -> LineRenderer {
+    /// frame ([`crate::passes::cull`]): the full strip's G-buffer, exactly — or, where `lod`,
+    /// each piece at the coarsest level of detail within [`crate::passes::cull::LOD_PIXELS`] of
+    /// it. Native lines are always drawn whole.
+    pub fn culled(mut self, device: &wgpu::Device, lod: bool) -> LineRenderer {
         if self.style == LineStyle::Native1px || self.culled.is_some() {
             return self;
         }
         let page = crate::line_geometry::page_layout(device);
         let pieces = crate::passes::cull::pieces_layout(device);
         let module = crate::shader::module(device, "lines.wgsl");
-        let create = |octants: bool| {
-            let (vertex, fragment) = if octants { ("vs_piece_octants", "fs_octants") } else { ("vs_piece", "fs_main") };
+        let create = |octants: bool, coarse: bool| {
+            let (vertex, fragment) = match (octants, coarse) {
+                (false, false) => ("vs_piece", "fs_main"),
+                (true, false) => ("vs_piece_octants", "fs_octants"),
+                (false, true) => ("vs_piece_coarse", "fs_main"),
+                (true, true) => ("vs_piece_coarse_octants", "fs_octants"),
+            };
             gbuffer::pipeline(
                 device,
                 &self.bindings.layout,
@@ -167,7 +173,7 @@ impl LineRenderer {
                 },
             )
         };
-        let culled = Culled::new(device, &self.bindings.layout, Shape::Lines, self.octants.is_some(), create);
+        let culled = Culled::new(device, &self.bindings.layout, Shape::Lines, lod, self.octants.is_some(), create);
         self.culled = Some(culled);
         self
     }
@@ -180,6 +186,11 @@ impl LineRenderer {
     /// Whether it culls ([`LineRenderer::culled`]).
     pub fn culls(&self) -> bool {
         self.culled.is_some()
+    }
+
+    /// Whether it culls at levels of detail ([`LineRenderer::culled`]).
+    pub fn lods(&self) -> bool {
+        self.culled.as_ref().is_some_and(|c| c.cull().lod())
     }
 
     /// Why it draws every line though asked to cull, once a frame found it out (the device's
@@ -216,6 +227,9 @@ impl LineRenderer {
         lighting: &Lighting,
     ) {
         self.bindings.write(queue, &GeometryUniform::new(view, color, line_width_px, 0.0), lighting);
+        if let Some(culled) = &self.culled {
+            culled.cull().set_view(view);
+        }
         let scale = if line_width_px <= MAX_ALTERNATING_WIDTH_PX { max_px_per_world(view) } else { f32::INFINITY };
         self.px_per_world.store(scale.to_bits(), Ordering::Relaxed);
     }

@@ -72,8 +72,9 @@ impl TubeRenderer {
         let page = crate::line_geometry::page_layout(device);
         let pieces = crate::passes::cull::pieces_layout(device);
         let groups = [&page, &pieces];
-        let create = |octants| tube_pipeline(device, &self.bindings, &self.module, &groups, "vs_tube_piece", octants);
-        self.culled = Some(Culled::new(device, &self.bindings.layout, Shape::Tubes, self.octants, create));
+        let create =
+            |octants, _coarse| tube_pipeline(device, &self.bindings, &self.module, &groups, "vs_tube_piece", octants);
+        self.culled = Some(Culled::new(device, &self.bindings.layout, Shape::Tubes, false, self.octants, create));
         self
     }
 
