@@ -51,12 +51,21 @@ pub fn options(args: &ViewArgs) -> app::Options {
         ColorArg::Tangent => ColorMode::Tangent,
         ColorArg::Constant(rgb) => ColorMode::Constant(rgb.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8)),
         ColorArg::Field(name) => ColorMode::Field(name.clone()),
+        ColorArg::Volume(path) => {
+            // Sampled as the lines arrive in `render` and Python; not in the viewer yet.
+            eprintln!(
+                "lineao: the viewer does not colour by a volume yet ({}): use `lineao render --color volume:FILE`",
+                path.display()
+            );
+            ColorMode::Tangent
+        }
     };
     controls.colormap = args.colormap;
     controls.debug_view = args.debug_view;
     controls.timings = args.timings;
     controls.params.chain.raytraced.max_rays = args.rays;
     controls.params.chain.cull = args.cull;
+    controls.params.chain.lod = args.lod;
     app::Options {
         source: Some(source),
         controls,

@@ -155,6 +155,20 @@ fn tractogram_dict<'py>(py: Python<'py>, t: Tractogram, format: &str) -> PyResul
     Ok(dict)
 }
 
+/// The NIfTI volume at `path` sampled at `points` (N, 3, RAS+ mm): trilinear between voxel
+/// centres, NaN outside (`lineao_tracts::Volume::sample`), what `--color volume:FILE` draws.
+#[pyfunction]
+fn sample_volume<'py>(
+    py: Python<'py>,
+    points: PyReadonlyArray2<'py, f32>,
+    path: PathBuf,
+) -> PyResult<Bound<'py, numpy::PyArray1<f32>>> {
+    let volume = py.detach(|| lineao_tracts::Volume::load(&path)).map_err(|e| load_error(py, e))?;
+    let points: &[[f32; 3]] = bytemuck::cast_slice(points.as_slice()?);
+    let values = py.detach(|| volume.sample_points(points));
+    Ok(values.into_pyarray(py))
+}
+
 /// `lineao info --json` of `path`, as its JSON text (CONTRACT.md's keys).
 #[pyfunction]
 fn info(py: Python<'_>, path: PathBuf) -> PyResult<String> {
@@ -492,10 +506,7 @@ impl Renderer {
     fn frame_args(&mut self, settings: &Bound<'_, PyDict>) -> PyResult<RenderArgs> {
         let args = parse(settings, self.opened.file.as_ref())?;
         let same = |a: &RenderArgs| {
-            let field = match &a.style.color {
-                lineao_session::args::ColorArg::Field(name) => Some(name.clone()),
-                _ => None,
-            };
+            let field = a.style.color.field();
             (
                 a.style.surfaces.clone(),
                 a.style.tube_radius_field.clone(),
@@ -556,6 +567,7 @@ fn _lineao(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("LoadError", m.py().get_type::<LoadError>())?;
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(info, m)?)?;
+    m.add_function(wrap_pyfunction!(sample_volume, m)?)?;
     m.add_function(wrap_pyfunction!(save, m)?)?;
     m.add_function(wrap_pyfunction!(settings, m)?)?;
     m.add_function(wrap_pyfunction!(methods, m)?)?;

@@ -382,7 +382,9 @@ pub struct ImageArgs {
     pub width: u32,
     #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=8192))]
     pub height: u32,
-    /// What to show: final, ao, normals, depth, zoom, or level:K (pyramid level K).
+    /// What to show: final, ao, normals, depth, zoom, level:K (pyramid level K), or pieces (the
+    /// final image, each culled piece of line colored by its level of detail: blue every point,
+    /// green every 2nd, orange every 4th, red every 8th; with `--cull on`).
     #[arg(long, default_value = "final", value_parser = parse_debug_view)]
     #[serde(deserialize_with = "crate::kwargs::debug_view")]
     pub debug_view: lineao::DebugView,
@@ -427,8 +429,10 @@ pub struct StyleArgs {
     #[arg(long, default_value = "0.8,0.8,0.8", value_parser = parse_vec3)]
     #[serde(deserialize_with = "crate::kwargs::vec3")]
     pub surface_color: [f32; 3],
-    /// Line color: `tangent` (|T| as RGB), R,G,B in [0, 1], or `field:NAME` (the file's
-    /// per-vertex field NAME through --colormap, its 2nd to 98th percentile spanning the map).
+    /// Line color: `tangent` (|T| as RGB), R,G,B in [0, 1], `field:NAME` (the file's
+    /// per-vertex field NAME through --colormap, its 2nd to 98th percentile spanning the map), or
+    /// `volume:FILE` (a NIfTI volume sampled at every vertex, trilinear between voxel centres;
+    /// gray outside it).
     #[arg(long, default_value = "tangent", value_parser = parse_color)]
     #[serde(deserialize_with = "crate::kwargs::color")]
     pub color: ColorArg,
@@ -440,10 +444,14 @@ pub struct StyleArgs {
     #[serde(deserialize_with = "crate::kwargs::vec3")]
     pub background: [f32; 3],
     /// Draw only the lines that can be seen, culled on the GPU against the frame before (`on`),
-    /// or every line (`off`) [default: off: one picture has no frame before it, and culled
-    /// it costs the full strip and the tests; the viewer culls].
+    /// or every line (`off`) [default: off: one picture has no frame before it; culled, the
+    /// view is drawn twice and the picture is the second frame; the viewer culls].
     #[arg(long, value_parser = parse_on_off)]
     pub cull: Option<bool>,
+    /// Where lines are culled, draw each visible piece at the coarsest level of detail within
+    /// half a pixel of it (`on`), or every point (`off`: the full strip exactly) [default: on].
+    #[arg(long, value_parser = parse_on_off)]
+    pub lod: Option<bool>,
 }
 
 /// `on` or `off`.
@@ -689,6 +697,20 @@ pub enum ColorArg {
     Constant([f32; 3]),
     /// A per-vertex field of the file through --colormap.
     Field(String),
+    /// A NIfTI volume sampled at every vertex (trilinear, NaN outside: gray) through --colormap.
+    Volume(std::path::PathBuf),
+}
+
+impl ColorArg {
+    /// The per-vertex field it colours by: the file's, or the volume's samples (named
+    /// `volume:PATH`).
+    pub fn field(&self) -> Option<String> {
+        match self {
+            ColorArg::Field(name) => Some(name.clone()),
+            ColorArg::Volume(path) => Some(format!("volume:{}", path.display())),
+            _ => None,
+        }
+    }
 }
 
 /// Keys of `lineao::ChainSettings` in JSON that replace what the options give, checked against
@@ -752,6 +774,9 @@ pub fn parse_vec3(s: &str) -> Result<[f32; 3], String> {
 }
 
 pub fn parse_color(s: &str) -> Result<ColorArg, String> {
+    if let Some(path) = s.strip_prefix("volume:").filter(|p| !p.is_empty()) {
+        return Ok(ColorArg::Volume(path.into()));
+    }
     match s.strip_prefix("field:") {
         Some(name) if !name.is_empty() => Ok(ColorArg::Field(name.to_string())),
         _ if s == "tangent" => Ok(ColorArg::Tangent),
@@ -767,9 +792,10 @@ pub fn parse_debug_view(s: &str) -> Result<lineao::DebugView, String> {
         "normals" => D::Normals,
         "depth" => D::Depth,
         "zoom" => D::Zoom,
+        "pieces" => D::Pieces,
         _ => match s.strip_prefix("level:").map(str::parse::<u32>) {
             Some(Ok(k)) => D::Level(k),
-            _ => return Err(format!("unknown debug view '{s}' (final, ao, normals, depth, zoom, level:K)")),
+            _ => return Err(format!("unknown debug view '{s}' (final, ao, normals, depth, zoom, level:K, pieces)")),
         },
     })
 }

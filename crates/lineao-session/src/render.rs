@@ -19,7 +19,7 @@ use lineao_tracts::scenes::ViewHint;
 
 use crate::args::{ColorArg, GeometryArg, Method, RenderArgs, SkyArg, VolumeNormal};
 use crate::label::Rgba8;
-use crate::source::{AttributeKey, Keep, Lines, Loaded, Source, submit_frame, vertex_field};
+use crate::source::{AttributeKey, Keep, Lines, Loaded, Sampled, Source, submit_frame, vertex_field};
 
 /// The sky of object-space AO: open, or lit from the world axis nearest to the camera's `up`.
 pub fn sky(args: &RenderArgs, up: Vec3) -> Sky {
@@ -122,7 +122,9 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky, lon
             ColorArg::Tangent => LineColor::Tangent,
             ColorArg::Constant(rgb) => LineColor::Constant(*rgb),
             // The range comes from the data (`run` sets it).
-            ColorArg::Field(_) => LineColor::Scalar { colormap: args.style.colormap, range: [0.0, 1.0] },
+            ColorArg::Field(_) | ColorArg::Volume(_) => {
+                LineColor::Scalar { colormap: args.style.colormap, range: [0.0, 1.0] }
+            }
         },
         background: args.style.background,
         strength: 1.0,
@@ -130,6 +132,7 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky, lon
         zoom_unit: args.camera.zoom_unit.unwrap_or(zoom_unit),
         guard_max_px: args.chain.guard_max,
         cull: args.style.cull.unwrap_or(false),
+        lod: args.style.lod.unwrap_or(true),
     }
     .with_preset(args.shown.preset);
     // What the command line names explicitly wins over the preset.
@@ -261,7 +264,8 @@ impl Session {
         let surfaces = load_surfaces(args)?;
         let base = base_attributes(args);
         let gpu = Gpu::headless()?;
-        let keep = Keep { points, scalar: base.scalar.clone(), radius: base.radius.clone(), fields: false };
+        let sampled = Sampled::of(&args.style.color)?;
+        let keep = Keep { points, scalar: base.scalar.clone(), radius: base.radius.clone(), fields: false, sampled };
         let bar = match &source {
             Source::File(path) => crate::source::progress_bar(path),
             _ => None,
@@ -280,9 +284,12 @@ impl Session {
     }
 
     /// [`Session::open`] on streamlines already in memory (the Python package's).
-    pub fn with_loaded(args: &RenderArgs, loaded: Loaded) -> Result<Session> {
+    pub fn with_loaded(args: &RenderArgs, mut loaded: Loaded) -> Result<Session> {
         let surfaces = load_surfaces(args)?;
         let base = base_attributes(args);
+        if let Some(sampled) = Sampled::of(&args.style.color)? {
+            sampled.add_to(&mut loaded.tracts);
+        }
         // The fields exist, before any GPU work.
         for field in base.scalar.iter().chain(&base.radius) {
             vertex_field(&loaded.name, &loaded.tracts, field)?;
@@ -482,6 +489,12 @@ impl Session {
             chain.set_ray_scene(&gpu.device, Some(self.ray_scene()?));
         }
         submit_frame(gpu, &mut chain, scene, (&self.camera, &self.bounds), &target.view);
+        if panel.settings.cull {
+            // Culled, the picture (and its timings) is the view's second frame, what a viewer
+            // shows of a still camera: drawn from what the first found visible, at the levels of
+            // detail it found.
+            submit_frame(gpu, &mut chain, scene, (&self.camera, &self.bounds), &target.view);
+        }
         if gpu_rays {
             crate::truth::accumulate(gpu, &mut chain, |chain| {
                 submit_frame(gpu, chain, scene, (&self.camera, &self.bounds), &target.view)
@@ -575,14 +588,7 @@ fn load_surfaces(args: &RenderArgs) -> Result<Vec<lineao_tracts::TriangleMesh>> 
 /// The attributes every panel has: the scalar of `--color field:NAME`, the radii of
 /// `--tube-radius-field`.
 fn base_attributes(args: &RenderArgs) -> AttributeKey {
-    AttributeKey {
-        scalar: match &args.style.color {
-            ColorArg::Field(field) => Some(field.clone()),
-            _ => None,
-        },
-        radius: args.style.tube_radius_field.clone(),
-        volume: None,
-    }
+    AttributeKey { scalar: args.style.color.field(), radius: args.style.tube_radius_field.clone(), volume: None }
 }
 
 /// Whether a panel `args` asks for needs the streamlines on the CPU: object-space AO (its

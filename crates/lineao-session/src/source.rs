@@ -446,6 +446,32 @@ pub struct Keep {
     pub radius: Option<String>,
     /// Every one-column per-vertex field (the viewer colours by any of them).
     pub fields: bool,
+    /// A volume sampled at every vertex as it arrives, kept as a per-vertex field.
+    pub sampled: Option<std::sync::Arc<Sampled>>,
+}
+
+/// A volume sampled at every vertex of a tractogram: a per-vertex field named `field`
+/// (`--color volume:FILE`).
+#[derive(Debug)]
+pub struct Sampled {
+    pub field: String,
+    pub volume: lineao_tracts::Volume,
+}
+
+impl Sampled {
+    /// The volume of `--color volume:FILE`, where the color asks for one.
+    pub fn of(color: &crate::args::ColorArg) -> Result<Option<std::sync::Arc<Sampled>>> {
+        let crate::args::ColorArg::Volume(path) = color else { return Ok(None) };
+        let volume = lineao_tracts::Volume::load(path).map_err(SourceError::Load)?;
+        Ok(Some(std::sync::Arc::new(Sampled { field: color.field().expect("a volume's field"), volume })))
+    }
+
+    /// Adds the samples at `tracts`' vertices as its field (replacing one of that name).
+    pub fn add_to(&self, tracts: &mut Tractogram) {
+        tracts.vertex_fields.retain(|f| f.name != self.field);
+        let values = self.volume.sample_points(&tracts.positions);
+        tracts.vertex_fields.push(Field { name: self.field.clone(), columns: 1, values });
+    }
 }
 
 impl Lines {
@@ -513,9 +539,12 @@ impl Lines {
     /// Appends a chunk of whole streamlines: onto the GPU (with the attributes the lines hold),
     /// and what the lines keep of it on the CPU. What has not filled a page yet is drawn after
     /// [`LineGeometry::flush`].
-    pub fn append_chunk(&mut self, chunk: Tractogram, on: &lineao::Gpu) -> Result<()> {
+    pub fn append_chunk(&mut self, mut chunk: Tractogram, on: &lineao::Gpu) -> Result<()> {
         if !chunk.has_points() {
             return Err(SourceError::ValuesWithoutPoints { path: self.name.clone(), format: "tsf" });
+        }
+        if let Some(sampled) = &self.keep.sampled {
+            sampled.add_to(&mut chunk);
         }
         let name = &self.name;
         let values = |field: &Option<String>| field.as_deref().map(|f| vertex_field(name, &chunk, f)).transpose();
@@ -564,6 +593,9 @@ impl Lines {
         (self.tracts.positions, self.tracts.offsets) = (loaded.tracts.positions, loaded.tracts.offsets);
         self.tracts.streamline_fields = loaded.tracts.streamline_fields;
         self.tracts.vertex_fields = loaded.tracts.vertex_fields;
+        if let Some(sampled) = &self.keep.sampled {
+            sampled.add_to(&mut self.tracts);
+        }
         self.points_kept = true;
         Ok(())
     }

@@ -34,6 +34,7 @@ pub mod mesh;
 pub mod scenes;
 mod stream;
 mod tractogram;
+pub mod volume;
 
 pub use error::{Error, ErrorKind};
 pub use input::{Progress, ProgressFn};
@@ -42,3 +43,4 @@ pub use mesh::{TriangleMesh, load_mesh};
 pub use scenes::{Scene, SceneKind, ViewHint};
 pub use stream::{ChunkDecoder, ChunkSink, Streamed, load_chunked};
 pub use tractogram::{Bounds, Field, Group, IDENTITY, Tractogram, VoxelSpace};
+pub use volume::Volume;

@@ -169,6 +169,15 @@ def load(path: "os.PathLike[str] | str", *, progress: Any = False) -> Tractogram
     return Tractogram(**parts)
 
 
+def sample_volume(streamlines: Any, path: "os.PathLike[str] | str") -> np.ndarray:
+    """A NIfTI volume (``.nii``, ``.nii.gz``) sampled at every vertex of ``streamlines`` (any
+    container ``render`` takes): float32, one value per row of its ``points``, trilinear between
+    voxel centres through the volume's affine (sform, else qform, as nibabel places it), NaN
+    outside the volume — the numbers ``render(..., color="volume:FILE")`` colours by.
+    """
+    return _lineao.sample_volume(_tractogram(streamlines).points, os.fspath(path))
+
+
 def info(path: "os.PathLike[str] | str") -> dict:
     """``lineao info --json`` of a file: format, counts, fields, groups, bounds, voxel space."""
     import json

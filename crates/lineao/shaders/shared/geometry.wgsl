@@ -17,7 +17,7 @@ struct GeometryUniform {
     line_width_px: f32,
     orthographic: u32,
     // 0: tangent direction |T| (world axes as RGB), 1: constant color, 2: the vertex's scalar
-    // through the colormap.
+    // through the colormap, 3: the cull's pieces (`piece_color`; gray where drawn whole).
     color_mode: u32,
     // Tubes: the radius in world units where the geometry carries none.
     tube_radius: f32,
@@ -55,13 +55,32 @@ fn base_color(t_world: vec3<f32>, scalar: f32) -> vec3<f32> {
         return abs(t_world) / max(length(t_world), 1e-20);
     }
     if frame.color_mode == 2u {
+        // NaN (a sampled volume outside its voxels): 50 % gray.
+        if (bitcast<u32>(scalar) & 0x7fffffffu) > 0x7f800000u {
+            return vec3<f32>(0.5);
+        }
         let span = frame.scalar_range.y - frame.scalar_range.x;
         let t = saturate(select(0.0, (scalar - frame.scalar_range.x) / span, span != 0.0));
         let x = t * 15.0;
         let k = min(u32(x), 14u);
         return mix(frame.colormap[k].rgb, frame.colormap[k + 1u].rgb, x - f32(k));
     }
+    if frame.color_mode == 3u {
+        return vec3<f32>(0.5);
+    }
     return frame.constant_color.rgb;
+}
+
+// Color mode 3: a culled piece drawn keeping every `stride`-th point (1 blue, 2 green, 4
+// orange, 8 red).
+fn piece_color(stride: u32) -> vec3<f32> {
+    let colors = array<vec3<f32>, 4>(
+        vec3<f32>(0.15, 0.35, 1.0),
+        vec3<f32>(0.1, 0.75, 0.25),
+        vec3<f32>(1.0, 0.55, 0.05),
+        vec3<f32>(0.9, 0.1, 0.1),
+    );
+    return colors[min(countTrailingZeros(stride), 3u)];
 }
 
 // The G-buffer's targets, in attachment order; octants only where object-space AO is on.

@@ -1,0 +1,62 @@
+"""lineao.sample_volume and render(color="volume:FILE"): a NIfTI volume sampled at every
+vertex against an independent trilinear interpolation (nibabel's array and affine, scipy's
+map_coordinates), and the picture the command line draws with it."""
+
+import nibabel as nib
+import numpy as np
+import pytest
+from scipy.ndimage import map_coordinates
+
+import lineao
+from conftest import DATA
+from test_render import SMALL, cli_render
+
+IMAGES = DATA / "niivue+niivue/packages/niivue/demos/images"
+STROKE = IMAGES / "stroke.trk.gz"
+
+
+def independent_samples(points, path):
+    """Trilinear between voxel centres through nibabel's affine; NaN outside the centres' box."""
+    img = nib.load(str(path))
+    data = np.asarray(img.dataobj, dtype=np.float64)
+    ijk = nib.affines.apply_affine(np.linalg.inv(img.affine), points.astype(np.float64)).T
+    values = map_coordinates(data, ijk, order=1, mode="nearest", prefilter=False)
+    inside = np.all((ijk >= 0) & (ijk <= (np.array(data.shape) - 1)[:, None]), axis=0)
+    return np.where(inside, values, np.nan)
+
+
+@pytest.mark.parametrize("volume", ["strokez.nii.gz", "MNI152_2009_template.nii.gz"])
+def test_samples_along_the_streamlines_are_scipys(volume):
+    t = lineao.load(STROKE)
+    got = lineao.sample_volume(t, IMAGES / volume)
+    assert got.dtype == np.float32 and got.shape == (len(t.points),)
+    expected = independent_samples(t.points, IMAGES / volume)
+    assert np.array_equal(np.isnan(got), np.isnan(expected))
+    finite = ~np.isnan(expected)
+    assert finite.mean() > 0.9, "stroke.trk.gz lies in the volume's space"
+    scale = np.nanmax(np.abs(expected))
+    assert np.abs(got[finite] - expected[finite]).max() <= 1e-5 * scale
+    # The same from nibabel's streamlines (any container render takes).
+    nib_streamlines = nib.streamlines.load(str(STROKE)).streamlines
+    assert np.array_equal(lineao.sample_volume(nib_streamlines, IMAGES / volume), got, equal_nan=True)
+
+
+def test_points_outside_are_nan_and_bad_files_raise(tmp_path):
+    far = lineao.Tractogram(np.array([[500.0, 0, 0], [0, -18, 18]], np.float32))
+    values = lineao.sample_volume(far, IMAGES / "MNI152_2009_template.nii.gz")
+    assert np.isnan(values[0]) and values[1] == 58.0
+    four_d = tmp_path / "4d.nii.gz"
+    nib.save(nib.Nifti1Image(np.zeros((4, 4, 4, 2), np.float32), np.eye(4)), str(four_d))
+    with pytest.raises(lineao.LoadError, match="3-D") as e:
+        lineao.sample_volume(far, four_d)
+    assert e.value.file == str(four_d)
+
+
+def test_render_colored_by_a_volume_is_the_command_lines(lineao_bin, tmp_path):
+    volume = IMAGES / "strokez.nii.gz"
+    image = lineao.render(STROKE, color=f"volume:{volume}", **SMALL)
+    expected = cli_render(lineao_bin, tmp_path, STROKE, "--color", f"volume:{volume}", "--width", 320, "--height", 256)
+    assert (image != expected).sum() == 0
+    # Not the tangent colours: the z-map through viridis (and gray outside).
+    plain = lineao.render(STROKE, **SMALL)
+    assert (image != plain).any(axis=2).mean() > 0.05
