@@ -43,6 +43,8 @@ pub struct Options {
     /// `--screenshot PNG --frames N`: save the window after N frames once the image is complete,
     /// then close.
     pub screenshot: Option<(PathBuf, u32)>,
+    /// `--color volume:FILE`: the volume sampled at every vertex of each dataset opened.
+    pub sampled: Option<Arc<crate::source::Sampled>>,
 }
 
 /// How a session ended, for `--screenshot`'s exit status.
@@ -124,6 +126,8 @@ pub struct App {
     save_dialog: FileDialog,
     screenshot: Option<(PathBuf, u32)>,
     screenshot_requested: bool,
+    /// The volume each dataset opened is coloured by (`--color volume:FILE`).
+    sampled: Option<Arc<crate::source::Sampled>>,
     pub outcome: Arc<Mutex<Outcome>>,
     frames: u64,
     /// File ▸ Open… where the app has no file dialog of its own (the web page's file input).
@@ -191,6 +195,7 @@ impl App {
                 .default_file_filter("Tractograms and meshes"),
             save_dialog: FileDialog::new().title("Save a screenshot (PNG)").default_file_name("lineao-view.png"),
             screenshot: options.screenshot,
+            sampled: options.sampled,
             screenshot_requested: false,
             outcome: Arc::default(),
             frames: 0,
@@ -246,7 +251,7 @@ impl App {
         self.load_failed = false;
         (self.camera, self.framed, self.first_picture, self.first_frame_ms) = (None, None, None, None);
         self.opened_at = Some(Instant::now());
-        self.send(ToWorker::Load(source));
+        self.send(ToWorker::Load(source, self.sampled.clone()));
     }
 
     fn send(&mut self, message: ToWorker) {

@@ -20,7 +20,7 @@ use lineao_tracts::{ChunkDecoder, SceneKind, Tractogram};
 use web_time::Instant;
 
 use super::worker::{PREVIEW_VERTICES, Source};
-use crate::source::{CHUNK_VERTICES, Keep, Lines, SourceError};
+use crate::source::{CHUNK_VERTICES, Keep, Lines, Sampled, SourceError};
 
 /// How long a step reads and uploads before it lets the worker draw and listen, at least; a
 /// step reads as long as the time between steps (what the frames and the window took), up to
@@ -113,10 +113,11 @@ pub enum Step {
 }
 
 impl Opening {
-    /// Starts opening `source` on `gpu`: nothing read yet.
-    pub fn start(source: Source, gpu: &Gpu) -> Result<Opening, String> {
+    /// Starts opening `source` on `gpu`: nothing read yet; `sampled`, a volume sampled at
+    /// every vertex as a field.
+    pub fn start(source: Source, sampled: Option<Arc<Sampled>>, gpu: &Gpu) -> Result<Opening, String> {
         let error = |e: SourceError| format!("{e:#}");
-        let keep = Keep { fields: true, ..Keep::default() };
+        let keep = Keep { fields: true, sampled, ..Keep::default() };
         let lines = Lines::empty(source.name(), &keep, gpu).map_err(error)?;
         let chunks: Arc<Mutex<VecDeque<Tractogram>>> = Arc::default();
         let sink = {

@@ -36,6 +36,12 @@ pub fn options(args: &ViewArgs) -> app::Options {
             Source::Scene { kind, vertices: args.vertices.unwrap_or(kind.default_vertices()), seed: 1 }
         }
     };
+    // A volume to colour by that cannot be read is said, and the lines keep their tangent
+    // colours (the page cannot read files by name: it drops them).
+    let sampled = crate::source::Sampled::of(&args.color).unwrap_or_else(|e| {
+        eprintln!("lineao: {e:#}");
+        None
+    });
     let preset = args.preset;
     let (methods, compare) = match args.compare {
         Some(pair) => (pair, true),
@@ -51,14 +57,9 @@ pub fn options(args: &ViewArgs) -> app::Options {
         ColorArg::Tangent => ColorMode::Tangent,
         ColorArg::Constant(rgb) => ColorMode::Constant(rgb.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8)),
         ColorArg::Field(name) => ColorMode::Field(name.clone()),
-        ColorArg::Volume(path) => {
-            // Sampled as the lines arrive in `render` and Python; not in the viewer yet.
-            eprintln!(
-                "lineao: the viewer does not colour by a volume yet ({}): use `lineao render --color volume:FILE`",
-                path.display()
-            );
-            ColorMode::Tangent
-        }
+        // Sampled at every vertex as the lines arrive: a field.
+        ColorArg::Volume(_) if sampled.is_some() => ColorMode::Field(args.color.field().expect("a volume's field")),
+        ColorArg::Volume(_) => ColorMode::Tangent,
     };
     controls.colormap = args.colormap;
     controls.debug_view = args.debug_view;
@@ -72,6 +73,7 @@ pub fn options(args: &ViewArgs) -> app::Options {
         orthographic: args.ortho,
         orbit: args.orbit,
         screenshot: args.screenshot.clone().map(|path| (path, args.frames)),
+        sampled,
     }
 }
 

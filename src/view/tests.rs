@@ -26,6 +26,7 @@ fn options(source: Source, methods: [crate::cli::Method; 2], compare: bool) -> O
         orthographic: false,
         orbit: None,
         screenshot: None,
+        sampled: None,
     }
 }
 
@@ -204,6 +205,29 @@ fn the_method_selector_switches_the_method() {
         mean_luminance(none),
         mean_luminance(&lineao)
     );
+}
+
+#[test]
+fn a_volume_colours_the_lines_it_is_sampled_at() {
+    // `--color volume:strokez.nii.gz` on stroke.trk.gz: the z-map sampled at every vertex as it
+    // arrives, a field the lines are coloured by through the colormap.
+    let images = "niivue+niivue/packages/niivue/demos/images";
+    let color = crate::args::ColorArg::Volume(data(&format!("{images}/strokez.nii.gz")));
+    let mut options =
+        options(Source::File(data(&format!("{images}/stroke.trk.gz"))), [methods()[1], methods()[4]], false);
+    options.sampled = crate::source::Sampled::of(&color).unwrap();
+    options.controls.color = super::controls::ColorMode::Field(color.field().unwrap());
+    let mut harness = harness(options);
+    settle(&mut harness);
+    let app = harness.state();
+    assert!(app.error.is_none(), "{:?}", app.error);
+    let frame = app.shown.as_ref().unwrap();
+    let lineao::LineColor::Scalar { range, .. } = frame.view.panels[0].settings.line_color else {
+        panic!("coloured by the volume's samples: {:?}", frame.view.panels[0].settings.line_color)
+    };
+    // The z-map along the streamlines spans 0 to about 1 (its 2nd to 98th percentile).
+    assert!(range[0] >= 0.0 && range[1] > 0.5 && range[1] < 1.3, "{range:?}");
+    assert!(non_background(&frame.images[0]) > 0.05);
 }
 
 #[test]

@@ -36,7 +36,7 @@ use lineao_tracts::ViewHint;
 
 use super::loading::{Opening, Preview, Step};
 pub use crate::source::Source;
-use crate::source::{AttributeKey, Lines, submit_frame};
+use crate::source::{AttributeKey, Lines, Sampled, submit_frame};
 
 /// Vertices of a preview frame at most.
 pub const PREVIEW_VERTICES: usize = 250_000;
@@ -63,7 +63,8 @@ pub struct View {
 }
 
 pub enum ToWorker {
-    Load(Source),
+    /// Open a source, sampling a volume at its vertices where one is given.
+    Load(Source, Option<Arc<Sampled>>),
     Render(View),
 }
 
@@ -274,18 +275,18 @@ impl Worker {
             pending.push(ToWorker::Render(timing.view));
         }
         let gpu = &self.gpu;
-        let last_load = pending.iter().rposition(|c| matches!(c, ToWorker::Load(_)));
+        let last_load = pending.iter().rposition(|c| matches!(c, ToWorker::Load(..)));
         let render =
             pending.iter().rposition(|c| matches!(c, ToWorker::Render(_))).filter(|&r| last_load.is_none_or(|l| r > l));
         if let Some(l) = last_load {
-            let ToWorker::Load(source) = &pending[l] else { unreachable!() };
+            let ToWorker::Load(source, sampled) = &pending[l] else { unreachable!() };
             (self.scene, self.continuing, self.opening, self.announced) = (None, None, None, false);
             for panel in &mut self.chains {
                 // The old dataset's BVH is freed now, not when the next one replaces it.
                 panel.chain.set_ray_scene(&gpu.device, None);
                 panel.scene = None;
             }
-            match Opening::start(source.clone(), gpu) {
+            match Opening::start(source.clone(), sampled.clone(), gpu) {
                 Ok(opening) => self.opening = Some(opening),
                 Err(e) => send(FromWorker::Error(e)),
             }

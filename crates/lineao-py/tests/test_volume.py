@@ -1,6 +1,7 @@
-"""lineao.sample_volume and render(color="volume:FILE"): a NIfTI volume sampled at every
-vertex against an independent trilinear interpolation (nibabel's array and affine, scipy's
-map_coordinates), and the picture the command line draws with it."""
+"""Colour by data: lineao.sample_volume and render(color="volume:FILE") — a NIfTI volume
+sampled at every vertex against an independent trilinear interpolation (nibabel's array and
+affine, scipy's map_coordinates), and the picture the command line draws with it — and a
+per-streamline field (TRX dps) spread over its streamlines' vertices."""
 
 import nibabel as nib
 import numpy as np
@@ -60,3 +61,14 @@ def test_render_colored_by_a_volume_is_the_command_lines(lineao_bin, tmp_path):
     # Not the tangent colours: the z-map through viridis (and gray outside).
     plain = lineao.render(STROKE, **SMALL)
     assert (image != plain).any(axis=2).mean() > 0.05
+
+
+def test_a_per_streamline_field_colours_whole_streamlines(lineao_bin, tmp_path):
+    trx = IMAGES / "dpsv.trx"
+    image = lineao.render(trx, color="field:DataSetID", **SMALL)
+    expected = cli_render(lineao_bin, tmp_path, trx, "--color", "field:DataSetID", "--width", 320, "--height", 256)
+    assert (image != expected).sum() == 0
+    assert (image != lineao.render(trx, **SMALL)).any(axis=2).mean() > 0.01
+    with pytest.raises(Exception, match="DataSetID"):
+        # The error lists the fields a file has, per-streamline ones included.
+        lineao.render(trx, color="field:nothing", **SMALL)

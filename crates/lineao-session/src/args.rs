@@ -430,7 +430,7 @@ pub struct StyleArgs {
     #[serde(deserialize_with = "crate::kwargs::vec3")]
     pub surface_color: [f32; 3],
     /// Line color: `tangent` (|T| as RGB), R,G,B in [0, 1], `field:NAME` (the file's
-    /// per-vertex field NAME through --colormap, its 2nd to 98th percentile spanning the map), or
+    /// per-vertex field NAME, or per-streamline one over its vertices, through --colormap, its 2nd to 98th percentile spanning the map), or
     /// `volume:FILE` (a NIfTI volume sampled at every vertex, trilinear between voxel centres;
     /// gray outside it).
     #[arg(long, default_value = "tangent", value_parser = parse_color)]

@@ -290,6 +290,9 @@ impl Session {
         if let Some(sampled) = Sampled::of(&args.style.color)? {
             sampled.add_to(&mut loaded.tracts);
         }
+        for field in base.scalar.iter().chain(&base.radius) {
+            loaded.tracts.spread_streamline_field(field);
+        }
         // The fields exist, before any GPU work.
         for field in base.scalar.iter().chain(&base.radius) {
             vertex_field(&loaded.name, &loaded.tracts, field)?;
@@ -673,6 +676,34 @@ mod tests {
         let default = lineao::ChainSettings::default();
         assert_eq!(default, lineao::ChainSettings::papers().with_preset(lineao::Preset::Legible));
         assert_eq!((default.line_ao.s_r, default.r0_px(), default.strength), (2, 9.0, 0.6));
+    }
+
+    /// A streamed file keeps the field it is coloured by, every chunk of it, so the colour
+    /// range is the field's (the first chunk once went unseen and the range was [0, 1]); a
+    /// per-streamline field spreads over its streamlines' vertices; a volume's samples are kept
+    /// as a field.
+    #[test]
+    fn a_streamed_file_keeps_the_field_it_is_coloured_by() {
+        let images =
+            concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared/data/niivue+niivue/packages/niivue/demos/images");
+        let trx = format!("{images}/dpsv.trx");
+        let mut loaded = lineao_tracts::load(&trx).unwrap();
+        loaded.tractogram.spread_streamline_field("DataSetID");
+        let volume = format!("volume:{images}/strokez.nii.gz");
+        for color in ["field:z", "field:DataSetID", &volume] {
+            let args = crate::args::parse_render(["lineao", "render", &trx, "--color", color]);
+            let session = super::Session::open(&args).unwrap();
+            let field = args.style.color.field().unwrap();
+            let kept = session.lines.field(&field).unwrap();
+            assert_eq!(kept.len(), 95865, "{color}");
+            let expected = match loaded.tractogram.vertex_field(&field) {
+                Some(f) => f.values.clone(),
+                None => lineao_tracts::Volume::load(format!("{images}/strokez.nii.gz"))
+                    .unwrap()
+                    .sample_points(&loaded.tractogram.positions),
+            };
+            assert!(kept.iter().zip(&expected).all(|(a, b)| a.to_bits() == b.to_bits()), "{color}");
+        }
     }
 
     /// Each method's samples and radius have flags of their own, so a grid sets them all; the

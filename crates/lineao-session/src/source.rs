@@ -526,7 +526,8 @@ impl Lines {
             .map_err(|source| SourceError::Gpu { name: name.clone(), source })?;
         Ok(Lines {
             name,
-            tracts: Tractogram::new(),
+            // No offsets yet: the first chunk decides which of its fields are kept (`append`).
+            tracts: Tractogram::default(),
             points_kept: keep.points,
             keep: keep.clone(),
             hint: ViewHint::for_sphere([0.0; 3], 1.0),
@@ -545,6 +546,10 @@ impl Lines {
         }
         if let Some(sampled) = &self.keep.sampled {
             sampled.add_to(&mut chunk);
+        }
+        // A per-streamline field named for the colour or the radii: at every vertex.
+        for field in [&self.held.scalar, &self.held.radius].into_iter().flatten() {
+            chunk.spread_streamline_field(field);
         }
         let name = &self.name;
         let values = |field: &Option<String>| field.as_deref().map(|f| vertex_field(name, &chunk, f)).transpose();
@@ -595,6 +600,9 @@ impl Lines {
         self.tracts.vertex_fields = loaded.tracts.vertex_fields;
         if let Some(sampled) = &self.keep.sampled {
             sampled.add_to(&mut self.tracts);
+        }
+        for field in [&self.held.scalar, &self.held.radius].into_iter().flatten() {
+            self.tracts.spread_streamline_field(field);
         }
         self.points_kept = true;
         Ok(())
@@ -659,7 +667,8 @@ impl Lines {
 /// The values of the per-vertex field `field` of `tracts` (source `name`), one column.
 pub fn vertex_field<'t>(name: &str, tracts: &'t Tractogram, field: &str) -> Result<&'t [f32]> {
     let found = tracts.vertex_field(field).ok_or_else(|| {
-        let names: Vec<&str> = tracts.vertex_fields.iter().map(|f| f.name.as_str()).collect();
+        let per_streamline = tracts.streamline_fields.iter().filter(|f| f.columns == 1);
+        let names: Vec<&str> = tracts.vertex_fields.iter().chain(per_streamline).map(|f| f.name.as_str()).collect();
         let available = if names.is_empty() { "none".to_string() } else { names.join(", ") };
         SourceError::NoField { name: name.to_string(), field: field.to_string(), available }
     })?;

@@ -129,6 +129,29 @@ impl Tractogram {
         self.streamline_fields.iter().find(|f| f.name == name)
     }
 
+    /// Makes the per-streamline field `name` (TrackVis properties, TRX dps) a per-vertex one as
+    /// well, each streamline's values repeated at its vertices, where there is no per-vertex
+    /// field of that name: what colours (or sizes) whole streamlines. Whether it did.
+    pub fn spread_streamline_field(&mut self, name: &str) -> bool {
+        if self.vertex_field(name).is_some() {
+            return false;
+        }
+        let Some(field) = self.streamline_field(name) else { return false };
+        let columns = field.columns;
+        if field.values.len() != self.streamlines() * columns {
+            return false;
+        }
+        let mut values = Vec::with_capacity(self.vertices() * columns);
+        for (s, range) in self.offsets.windows(2).enumerate() {
+            let row = &field.values[s * columns..(s + 1) * columns];
+            for _ in range[0]..range[1] {
+                values.extend_from_slice(row);
+            }
+        }
+        self.vertex_fields.push(Field { name: name.to_string(), columns, values });
+        true
+    }
+
     /// Checks the invariants every loader guarantees: offsets start at 0, never decrease and end
     /// at the vertex count; every field and group fits.
     pub fn validate(&self) -> Result<(), String> {
@@ -198,4 +221,22 @@ pub fn invert_affine(m: &[[f64; 4]; 4]) -> Option<[[f64; 4]; 4]> {
         out[r][3] = -(inv[r][0] * t[0] + inv[r][1] * t[1] + inv[r][2] * t[2]);
     }
     Some(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_streamline_field_spreads_to_its_vertices() {
+        let mut t = Tractogram::new();
+        t.positions = vec![[0.0; 3]; 5];
+        t.offsets = vec![0, 2, 2, 5];
+        t.streamline_fields.push(Field { name: "weight".into(), columns: 1, values: vec![1.0, 2.0, 3.0] });
+        assert!(t.spread_streamline_field("weight"));
+        assert_eq!(t.vertex_field("weight").unwrap().values, [1.0, 1.0, 3.0, 3.0, 3.0]);
+        // Once, and never over a per-vertex field of the same name; none where there is none.
+        assert!(!t.spread_streamline_field("weight"));
+        assert!(!t.spread_streamline_field("length"));
+    }
 }
