@@ -43,9 +43,11 @@ def test_cull_and_level_of_detail_are_the_command_lines(lineao_bin, tmp_path):
             lineao_bin, tmp_path, TRK, "--cull", "on", "--lod", "on" if lod else "off", "--width", 320, "--height", 256
         )
         assert (image != expected).sum() == 0, lod
-    # Levels of detail move lines by under half a pixel: a few pixels at line edges change.
-    on, off = (lineao.render(t, cull=True, lod=lod, **SMALL) for lod in (True, False))
-    assert (on != off).any(axis=2).mean() < 0.05
+    # Levels of detail move lines by under half a pixel: line edges change, and the occlusion
+    # near them a little (measured: mean 0.42 / 255, 0.37 % of the pixels by more than 32).
+    on, off = (lineao.render(t, cull=True, lod=lod, **SMALL).astype(int) for lod in (True, False))
+    difference = np.abs(on - off)[..., :3]
+    assert difference.mean() < 1.0 and (difference.max(axis=2) > 32).mean() < 0.01
 
 
 def test_settings_compare_and_grid_are_the_command_lines(lineao_bin, tmp_path):
