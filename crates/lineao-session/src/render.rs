@@ -478,7 +478,9 @@ impl Session {
             }
             None => AoChain::new(&gpu.device, format, panel.settings.clone())?,
         };
-        if args.image.timings {
+        // Culled, the second frame is timed (the timer skips a frame submitted while it reads
+        // the one before).
+        if args.image.timings && !panel.settings.cull {
             chain.set_timing(&gpu.device, &gpu.queue, true);
         }
         chain.resize(args.image.width, args.image.height)?;
@@ -496,6 +498,9 @@ impl Session {
             // Culled, the picture (and its timings) is the view's second frame, what a viewer
             // shows of a still camera: drawn from what the first found visible, at the levels of
             // detail it found.
+            if args.image.timings {
+                chain.set_timing(&gpu.device, &gpu.queue, true);
+            }
             submit_frame(gpu, &mut chain, scene, (&self.camera, &self.bounds), &target.view);
         }
         if gpu_rays {
