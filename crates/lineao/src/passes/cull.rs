@@ -46,20 +46,19 @@
 //! was visible before, so the late phase draws all that passes against an empty pyramid).
 //!
 //! **Level of detail** (lines, where asked: [`LineCull::new`]'s `lod`, the chain's default):
-//! the settling also picks for each piece drawn and still visible the coarsest level — every 2nd, 4th or 8th
-//! point kept, and its last — at which each dropped point lies within [`LOD_PIXELS`] of the
-//! segment between the kept points around it, on screen at the piece's nearest point, and the
-//! sideways push at it turns by no more (half a line width times how far its tangent turns from
-//! the segment's direction). Kept points keep their own tangents, so the strip's corners there
-//! and the joins between pieces are the full strip's. The level is kept with the piece's mark,
-//! and the next frame's early phase draws the piece at it (a piece seen first is drawn whole
-//! by the late phase; the settling tests a compact list, where the late test's invocations
-//! beside a visible piece would wait for it) — where the view is close to the one the levels
-//! were found for ([`LevelsView::holds`]: the same projection, the eye moved by under 5 % of
-//! the near distance, turned by under 0.05 rad); after a cut it draws every piece whole;
-//! coarse pieces are listed from the
-//! back of their phase's list and drawn with 12 vertices a piece instead of 20. Without it the
-//! G-buffer is the full strip's exactly.
+//! the settling also picks for each piece drawn and still visible the coarsest level — every
+//! 2nd, 4th or 8th point kept, and its last — at which each dropped point lies within
+//! [`LOD_PIXELS`] of the segment between the kept points around it, on screen at the piece's
+//! nearest point, and the sideways push at it turns by no more (half a line width times how far
+//! its tangent turns from the segment's direction). Kept points keep their own tangents, so the
+//! strip's corners there and the joins between pieces are the full strip's. The level is kept
+//! with the piece's mark, and the next frame's early phase draws the piece at it (a piece seen
+//! first is drawn whole by the late phase; the settling tests a compact list, where the late
+//! test's invocations beside a visible piece would wait for it) — where the view is close to the
+//! one the levels were found for ([`LevelsView::holds`]: the same projection, the eye moved by
+//! under 5 % of the near distance, turned by under 0.05 rad); after a cut it draws every piece
+//! whole. Coarse pieces are listed from the back of their phase's list and drawn with 12
+//! vertices a piece instead of 20. Without it the G-buffer is the full strip's exactly.
 //!
 //! **Tubes** ([`Shape::Tubes`], `crate::passes::tubes`) are culled the same way, piece by
 //! piece: a segment's fragments lie within its billboard (`shaders/shared/billboard.wgsl`: the
@@ -68,8 +67,7 @@
 //! hold (its uniform) or the frame's; a group's box grows by that radius.
 //!
 //! Each page keeps its state ([`PageCull`]), one for lines, lines at levels of detail and
-//! tubes each: a word a cluster
-//! (its visible pieces), the list of pieces to draw (a word each), the listed groups and the
+//! tubes each: a word a cluster (its visible pieces), the list of pieces to draw (a word each), the listed groups and the
 //! indirect draws and dispatch: about 1.3 bytes a point, made on the page's first culled frame.
 
 use std::sync::Arc;
