@@ -162,10 +162,10 @@ impl Passes {
         for renderer in
             [&passes.lines, &passes.lines_culled, &passes.lines_culled_exact, &passes.lines_native, &passes.lines_full]
         {
-            renderer.prepare(queue, view, settings.line_width_px, settings.line_color, &settings.lighting);
+            renderer.prepare(queue, view, settings.line_width_px, settings.line_color, &settings.lighting, None);
         }
         for renderer in [&passes.tubes, &passes.tubes_culled] {
-            renderer.prepare(queue, view, TUBE_RADIUS * view.zoom_unit, settings.line_color, &settings.lighting);
+            renderer.prepare(queue, view, TUBE_RADIUS * view.zoom_unit, settings.line_color, &settings.lighting, None);
         }
         passes.nd_from_depth.prepare(queue, view);
         passes.pyramid.resize(device, targets);

@@ -71,6 +71,10 @@ pub struct ViewArgs {
     /// half a pixel of it (`on`), or every point (`off`: the full strip exactly).
     #[arg(long, value_parser = parse_on_off, default_value = "on")]
     pub lod: bool,
+    /// Cut the lines to a slab: AXIS (x, y, z or view), CENTRE and THICKNESS in world mm
+    /// (`z,0,8`); `[` and `]` move it (see `render --slab`).
+    #[arg(long, value_name = "AXIS,CENTRE,THICKNESS", value_parser = lineao_session::args::parse_slab, allow_hyphen_values = true)]
+    pub slab: Option<lineao::Slab>,
     /// Line color: `tangent`, R,G,B in [0, 1], or `field:NAME` (see `render --color`).
     #[arg(long, default_value = "tangent", value_parser = parse_color)]
     pub color: ColorArg,

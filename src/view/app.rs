@@ -365,6 +365,8 @@ impl App {
                         );
                     }
                     self.controls.set_zoom_unit(dataset.hint.zoom_unit);
+                    let distance = glam::Vec3::from(dataset.hint.eye).distance(glam::Vec3::from(dataset.hint.target));
+                    self.controls.slab_reach = 0.5 * distance;
                     if let ColorMode::Field(name) = &self.controls.color
                         && !dataset.fields.iter().any(|(f, _)| f == name)
                     {
@@ -711,6 +713,11 @@ impl App {
                 }
                 if i.key_pressed(Key::O) {
                     camera.orthographic = !camera.orthographic;
+                }
+                for (key, steps) in [(Key::OpenBracket, -1.0), (Key::CloseBracket, 1.0)] {
+                    if i.key_pressed(key) {
+                        self.controls.move_slab(steps);
+                    }
                 }
             });
             self.orthographic = camera.orthographic;

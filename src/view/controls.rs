@@ -10,8 +10,8 @@ use glam::Vec3;
 use lineao::lighting::LineShading;
 use lineao::volume::{ScalarForm, Sky, VolumeAoOptions, VolumeMethod};
 use lineao::{
-    AoMethod, BilateralSettings, ChainSettings, Colormap, DebugView, LineAoOuter, LineAoVariant, LineColor, Preset,
-    SsaoKernel, TubeSettings, VoCombine, VolumeAoSettings,
+    AoMethod, BilateralSettings, ChainSettings, Colormap, DebugView, LineAoOuter, LineAoVariant, LineColor, Named,
+    Preset, Slab, SlabAxis, SsaoKernel, TubeSettings, VoCombine, VolumeAoSettings,
 };
 
 use super::worker::Panel;
@@ -137,6 +137,11 @@ pub struct Controls {
     /// What a ray-traced panel shows while the camera moves (a screen-space method: the rays
     /// start again once the camera rests).
     pub moving_method: Method,
+    /// The last slab the lines were cut to (`params.chain.slab`), kept while it is off.
+    pub slab: Slab,
+    /// How far the slab's centre slider reaches either way (world units): half the dataset's
+    /// viewing distance.
+    pub slab_reach: f32,
 }
 
 impl Controls {
@@ -156,14 +161,25 @@ impl Controls {
             params: Params::preset(preset, 1.0),
             preset,
             moving_method: MOVING_DEFAULT,
+            slab: Slab { axis: SlabAxis::Z, center: 0.0, thickness: 10.0 },
+            slab_reach: 100.0,
+        }
+    }
+
+    /// Moves the slab (when it is on) by `steps` quarters of its thickness: the `[` and `]` keys.
+    pub fn move_slab(&mut self, steps: f32) {
+        if let Some(slab) = &mut self.params.chain.slab {
+            slab.center = (slab.center + 0.25 * steps * slab.thickness).clamp(-self.slab_reach, self.slab_reach);
+            self.slab = *slab;
         }
     }
 
     /// The data's zoom unit changed (a new file): the parameters take the preset's values in it,
     /// except the ray counts (`view --rays`) and the denoiser's switch, which are no lengths.
     pub fn set_zoom_unit(&mut self, zoom_unit: f32) {
-        let rays = self.params.chain.raytraced.clone();
+        let (rays, slab) = (self.params.chain.raytraced.clone(), self.params.chain.slab);
         self.params = Params::preset(self.preset, zoom_unit);
+        self.params.chain.slab = slab;
         let r = &mut self.params.chain.raytraced;
         (r.rays_per_frame, r.max_rays, r.denoise) = (rays.rays_per_frame, rays.max_rays, rays.denoise);
     }
@@ -256,6 +272,7 @@ impl Controls {
         self.color_ui(ui, fields);
         ui.add(egui::Slider::new(&mut self.light_azimuth, -180.0..=180.0).text("light azimuth (°)"));
         ui.add(egui::Slider::new(&mut self.light_elevation, -89.0..=89.0).text("light elevation (°)"));
+        self.slab_ui(ui);
         ui.separator();
 
         ui.heading("Parameters");
@@ -334,6 +351,27 @@ impl Controls {
             }
         });
         ui.checkbox(&mut self.timings, "GPU time per pass");
+    }
+
+    /// The slab: on or off, its axis, centre and thickness.
+    fn slab_ui(&mut self, ui: &mut Ui) {
+        let mut on = self.params.chain.slab.is_some();
+        ui.checkbox(&mut on, "slab").on_hover_text("show only the lines between two parallel planes ([ and ] move it)");
+        // Turned off, the slab is kept for when it is turned on again.
+        let chain = &mut self.params.chain;
+        let Some(slab) = on.then(|| chain.slab.get_or_insert(self.slab)) else {
+            chain.slab = None;
+            return;
+        };
+        ui.horizontal(|ui| {
+            for axis in SlabAxis::VALUES {
+                ui.selectable_value(&mut slab.axis, *axis, axis.name()).on_hover_text(axis.help());
+            }
+        });
+        let reach = self.slab_reach;
+        ui.add(egui::Slider::new(&mut slab.center, -reach..=reach).text("centre"));
+        ui.add(egui::Slider::new(&mut slab.thickness, (0.005 * reach).max(1e-3)..=reach).text("thickness"));
+        self.slab = *slab;
     }
 
     fn color_ui(&mut self, ui: &mut Ui, fields: &[(String, [f32; 2])]) {

@@ -420,3 +420,25 @@ fn the_ray_traced_method_accumulates_while_the_camera_rests_and_shows_lineao_whi
     assert_eq!(frame.view.panels[0].settings.method, AoMethod::RayTraced, "ray traced at rest");
     assert!(frame.rays[0].is_some_and(|r| r.progress.rays_per_pixel <= 12));
 }
+
+#[test]
+fn a_slab_cuts_the_lines_and_the_brackets_move_it() {
+    let path = data("niivue+niivue/packages/niivue/demos/images/stroke.trk.gz");
+    let mut harness = harness(options(Source::File(path), [methods()[1], methods()[4]], false));
+    settle(&mut harness);
+    let whole = non_background(&harness.state().shown.as_ref().unwrap().images[0]);
+    let slab = lineao::Slab { axis: lineao::SlabAxis::Z, center: 10.0, thickness: 6.0 };
+    harness.state_mut().controls.params.chain.slab = Some(slab);
+    settle(&mut harness);
+    let app = harness.state();
+    assert!(app.error.is_none(), "{:?}", app.error);
+    let frame = app.shown.as_ref().unwrap();
+    assert_eq!(frame.view.panels[0].settings.slab, Some(slab));
+    let cut = non_background(&frame.images[0]);
+    assert!(cut > 0.005 && cut < 0.5 * whole, "{cut} of the pixels in the slab, {whole} without it");
+    // `]` moves it a quarter of its thickness along its axis.
+    harness.key_press(egui::Key::CloseBracket);
+    settle(&mut harness);
+    let moved = harness.state().shown.as_ref().unwrap().view.panels[0].settings.slab.unwrap();
+    assert_eq!(moved.center, 11.5);
+}

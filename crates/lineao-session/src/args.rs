@@ -285,6 +285,9 @@ pub struct RenderArgs {
     pub style: StyleArgs,
     #[command(flatten)]
     #[serde(flatten)]
+    pub context: ContextArgs,
+    #[command(flatten)]
+    #[serde(flatten)]
     pub camera: CameraArgs,
     #[command(flatten)]
     #[serde(flatten)]
@@ -452,6 +455,75 @@ pub struct StyleArgs {
     /// half a pixel of it (`on`), or every point (`off`: the full strip exactly) [default: on].
     #[arg(long, value_parser = parse_on_off)]
     pub lod: Option<bool>,
+}
+
+/// What the tracts are shown in: anatomy slices, a slab.
+#[derive(Args, Clone, Debug, serde::Deserialize)]
+#[command(next_help_heading = "Context")]
+#[serde(default)]
+pub struct ContextArgs {
+    /// Anatomy: a NIfTI-1 volume (.nii, .nii.gz) placed by its sform (else qform, else voxel
+    /// sizes: nibabel's rule), shown as slices that occlude the lines and that their AO darkens.
+    #[arg(long, value_name = "NIFTI")]
+    pub volume: Option<PathBuf>,
+    /// Where the sagittal, coronal and axial slices cut x, y and z (world mm, RAS+), `-` for no
+    /// slice on an axis: `0,-18,10`, `-,-,10` [default: all three through the volume's centre].
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_slices, allow_hyphen_values = true, requires = "volume")]
+    #[serde(deserialize_with = "crate::kwargs::opt_slices")]
+    pub slices: Option<[Option<f32>; 3]>,
+    /// The slices' values at the colormap's ends [default: the volume's 2nd and 98th percentiles].
+    #[arg(long, value_name = "MIN,MAX", value_parser = parse_window, allow_hyphen_values = true, requires = "volume")]
+    #[serde(deserialize_with = "crate::kwargs::opt_window")]
+    pub window: Option<[f32; 2]>,
+    /// The slices' colormap.
+    #[arg(long, value_parser = named::<Colormap>(), default_value = "gray")]
+    pub slice_colormap: Colormap,
+    /// Cut the lines to a slab: AXIS (x, y, z, or view: facing the eye, the centre measured
+    /// from the middle of the scene), its CENTRE and THICKNESS in world mm: `z,0,8`.
+    #[arg(long, value_name = "AXIS,CENTRE,THICKNESS", value_parser = parse_slab, allow_hyphen_values = true)]
+    #[serde(deserialize_with = "crate::kwargs::opt_slab")]
+    pub slab: Option<lineao::Slab>,
+}
+
+/// `--slices`: three positions, each a number or `-`.
+pub fn parse_slices(s: &str) -> Result<[Option<f32>; 3], String> {
+    let parts: Vec<Option<f32>> = s
+        .split(',')
+        .map(|p| match p.trim() {
+            "-" | "" => Ok(None),
+            p => match p.parse::<f32>() {
+                Ok(v) if v.is_finite() => Ok(Some(v)),
+                _ => Err(format!("'{p}' is neither a position in mm nor '-'")),
+            },
+        })
+        .collect::<Result<_, _>>()?;
+    parts.try_into().map_err(|_| format!("expected X,Y,Z (a position or '-' each), got '{s}'"))
+}
+
+/// `--window`: MIN,MAX with MIN < MAX.
+pub fn parse_window(s: &str) -> Result<[f32; 2], String> {
+    let parts: Vec<f32> =
+        s.split(',').map(|p| p.trim().parse::<f32>().map_err(|e| format!("'{p}': {e}"))).collect::<Result<_, _>>()?;
+    match parts[..] {
+        [lo, hi] if lo.is_finite() && hi.is_finite() && lo < hi => Ok([lo, hi]),
+        [_, _] => Err(format!("expected finite MIN < MAX, got '{s}'")),
+        _ => Err(format!("expected MIN,MAX, got '{s}'")),
+    }
+}
+
+/// `--slab`: AXIS,CENTRE,THICKNESS.
+pub fn parse_slab(s: &str) -> Result<lineao::Slab, String> {
+    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
+    let [axis, center, thickness] = parts[..] else {
+        return Err(format!("expected AXIS,CENTRE,THICKNESS (e.g. z,0,8), got '{s}'"));
+    };
+    let axis = lineao::SlabAxis::from_name(axis)
+        .ok_or_else(|| format!("'{axis}' is not a slab axis (one of x, y, z, view)"))?;
+    let number = |p: &str| p.parse::<f32>().ok().filter(|v| v.is_finite());
+    match (number(center), number(thickness)) {
+        (Some(center), Some(thickness)) if thickness > 0.0 => Ok(lineao::Slab { axis, center, thickness }),
+        _ => Err(format!("expected a centre and a thickness > 0 in mm, got '{s}'")),
+    }
 }
 
 /// `on` or `off`.
@@ -682,6 +754,7 @@ defaults_from_render_args! {
     shown: ShownArgs,
     image: ImageArgs,
     style: StyleArgs,
+    context: ContextArgs,
     camera: CameraArgs,
     line_ao: LineAoArgs,
     ssao: SsaoArgs,

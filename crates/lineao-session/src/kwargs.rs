@@ -145,8 +145,13 @@ impl RenderArgs {
 }
 
 /// The options that need another (clap's `requires`, which it does not expose).
-const REQUIRES: [(&str, &str); 3] =
-    [("combine", "radius2"), ("bilateral_radius", "bilateral"), ("bilateral_sigma", "bilateral")];
+const REQUIRES: [(&str, &str); 5] = [
+    ("combine", "radius2"),
+    ("bilateral_radius", "bilateral"),
+    ("bilateral_sigma", "bilateral"),
+    ("slices", "volume"),
+    ("window", "volume"),
+];
 
 /// A value as the command line's text: a string as it is, a number or bool as written, a
 /// sequence of them joined by commas (`(0, 0, 0)` → `0,0,0`, `("lineao", "ssao")` → `lineao,ssao`).
@@ -211,6 +216,9 @@ optional! {
     opt_vec3: [f32; 3] = crate::args::parse_vec3;
     opt_positive: f32 = crate::args::parse_positive;
     opt_delta_scale: f32 = crate::args::parse_delta_scale;
+    opt_slices: [Option<f32>; 3] = crate::args::parse_slices;
+    opt_window: [f32; 2] = crate::args::parse_window;
+    opt_slab: lineao::Slab = crate::args::parse_slab;
 }
 
 /// `settings`: an object of `ChainSettings` keys, or the command line's text (JSON or a file).
@@ -292,7 +300,12 @@ mod tests {
         let refuses = |argv: &[&str]| crate::args::try_parse_render(["lineao", "render"].iter().chain(argv)).is_err();
         let flag = |name: &str| format!("--{}", name.replace('_', "-"));
         for (a, b) in REQUIRES {
-            let value = if a == "combine" { "min" } else { "1" };
+            let value = match a {
+                "combine" => "min",
+                "slices" => "1,2,3",
+                "window" => "0,1",
+                _ => "1",
+            };
             assert!(refuses(&[&flag(a), value]), "{a} without {b}");
             assert!(from(json!({a: value})).is_err(), "{a} without {b}");
         }

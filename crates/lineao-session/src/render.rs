@@ -3,6 +3,7 @@
 //! them side by side, labelled.
 
 use std::path::Path;
+use std::sync::Arc;
 
 use anyhow::{Context, Result};
 use glam::Vec3;
@@ -11,8 +12,8 @@ use lineao::volume::density::DensityOptions;
 use lineao::volume::sweep::SweepSettings;
 use lineao::volume::{ScalarForm, Sky, VolumeAoOptions, VolumeMethod};
 use lineao::{
-    AoChain, AoMethod, BilateralSettings, ChainSettings, Gpu, LineAoSettings, LineAoVariant, LineColor, SsaoSettings,
-    SurfaceSettings, TubeSettings, VoSettings, VolumeAoSettings,
+    AoChain, AoMethod, BilateralSettings, ChainSettings, Gpu, LineAoSettings, LineAoVariant, LineColor, SliceSettings,
+    SliceVolume, SsaoSettings, SurfaceSettings, TubeSettings, VoSettings, VolumeAoSettings,
 };
 use lineao::{Bounds, Camera, Projection};
 use lineao_tracts::scenes::ViewHint;
@@ -118,6 +119,8 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky, lon
         tubes: (args.style.geometry == GeometryArg::Tubes)
             .then(|| TubeSettings { radius_world: tube_radius(args, zoom_unit) }),
         surfaces: (!args.style.surfaces.is_empty()).then_some(SurfaceSettings { color: args.style.surface_color }),
+        slices: slice_settings(args),
+        slab: args.context.slab,
         line_color: match &args.style.color {
             ColorArg::Tangent => LineColor::Tangent,
             ColorArg::Constant(rgb) => LineColor::Constant(*rgb),
@@ -230,6 +233,8 @@ pub struct Session {
     pub surfaces: Vec<lineao_tracts::TriangleMesh>,
     pub gpu: Gpu,
     pub meshes: Vec<MeshGeometry>,
+    /// The `--volume` the slices cut, on the GPU, where it loaded.
+    pub anatomy: Option<Arc<SliceVolume>>,
     pub bounds: Bounds,
     /// The longest side of the axis-aligned box around the streamlines and surfaces, world
     /// units: what `--ao-distance 20%` is a share of.
@@ -317,8 +322,11 @@ impl Session {
             .iter()
             .map(|m| MeshGeometry::new(&gpu.device, &gpu.queue, &m.positions, &m.normals, &m.indices))
             .collect::<Result<Vec<_>, _>>()?;
+        let anatomy = load_anatomy(args, &gpu);
         let lines_bounds = lines.geometry.bounds.expect("checked at upload");
-        let bounds = meshes.iter().filter_map(|m| m.bounds).fold(lines_bounds, |b, m| b.union(&m));
+        let slice_bounds =
+            anatomy.as_ref().zip(slice_settings(args)).and_then(|(v, s)| v.slice_bounds(&fit_slices(v, s)));
+        let bounds = meshes.iter().filter_map(|m| m.bounds).chain(slice_bounds).fold(lines_bounds, |b, m| b.union(&m));
         let corners = lines.geometry.corners().map(|(lo, hi)| [lo.to_array(), hi.to_array()]);
         let points = corners.iter().flatten().chain(surfaces.iter().flat_map(|m| &m.positions));
         let longest_side = longest_side(points);
@@ -330,6 +338,7 @@ impl Session {
             surfaces,
             gpu,
             meshes,
+            anatomy,
             bounds,
             longest_side,
             ray_scene: Default::default(),
@@ -343,7 +352,11 @@ impl Session {
         settings
     }
 
+    /// The colour range from the data, and the slices placed in the volume.
     fn fit_color_range(&self, settings: &mut ChainSettings) {
+        if let (Some(volume), Some(slices)) = (&self.anatomy, settings.slices.take()) {
+            settings.slices = Some(fit_slices(volume, slices));
+        }
         let scalars = self.base.scalar.as_deref().and_then(|field| self.lines.field(field).ok());
         if let (Some(values), LineColor::Scalar { range, .. }) = (scalars, &mut settings.line_color) {
             *range = percentile_range(values);
@@ -493,6 +506,7 @@ impl Session {
         if gpu_rays {
             chain.set_ray_scene(&gpu.device, Some(self.ray_scene()?));
         }
+        chain.set_slice_volume(&gpu.device, self.anatomy.clone());
         submit_frame(gpu, &mut chain, scene, (&self.camera, &self.bounds), &target.view);
         if panel.settings.cull {
             // Culled, the picture (and its timings) is the view's second frame, what a viewer
@@ -585,6 +599,45 @@ impl Session {
             100.0 * truth.buried_share()
         );
         Ok(truth)
+    }
+}
+
+/// The slices of `--volume` as the command line gives them (where they lie by default comes
+/// from the volume: [`fit_slices`]).
+fn slice_settings(args: &RenderArgs) -> Option<SliceSettings> {
+    args.context.volume.as_ref().map(|_| SliceSettings {
+        positions: args.context.slices.unwrap_or([None; 3]),
+        window: args.context.window,
+        colormap: args.context.slice_colormap,
+    })
+}
+
+/// `slices` with every axis through the volume's centre where none was asked for.
+fn fit_slices(volume: &SliceVolume, slices: SliceSettings) -> SliceSettings {
+    if slices.positions.iter().any(Option::is_some) {
+        return slices;
+    }
+    let (lo, hi) = volume.world_box();
+    let center = 0.5 * (lo + hi);
+    SliceSettings { positions: center.to_array().map(Some), ..slices }
+}
+
+/// The volume of `--volume` on the GPU; one that does not load is said on stderr and left out
+/// (the tractogram is still shown).
+fn load_anatomy(args: &RenderArgs, gpu: &Gpu) -> Option<Arc<SliceVolume>> {
+    let path = args.context.volume.as_ref()?;
+    let uploaded = lineao_tracts::Volume::load(path).map_err(anyhow::Error::from).and_then(|v| {
+        let dims = v.dims.map(|d| d as u32);
+        let affine = v.affine.as_mat4();
+        SliceVolume::new(&gpu.device, &gpu.queue, dims, &v.values, affine)
+            .with_context(|| format!("uploading {}", path.display()))
+    });
+    match uploaded {
+        Ok(volume) => Some(Arc::new(volume)),
+        Err(e) => {
+            eprintln!("lineao: warning: {e:#}; the tractogram is shown without its slices");
+            None
+        }
     }
 }
 

@@ -253,8 +253,12 @@ fn fs_octants(in: VsOutOctants) -> GBufferOctants {
     return with_octants(line_gbuffer(in.view_pos, in.view_tangent, in.color), in.octants_lo, in.octants_hi);
 }
 
-// The G-buffer of a point of the line at `view_pos` with tangent `view_tangent`.
+// The G-buffer of a point of the line at `view_pos` with tangent `view_tangent`; discarded
+// outside the slab.
 fn line_gbuffer(view_pos: vec3<f32>, view_tangent: vec3<f32>, color: vec3<f32>) -> GBuffer {
+    if outside_slab(view_pos) {
+        discard;
+    }
     let t = normalize(view_tangent);
     let c = gbuffer_eye_direction(view_pos, is_orthographic());
     let n = gbuffer_line_normal(t, c);

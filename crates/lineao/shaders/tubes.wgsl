@@ -158,7 +158,7 @@ struct TubeHit {
     depth: f32,
 }
 
-// The pixel's ray, the hit and its G-buffer; discards a miss.
+// The pixel's ray, the hit and its G-buffer; discards a miss, and a hit outside the slab.
 fn tube_hit(in: TubeOut) -> TubeHit {
     let ro = in.ray_origin;
     let rd = normalize(in.ray_direction);
@@ -167,6 +167,9 @@ fn tube_hit(in: TubeOut) -> TubeHit {
         discard;
     }
     let p = ro + hit.x * rd;
+    if outside_slab(p) {
+        discard;
+    }
     // Unit, as the ND map wants (an end sphere's (p − c) / r is only within rounding).
     let n = normalize(hit.yzw);
     let ab = in.b - in.a;

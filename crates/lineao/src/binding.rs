@@ -11,6 +11,8 @@ pub enum Slot {
     StorageReadWrite,
     /// `texture_2d<f32>` read with `textureLoad` (unfilterable, so f32 formats work everywhere).
     Texture,
+    /// `texture_3d<f32>` read with `textureLoad` (unfilterable).
+    Texture3d,
     /// `texture_2d<u32>` read with `textureLoad`.
     UintTexture,
     /// `texture_2d_array<u32>` read with `textureLoad`.
@@ -50,6 +52,11 @@ pub fn layout(
                 Slot::Texture => wgpu::BindingType::Texture {
                     sample_type: wgpu::TextureSampleType::Float { filterable: false },
                     view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+                Slot::Texture3d => wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                    view_dimension: wgpu::TextureViewDimension::D3,
                     multisampled: false,
                 },
                 Slot::DepthTexture { multisampled } => wgpu::BindingType::Texture {

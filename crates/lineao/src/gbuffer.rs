@@ -33,6 +33,10 @@ pub struct GeometryUniform {
     pub ndc_per_px: [f32; 2],
     /// [`LineColor::Scalar`]: the scalar range mapped to the colormap's ends, and its table.
     pub scalar_range: [f32; 4],
+    /// A [`crate::settings::Slab`] in eye space: (n, d), the signed distance dot(n, p) + d.
+    pub slab_plane: [f32; 4],
+    /// x: the slab's half thickness; negative without a slab.
+    pub slab_half: [f32; 4],
     pub colormap: [[f32; 4]; crate::settings::COLORMAP_ENTRIES],
 }
 
@@ -65,7 +69,20 @@ impl GeometryUniform {
             tube_radius,
             ndc_per_px: [2.0 / w as f32, 2.0 / h as f32],
             scalar_range,
+            slab_plane: [0.0; 4],
+            slab_half: [-1.0, 0.0, 0.0, 0.0],
             colormap,
+        }
+    }
+
+    /// `self` cutting the lines to `slab` (as seen in `view`).
+    pub fn with_slab(self, view: &FrameView, slab: Option<&crate::settings::Slab>) -> GeometryUniform {
+        match slab {
+            Some(slab) => {
+                let (slab_plane, half) = slab.in_view(view);
+                GeometryUniform { slab_plane, slab_half: [half, 0.0, 0.0, 0.0], ..self }
+            }
+            None => self,
         }
     }
 }

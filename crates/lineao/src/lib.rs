@@ -116,10 +116,11 @@ pub use method::vo_line::settings::{VoCombine, VoSettings};
 pub use passes::composite::OverlayDepth;
 pub use passes::meshes::MeshGeometry;
 pub use passes::nd_from_depth::{HostConfig, HostInputs};
+pub use passes::slices::SliceVolume;
 pub use ray_scene::{RayGeometry, RayScene};
 pub use settings::{
-    BilateralSettings, ChainSettings, DebugView, LineColor, Named, Preset, SurfaceSettings, TubeSettings,
-    VolumeAoSettings,
+    BilateralSettings, ChainSettings, DebugView, LineColor, Named, Preset, Slab, SlabAxis, SliceSettings,
+    SurfaceSettings, TubeSettings, VolumeAoSettings,
 };
 
 // docs/embedding.md's code compiles as it stands: `cargo test --doc` checks it.

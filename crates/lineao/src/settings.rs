@@ -220,6 +220,91 @@ impl Default for SurfaceSettings {
     }
 }
 
+/// Anatomy slices ([`crate::passes::slices`]) drawn with the lines: up to three planes of a
+/// scalar volume ([`crate::SliceVolume`]), each orthogonal to a world axis (RAS+ mm for
+/// tractograms), its values through a window and a colormap.
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct SliceSettings {
+    /// Where the sagittal (x), coronal (y) and axial (z) slices cut their axis, world units, or
+    /// none for no slice on that axis. Default the axial slice at 0.
+    pub positions: [Option<f32>; 3],
+    /// The values at the colormap's ends, or none for the volume's 2nd and 98th percentiles
+    /// ([`crate::SliceVolume::percentiles`]). Default none.
+    pub window: Option<[f32; 2]>,
+    /// Default gray.
+    pub colormap: Colormap,
+}
+
+impl Default for SliceSettings {
+    fn default() -> Self {
+        SliceSettings { positions: [None, None, Some(0.0)], window: None, colormap: Colormap::Gray }
+    }
+}
+
+/// The axis a [`Slab`] is thick along.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum SlabAxis {
+    X,
+    Y,
+    #[default]
+    Z,
+    /// The view direction, the slab's centre measured from the middle of the scene's depth
+    /// range (the bounding sphere's centre, unless the eye is inside it).
+    View,
+}
+
+named!(SlabAxis {
+    Z => "Between two axial planes (z = centre ± thickness / 2)",
+    X => "Between two sagittal planes",
+    Y => "Between two coronal planes",
+    View => "Between two planes facing the eye, the centre measured from the middle of the scene",
+});
+
+impl SlabAxis {
+    pub fn name(self) -> &'static str {
+        match self {
+            SlabAxis::X => "x",
+            SlabAxis::Y => "y",
+            SlabAxis::Z => "z",
+            SlabAxis::View => "view",
+        }
+    }
+}
+
+/// Lines (and tubes) cut per fragment to what lies between two parallel planes: a thick slice
+/// of a whole brain, seen inside.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct Slab {
+    pub axis: SlabAxis,
+    /// The slab's middle along its axis, world units.
+    pub center: f32,
+    /// The distance between its planes, world units, > 0.
+    pub thickness: f32,
+}
+
+impl Slab {
+    /// The slab as a plane in `view`'s eye space, (n, d) with dot(n, p) + d the signed distance
+    /// of eye-space point p from its middle, and its half thickness.
+    pub fn in_view(&self, view: &crate::FrameView) -> ([f32; 4], f32) {
+        use glam::Vec3;
+        let (n, d) = match self.axis {
+            SlabAxis::View => (Vec3::NEG_Z, -(0.5 * (view.near + view.far) + self.center)),
+            axis => {
+                let n_world = Vec3::AXES[axis as usize];
+                let n = view.view.transform_vector3(n_world);
+                let on_plane = view.view.transform_point3(self.center * n_world);
+                (n, -n.dot(on_plane))
+            }
+        };
+        ([n.x, n.y, n.z, d], 0.5 * self.thickness)
+    }
+}
+
 /// Everything the pass chain needs to know besides the camera.
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -244,6 +329,11 @@ pub struct ChainSettings {
     /// Context surfaces drawn with the lines ([`crate::AoChain::encode_with_meshes`]), or none.
     /// Default none.
     pub surfaces: Option<SurfaceSettings>,
+    /// Anatomy slices drawn with the lines ([`crate::AoChain::encode_with_context`]), or none.
+    /// Default none.
+    pub slices: Option<SliceSettings>,
+    /// Lines cut to a slab, or none. Default none.
+    pub slab: Option<Slab>,
     pub line_color: LineColor,
     /// Linear RGB of the background.
     pub background: [f32; 3],
@@ -300,6 +390,8 @@ impl ChainSettings {
             line_width_px: 2.0,
             tubes: None,
             surfaces: None,
+            slices: None,
+            slab: None,
             line_color: LineColor::Tangent,
             background: [1.0, 1.0, 1.0],
             strength: 1.0,
@@ -462,6 +554,24 @@ impl ChainSettings {
         }
         if self.lighting.lights.len() > crate::lighting::MAX_LIGHTS {
             return bad(format!("at most {} lights, got {}", crate::lighting::MAX_LIGHTS, self.lighting.lights.len()));
+        }
+        if let Some(slab) = &self.slab
+            && !(slab.center.is_finite() && slab.thickness.is_finite() && slab.thickness > 0.0)
+        {
+            return bad(format!(
+                "a slab needs a finite centre and a thickness > 0, got centre {} and thickness {}",
+                slab.center, slab.thickness
+            ));
+        }
+        if let Some(slices) = &self.slices {
+            if let Some(p) = slices.positions.iter().flatten().find(|p| !p.is_finite()) {
+                return bad(format!("slice positions must be finite, got {p}"));
+            }
+            if let Some([lo, hi]) = slices.window
+                && !(lo.is_finite() && hi.is_finite() && lo < hi)
+            {
+                return bad(format!("a slice window needs finite min < max, got {lo}, {hi}"));
+            }
         }
         if let DebugView::Level(k) = self.debug_view
             && k >= self.levels()

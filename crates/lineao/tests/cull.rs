@@ -78,7 +78,7 @@ fn outside() -> Camera {
 /// The G-buffer (color, ND, zoom, hardware depth) `renderer` draws of `geometry` for `camera`.
 fn draw(gpu: &lineao::Gpu, renderer: &LineRenderer, geometry: &LineGeometry, camera: &Camera) -> [NdImage; 4] {
     draw_with(gpu, camera, |encoder, targets, view, s| {
-        renderer.prepare(&gpu.queue, view, s.line_width_px, s.line_color, &s.lighting);
+        renderer.prepare(&gpu.queue, view, s.line_width_px, s.line_color, &s.lighting, None);
         renderer.encode(encoder, targets, geometry, lineao::passes::Load::Clear(s.background), None);
     })
 }
@@ -87,7 +87,7 @@ fn draw(gpu: &lineao::Gpu, renderer: &LineRenderer, geometry: &LineGeometry, cam
 /// points' own).
 fn draw_tubes(gpu: &lineao::Gpu, renderer: &TubeRenderer, geometry: &LineGeometry, camera: &Camera) -> [NdImage; 4] {
     draw_with(gpu, camera, |encoder, targets, view, s| {
-        renderer.prepare(&gpu.queue, view, TUBE_RADIUS, s.line_color, &s.lighting);
+        renderer.prepare(&gpu.queue, view, TUBE_RADIUS, s.line_color, &s.lighting, None);
         renderer.encode(encoder, targets, geometry, lineao::passes::Load::Clear(s.background), None);
     })
 }

@@ -327,7 +327,7 @@ fn native_lines_are_one_pixel() {
     let targets = FrameTargets::new(d, SIZE.0, SIZE.1, 0, 1);
     let renderer = LineRenderer::with_style(d, LineStyle::Native1px);
     let s = plain(4.0);
-    renderer.prepare(q, &view, s.line_width_px, s.line_color, &s.lighting);
+    renderer.prepare(q, &view, s.line_width_px, s.line_color, &s.lighting, None);
     let covered = || {
         let geometry = LineGeometry::new(d, q, &positions, &offsets).unwrap();
         let mut encoder = d.create_command_encoder(&Default::default());
@@ -483,7 +483,7 @@ fn draw(
     let targets = FrameTargets::new(d, SIZE.0, SIZE.1, 0, 1);
     let renderer = LineRenderer::with_style(d, style);
     let s = plain(2.0);
-    renderer.prepare(q, &view, s.line_width_px, s.line_color, &s.lighting);
+    renderer.prepare(q, &view, s.line_width_px, s.line_color, &s.lighting, None);
     let mut encoder = d.create_command_encoder(&Default::default());
     renderer.encode(&mut encoder, &targets, geometry, lineao::passes::Load::Clear(s.background), None);
     q.submit([encoder.finish()]);
@@ -599,7 +599,7 @@ fn clusters_draw_the_g_buffer_of_the_earlier_strip() {
         let view = FrameView::new(&cam, &bounds, size.0, size.1, 0, 1.0);
         let settings = plain(2.0);
         let renderer = LineRenderer::with_style(d, LineStyle::FullStrip);
-        renderer.prepare(q, &view, settings.line_width_px, settings.line_color, &settings.lighting);
+        renderer.prepare(q, &view, settings.line_width_px, settings.line_color, &settings.lighting, None);
         let background = lineao::passes::Load::Clear(settings.background);
         let new = gbuffer_of(&gpu, size, |e, t| renderer.encode(e, t, &geometry, background, None));
         let mut old_renderer = StripRenderer::new(d, true);

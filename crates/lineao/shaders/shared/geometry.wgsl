@@ -25,6 +25,10 @@ struct GeometryUniform {
     ndc_per_px: vec2<f32>,
     // Color mode 2: xy the scalars at the colormap's ends; its table of linear RGB.
     scalar_range: vec4<f32>,
+    // A slab in eye space: the signed distance dot(xyz, p) + w; x of `slab_half` its half
+    // thickness, negative without one.
+    slab_plane: vec4<f32>,
+    slab_half: vec4<f32>,
     colormap: array<vec4<f32>, 16>,
 }
 
@@ -33,6 +37,13 @@ struct GeometryUniform {
 
 fn is_orthographic() -> bool {
     return frame.orthographic != 0u;
+}
+
+// Whether eye-space point `view_pos` lies outside the slab (never without one): the lines'
+// and tubes' fragments there are discarded.
+fn outside_slab(view_pos: vec3<f32>) -> bool {
+    let half = frame.slab_half.x;
+    return half >= 0.0 && abs(dot(frame.slab_plane.xyz, view_pos) + frame.slab_plane.w) > half;
 }
 
 // Phong lighting of a surface with unit normal n seen along unit v (toward the eye): the

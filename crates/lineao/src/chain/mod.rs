@@ -53,6 +53,7 @@ use crate::passes::composite::{Composite, Shown};
 use crate::passes::lines::LineRenderer;
 use crate::passes::lines::LineStyle;
 use crate::passes::meshes::{MeshGeometry, MeshRenderer};
+use crate::passes::slices::{SliceRenderer, SliceVolume};
 use crate::passes::tubes::TubeRenderer;
 use crate::passes::volume_ao::VolumeAo;
 use crate::ray_scene::RayScene;
@@ -72,6 +73,10 @@ pub struct AoChain {
     tubes: Option<TubeRenderer>,
     /// Made when the settings ask for context surfaces.
     meshes: Option<MeshRenderer>,
+    /// Made when the settings ask for anatomy slices; draws them once a volume is set.
+    slices: Option<SliceRenderer>,
+    /// The volume the slices cut ([`AoChain::set_slice_volume`]).
+    slice_volume: Option<Arc<SliceVolume>>,
     /// The method's stage (built for the active method only; [`crate::stage`]).
     stages: Stages,
     bilateral: Bilateral,
@@ -120,6 +125,8 @@ impl AoChain {
             lines: line_renderer(device, &settings),
             tubes: tube_renderer(device, &settings),
             meshes: settings.surfaces.as_ref().map(|_| MeshRenderer::new(device, settings.volume.is_some())),
+            slices: settings.slices.as_ref().map(|_| SliceRenderer::new(device, settings.volume.is_some())),
+            slice_volume: None,
             bilateral: Bilateral::new(device),
             volume_ao: settings.volume.as_ref().map(|_| VolumeAo::new(device)),
             composite: Composite::new(device, format),
@@ -174,13 +181,15 @@ impl AoChain {
         if !tubes_match {
             self.tubes = tube_renderer(device, &settings);
         }
-        let meshes_match = match (&self.meshes, &settings.surfaces) {
-            (Some(renderer), Some(_)) => renderer.writes_octants() == octants,
-            (None, None) => true,
-            _ => false,
-        };
-        if !meshes_match {
+        // Surfaces and slices: there when asked for, writing the octants where object-space AO is on.
+        if self.meshes.as_ref().map(MeshRenderer::writes_octants) != settings.surfaces.as_ref().map(|_| octants) {
             self.meshes = settings.surfaces.as_ref().map(|_| MeshRenderer::new(device, octants));
+        }
+        if self.slices.as_ref().map(SliceRenderer::writes_octants) != settings.slices.as_ref().map(|_| octants) {
+            self.slices = settings.slices.as_ref().map(|_| SliceRenderer::new(device, octants));
+            if let Some(renderer) = &mut self.slices {
+                renderer.set_volume(device, self.slice_volume.clone());
+            }
         }
         // The pyramid's depth, the method's own targets, the blur's and object-space AO's, and
         // what the composite shows are bound at allocation.
@@ -197,6 +206,16 @@ impl AoChain {
     /// occlusion. A new scene starts the progressive picture again.
     pub fn set_ray_scene(&mut self, device: &wgpu::Device, scene: Option<Arc<RayScene>>) {
         self.stages.set_scene(device, scene, self.targets.as_ref());
+    }
+
+    /// The volume whose anatomy slices the frame shows with [`ChainSettings::slices`] (kept
+    /// while the settings change; none: no slices are drawn). The frame's `bounds` given to
+    /// `prepare` should hold the slices ([`SliceVolume::slice_bounds`]).
+    pub fn set_slice_volume(&mut self, device: &wgpu::Device, volume: Option<Arc<SliceVolume>>) {
+        if let Some(renderer) = &mut self.slices {
+            renderer.set_volume(device, volume.clone());
+        }
+        self.slice_volume = volume;
     }
 
     /// How far the ray-traced method's picture has come (rays per pixel so far, the cap), or
@@ -376,11 +395,14 @@ impl AoChain {
         let targets = self.targets.as_ref()?;
         let color = if s.debug_view == DebugView::Pieces { LineColor::Pieces } else { s.line_color };
         match (&self.tubes, &s.tubes) {
-            (Some(tubes), Some(t)) => tubes.prepare(queue, &view, t.radius_world, color, &s.lighting),
-            _ => self.lines.prepare(queue, &view, s.line_width_px, color, &s.lighting),
+            (Some(tubes), Some(t)) => tubes.prepare(queue, &view, t.radius_world, color, &s.lighting, s.slab.as_ref()),
+            _ => self.lines.prepare(queue, &view, s.line_width_px, color, &s.lighting, s.slab.as_ref()),
         }
         if let (Some(meshes), Some(surfaces)) = (&self.meshes, &s.surfaces) {
             meshes.prepare(queue, &view, surfaces.color, &s.lighting);
+        }
+        if let (Some(renderer), Some(slices)) = (&self.slices, &s.slices) {
+            renderer.prepare(queue, &view, slices, &s.lighting);
         }
         if let Some(stage) = self.stages.active() {
             stage.prepare(queue, targets, &view, s);
@@ -490,7 +512,8 @@ impl AoChain {
         encoder.pop_debug_group();
     }
 
-    /// The lines (or tubes) and the context surfaces into the G-buffer, under one `span`.
+    /// The lines (or tubes), the context surfaces and the anatomy slices into the G-buffer,
+    /// under one `span`.
     fn draw_geometry(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -500,17 +523,24 @@ impl AoChain {
         span: Option<Span<'_>>,
     ) {
         let load = Load::Clear(self.settings.background);
-        // The lines' span covers the surfaces when there are any.
-        let (lines_span, meshes_span) = match (&self.meshes, meshes.is_empty()) {
-            (Some(_), false) => Span::split(span),
-            _ => (span, None),
+        let meshes = self.meshes.as_ref().filter(|_| !meshes.is_empty()).map(|renderer| (renderer, meshes));
+        let slices = self.slices.as_ref().filter(|renderer| renderer.has_volume());
+        // The lines' span covers the surfaces and slices when there are any: its end is the
+        // last pass's.
+        let (lines_span, last_span) = match (&meshes, slices) {
+            (None, None) => (span, None),
+            _ => Span::split(span),
         };
         match &self.tubes {
             Some(tubes) => tubes.encode(encoder, targets, geometry, load, lines_span),
             None => self.lines.encode(encoder, targets, geometry, load, lines_span),
         }
-        if let (Some(renderer), false) = (&self.meshes, meshes.is_empty()) {
-            renderer.encode(encoder, targets, meshes, Load::Keep, meshes_span);
+        if let Some((renderer, meshes)) = meshes {
+            let span = if slices.is_some() { None } else { last_span };
+            renderer.encode(encoder, targets, meshes, Load::Keep, span);
+        }
+        if let Some(renderer) = slices {
+            renderer.encode(encoder, targets, Load::Keep, last_span);
         }
     }
 

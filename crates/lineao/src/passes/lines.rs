@@ -25,7 +25,7 @@ use crate::line_geometry::{
     LineGeometry, MAX_ALTERNATING_WIDTH_PX, MAX_TOLERANCE_PX, Page, alternating_vertices, class_segments, full_vertices,
 };
 use crate::passes::cull::{Culled, Shape};
-use crate::settings::LineColor;
+use crate::settings::{LineColor, Slab};
 use crate::targets::FrameTargets;
 use crate::timing::Span;
 
@@ -225,8 +225,10 @@ impl LineRenderer {
         line_width_px: f32,
         color: LineColor,
         lighting: &Lighting,
+        slab: Option<&Slab>,
     ) {
-        self.bindings.write(queue, &GeometryUniform::new(view, color, line_width_px, 0.0), lighting);
+        let uniform = GeometryUniform::new(view, color, line_width_px, 0.0).with_slab(view, slab);
+        self.bindings.write(queue, &uniform, lighting);
         if let Some(culled) = &self.culled {
             culled.cull().set_view(view);
         }

@@ -1,4 +1,5 @@
-//! The passes every method shares — the geometry (lines, tubes, meshes, a host's depth), the ND
+//! The passes every method shares — the geometry (lines, tubes, meshes, anatomy slices, a host's
+//! depth), the ND
 //! pyramid, the bilateral blur, object-space AO and the composite — one module (and one WGSL
 //! file) each; the methods' own passes are in [`crate::method`]. Every pass owns its long-lived pipeline and
 //! layouts, rebuilds its bind groups on `resize`, writes its uniforms in `prepare` and records
@@ -14,6 +15,7 @@ pub mod lines;
 pub mod meshes;
 pub mod nd_from_depth;
 pub mod nd_pyramid;
+pub mod slices;
 pub mod tubes;
 pub mod volume_ao;
 

@@ -32,7 +32,7 @@ use crate::gbuffer::{self, GeometryBindings, GeometryUniform, Load, PipelineSpec
 use crate::lighting::Lighting;
 use crate::line_geometry::{LineGeometry, class_segments};
 use crate::passes::cull::{Culled, Shape};
-use crate::settings::LineColor;
+use crate::settings::{LineColor, Slab};
 use crate::targets::FrameTargets;
 use crate::timing::Span;
 
@@ -96,8 +96,10 @@ impl TubeRenderer {
         radius_world: f32,
         color: LineColor,
         lighting: &Lighting,
+        slab: Option<&Slab>,
     ) {
-        self.bindings.write(queue, &GeometryUniform::new(view, color, 0.0, radius_world), lighting);
+        let uniform = GeometryUniform::new(view, color, 0.0, radius_world).with_slab(view, slab);
+        self.bindings.write(queue, &uniform, lighting);
     }
 
     /// Draws `geometry` as tubes into the G-buffer, clearing it first or over earlier passes

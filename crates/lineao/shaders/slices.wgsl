@@ -1,0 +1,101 @@
+// Anatomy slices (`lineao::passes::slices`): one quad an axis over the world box of the voxel
+// centres; each fragment samples the volume trilinearly between voxel centres through the
+// inverse affine and writes the G-buffer of CONTRACT.md with the value through the window and
+// colormap (`base_color`, color mode 2), unlit, the plane's normal turned toward the eye.
+#import shared/geometry.wgsl
+
+// Keep in sync with `lineao::passes::slices::SliceUniform`.
+struct SliceUniform {
+    world_to_voxel: mat4x4<f32>,
+    box_min: vec4<f32>,
+    box_max: vec4<f32>,
+    // xyz: where each axis's slice lies (world units).
+    positions: vec4<f32>,
+    // xyz: 1 where the axis has a slice.
+    shown: vec4<u32>,
+    // xyz: the last voxel index on each axis.
+    last_voxel: vec4<f32>,
+}
+
+@group(1) @binding(0) var volume: texture_3d<f32>;
+@group(1) @binding(1) var<uniform> slice: SliceUniform;
+
+struct SliceOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) view_pos: vec3<f32>,
+    @location(1) world: vec3<f32>,
+    @location(2) @interpolate(flat) axis: u32,
+}
+
+// Vertex v (0..6: two triangles) of axis `axis`'s quad; every vertex at the origin (no area)
+// where the axis has no slice or it misses the box.
+@vertex
+fn vs_slice(@builtin(vertex_index) v: u32, @builtin(instance_index) axis: u32) -> SliceOut {
+    var out: SliceOut;
+    out.axis = axis;
+    let p = slice.positions[axis];
+    if slice.shown[axis] == 0u || p < slice.box_min[axis] || p > slice.box_max[axis] {
+        out.clip = vec4<f32>(0.0, 0.0, 0.0, 1.0);
+        return out;
+    }
+    let corners = array<vec2<f32>, 6>(
+        vec2<f32>(0.0, 0.0), vec2<f32>(1.0, 0.0), vec2<f32>(1.0, 1.0),
+        vec2<f32>(0.0, 0.0), vec2<f32>(1.0, 1.0), vec2<f32>(0.0, 1.0),
+    );
+    let c = corners[v];
+    let u = (axis + 1u) % 3u;
+    let w = (axis + 2u) % 3u;
+    var world = vec3<f32>(0.0);
+    world[axis] = p;
+    world[u] = mix(slice.box_min[u], slice.box_max[u], c.x);
+    world[w] = mix(slice.box_min[w], slice.box_max[w], c.y);
+    let view_pos = frame.view * vec4<f32>(world, 1.0);
+    out.clip = frame.proj * view_pos;
+    out.view_pos = view_pos.xyz;
+    out.world = world;
+    return out;
+}
+
+// The volume at voxel coordinates `x` (within the box of the voxel centres), trilinear.
+fn trilinear(x: vec3<f32>) -> f32 {
+    let last = vec3<i32>(slice.last_voxel.xyz);
+    let i0 = clamp(vec3<i32>(floor(x)), vec3<i32>(0), last);
+    let i1 = min(i0 + vec3<i32>(1), last);
+    let f = clamp(x - vec3<f32>(i0), vec3<f32>(0.0), vec3<f32>(1.0));
+    var sum = 0.0;
+    for (var corner = 0u; corner < 8u; corner++) {
+        let pick = vec3<bool>((corner & 1u) != 0u, (corner & 2u) != 0u, (corner & 4u) != 0u);
+        let weight = select(1.0 - f, f, pick);
+        sum += weight.x * weight.y * weight.z * textureLoad(volume, select(i0, i1, pick), 0).r;
+    }
+    return sum;
+}
+
+fn slice_gbuffer(in: SliceOut) -> GBuffer {
+    let x = (slice.world_to_voxel * vec4<f32>(in.world, 1.0)).xyz;
+    // Outside the box of the voxel centres (a little slack for rounding on its faces).
+    let slack = 1e-3;
+    if any(x < vec3<f32>(-slack)) || any(x > slice.last_voxel.xyz + vec3<f32>(slack)) {
+        discard;
+    }
+    var axis_world = vec3<f32>(0.0);
+    axis_world[in.axis] = 1.0;
+    let n = (frame.view * vec4<f32>(axis_world, 0.0)).xyz;
+    var out: GBuffer;
+    out.nd = gbuffer_nd(in.view_pos, n, frame.near, frame.far, is_orthographic());
+    out.color = vec4<f32>(base_color(vec3<f32>(0.0), trilinear(x)), 1.0);
+    out.zoom = gbuffer_zoom(in.view_pos, frame.f_px, frame.zoom_unit, is_orthographic());
+    out.specular = 0.0;
+    return out;
+}
+
+@fragment
+fn fs_slice(in: SliceOut) -> GBuffer {
+    return slice_gbuffer(in);
+}
+
+// Slices are not in the lines' density volume: fully visible to object-space AO.
+@fragment
+fn fs_slice_octants(in: SliceOut) -> GBufferOctants {
+    return with_octants(slice_gbuffer(in), vec4<f32>(1.0), vec4<f32>(1.0));
+}

@@ -1,0 +1,270 @@
+//! Anatomy slices: up to three planes through a scalar volume (a T1 image, an FA map), each
+//! orthogonal to a world axis, drawn into the same G-buffer as the lines
+//! (`shaders/slices.wgsl`), so that the lines' occlusion darkens a slice where fibres run close
+//! to it and every method sees the slice as a surface: the contact cue that tells where the
+//! fibres are in the head.
+//!
+//! A slice is one quad per axis over the world box of the volume's voxel centres. Each
+//! fragment maps its world position to voxel coordinates through the inverse of the volume's
+//! affine (voxel indices → world, the convention of NIfTI and nibabel) and interpolates the
+//! values trilinearly between the eight voxel centres around it — the numbers
+//! `lineao_tracts::Volume::sample` gives on the CPU, which the tests compare. Fragments
+//! outside the box of the voxel centres are discarded, so an oblique affine shows its true,
+//! rotated outline. The value goes through a window (the ends of the colormap; by default the
+//! 2nd and 98th percentiles of the volume's finite values) and a colormap, unlit: a slice is a
+//! picture of the data, and the only darkening on it is the occlusion.
+//!
+//! The volume lives in an `R32Float` 3-D texture read with `textureLoad` (f32 textures are not
+//! filterable everywhere; eight loads are exact and cheap next to the lines).
+
+use std::sync::Arc;
+
+use glam::{Mat4, Vec3};
+
+use crate::Error;
+use crate::binding::{self, Slot};
+use crate::camera::{Bounds, FrameView};
+use crate::gbuffer::{self, GeometryBindings, GeometryUniform, Load, PipelineSpec};
+use crate::lighting::Lighting;
+use crate::settings::{LineColor, SliceSettings};
+use crate::targets::FrameTargets;
+use crate::timing::Span;
+
+/// A scalar volume on the GPU for [`SliceRenderer`].
+pub struct SliceVolume {
+    view: wgpu::TextureView,
+    dims: [u32; 3],
+    world_to_voxel: Mat4,
+    /// The axis-aligned world box around the voxel centres.
+    box_min: Vec3,
+    box_max: Vec3,
+    percentiles: [f32; 2],
+}
+
+impl SliceVolume {
+    /// Uploads `values` (x fastest, then y, then z: NIfTI's order) of a `dims` volume whose
+    /// voxel (i, j, k) centre lies at `voxel_to_world · (i, j, k, 1)`.
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        dims: [u32; 3],
+        values: &[f32],
+        voxel_to_world: Mat4,
+    ) -> Result<SliceVolume, Error> {
+        let count = dims.iter().map(|&d| d as u64).product::<u64>();
+        if count == 0 || count != values.len() as u64 {
+            return Err(Error::InvalidGeometry(format!("{} values for a {dims:?} volume", values.len())));
+        }
+        let limit = device.limits().max_texture_dimension_3d;
+        if dims.iter().any(|&d| d > limit) {
+            return Err(Error::TooLarge(format!(
+                "a {dims:?} volume exceeds the device's 3-D textures of {limit} voxels a side"
+            )));
+        }
+        let det = voxel_to_world.determinant();
+        if !(det.is_finite() && det.abs() > 1e-12 && voxel_to_world.is_finite()) {
+            return Err(Error::InvalidGeometry(format!("a singular voxel-to-world affine (determinant {det})")));
+        }
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("lineao::SliceVolume"),
+            size: wgpu::Extent3d { width: dims[0], height: dims[1], depth_or_array_layers: dims[2] },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D3,
+            format: wgpu::TextureFormat::R32Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        queue.write_texture(
+            texture.as_image_copy(),
+            bytemuck::cast_slice(values),
+            wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(4 * dims[0]), rows_per_image: Some(dims[1]) },
+            texture.size(),
+        );
+        let last = Vec3::new(dims[0] as f32 - 1.0, dims[1] as f32 - 1.0, dims[2] as f32 - 1.0);
+        let corners = (0..8).map(|c| {
+            let pick = |bit: u32, v: f32| if c & (1 << bit) != 0 { v } else { 0.0 };
+            voxel_to_world.transform_point3(Vec3::new(pick(0, last.x), pick(1, last.y), pick(2, last.z)))
+        });
+        let (box_min, box_max) =
+            corners.fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)));
+        Ok(SliceVolume {
+            view: texture.create_view(&Default::default()),
+            dims,
+            world_to_voxel: voxel_to_world.inverse(),
+            box_min,
+            box_max,
+            percentiles: percentiles(values, [0.02, 0.98]),
+        })
+    }
+
+    /// The 2nd and 98th percentiles of the finite values other than 0 (the default window: an
+    /// MRI's background of zeros does not count; a constant volume gets [v, v + 1]).
+    pub fn percentiles(&self) -> [f32; 2] {
+        self.percentiles
+    }
+
+    pub fn dims(&self) -> [u32; 3] {
+        self.dims
+    }
+
+    /// The world box around the voxel centres (min, max).
+    pub fn world_box(&self) -> (Vec3, Vec3) {
+        (self.box_min, self.box_max)
+    }
+
+    /// The bounding sphere of what `slices` shows of the volume: the box cut to the shown
+    /// planes (a frame's bounds must hold it); `None` when no slice cuts the box.
+    pub fn slice_bounds(&self, slices: &SliceSettings) -> Option<Bounds> {
+        let mut points = Vec::new();
+        for (axis, p) in slices.positions.iter().enumerate() {
+            let Some(p) = *p else { continue };
+            if !(self.box_min[axis]..=self.box_max[axis]).contains(&p) {
+                continue;
+            }
+            for c in 0..8 {
+                let corner =
+                    Vec3::select(glam::BVec3::new(c & 1 != 0, c & 2 != 0, c & 4 != 0), self.box_max, self.box_min);
+                let mut q = corner;
+                q[axis] = p;
+                points.push(q.to_array());
+            }
+        }
+        Bounds::of_points(&points)
+    }
+}
+
+/// The `quantiles` (in [0, 1]) of the finite `values` other than 0, from at most 2^20 of them
+/// evenly spaced; [v, v + 1] where they coincide, [0, 1] without such values.
+fn percentiles(values: &[f32], quantiles: [f32; 2]) -> [f32; 2] {
+    let step = values.len().div_ceil(1 << 20).max(1);
+    let mut finite: Vec<f32> = values.iter().step_by(step).copied().filter(|v| v.is_finite() && *v != 0.0).collect();
+    if finite.is_empty() {
+        return [0.0, 1.0];
+    }
+    let mut at = |q: f32| {
+        let k = ((q * (finite.len() - 1) as f32).round() as usize).min(finite.len() - 1);
+        *finite.select_nth_unstable_by(k, f32::total_cmp).1
+    };
+    let (lo, hi) = (at(quantiles[0]), at(quantiles[1]));
+    if hi > lo { [lo, hi] } else { [lo, lo + 1.0] }
+}
+
+/// Keep in sync with `SliceUniform` in `shaders/slices.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct SliceUniform {
+    world_to_voxel: [[f32; 4]; 4],
+    box_min: [f32; 4],
+    box_max: [f32; 4],
+    /// xyz: where each axis's slice lies (world units).
+    positions: [f32; 4],
+    /// xyz: 1 where the axis has a slice.
+    shown: [u32; 4],
+    /// xyz: the last voxel index on each axis.
+    last_voxel: [f32; 4],
+}
+
+/// Draws a [`SliceVolume`]'s slices into the G-buffer of [`FrameTargets`].
+pub struct SliceRenderer {
+    pipeline: wgpu::RenderPipeline,
+    octants: bool,
+    bindings: GeometryBindings,
+    layout: wgpu::BindGroupLayout,
+    uniform: wgpu::Buffer,
+    /// The volume and its bind group, once set.
+    volume: Option<(Arc<SliceVolume>, wgpu::BindGroup)>,
+}
+
+impl SliceRenderer {
+    /// With `octants`, targets that have an `octants` texture get full visibility where a
+    /// slice is (slices are not in the lines' volume, [`crate::passes::volume_ao`]).
+    pub fn new(device: &wgpu::Device, octants: bool) -> SliceRenderer {
+        let label = "lineao::SliceRenderer";
+        let bindings = GeometryBindings::new(device, label);
+        let layout =
+            binding::layout(device, label, wgpu::ShaderStages::VERTEX_FRAGMENT, &[Slot::Texture3d, Slot::Uniform]);
+        let module = crate::shader::module(device, "slices.wgsl");
+        let pipeline = gbuffer::pipeline(
+            device,
+            &bindings.layout,
+            PipelineSpec {
+                groups: &[&layout],
+                label,
+                module: &module,
+                vertex: "vs_slice",
+                fragment: if octants { "fs_slice_octants" } else { "fs_slice" },
+                buffers: &[],
+                topology: wgpu::PrimitiveTopology::TriangleList,
+                octants,
+            },
+        );
+        let uniform = binding::uniform_buffer::<SliceUniform>(device, label);
+        SliceRenderer { pipeline, octants, bindings, layout, uniform, volume: None }
+    }
+
+    /// Whether this renderer writes the `octants` target.
+    pub fn writes_octants(&self) -> bool {
+        self.octants
+    }
+
+    /// The volume the slices cut, or none (nothing is drawn).
+    pub fn set_volume(&mut self, device: &wgpu::Device, volume: Option<Arc<SliceVolume>>) {
+        self.volume = volume.map(|volume| {
+            let group = binding::group(
+                device,
+                "lineao::SliceRenderer::volume",
+                &self.layout,
+                &[wgpu::BindingResource::TextureView(&volume.view), self.uniform.as_entire_binding()],
+            );
+            (volume, group)
+        });
+    }
+
+    /// Whether a volume is set.
+    pub fn has_volume(&self) -> bool {
+        self.volume.is_some()
+    }
+
+    pub fn prepare(&self, queue: &wgpu::Queue, view: &FrameView, slices: &SliceSettings, lighting: &Lighting) {
+        let Some((volume, _)) = &self.volume else { return };
+        let range = slices.window.unwrap_or(volume.percentiles);
+        let color = LineColor::Scalar { colormap: slices.colormap, range };
+        self.bindings.write(queue, &GeometryUniform::new(view, color, 0.0, 0.0), lighting);
+        let [x, y, z] = slices.positions;
+        let uniform = SliceUniform {
+            world_to_voxel: volume.world_to_voxel.to_cols_array_2d(),
+            box_min: volume.box_min.extend(0.0).to_array(),
+            box_max: volume.box_max.extend(0.0).to_array(),
+            positions: [x.unwrap_or(0.0), y.unwrap_or(0.0), z.unwrap_or(0.0), 0.0],
+            shown: [x.is_some() as u32, y.is_some() as u32, z.is_some() as u32, 0],
+            last_voxel: [volume.dims[0], volume.dims[1], volume.dims[2], 1].map(|d| d as f32 - 1.0),
+        };
+        queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
+    }
+
+    /// Draws the slices over the G-buffer (or clearing it first: `load`), timed into `span`.
+    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, targets: &FrameTargets, load: Load, span: Option<Span>) {
+        let Some((_, group)) = &self.volume else { return };
+        let octants = self.octants && targets.octants.is_some();
+        let mut pass = gbuffer::begin(encoder, "lineao::SliceRenderer", targets, load, octants, span);
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, &self.bindings.group, &[]);
+        pass.set_bind_group(1, group, &[]);
+        // One quad (two triangles) an axis.
+        pass.draw(0..6, 0..3);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::percentiles;
+
+    #[test]
+    fn percentiles_skip_zeros_and_non_finite_values_and_widen_a_constant_volume() {
+        let values: Vec<f32> = (1..=101).map(|v| v as f32).chain([f32::NAN, f32::INFINITY, 0.0, 0.0]).collect();
+        assert_eq!(percentiles(&values, [0.02, 0.98]), [3.0, 99.0]);
+        assert_eq!(percentiles(&[3.0; 10], [0.02, 0.98]), [3.0, 4.0]);
+        assert_eq!(percentiles(&[f32::NAN], [0.02, 0.98]), [0.0, 1.0]);
+    }
+}

@@ -1,0 +1,118 @@
+//! Tractograms in context: anatomy slices show the volume where nibabel's affine puts it, and a
+//! slab leaves no line outside it. Each test renders through the session (`lineao render`'s
+//! path), reads the G-buffer back and checks it against numbers computed apart from the GPU:
+//! the CPU volume's trilinear sample (`lineao_tracts::Volume`, itself checked against
+//! nibabel and scipy in the Python tests) at each pixel's unprojected world position.
+
+use std::path::Path;
+
+use glam::{Mat4, Vec3, Vec4};
+use lineao::readback::read_texture;
+use lineao_session::args::RenderArgs;
+use lineao_session::render::Session;
+
+fn images(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../shared/data/niivue+niivue/packages/niivue/demos/images")
+        .join(name)
+        .to_string_lossy()
+        .into_owned()
+}
+
+/// `render FILE` with `keywords`, one frame: the session and the chain that drew it.
+fn render(file: &str, keywords: serde_json::Value) -> (Session, lineao::AoChain) {
+    let serde_json::Value::Object(map) = keywords else { panic!("keywords are an object") };
+    let mut args = RenderArgs::from_keywords(map).unwrap();
+    args.file = Some(file.into());
+    let mut session = Session::open(&args).unwrap();
+    let mut chains = Vec::new();
+    session.compose(&args, &mut chains).unwrap();
+    (session, chains.pop().unwrap())
+}
+
+/// The world position of every pixel with geometry: (x, y, world, pixel index) from the depth
+/// buffer through the inverse of the frame's projection and view.
+fn geometry_points(session: &Session, chain: &lineao::AoChain) -> Vec<(usize, Vec3)> {
+    let gpu = &session.gpu;
+    let targets = chain.targets().unwrap();
+    let view = chain.frame_view().unwrap();
+    let depth = read_texture(&gpu.device, &gpu.queue, &targets.depth.texture).unwrap().to_f32();
+    let (w, h) = (targets.depth.texture.width() as usize, targets.depth.texture.height() as usize);
+    let to_world: Mat4 = view.view.inverse() * view.proj.inverse();
+    let mut points = Vec::new();
+    for y in 0..h {
+        for x in 0..w {
+            let d = depth[y * w + x];
+            if d >= 1.0 {
+                continue;
+            }
+            let ndc =
+                Vec4::new((x as f32 + 0.5) / w as f32 * 2.0 - 1.0, 1.0 - (y as f32 + 0.5) / h as f32 * 2.0, d, 1.0);
+            let p = to_world * ndc;
+            points.push((y * w + x, p.truncate() / p.w));
+        }
+    }
+    points
+}
+
+#[test]
+fn a_slice_shows_the_volume_where_its_affine_puts_it() {
+    let mni = images("MNI152_2009_template.nii.gz");
+    let keywords = serde_json::json!({
+        "volume": mni, "slices": "-,-18,-", "method": "none", "width": 320, "height": 256,
+        "eye": "60,-260,40", "target": "0,-18,10", "up": "0,0,1",
+    });
+    let (session, chain) = render(&images("stroke.trk.gz"), keywords);
+    let volume = lineao_tracts::Volume::load(&mni).unwrap();
+    let window = session.anatomy.as_ref().expect("the volume loads").percentiles();
+    let table = lineao::Colormap::Gray.table();
+    // The shader's colormap: 16 entries, linear between them.
+    let gray = |v: f32| {
+        let t = ((v - window[0]) / (window[1] - window[0])).clamp(0.0, 1.0) * 15.0;
+        let k = (t as usize).min(14);
+        table[k][0] + (table[k + 1][0] - table[k][0]) * (t - k as f32)
+    };
+    let gpu = &session.gpu;
+    let color = read_texture(&gpu.device, &gpu.queue, &chain.targets().unwrap().color.texture).unwrap().to_vec4();
+    let (mut on_slice, mut off, mut worst) = (0, 0, 0.0f32);
+    for (i, p) in geometry_points(&session, &chain) {
+        // The slice's pixels (the lines in front of it lie off its plane).
+        if (p.y + 18.0).abs() > 0.05 {
+            continue;
+        }
+        let value = volume.sample(p.to_array());
+        if value.is_nan() {
+            continue;
+        }
+        on_slice += 1;
+        let error = (color[i][0] - gray(value)).abs();
+        worst = worst.max(error);
+        // Half floats hold 11 bits; a value gradient across the depth's rounding adds a little.
+        if error > 4e-3 {
+            off += 1;
+        }
+    }
+    assert!(on_slice > 20_000, "only {on_slice} slice pixels");
+    assert!(off * 1000 <= on_slice, "{off} of {on_slice} slice pixels differ from the CPU's sample (worst {worst})");
+}
+
+#[test]
+fn a_slab_leaves_no_line_outside_it() {
+    let (center, thickness) = (16.0, 12.0);
+    let keywords = serde_json::json!({
+        "slab": format!("z,{center},{thickness}"), "method": "none", "width": 320, "height": 256,
+    });
+    let (session, chain) = render(&images("stroke.trk.gz"), keywords);
+    let view = *chain.frame_view().unwrap();
+    let points = geometry_points(&session, &chain);
+    assert!(points.len() > 2_000, "only {} line pixels", points.len());
+    for (_, p) in points {
+        // A line's pixels lie within half its width (2 px) of its centre, whose depth they carry.
+        let px_world = -view.view.transform_point3(p).z / view.f_px;
+        let slack = 1.5 * px_world + 1e-3;
+        assert!((p.z - center).abs() <= 0.5 * thickness + slack, "a line pixel at z = {} outside the slab", p.z);
+    }
+    // A slab beside the data leaves nothing.
+    let (session, chain) = render(&images("stroke.trk.gz"), serde_json::json!({"slab": "x,500,2", "method": "none"}));
+    assert!(geometry_points(&session, &chain).is_empty());
+}
