@@ -288,6 +288,9 @@ pub struct RenderArgs {
     pub context: ContextArgs,
     #[command(flatten)]
     #[serde(flatten)]
+    pub select: SelectArgs,
+    #[command(flatten)]
+    #[serde(flatten)]
     pub camera: CameraArgs,
     #[command(flatten)]
     #[serde(flatten)]
@@ -483,6 +486,101 @@ pub struct ContextArgs {
     #[arg(long, value_name = "AXIS,CENTRE,THICKNESS", value_parser = parse_slab, allow_hyphen_values = true)]
     #[serde(deserialize_with = "crate::kwargs::opt_slab")]
     pub slab: Option<lineao::Slab>,
+}
+
+/// Which streamlines are shown (`lineao_tracts::selection`): each rule keeps fewer.
+#[derive(Args, Clone, Debug, serde::Deserialize)]
+#[command(next_help_heading = "Selection")]
+#[serde(default)]
+pub struct SelectArgs {
+    /// Show a random share of the streamlines (0–1, or N%), the same ones for the same
+    /// --subset-seed.
+    #[arg(long, value_parser = parse_share)]
+    #[serde(deserialize_with = "crate::kwargs::opt_share")]
+    pub subset: Option<f64>,
+    /// The seed of --subset.
+    #[arg(long, default_value_t = 0)]
+    pub subset_seed: u64,
+    /// Show the streamlines whose arc length in world mm lies in MIN,MAX.
+    #[arg(long, value_name = "MIN,MAX", value_parser = parse_window)]
+    #[serde(deserialize_with = "crate::kwargs::opt_window")]
+    pub length: Option<[f32; 2]>,
+    /// Show the streamlines whose per-streamline field NAME (TRX dps, .trk property) lies in
+    /// MIN,MAX.
+    #[arg(long, value_name = "NAME,MIN,MAX", value_parser = parse_field_range, allow_hyphen_values = true)]
+    #[serde(deserialize_with = "crate::kwargs::opt_field_range")]
+    pub field: Option<(String, [f32; 2])>,
+    /// Show the streamlines of this group (TRX groups); may be given several times (any of them).
+    #[arg(long = "group", value_name = "NAME")]
+    #[serde(deserialize_with = "crate::kwargs::strings")]
+    pub groups: Vec<String>,
+    /// Show only the streamlines that pass through this region (`sphere:X,Y,Z,R` or
+    /// `box:X0,Y0,Z0,X1,Y1,Z1`, world mm); several: through every one (mrview's rule).
+    #[arg(long = "include", value_name = "REGION", value_parser = parse_region, allow_hyphen_values = true)]
+    #[serde(deserialize_with = "crate::kwargs::regions")]
+    pub include: Vec<lineao_tracts::Region>,
+    /// Hide the streamlines that pass through this region; may be given several times.
+    #[arg(long = "exclude", value_name = "REGION", value_parser = parse_region, allow_hyphen_values = true)]
+    #[serde(deserialize_with = "crate::kwargs::regions")]
+    pub exclude: Vec<lineao_tracts::Region>,
+}
+
+impl SelectArgs {
+    /// The selection these flags ask for, or none where they keep every streamline.
+    pub fn selection(&self) -> Option<std::sync::Arc<lineao_tracts::Selection>> {
+        let selection = lineao_tracts::Selection {
+            subset: self.subset.map(|share| (share, self.subset_seed)),
+            length: self.length,
+            field: self.field.clone(),
+            groups: self.groups.clone(),
+            include: self.include.clone(),
+            exclude: self.exclude.clone(),
+        };
+        (!selection.is_everything()).then(|| std::sync::Arc::new(selection))
+    }
+}
+
+/// `--subset`: a share in [0, 1], or a percentage `N%`.
+pub fn parse_share(s: &str) -> Result<f64, String> {
+    let (text, scale) = match s.strip_suffix('%') {
+        Some(percent) => (percent, 0.01),
+        None => (s, 1.0),
+    };
+    match text.trim().parse::<f64>() {
+        Ok(v) if (0.0..=1.0).contains(&(v * scale)) => Ok(v * scale),
+        _ => Err(format!("expected a share in [0, 1] or a percentage, got '{s}'")),
+    }
+}
+
+/// `--field`: NAME,MIN,MAX.
+pub fn parse_field_range(s: &str) -> Result<(String, [f32; 2]), String> {
+    let Some((name, range)) = s.split_once(',').filter(|(name, _)| !name.is_empty()) else {
+        return Err(format!("expected NAME,MIN,MAX, got '{s}'"));
+    };
+    Ok((name.to_string(), parse_window(range)?))
+}
+
+/// `--include`/`--exclude`: `sphere:X,Y,Z,R` or `box:X0,Y0,Z0,X1,Y1,Z1`.
+pub fn parse_region(s: &str) -> Result<lineao_tracts::Region, String> {
+    let numbers = |text: &str| -> Result<Vec<f32>, String> {
+        text.split(',')
+            .map(|p| p.trim().parse::<f32>().ok().filter(|v| v.is_finite()).ok_or(format!("'{p}' is not a number")))
+            .collect()
+    };
+    match s.split_once(':') {
+        Some(("sphere", rest)) => match numbers(rest)?[..] {
+            [x, y, z, r] if r > 0.0 => Ok(lineao_tracts::Region::Sphere { center: [x, y, z], radius: r }),
+            _ => Err(format!("expected sphere:X,Y,Z,R with R > 0, got '{s}'")),
+        },
+        Some(("box", rest)) => match numbers(rest)?[..] {
+            [x0, y0, z0, x1, y1, z1] => Ok(lineao_tracts::Region::Box {
+                min: [x0.min(x1), y0.min(y1), z0.min(z1)],
+                max: [x0.max(x1), y0.max(y1), z0.max(z1)],
+            }),
+            _ => Err(format!("expected box:X0,Y0,Z0,X1,Y1,Z1, got '{s}'")),
+        },
+        _ => Err(format!("expected sphere:X,Y,Z,R or box:X0,Y0,Z0,X1,Y1,Z1, got '{s}'")),
+    }
 }
 
 /// `--slices`: three positions, each a number or `-`.
@@ -755,6 +853,7 @@ defaults_from_render_args! {
     image: ImageArgs,
     style: StyleArgs,
     context: ContextArgs,
+    select: SelectArgs,
     camera: CameraArgs,
     line_ao: LineAoArgs,
     ssao: SsaoArgs,
@@ -921,6 +1020,9 @@ pub struct InfoArgs {
     /// Print CONTRACT.md's JSON.
     #[arg(long)]
     pub json: bool,
+    /// With a selection, the count it keeps is reported (`"selected"`).
+    #[command(flatten)]
+    pub select: SelectArgs,
 }
 
 /// `lineao convert`'s arguments.

@@ -33,6 +33,21 @@ use npyz::WriterBuilder;
 use serde_json::json;
 
 fn write_npy(dir: &Path, name: &str, shape: &[u64], data: &[f32]) -> Result<()> {
+    write_typed_npy(dir, name, shape, data)
+}
+
+/// `selected.npy`: with a selection, one byte per streamline, 1 where it is shown.
+pub fn write_selection(dir: &Path, selected: &[bool]) -> Result<()> {
+    let bytes: Vec<u8> = selected.iter().map(|&s| s as u8).collect();
+    write_typed_npy(dir, "selected.npy", &[bytes.len() as u64], &bytes)
+}
+
+fn write_typed_npy<T: npyz::Serialize + npyz::AutoSerialize + Copy>(
+    dir: &Path,
+    name: &str,
+    shape: &[u64],
+    data: &[T],
+) -> Result<()> {
     let path = dir.join(name);
     let file = File::create(&path).with_context(|| format!("cannot create {}", path.display()))?;
     let mut writer = npyz::WriteOptions::new()

@@ -51,7 +51,12 @@ fn trimmed(name: &str) -> String {
 
 pub fn run(args: &InfoArgs) -> Result<()> {
     let loaded = load(&args.file)?;
-    let info = describe(&loaded);
+    let mut info = describe(&loaded);
+    if let Some(selection) = args.select.selection() {
+        let selected =
+            selection.mask(&loaded.tractogram).map_err(|e| anyhow::anyhow!("{}: {e}", args.file.display()))?;
+        info["selected"] = json!(selected.iter().filter(|&&k| k).count());
+    }
     if args.json {
         println!("{}", serde_json::to_string_pretty(&info)?);
         return Ok(());
@@ -66,6 +71,9 @@ pub fn run(args: &InfoArgs) -> Result<()> {
     }
     for key in ["vertex_fields", "streamline_fields", "groups"] {
         println!("{key:<12} {}", info[key]);
+    }
+    if let Some(selected) = info.get("selected") {
+        println!("selected     {selected}");
     }
     Ok(())
 }

@@ -219,6 +219,36 @@ optional! {
     opt_slices: [Option<f32>; 3] = crate::args::parse_slices;
     opt_window: [f32; 2] = crate::args::parse_window;
     opt_slab: lineao::Slab = crate::args::parse_slab;
+    opt_share: f64 = crate::args::parse_share;
+    opt_field_range: (String, [f32; 2]) = crate::args::parse_field_range;
+}
+
+/// A repeatable option: one value (its text) or a sequence of values, each through `parse`.
+fn repeated<'de, D: serde::Deserializer<'de>, T>(
+    d: D,
+    parse: fn(&str) -> Result<T, String>,
+) -> Result<Vec<T>, D::Error> {
+    #[derive(Deserialize)]
+    #[serde(untagged)]
+    enum OneOrMany {
+        One(String),
+        Many(Vec<String>),
+    }
+    let texts = match OneOrMany::deserialize(d)? {
+        OneOrMany::One(text) => vec![text],
+        OneOrMany::Many(texts) => texts,
+    };
+    texts.iter().map(|t| parse(t)).collect::<Result<_, _>>().map_err(serde::de::Error::custom)
+}
+
+/// `group`: one name or several.
+pub(crate) fn strings<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<String>, D::Error> {
+    repeated(d, |s| Ok(s.to_string()))
+}
+
+/// `include`, `exclude`: one region or several.
+pub(crate) fn regions<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<lineao_tracts::Region>, D::Error> {
+    repeated(d, crate::args::parse_region)
 }
 
 /// `settings`: an object of `ChainSettings` keys, or the command line's text (JSON or a file).

@@ -241,6 +241,8 @@ pub struct Session {
     pub longest_side: f32,
     /// The ray tracer's scene on the GPU, built when a panel first needs it.
     ray_scene: std::sync::OnceLock<std::sync::Arc<lineao::RayScene>>,
+    /// With a selection, the streamlines shown, for the truth (made when it is traced).
+    selected_tracts: std::sync::OnceLock<lineao_tracts::Tractogram>,
 }
 
 impl Session {
@@ -270,7 +272,14 @@ impl Session {
         let base = base_attributes(args);
         let gpu = Gpu::headless()?;
         let sampled = Sampled::of(&args.style.color)?;
-        let keep = Keep { points, scalar: base.scalar.clone(), radius: base.radius.clone(), fields: false, sampled };
+        let keep = Keep {
+            points,
+            scalar: base.scalar.clone(),
+            radius: base.radius.clone(),
+            fields: false,
+            sampled,
+            selection: args.select.selection(),
+        };
         let bar = match &source {
             Source::File(path) => crate::source::progress_bar(path),
             _ => None,
@@ -305,6 +314,9 @@ impl Session {
         let gpu = Gpu::headless()?;
         let mut lines = Lines::new(loaded, &gpu)?;
         lines.hold((&gpu.device, &gpu.queue), &base, || {})?;
+        if let Some(selection) = args.select.selection() {
+            lines.select(selection, &gpu)?;
+        }
         Self::assemble(args, lines, surfaces, base, gpu)
     }
 
@@ -342,6 +354,7 @@ impl Session {
             bounds,
             longest_side,
             ray_scene: Default::default(),
+            selected_tracts: Default::default(),
         })
     }
 
@@ -364,10 +377,16 @@ impl Session {
     }
 
     /// What the truth is traced against (the session keeps the points for a method that
-    /// traces them).
+    /// traces them): the streamlines shown.
     pub fn truth_scene(&self) -> Result<crate::truth::Scene<'_>> {
-        let radii = self.base.radius.as_deref().and_then(|field| self.lines.field(field).ok());
-        Ok(crate::truth::Scene { tracts: self.lines.points()?, surfaces: &self.surfaces, radii })
+        let points = self.lines.points()?;
+        let tracts = match &self.lines.selected {
+            Some(selected) if selected.contains(&false) => self.selected_tracts.get_or_init(|| points.select(selected)),
+            _ => points,
+        };
+        let radius = self.base.radius.as_deref();
+        let radii = radius.and_then(|f| crate::source::vertex_field(&self.lines.name, tracts, f).ok());
+        Ok(crate::truth::Scene { tracts, surfaces: &self.surfaces, radii })
     }
 }
 
@@ -377,6 +396,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let output = args.image.output.clone().unwrap_or_else(|| "lineao.png".into());
     crate::output::write_png(&output, image.width, image.height, &image.data)?;
     let methods: Vec<&str> = panels.iter().map(|p| p.label.as_str()).collect();
+    if session.lines.selected.is_some() {
+        let (shown, all) = (session.lines.selected_count(), session.lines.geometry.streamlines);
+        eprintln!("lineao: {shown} of {all} streamlines selected");
+    }
     eprintln!(
         "lineao: {} ({} streamlines, {} vertices) with {} at {} x {} on {} -> {}",
         session.lines.name,
@@ -559,6 +582,9 @@ impl Session {
         let image = lineao::readback::read_texture(&gpu.device, &gpu.queue, &target.texture)?;
         if let Some(dir) = dump {
             crate::dump::write(dir, gpu, &chain, &self.camera, &panel.name, volume)?;
+            if let Some(selected) = &self.lines.selected {
+                crate::dump::write_selection(dir, selected)?;
+            }
             if let Some(truth) = &truth {
                 crate::dump::write_truth(dir, truth, &crate::truth::settings(args, self.longest_side))?;
             }

@@ -40,6 +40,9 @@ pub enum SourceError {
     /// A file read as it arrived, whose bytes were not kept, cannot be read again.
     #[error("{0} was read as it arrived and not kept: open it again to use this")]
     NotReadable(String),
+    /// A selection rule names what the file lacks.
+    #[error("{name}: {source}")]
+    Selection { name: String, source: lineao_tracts::SelectionError },
 }
 
 type Result<T> = std::result::Result<T, SourceError>;
@@ -195,16 +198,17 @@ impl Source {
         &self,
         progress: Option<lineao_tracts::ProgressFn<'_>>,
         sink: &mut dyn FnMut(Tractogram) -> ControlFlow<()>,
-    ) -> Result<Option<ViewHint>> {
+    ) -> Result<(Option<ViewHint>, Vec<lineao_tracts::Group>)> {
         match self {
             Source::Scene { kind: SceneKind::WholeBrain, vertices, seed } => {
                 whole_brain_in_chunks(*seed, *vertices as u64, sink);
-                Ok(None)
+                Ok((None, Vec::new()))
             }
             Source::Scene { kind, vertices, seed } => {
                 let scene = kind.build(*seed, *vertices);
+                let groups = scene.tractogram.groups.clone();
                 let _ = sink(scene.tractogram);
-                Ok(Some(scene.view))
+                Ok((Some(scene.view), groups))
             }
             Source::File(path) => {
                 let streamed = lineao_tracts::load_chunked(path, &Default::default(), CHUNK_VERTICES, progress, sink)?;
@@ -213,7 +217,7 @@ impl Source {
                     let format = streamed.format.map_or("tsf", |f| f.name());
                     return Err(SourceError::ValuesWithoutPoints { path, format });
                 }
-                Ok(None)
+                Ok((None, streamed.groups))
             }
             Source::Feed { name, .. } => Err(SourceError::NotReadable(name.clone())),
             Source::Bytes { name, bytes } => {
@@ -230,7 +234,7 @@ impl Source {
                     let format = streamed.format.map_or("tsf", |f| f.name());
                     return Err(SourceError::ValuesWithoutPoints { path: name.clone(), format });
                 }
-                Ok(None)
+                Ok((None, streamed.groups))
             }
         }
     }
@@ -432,6 +436,8 @@ pub struct Lines {
     pub geometry: LineGeometry,
     pub volumes: VolumeCache,
     held: AttributeKey,
+    /// With a selection, whether each streamline is shown (what has arrived so far).
+    pub selected: Option<Vec<bool>>,
 }
 
 /// What a stream keeps on the CPU beside the GPU's geometry.
@@ -448,6 +454,9 @@ pub struct Keep {
     pub fields: bool,
     /// A volume sampled at every vertex as it arrives, kept as a per-vertex field.
     pub sampled: Option<std::sync::Arc<Sampled>>,
+    /// The streamlines shown (`--subset`, `--length`, `--include`, …), judged as they arrive;
+    /// the others stay on the GPU, selected out.
+    pub selection: Option<std::sync::Arc<lineao_tracts::Selection>>,
 }
 
 /// A volume sampled at every vertex of a tractogram: a per-vertex field named `field`
@@ -488,6 +497,7 @@ impl Lines {
             geometry,
             volumes: VolumeCache::default(),
             held: AttributeKey::default(),
+            selected: None,
         })
     }
 
@@ -513,8 +523,9 @@ impl Lines {
         if let Some(error) = failed {
             return Err(error);
         }
-        let hint = streamed?;
+        let (hint, groups) = streamed?;
         lines.finish(hint, on)?;
+        lines.apply_selection(&groups, on)?;
         Ok(lines)
     }
 
@@ -534,6 +545,7 @@ impl Lines {
             geometry,
             volumes: VolumeCache::default(),
             held: AttributeKey { scalar: keep.scalar.clone(), radius: keep.radius.clone(), volume: None },
+            selected: None,
         })
     }
 
@@ -552,6 +564,13 @@ impl Lines {
             chunk.spread_streamline_field(field);
         }
         let name = &self.name;
+        if let Some(selection) = &self.keep.selection {
+            let first = self.geometry.streamlines as u64;
+            let chunk_selected = selection
+                .chunk(&chunk, first)
+                .map_err(|source| SourceError::Selection { name: name.clone(), source })?;
+            self.selected.get_or_insert_default().extend(chunk_selected);
+        }
         let values = |field: &Option<String>| field.as_deref().map(|f| vertex_field(name, &chunk, f)).transpose();
         let attributes =
             VertexAttributes { scalar: values(&self.held.scalar)?, radius: values(&self.held.radius)?, octants: None };
@@ -581,6 +600,37 @@ impl Lines {
         }
         self.hint = hint.unwrap_or_else(|| framing(&self.geometry));
         Ok(())
+    }
+
+    /// Applies the selection's group rule with the file's `groups` (known once it is read) and
+    /// selects out on the GPU what the selection leaves out.
+    pub fn apply_selection(&mut self, groups: &[lineao_tracts::Group], on: &lineao::Gpu) -> Result<()> {
+        let (Some(selection), Some(selected)) = (&self.keep.selection, &mut self.selected) else { return Ok(()) };
+        let name = &self.name;
+        selection
+            .apply_groups(selected, groups)
+            .map_err(|source| SourceError::Selection { name: name.clone(), source })?;
+        let shown = if selected.iter().all(|&s| s) { None } else { Some(&selected[..]) };
+        self.geometry
+            .set_selection(&on.device, &on.queue, shown)
+            .map_err(|source| SourceError::Gpu { name: name.clone(), source })
+    }
+
+    /// Selects the streamlines of lines made whole ([`Lines::new`]) by `selection`.
+    pub fn select(&mut self, selection: std::sync::Arc<lineao_tracts::Selection>, on: &lineao::Gpu) -> Result<()> {
+        let name = &self.name;
+        let selected =
+            selection.chunk(&self.tracts, 0).map_err(|source| SourceError::Selection { name: name.clone(), source })?;
+        (self.keep.selection, self.selected) = (Some(selection), Some(selected));
+        let groups = std::mem::take(&mut self.tracts.groups);
+        let applied = self.apply_selection(&groups, on);
+        self.tracts.groups = groups;
+        applied
+    }
+
+    /// How many streamlines are shown (all without a selection).
+    pub fn selected_count(&self) -> usize {
+        self.selected.as_ref().map_or(self.geometry.streamlines, |s| s.iter().filter(|&&k| k).count())
     }
 
     /// Whether the streamlines are kept on the CPU.

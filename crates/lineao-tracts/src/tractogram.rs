@@ -152,6 +152,31 @@ impl Tractogram {
         true
     }
 
+    /// The streamlines `keep` marks (one entry per streamline), with their per-vertex and
+    /// per-streamline fields; groups and the voxel grid are left out (their indices would not
+    /// hold).
+    pub fn select(&self, keep: &[bool]) -> Tractogram {
+        let kept: Vec<usize> = (0..self.streamlines()).filter(|&i| keep.get(i).copied().unwrap_or(false)).collect();
+        let mut out = Tractogram::new();
+        let range = |i: usize| self.offsets[i] as usize..self.offsets[i + 1] as usize;
+        for &i in &kept {
+            out.positions.extend_from_slice(&self.positions[range(i)]);
+            out.offsets.push(out.positions.len() as u64);
+        }
+        let pick = |field: &Field, per: &dyn Fn(usize) -> std::ops::Range<usize>| Field {
+            name: field.name.clone(),
+            columns: field.columns,
+            values: kept
+                .iter()
+                .flat_map(|&i| per(i))
+                .flat_map(|r| field.values[r * field.columns..(r + 1) * field.columns].iter().copied())
+                .collect(),
+        };
+        out.vertex_fields = self.vertex_fields.iter().map(|f| pick(f, &range)).collect();
+        out.streamline_fields = self.streamline_fields.iter().map(|f| pick(f, &|i| i..i + 1)).collect();
+        out
+    }
+
     /// Checks the invariants every loader guarantees: offsets start at 0, never decrease and end
     /// at the vertex count; every field and group fits.
     pub fn validate(&self) -> Result<(), String> {

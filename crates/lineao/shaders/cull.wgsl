@@ -364,8 +364,11 @@ fn piece_level(c: Cluster, first: u32, last: u32) -> u32 {
 }
 
 // Whether strip points `first ..= last` of cluster `c` may leave a fragment in front of the
-// pyramid: whether one of their segments may.
+// pyramid: whether one of their segments may (never for a cluster selected out).
 fn piece_visible(c: Cluster, first: u32, last: u32) -> bool {
+    if !is_selected(c) {
+        return false;
+    }
     let count = c.flags & CLUSTER_COUNT;
     var previous = vec3<f32>(0.0);
     for (var k = first; k <= last; k++) {

@@ -124,7 +124,7 @@ fn collapsed() -> VsOut {
 }
 
 fn strip_vertex(c: Cluster, at: StripPosition) -> VsOut {
-    if at.point < 0 {
+    if at.point < 0 || !is_selected(c) {
         return collapsed();
     }
     let q = pulled_point(c, u32(at.point));
@@ -150,7 +150,7 @@ fn vs_alternating(@builtin(vertex_index) v: u32, @builtin(instance_index) cluste
 fn vs_native(@builtin(vertex_index) v: u32, @builtin(instance_index) cluster: u32) -> VsOut {
     let c = clusters[cluster];
     let segment = v >> 1u;
-    if segment + 1u >= drawn_points(c) {
+    if segment + 1u >= drawn_points(c) || !is_selected(c) {
         var out: VsOut;
         out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
         return out;

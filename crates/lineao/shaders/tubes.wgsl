@@ -75,7 +75,7 @@ fn tube_vertex(corner: u32, a_world: PulledPoint, b_world: PulledPoint, ra: f32,
 // Corner `corner` (0..5: two triangles) of segment `segment` of cluster `c`'s strip, whose
 // points before `end` are drawn; a segment past them lies outside the clip volume.
 fn segment_vertex(c: Cluster, segment: u32, corner: u32, end: u32) -> TubeOut {
-    if segment + 1u >= end {
+    if segment + 1u >= end || !is_selected(c) {
         var out: TubeOut;
         out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
         return out;

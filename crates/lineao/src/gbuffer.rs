@@ -275,6 +275,8 @@ fn uniform_matches_its_wgsl_struct() {
             tube_radius,
             ndc_per_px,
             scalar_range,
+            slab_plane,
+            slab_half,
             colormap
         ]
     );

@@ -299,3 +299,62 @@ fn culled_lines_at_levels_of_detail_stay_within_half_a_pixel() {
         }
     }
 }
+
+/// The streamlines of (`positions`, `offsets`) that `keep` marks.
+fn subset(positions: &[[f32; 3]], offsets: &[u64], keep: &[bool]) -> (Vec<[f32; 3]>, Vec<u64>) {
+    let (mut kept, mut kept_offsets) = (Vec::new(), vec![0u64]);
+    for (_, w) in offsets.windows(2).enumerate().filter(|(i, _)| keep[*i]) {
+        kept.extend_from_slice(&positions[w[0] as usize..w[1] as usize]);
+        kept_offsets.push(kept.len() as u64);
+    }
+    (kept, kept_offsets)
+}
+
+#[test]
+fn a_selection_draws_what_the_selected_streamlines_alone_draw() {
+    use lineao::passes::lines::GeometryOptions;
+    let gpu = gpu();
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let (positions, offsets) = ball(600);
+    // One tolerance for both, so that each cluster takes the same strip in both.
+    let options = GeometryOptions { tolerance: Some(0.02), cluster_points: 16, ..GeometryOptions::default() };
+    let keep: Vec<bool> = (0..600).map(|i| i % 3 != 1).collect();
+    let mut masked = LineGeometry::with_options(d, q, &positions, &offsets, options).unwrap();
+    masked.set_selection(d, q, Some(&keep)).unwrap();
+    assert_eq!((masked.streamlines, masked.selected()), (600, 400));
+    let (kept, kept_offsets) = subset(&positions, &offsets, &keep);
+    let alone = LineGeometry::with_options(d, q, &kept, &kept_offsets, options).unwrap();
+    let camera = outside();
+    // Drawn whole, culled (the second frame draws what the first found), and as tubes.
+    let lines = |culled: bool| if culled { LineRenderer::new(d).culled(d, false) } else { LineRenderer::new(d) };
+    for culled in [false, true] {
+        let (a, b) = (lines(culled), lines(culled));
+        let frames = 1 + culled as usize;
+        let expected = (0..frames).map(|_| draw(&gpu, &a, &alone, &camera)).last().unwrap();
+        let got = (0..frames).map(|_| draw(&gpu, &b, &masked, &camera)).last().unwrap();
+        let (covered, ties) = same_gbuffer(&expected, &got, if culled { "culled lines" } else { "lines" });
+        assert!(covered > 5_000 && ties * 1000 <= covered, "{ties} ties of {covered}");
+        if culled {
+            same_marks_as_the_cpu_reference(&gpu, &b, &masked, &camera, &got[3], "culled lines");
+        }
+    }
+    let (a, b) = (TubeRenderer::new(d, false), TubeRenderer::new(d, false));
+    let (expected, got) = (draw_tubes(&gpu, &a, &alone, &camera), draw_tubes(&gpu, &b, &masked, &camera));
+    let (covered, ties) = same_gbuffer(&expected, &got, "tubes");
+    assert!(covered > 5_000 && ties * 1000 <= covered, "{ties} ties of {covered}");
+    // Nothing selected draws nothing; no selection draws every streamline again.
+    masked.set_selection(d, q, Some(&[false; 600])).unwrap();
+    let empty = draw(&gpu, &lines(false), &masked, &camera);
+    assert!(!empty[1].data.iter().any(|&nd| is_geometry(nd)));
+    masked.set_selection(d, q, None).unwrap();
+    assert_eq!(masked.selected(), 600);
+    let everything = LineGeometry::with_options(d, q, &positions, &offsets, options).unwrap();
+    let (covered, ties) = same_gbuffer(
+        &draw(&gpu, &lines(false), &everything, &camera),
+        &draw(&gpu, &lines(false), &masked, &camera),
+        "all",
+    );
+    assert!(ties * 1000 <= covered);
+    // A selection of the wrong length is refused.
+    assert!(masked.set_selection(d, q, Some(&[true; 3])).is_err());
+}

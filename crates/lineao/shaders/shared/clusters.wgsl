@@ -28,6 +28,7 @@ struct ClusterPage {
 const CLUSTER_COUNT: u32 = 0x1fu;
 const JOINS_PREVIOUS: u32 = 0x20u;
 const JOINS_NEXT: u32 = 0x40u;
+const DESELECTED: u32 = 0x80u;
 const BENT_SHIFT: u32 = 8u;
 const HAS_OCTANTS: u32 = 1u;
 const HAS_SCALARS: u32 = 2u;
@@ -83,6 +84,12 @@ struct PulledPoint {
 }
 
 // The points a cluster's strip draws: its own, and the next cluster's first when its run goes on.
+// Whether the cluster's streamline is selected (`LineGeometry::set_selection`): a cluster
+// selected out is neither drawn nor culled visible.
+fn is_selected(c: Cluster) -> bool {
+    return (c.flags & DESELECTED) == 0u;
+}
+
 fn drawn_points(c: Cluster) -> u32 {
     return (c.flags & CLUSTER_COUNT) + select(0u, 1u, (c.flags & JOINS_NEXT) != 0u);
 }

@@ -64,6 +64,9 @@ pub(crate) mod flags {
     pub const JOINS_PREVIOUS: u32 = 1 << 5;
     /// Its run goes on after it: it also draws `next`'s first point.
     pub const JOINS_NEXT: u32 = 1 << 6;
+    /// Its streamline is selected out ([`crate::LineGeometry::set_selection`]): nothing of it
+    /// is drawn, culled or occludes.
+    pub const DESELECTED: u32 = 1 << 7;
     /// Bits 8–31: inner point k (1 ≤ k ≤ 24 of the strip) is bent at bit 7 + k.
     pub const BENT_SHIFT: u32 = 8;
 }
@@ -96,6 +99,11 @@ impl ClusterRecord {
         self.count() + (self.flags & flags::JOINS_NEXT != 0) as u32
     }
 
+    /// Whether its streamline is selected ([`crate::LineGeometry::set_selection`]).
+    pub fn is_selected(&self) -> bool {
+        self.flags & flags::DESELECTED == 0
+    }
+
     /// How many of its inner points are bent (take both sides in the alternating strip).
     pub fn bent(&self) -> u32 {
         (self.flags >> flags::BENT_SHIFT).count_ones()
@@ -119,6 +127,8 @@ pub(crate) const RECORD_SIZE: u64 = std::mem::size_of::<ClusterRecord>() as u64;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) struct RunMap {
     pub input: u64,
+    /// The polyline it is part of (its index among every polyline appended).
+    pub streamline: u32,
     pub first: u32,
     pub len: u32,
 }
@@ -225,6 +235,8 @@ pub(crate) struct PageBuilder {
     /// cluster's first).
     pub boxes: Vec<(Vec3, Vec3)>,
     pub runs: Vec<RunMap>,
+    /// Per record, its run's polyline.
+    pub streamlines: Vec<u32>,
     /// The largest tolerance a point of this page was judged bent with.
     pub tolerance: f32,
     /// The box of its input points (min, max).
@@ -243,10 +255,10 @@ impl PageBuilder {
 
     /// Appends a run of ≥ 2 finite points (input vertex `input` first), cut into clusters of at
     /// most `per_cluster` points, its points bent beyond `tolerance` (world units) marked.
-    pub fn add_run(&mut self, run: &[[f32; 3]], input: u64, per_cluster: usize, tolerance: f32) {
+    pub fn add_run(&mut self, run: &[[f32; 3]], input: u64, streamline: u32, per_cluster: usize, tolerance: f32) {
         debug_assert!(run.len() >= 2 && run.iter().all(|p| p.iter().all(|c| c.is_finite())));
         let page_first = self.xy.len() as u32;
-        self.runs.push(RunMap { input, first: page_first, len: run.len() as u32 });
+        self.runs.push(RunMap { input, streamline, first: page_first, len: run.len() as u32 });
         self.tangents.clear();
         self.tangents.extend((0..run.len()).map(|k| vertex_tangent(run, k)));
         self.tolerance = self.tolerance.max(tolerance);
@@ -290,6 +302,7 @@ impl PageBuilder {
             // The box of what its strip draws: its points and the next cluster's first.
             let joined = run.get(start + count).filter(|_| joins_next).map(|p| Vec3::from_array(*p));
             self.boxes.push(joined.map_or((min, max), |p| (min.min(p), max.max(p))));
+            self.streamlines.push(streamline);
             self.records.push(ClusterRecord {
                 origin: min.to_array(),
                 scale,
@@ -365,7 +378,8 @@ impl PageBuilder {
                 [lo.x, lo.y, lo.z, 0.0, hi.x, hi.y, hi.z, 0.0]
             })
             .collect();
-        PageData { xy: self.xy, z, records, groups, classes, runs: self.runs, tolerance: self.tolerance }
+        let streamlines = order.iter().map(|&old| self.streamlines[old as usize]).collect();
+        PageData { xy: self.xy, z, records, groups, classes, runs: self.runs, streamlines, tolerance: self.tolerance }
     }
 }
 
@@ -379,6 +393,8 @@ pub(crate) struct PageData {
     pub groups: Vec<[f32; 8]>,
     pub classes: [Range<u32>; DRAW_CLASSES],
     pub runs: Vec<RunMap>,
+    /// Per record, its polyline.
+    pub streamlines: Vec<u32>,
     pub tolerance: f32,
 }
 
@@ -424,7 +440,7 @@ mod tests {
         let mut page = PageBuilder::default();
         let mut input = 0u64;
         for line in polylines {
-            page.add_run(line, input, per, tolerance);
+            page.add_run(line, input, 0, per, tolerance);
             input += line.len() as u64;
         }
         page.finish()

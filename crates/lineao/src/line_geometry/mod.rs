@@ -240,6 +240,8 @@ pub(crate) struct Page {
     pub cull: [std::sync::OnceLock<crate::passes::cull::PageCull>; 3],
     points: u32,
     runs: Vec<RunMap>,
+    /// Per record, its polyline (for [`LineGeometry::set_selection`]).
+    streamlines: Vec<u32>,
     pub xy: wgpu::Buffer,
     pub z: wgpu::Buffer,
     pub clusters: wgpu::Buffer,
@@ -255,6 +257,7 @@ impl Page {
         let attributes: u64 = self.attributes.iter().flatten().map(wgpu::Buffer::size).sum();
         let cull: u64 = self.cull.iter().filter_map(|c| c.get()).map(crate::passes::cull::PageCull::bytes).sum();
         let own = self.xy.size() + self.z.size() + self.clusters.size() + self.groups.size();
+        // (`streamlines` is on the CPU.)
         own + attributes + self.uniform.size() + cull
     }
 }
@@ -278,6 +281,8 @@ pub struct LineGeometry {
     /// Input vertices appended so far.
     pub vertices: usize,
     pub streamlines: usize,
+    /// Of those, the ones drawn ([`LineGeometry::set_selection`]).
+    selected: usize,
     /// Bounding sphere of the finite points; `None` when there are none. Exact for a geometry
     /// made whole ([`LineGeometry::new`]) or finished ([`LineGeometry::finish`]); while a
     /// geometry is appended to, the sphere around the box of what arrived.
@@ -347,6 +352,7 @@ impl LineGeometry {
             corners: None,
             vertices: 0,
             streamlines: 0,
+            selected: 0,
             bounds: None,
         })
     }
@@ -413,7 +419,10 @@ impl LineGeometry {
         if self.vertices == 0 && !attributes.is_empty() {
             self.pending_attributes = Some(PageAttributes::holding(attributes));
         }
+        let first_streamline = self.streamlines;
         for (input, run) in clusters::runs(positions, offsets) {
+            // The polyline holding input vertex `input` (the last offset at or before it).
+            let streamline = first_streamline + offsets.partition_point(|&o| o <= input) - 1;
             let records = clusters::cluster_sizes(run.len(), per_cluster).count();
             if self.pending.points() + run.len() > self.page_points
                 || self.pending.records.len() + records > self.page_records
@@ -427,13 +436,14 @@ impl LineGeometry {
                     self.page_points
                 )));
             }
-            self.pending.add_run(run, base + input, per_cluster, tolerance);
+            self.pending.add_run(run, base + input, streamline as u32, per_cluster, tolerance);
             if let Some(pending) = &mut self.pending_attributes {
                 pending.push_run(attributes, input as usize, run.len());
             }
         }
         self.vertices += positions.len();
         self.streamlines += offsets.len() - 1;
+        self.selected += offsets.len() - 1;
         Ok(())
     }
 
@@ -509,6 +519,7 @@ impl LineGeometry {
             cull: Default::default(),
             points,
             runs: data.runs,
+            streamlines: data.streamlines,
             xy,
             z,
             clusters,
@@ -594,6 +605,44 @@ impl LineGeometry {
             page.group = group;
         }
         settle(device, queue, self.options.bounded_staging)
+    }
+
+    /// Draws only the polylines `selected` marks (one entry per polyline appended; `None`:
+    /// all of them): the others are neither drawn, culled nor occlude, in every pass. Nothing
+    /// is uploaded again but a bit per cluster, which a compute pass writes into the cluster
+    /// records; polylines appended later are selected. Flushes first.
+    pub fn set_selection(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        selected: Option<&[bool]>,
+    ) -> Result<(), Error> {
+        if let Some(selected) = selected
+            && selected.len() != self.streamlines
+        {
+            return Err(Error::InvalidGeometry(format!(
+                "a selection of {} polylines for a geometry of {}",
+                selected.len(),
+                self.streamlines
+            )));
+        }
+        self.flush(device, queue)?;
+        for page in &self.pages {
+            let mut words = vec![0u32; page.streamlines.len().div_ceil(32).max(1)];
+            if let Some(selected) = selected {
+                for (i, &s) in page.streamlines.iter().enumerate() {
+                    words[i / 32] |= (!selected[s as usize] as u32) << (i % 32);
+                }
+            }
+            farthest::select(device, queue, page, &words);
+        }
+        self.selected = selected.map_or(self.streamlines, |s| s.iter().filter(|&&k| k).count());
+        settle(device, queue, self.options.bounded_staging)
+    }
+
+    /// The polylines drawn: all of them but those [`LineGeometry::set_selection`] left out.
+    pub fn selected(&self) -> usize {
+        self.selected
     }
 
     /// The corners (min, max) of the box around every finite point appended.
@@ -723,7 +772,8 @@ fn settle(device: &wgpu::Device, queue: &wgpu::Queue, bounded_staging: bool) -> 
 }
 
 /// The compute passes over a page's clusters: the farthest point from a centre (the exact
-/// bounding sphere of [`LineGeometry::finish`]) and, for the tests, every point decoded
+/// bounding sphere of [`LineGeometry::finish`]), the selection written into the records
+/// ([`LineGeometry::set_selection`]) and, for the tests, every point decoded
 /// (`shaders/line_geometry.wgsl`).
 mod farthest {
     use super::Page;
@@ -795,6 +845,43 @@ mod farthest {
             cpass.set_bind_group(1, &page.group, &[]);
             let rows = page.records.div_ceil(ROW);
             cpass.dispatch_workgroups(page.records.min(ROW), rows, 1);
+        }
+        queue.submit([encoder.finish()]);
+    }
+
+    /// Marks the records of `page` whose bit in `deselected` is set (record i: word i / 32,
+    /// bit i % 32) with `flags::DESELECTED` and clears the others' (`select_clusters`).
+    pub fn select(device: &wgpu::Device, queue: &wgpu::Queue, page: &Page, deselected: &[u32]) {
+        use crate::binding::Slot;
+        use wgpu::util::DeviceExt;
+        let label = "lineao::LineGeometry::select";
+        let layout = crate::binding::layout(
+            device,
+            label,
+            wgpu::ShaderStages::COMPUTE,
+            &[Slot::Uniform, Slot::StorageReadWrite, Slot::Storage],
+        );
+        let pipeline =
+            crate::binding::compute_pipeline(device, label, &layout, "line_geometry.wgsl", "select_clusters", &[]);
+        let params = Params { center: [0.0; 3], clusters: page.records };
+        let init = |contents: &[u8], usage| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+        };
+        let uniform = init(bytemuck::bytes_of(&params), wgpu::BufferUsages::UNIFORM);
+        let mask = init(bytemuck::cast_slice(deselected), wgpu::BufferUsages::STORAGE);
+        let group = crate::binding::group(
+            device,
+            label,
+            &layout,
+            &[uniform.as_entire_binding(), page.clusters.as_entire_binding(), mask.as_entire_binding()],
+        );
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
+        {
+            let mut cpass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor::default());
+            cpass.set_pipeline(&pipeline);
+            cpass.set_bind_group(0, &group, &[]);
+            let groups = page.records.div_ceil(64);
+            cpass.dispatch_workgroups(groups.min(ROW), groups.div_ceil(ROW), 1);
         }
         queue.submit([encoder.finish()]);
     }

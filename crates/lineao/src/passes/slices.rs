@@ -261,6 +261,16 @@ mod tests {
     use super::percentiles;
 
     #[test]
+    fn the_uniform_matches_its_wgsl_struct() {
+        crate::shader::assert_wgsl_layout!(
+            super::SliceUniform,
+            "slices.wgsl",
+            "SliceUniform",
+            [world_to_voxel, box_min, box_max, positions, shown, last_voxel]
+        );
+    }
+
+    #[test]
     fn percentiles_skip_zeros_and_non_finite_values_and_widen_a_constant_volume() {
         let values: Vec<f32> = (1..=101).map(|v| v as f32).chain([f32::NAN, f32::INFINITY, 0.0, 0.0]).collect();
         assert_eq!(percentiles(&values, [0.02, 0.98]), [3.0, 99.0]);

@@ -69,8 +69,8 @@ pub fn depth_pyramid(depth: &Image<f32>) -> Vec<Image<f32>> {
     levels
 }
 
-/// Every piece's verdict (per page, per cluster, pieces 0–2; a piece a cluster lacks is
-/// hidden) for a frame of `view` whose final depth is `depth`.
+/// Every piece's verdict (per page, per cluster, pieces 0–2; a piece a cluster lacks, and
+/// every piece of a cluster selected out, is hidden) for a frame of `view` whose final depth is `depth`.
 pub fn marks(pages: &[PageContents], view: &CullView, depth: &Image<f32>, slack: Slack) -> Vec<Vec<[Verdict; 3]>> {
     let pyramid = depth_pyramid(depth);
     let test = Tester { view, pyramid: &pyramid };
@@ -94,7 +94,8 @@ pub fn marks(pages: &[PageContents], view: &CullView, depth: &Image<f32>, slack:
                     std::array::from_fn(|p| {
                         let drawn = c.drawn() as usize;
                         let first = p * PIECE_SEGMENTS as usize;
-                        if first + 1 >= drawn {
+                        // A cluster selected out is never visible.
+                        if first + 1 >= drawn || !c.is_selected() {
                             return Verdict::Hidden;
                         }
                         let last = (first + PIECE_SEGMENTS as usize).min(drawn - 1);
