@@ -51,7 +51,11 @@
 //!   the upload): what a new geometry costs; the table adds its bytes per vertex;
 //! - `raytraced-cpu-64`: the CPU truth with 64 rays per geometry pixel of the bench's frame
 //!   (binary AO to 2 mm), on all cores; the table adds rays per second per core and the BVH's
-//!   bytes per segment.
+//!   bytes per segment;
+//! - `select`: a change of selection (every other streamline selected out, then the others):
+//!   a bit per cluster uploaded and written into the records on the GPU
+//!   ([`LineGeometry::set_selection`]), until the device has finished; compare it with the
+//!   frame's `lines-culled`.
 
 use std::time::Instant;
 
@@ -272,7 +276,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     // cores), its points kept only where a selected pass needs them.
     let start = Instant::now();
     let keep = crate::source::Keep { points, ..Default::default() };
-    let scene = crate::source::Lines::stream(&source, &keep, None, &gpu)?;
+    let mut scene = crate::source::Lines::stream(&source, &keep, None, &gpu)?;
     let load_ms = start.elapsed().as_secs_f64() * 1e3;
     let geometry = &scene.geometry;
     let bytes_per_vertex = geometry.gpu_bytes() as f64 / geometry.vertices.max(1) as f64;
@@ -426,6 +430,20 @@ pub fn run(args: &BenchArgs) -> Result<()> {
             ray_scene.layers()
         );
     }
+    let vertices = geometry.vertices;
+    if selected("select") {
+        let geometry = &mut scene.geometry;
+        let mut ms = Vec::new();
+        for run in 0..runs {
+            let keep: Vec<bool> = (0..geometry.streamlines).map(|i| (i + run as usize) % 2 == 0).collect();
+            let start = Instant::now();
+            geometry.set_selection(device, queue, Some(&keep))?;
+            gpu.wait()?;
+            ms.push(start.elapsed().as_secs_f64() * 1e3);
+        }
+        geometry.set_selection(device, queue, None)?;
+        passes.push(summary("select", "cpu", ms));
+    }
     let info = gpu.adapter.get_info();
     let report = json!({
         "adapter": info.name,
@@ -433,7 +451,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         "width": args.width,
         "height": args.height,
         "scene": scene.name,
-        "vertices": geometry.vertices,
+        "vertices": vertices,
         "gpu_bytes_per_vertex": bytes_per_vertex,
         "strip_bytes_per_vertex": strip_bytes,
         "visible_pieces": visible_pieces,

@@ -232,8 +232,8 @@ pub fn gpu_passes() -> Vec<&'static str> {
 }
 
 /// The CPU passes, after the GPU's.
-pub const CPU_PASSES: [&str; 6] =
-    ["density-256", "sweep-256", "variance-volume-256", "bvh-build-1m", "bvh-upload", "raytraced-cpu-64"];
+pub const CPU_PASSES: [&str; 7] =
+    ["density-256", "sweep-256", "variance-volume-256", "bvh-build-1m", "bvh-upload", "raytraced-cpu-64", "select"];
 
 /// Whether `name` is a pass of the benchmark.
 pub fn is_pass(name: &str) -> bool {

@@ -14,6 +14,10 @@
 #import shared/geometry.wgsl
 #import shared/pieces.wgsl
 
+// Whether the fragments test the slab (`LineRenderer::with_slab`): a `discard` costs the
+// rasterizer its early depth test even where it never runs, so it is compiled in only then.
+override SLAB: bool = false;
+
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) view_pos: vec3<f32>,
@@ -254,9 +258,9 @@ fn fs_octants(in: VsOutOctants) -> GBufferOctants {
 }
 
 // The G-buffer of a point of the line at `view_pos` with tangent `view_tangent`; discarded
-// outside the slab.
+// outside the slab where the pipeline tests it.
 fn line_gbuffer(view_pos: vec3<f32>, view_tangent: vec3<f32>, color: vec3<f32>) -> GBuffer {
-    if outside_slab(view_pos) {
+    if SLAB && outside_slab(view_pos) {
         discard;
     }
     let t = normalize(view_tangent);

@@ -132,6 +132,8 @@ pub(crate) struct PipelineSpec<'a> {
     pub topology: wgpu::PrimitiveTopology,
     /// Also write the `octants` target (the fragment entry returns `GBufferOctants`).
     pub octants: bool,
+    /// The module's `override` constants, for both stages.
+    pub constants: &'a [(&'a str, f64)],
 }
 
 /// A render pipeline writing the G-buffer (depth test `Less`, depth written).
@@ -157,7 +159,7 @@ pub(crate) fn pipeline(
         vertex: wgpu::VertexState {
             module: spec.module,
             entry_point: Some(spec.vertex),
-            compilation_options: Default::default(),
+            compilation_options: wgpu::PipelineCompilationOptions { constants: spec.constants, ..Default::default() },
             buffers: spec.buffers,
         },
         primitive: wgpu::PrimitiveState {
@@ -178,7 +180,7 @@ pub(crate) fn pipeline(
         fragment: Some(wgpu::FragmentState {
             module: spec.module,
             entry_point: Some(spec.fragment),
-            compilation_options: Default::default(),
+            compilation_options: wgpu::PipelineCompilationOptions { constants: spec.constants, ..Default::default() },
             targets: &color_targets,
         }),
         multiview_mask: None,

@@ -164,10 +164,12 @@ impl AoChain {
         .await?;
         let octants = settings.volume.is_some();
         if octants != self.lines.writes_octants()
+            || settings.slab.is_some() != self.lines.cuts()
             || settings.cull != self.lines.culls()
             || (settings.cull && settings.levels_of_detail() != self.lines.lods())
         {
-            // Writing octants or not, culling (at levels of detail) or not, is a matter of the geometry pipelines.
+            // Writing octants or not, testing a slab or not, culling (at levels of detail) or not, is a
+            // matter of the geometry pipelines.
             self.lines = line_renderer(device, &settings);
             self.volume_ao = settings.volume.as_ref().map(|_| VolumeAo::new(device));
         }
@@ -585,10 +587,11 @@ impl AoChain {
 }
 
 /// The chain's line renderer for `settings`: fixed-width quads, writing the octants with
-/// object-space AO, culled on the GPU with [`ChainSettings::cull`] (at levels of detail with
+/// object-space AO, testing the slab where there is one, culled on the GPU with [`ChainSettings::cull`] (at levels of detail with
 /// [`ChainSettings::lod`]).
 fn line_renderer(device: &wgpu::Device, settings: &ChainSettings) -> LineRenderer {
-    let renderer = LineRenderer::with_outputs(device, LineStyle::Quads, settings.volume.is_some());
+    let renderer =
+        LineRenderer::with_slab(device, LineStyle::Quads, settings.volume.is_some(), settings.slab.is_some());
     if settings.cull { renderer.culled(device, settings.levels_of_detail()) } else { renderer }
 }
 

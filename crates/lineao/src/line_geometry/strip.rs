@@ -159,6 +159,7 @@ impl StripRenderer {
                 buffers: &buffers,
                 topology: wgpu::PrimitiveTopology::TriangleStrip,
                 octants: false,
+                constants: &[],
             },
         );
         StripRenderer { pipeline, bindings, px_per_world: f32::INFINITY, full }

@@ -66,6 +66,9 @@ struct Pipelines {
 /// Renders [`LineGeometry`] into the G-buffer of [`FrameTargets`].
 pub struct LineRenderer {
     style: LineStyle,
+    /// Its fragments test the slab ([`LineRenderer::with_slab`]): a `discard` in the shader,
+    /// which costs the rasterizer its early depth test, so only where a slab is asked for.
+    slab: bool,
     plain: Pipelines,
     /// Culling on the GPU ([`LineRenderer::culled`]): the visible pieces' full strips.
     culled: Option<Culled>,
@@ -91,6 +94,14 @@ impl LineRenderer {
     /// With `octants`, targets that have an `octants` texture also get the geometry's
     /// per-vertex octant visibilities, interpolated ([`crate::passes::volume_ao`]); quads only.
     pub fn with_outputs(device: &wgpu::Device, style: LineStyle, octants: bool) -> LineRenderer {
+        Self::with_slab(device, style, octants, false)
+    }
+
+    /// [`LineRenderer::with_outputs`] whose fragments outside the frame's slab are discarded,
+    /// with `slab` (the slab itself comes with each frame's [`LineRenderer::prepare`]; without
+    /// `slab` it is ignored). Measured on lavapipe at 10 M points: the test alone, never
+    /// discarding, made drawing every line 1.5 × slower (8.6 s against 5.8 s).
+    pub fn with_slab(device: &wgpu::Device, style: LineStyle, octants: bool, slab: bool) -> LineRenderer {
         let bindings = GeometryBindings::new(device, "lineao::LineRenderer::bindings");
         let page = crate::line_geometry::page_layout(device);
         let module = crate::shader::module(device, "lines.wgsl");
@@ -112,6 +123,7 @@ impl LineRenderer {
                     buffers: &[],
                     topology,
                     octants,
+                    constants: &[("SLAB", slab as u32 as f64)],
                 },
             )
         };
@@ -132,6 +144,7 @@ impl LineRenderer {
         });
         LineRenderer {
             style,
+            slab,
             plain,
             octants,
             culled: None,
@@ -170,6 +183,7 @@ impl LineRenderer {
                     buffers: &[],
                     topology: wgpu::PrimitiveTopology::TriangleStrip,
                     octants,
+                    constants: &[("SLAB", self.slab as u32 as f64)],
                 },
             )
         };
@@ -181,6 +195,11 @@ impl LineRenderer {
     /// Its culling, where it culls.
     pub fn cull(&self) -> Option<&Culled> {
         self.culled.as_ref()
+    }
+
+    /// Whether its fragments test the slab ([`LineRenderer::with_slab`]).
+    pub fn cuts(&self) -> bool {
+        self.slab
     }
 
     /// Whether it culls ([`LineRenderer::culled`]).

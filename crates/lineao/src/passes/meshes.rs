@@ -111,6 +111,7 @@ impl MeshRenderer {
                 buffers: &buffers,
                 topology: wgpu::PrimitiveTopology::TriangleList,
                 octants,
+                constants: &[],
             },
         );
         MeshRenderer { pipeline, octants, bindings }

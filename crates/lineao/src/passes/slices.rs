@@ -197,6 +197,7 @@ impl SliceRenderer {
                 buffers: &[],
                 topology: wgpu::PrimitiveTopology::TriangleList,
                 octants,
+                constants: &[],
             },
         );
         let uniform = binding::uniform_buffer::<SliceUniform>(device, label);

@@ -152,6 +152,7 @@ fn tube_pipeline(
             buffers: &[],
             topology: wgpu::PrimitiveTopology::TriangleList,
             octants,
+            constants: &[],
         },
     )
 }
