@@ -435,7 +435,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let geometry = &mut scene.geometry;
         let mut ms = Vec::new();
         for run in 0..runs {
-            let keep: Vec<bool> = (0..geometry.streamlines).map(|i| (i + run as usize) % 2 == 0).collect();
+            let keep: Vec<bool> = (0..geometry.streamlines).map(|i| (i + run as usize).is_multiple_of(2)).collect();
             let start = Instant::now();
             geometry.set_selection(device, queue, Some(&keep))?;
             gpu.wait()?;
