@@ -395,12 +395,15 @@ impl Controls {
             });
         });
         match &mut self.color {
-            ColorMode::Field(_) => {
+            ColorMode::Field(name) => {
                 egui::ComboBox::from_id_salt("colormap").selected_text(self.colormap.name()).show_ui(ui, |ui| {
                     for map in Colormap::ALL {
                         ui.selectable_value(&mut self.colormap, map, map.name());
                     }
                 });
+                if let Some((_, range)) = fields.iter().find(|(field, _)| field == name) {
+                    colour_bar(ui, self.colormap, *range);
+                }
             }
             ColorMode::Constant(rgb) => {
                 ui.color_edit_button_srgb(rgb);
@@ -408,6 +411,28 @@ impl Controls {
             ColorMode::Tangent => {}
         }
     }
+}
+
+/// The legend of a field's colours: the colormap over `range`, its ends' and middle's numbers
+/// (those of `render --legend`).
+fn colour_bar(ui: &mut Ui, colormap: Colormap, range: [f32; 2]) {
+    let (rect, _) = ui.allocate_exact_size(egui::vec2(ui.available_width().min(220.0), 12.0), egui::Sense::hover());
+    let steps = 64;
+    for i in 0..steps {
+        let [r, g, b] = colormap.color((i as f32 + 0.5) / steps as f32).map(crate::label::srgb8);
+        let x0 = rect.left() + rect.width() * i as f32 / steps as f32;
+        let x1 = rect.left() + rect.width() * (i + 1) as f32 / steps as f32;
+        let cell = egui::Rect::from_x_y_ranges(x0..=x1, rect.y_range());
+        ui.painter().rect_filled(cell, 0.0, egui::Color32::from_rgb(r, g, b));
+    }
+    let [low, middle, high] = crate::label::legend_labels(range);
+    ui.horizontal(|ui| {
+        ui.set_width(rect.width());
+        ui.small(low);
+        ui.add_space((rect.width() / 2.0 - 40.0).max(0.0));
+        ui.small(middle);
+        ui.with_layout(egui::Layout::right_to_left(egui::Align::Center), |ui| ui.small(high));
+    });
 }
 
 fn srgb_to_linear(c: f32) -> f32 {

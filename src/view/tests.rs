@@ -228,6 +228,10 @@ fn a_volume_colours_the_lines_it_is_sampled_at() {
     // The z-map along the streamlines spans 0 to about 1 (its 2nd to 98th percentile).
     assert!(range[0] >= 0.0 && range[1] > 0.5 && range[1] < 1.3, "{range:?}");
     assert!(non_background(&frame.images[0]) > 0.05);
+    // The side panel's colour bar says the range.
+    for label in crate::label::legend_labels(range) {
+        harness.get_by_label(&label);
+    }
 }
 
 #[test]

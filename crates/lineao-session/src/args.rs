@@ -400,6 +400,10 @@ pub struct ImageArgs {
     /// Print the time of each pass (GPU timestamps, or the frame's CPU wall time without them).
     #[arg(long)]
     pub timings: bool,
+    /// Draw the colour bar of `--color field:NAME` or `volume:FILE` with its range's numbers
+    /// into the picture (bottom left).
+    #[arg(long)]
+    pub legend: bool,
 }
 
 /// How the streamlines and surfaces are drawn.

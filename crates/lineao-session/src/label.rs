@@ -74,6 +74,55 @@ impl Rgba8 {
     }
 }
 
+impl Rgba8 {
+    /// A colour bar at the bottom left: `colormap` from `range[0]` (left) to `range[1]`, the
+    /// numbers of [`legend_labels`] under its ends and middle, `title` above it.
+    pub fn legend(&mut self, title: &str, colormap: lineao::Colormap, range: [f32; 2]) {
+        let scale = self.label_scale() as i64;
+        let labels = legend_labels(range);
+        // A label's box (`label`): 8 px glyphs and 3 px of padding each side, scaled.
+        let boxed = |text: &str| 8 * scale * text.chars().count() as i64 + 6 * scale;
+        let widest = labels.iter().map(|l| boxed(l)).max().unwrap_or(0);
+        let (w, h) = ((self.width as i64 / 3).max(3 * widest + 8 * scale), 10 * scale);
+        let margin = 8 * scale;
+        let label_h = 14 * scale;
+        let (x, y) = (margin, self.height as i64 - margin - label_h - h);
+        self.fill(x - scale, y - scale, w + 2 * scale, h + 2 * scale, [0, 0, 0, 255]);
+        for i in 0..w {
+            let [r, g, b] = colormap.color(i as f32 / (w - 1) as f32).map(srgb8);
+            self.fill(x + i, y, 1, h, [r, g, b, 255]);
+        }
+        let [low, middle, high] = labels;
+        self.label(&low, x, y + h + scale, false);
+        self.label(&middle, x + w / 2 - boxed(&middle) / 2, y + h + scale, false);
+        self.label(&high, x + w, y + h + scale, true);
+        if !title.is_empty() {
+            self.label(title, x, y - 2 * scale - 14 * scale, false);
+        }
+    }
+}
+
+/// A linear RGB channel (clamped to [0, 1]) as an sRGB byte.
+pub fn srgb8(c: f32) -> u8 {
+    let c = c.clamp(0.0, 1.0);
+    let s = if c <= 0.003_130_8 { 12.92 * c } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 };
+    (s * 255.0).round() as u8
+}
+
+/// The numbers a colour bar over `range` shows under its start, middle and end: up to three
+/// decimals with the trailing zeros dropped, scientific below 0.01 and from 10 000 on.
+pub fn legend_labels(range: [f32; 2]) -> [String; 3] {
+    let number = |v: f32| {
+        if v != 0.0 && !(0.01..10_000.0).contains(&v.abs()) {
+            return format!("{v:.2e}");
+        }
+        let text = format!("{v:.3}");
+        let text = text.trim_end_matches('0').trim_end_matches('.');
+        if text == "-0" { "0".to_string() } else { text.to_string() }
+    };
+    [range[0], 0.5 * (range[0] + range[1]), range[1]].map(number)
+}
+
 /// The split screen: the left half of `a`, the right half of `b`, a dark divider between them,
 /// each half labelled at the top next to the divider.
 pub fn split(a: &Rgba8, b: &Rgba8, labels: [&str; 2]) -> Result<Rgba8> {
@@ -113,6 +162,19 @@ pub fn grid(tiles: &[(&str, &Rgba8)], columns: u32) -> Rgba8 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_legend_labels_its_range_and_draws_the_colormap_between_them() {
+        assert_eq!(legend_labels([0.0, 1.0]), ["0", "0.5", "1"]);
+        assert_eq!(legend_labels([-2.5, 97.25]), ["-2.5", "47.375", "97.25"]);
+        assert_eq!(legend_labels([0.001, 12_000.0]), ["1.00e-3", "6000", "1.20e4"]);
+        let mut image = Rgba8::filled(300, 200, [255, 255, 255, 255]);
+        image.legend("fa", lineao::Colormap::Gray, [0.0, 1.0]);
+        // The bar's first and last columns: the colormap's ends (black and white).
+        let (x0, x1, y) = (8, 8 + 100 - 1, 200 - 8 - 14 - 5);
+        let at = |x: usize| &image.data[4 * (y * 300 + x)..4 * (y * 300 + x) + 3];
+        assert_eq!((at(x0), at(x1)), (&[0u8, 0, 0][..], &[255u8, 255, 255][..]));
+    }
 
     #[test]
     fn split_takes_halves_and_draws_the_divider_and_labels() {

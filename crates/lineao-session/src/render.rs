@@ -460,7 +460,7 @@ impl Session {
             images.push(rendered.image);
             chains.push(rendered.chain);
         }
-        let image = match &images[..] {
+        let mut image = match &images[..] {
             [single] => single.clone(),
             [a, b] if args.shown.compare.is_some() => {
                 crate::label::split(a, b, [&panels[0].label, &panels[1].label]).context("composing --compare")?
@@ -470,6 +470,14 @@ impl Session {
                 crate::label::grid(&labelled, 3)
             }
         };
+        if let (true, LineColor::Scalar { colormap, range }) = (args.image.legend, panels[0].settings.line_color) {
+            let title = match &args.style.color {
+                ColorArg::Field(name) => name.clone(),
+                ColorArg::Volume(path) => path.file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned()),
+                _ => String::new(),
+            };
+            image.legend(&title, colormap, range);
+        }
         Ok((image, panels))
     }
 }
