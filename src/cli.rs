@@ -75,6 +75,14 @@ pub struct ViewArgs {
     /// (`z,0,8`); `[` and `]` move it (see `render --slab`).
     #[arg(long, value_name = "AXIS,CENTRE,THICKNESS", value_parser = lineao_session::args::parse_slab, allow_hyphen_values = true)]
     pub slab: Option<lineao::Slab>,
+    /// Anatomy: a NIfTI-1 volume shown as slices with each dataset opened (see `render
+    /// --volume`); the side panel moves them.
+    #[arg(long, value_name = "NIFTI")]
+    pub volume: Option<PathBuf>,
+    /// Where the slices cut x, y and z (mm; `-` for none) [default: all three through the
+    /// volume's centre].
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_slices, allow_hyphen_values = true, requires = "volume")]
+    pub slices: Option<[Option<f32>; 3]>,
     /// Line color: `tangent`, R,G,B in [0, 1], or `field:NAME` (see `render --color`).
     #[arg(long, default_value = "tangent", value_parser = parse_color)]
     pub color: ColorArg,

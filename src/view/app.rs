@@ -45,6 +45,8 @@ pub struct Options {
     pub screenshot: Option<(PathBuf, u32)>,
     /// `--color volume:FILE`: the volume sampled at every vertex of each dataset opened.
     pub sampled: Option<Arc<crate::source::Sampled>>,
+    /// `--volume FILE`: the anatomy whose slices are shown with each dataset opened.
+    pub anatomy: Option<Arc<lineao_tracts::Volume>>,
 }
 
 /// How a session ended, for `--screenshot`'s exit status.
@@ -128,6 +130,7 @@ pub struct App {
     screenshot_requested: bool,
     /// The volume each dataset opened is coloured by (`--color volume:FILE`).
     sampled: Option<Arc<crate::source::Sampled>>,
+    anatomy: Option<Arc<lineao_tracts::Volume>>,
     pub outcome: Arc<Mutex<Outcome>>,
     frames: u64,
     /// File ▸ Open… where the app has no file dialog of its own (the web page's file input).
@@ -196,6 +199,7 @@ impl App {
             save_dialog: FileDialog::new().title("Save a screenshot (PNG)").default_file_name("lineao-view.png"),
             screenshot: options.screenshot,
             sampled: options.sampled,
+            anatomy: options.anatomy,
             screenshot_requested: false,
             outcome: Arc::default(),
             frames: 0,
@@ -251,7 +255,7 @@ impl App {
         self.load_failed = false;
         (self.camera, self.framed, self.first_picture, self.first_frame_ms) = (None, None, None, None);
         self.opened_at = Some(Instant::now());
-        self.send(ToWorker::Load(source, self.sampled.clone()));
+        self.send(ToWorker::Load(source, self.sampled.clone(), self.anatomy.clone()));
     }
 
     fn send(&mut self, message: ToWorker) {

@@ -11,7 +11,7 @@ use lineao::lighting::LineShading;
 use lineao::volume::{ScalarForm, Sky, VolumeAoOptions, VolumeMethod};
 use lineao::{
     AoMethod, BilateralSettings, ChainSettings, Colormap, DebugView, LineAoOuter, LineAoVariant, LineColor, Named,
-    Preset, Slab, SlabAxis, SsaoKernel, TubeSettings, VoCombine, VolumeAoSettings,
+    Preset, Slab, SlabAxis, SliceSettings, SsaoKernel, TubeSettings, VoCombine, VolumeAoSettings,
 };
 
 use super::worker::Panel;
@@ -142,6 +142,8 @@ pub struct Controls {
     /// How far the slab's centre slider reaches either way (world units): half the dataset's
     /// viewing distance.
     pub slab_reach: f32,
+    /// The world box of the anatomy's voxel centres (`--volume`), which its slices' sliders span.
+    pub slice_box: Option<([f32; 3], [f32; 3])>,
 }
 
 impl Controls {
@@ -163,7 +165,18 @@ impl Controls {
             moving_method: MOVING_DEFAULT,
             slab: Slab { axis: SlabAxis::Z, center: 0.0, thickness: 10.0 },
             slab_reach: 100.0,
+            slice_box: None,
         }
+    }
+
+    /// Slices of an anatomy whose voxel centres span `world_box`, at `positions` (default:
+    /// all three through its centre).
+    pub fn set_anatomy(&mut self, world_box: ([f32; 3], [f32; 3]), positions: Option<[Option<f32>; 3]>) {
+        let (lo, hi) = world_box;
+        let center = std::array::from_fn(|a| Some(0.5 * (lo[a] + hi[a])));
+        let positions = positions.unwrap_or(center);
+        self.params.chain.slices = Some(SliceSettings { positions, ..SliceSettings::default() });
+        self.slice_box = Some(world_box);
     }
 
     /// Moves the slab (when it is on) by `steps` quarters of its thickness: the `[` and `]` keys.
@@ -177,9 +190,10 @@ impl Controls {
     /// The data's zoom unit changed (a new file): the parameters take the preset's values in it,
     /// except the ray counts (`view --rays`) and the denoiser's switch, which are no lengths.
     pub fn set_zoom_unit(&mut self, zoom_unit: f32) {
-        let (rays, slab) = (self.params.chain.raytraced.clone(), self.params.chain.slab);
+        let (rays, slab, slices) =
+            (self.params.chain.raytraced.clone(), self.params.chain.slab, self.params.chain.slices.take());
         self.params = Params::preset(self.preset, zoom_unit);
-        self.params.chain.slab = slab;
+        (self.params.chain.slab, self.params.chain.slices) = (slab, slices);
         let r = &mut self.params.chain.raytraced;
         (r.rays_per_frame, r.max_rays, r.denoise) = (rays.rays_per_frame, rays.max_rays, rays.denoise);
     }
@@ -273,6 +287,7 @@ impl Controls {
         ui.add(egui::Slider::new(&mut self.light_azimuth, -180.0..=180.0).text("light azimuth (°)"));
         ui.add(egui::Slider::new(&mut self.light_elevation, -89.0..=89.0).text("light elevation (°)"));
         self.slab_ui(ui);
+        self.slices_ui(ui);
         ui.separator();
 
         ui.heading("Parameters");
@@ -372,6 +387,21 @@ impl Controls {
         ui.add(egui::Slider::new(&mut slab.center, -reach..=reach).text("centre"));
         ui.add(egui::Slider::new(&mut slab.thickness, (0.005 * reach).max(1e-3)..=reach).text("thickness"));
         self.slab = *slab;
+    }
+
+    /// The anatomy's slices (with `--volume`): each axis's on or off and where it cuts.
+    fn slices_ui(&mut self, ui: &mut Ui) {
+        let (Some((lo, hi)), Some(slices)) = (self.slice_box, &mut self.params.chain.slices) else { return };
+        ui.label("anatomy slices");
+        for (axis, name) in ["x (sagittal)", "y (coronal)", "z (axial)"].into_iter().enumerate() {
+            ui.horizontal(|ui| {
+                let mut on = slices.positions[axis].is_some();
+                ui.checkbox(&mut on, "");
+                let mut at = slices.positions[axis].unwrap_or(0.5 * (lo[axis] + hi[axis]));
+                ui.add_enabled(on, egui::Slider::new(&mut at, lo[axis]..=hi[axis]).text(name));
+                slices.positions[axis] = on.then_some(at);
+            });
+        }
     }
 
     fn color_ui(&mut self, ui: &mut Ui, fields: &[(String, [f32; 2])]) {

@@ -42,6 +42,14 @@ pub fn options(args: &ViewArgs) -> app::Options {
         eprintln!("lineao: {e:#}");
         None
     });
+    // Likewise a volume for the slices (the lines are shown without them).
+    let anatomy = args.volume.as_ref().and_then(|path| match lineao_tracts::Volume::load(path) {
+        Ok(volume) => Some(std::sync::Arc::new(volume)),
+        Err(e) => {
+            eprintln!("lineao: {e}; the tractogram is shown without its slices");
+            None
+        }
+    });
     let preset = args.preset;
     let (methods, compare) = match args.compare {
         Some(pair) => (pair, true),
@@ -70,6 +78,9 @@ pub fn options(args: &ViewArgs) -> app::Options {
     if let Some(slab) = args.slab {
         (controls.slab, controls.params.chain.slab) = (slab, Some(slab));
     }
+    if let Some(volume) = &anatomy {
+        controls.set_anatomy(volume.world_box(), args.slices);
+    }
     app::Options {
         source: Some(source),
         controls,
@@ -77,6 +88,7 @@ pub fn options(args: &ViewArgs) -> app::Options {
         orbit: args.orbit,
         screenshot: args.screenshot.clone().map(|path| (path, args.frames)),
         sampled,
+        anatomy,
     }
 }
 

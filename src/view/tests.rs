@@ -21,6 +21,7 @@ const SIZE: [f32; 2] = [1000.0, 640.0];
 
 fn options(source: Source, methods: [crate::cli::Method; 2], compare: bool) -> Options {
     Options {
+        anatomy: None,
         source: Some(source),
         controls: Controls::new(methods, compare, Preset::Paper),
         orthographic: false,
@@ -445,4 +446,34 @@ fn a_slab_cuts_the_lines_and_the_brackets_move_it() {
     settle(&mut harness);
     let moved = harness.state().shown.as_ref().unwrap().view.panels[0].settings.slab.unwrap();
     assert_eq!(moved.center, 11.5);
+}
+
+#[test]
+fn anatomy_slices_show_with_the_lines_and_each_axis_turns_off() {
+    // `view stroke.trk.gz --volume MNI152_2009_template.nii.gz --slices -,-,10`: the axial slice
+    // under the lines, black around the head (the template's zeros; no line is drawn black).
+    let images = "niivue+niivue/packages/niivue/demos/images";
+    let volume = lineao_tracts::Volume::load(data(&format!("{images}/MNI152_2009_template.nii.gz"))).unwrap();
+    // Without occlusion: the lines' own darkest pixels stay far from black.
+    let mut options =
+        options(Source::File(data(&format!("{images}/stroke.trk.gz"))), [methods()[0], methods()[4]], false);
+    options.controls.set_anatomy(volume.world_box(), Some([None, None, Some(10.0)]));
+    options.anatomy = Some(std::sync::Arc::new(volume));
+    let mut harness = harness(options);
+    settle(&mut harness);
+    let gray = |image: &[u8]| {
+        let pixels = image.chunks_exact(4);
+        let count = pixels.clone().filter(|p| p[..3].iter().all(|&c| c < 8)).count();
+        count as f64 / pixels.len() as f64
+    };
+    let app = harness.state();
+    assert!(app.error.is_none(), "{:?}", app.error);
+    let shown = gray(&app.shown.as_ref().unwrap().images[0]);
+    assert!(shown > 0.05, "{shown} of the pixels black");
+    // Its checkbox off: no slice, no black.
+    harness.state_mut().controls.params.chain.slices.as_mut().unwrap().positions[2] = None;
+    settle(&mut harness);
+    let off = gray(&harness.state().shown.as_ref().unwrap().images[0]);
+    assert!(off < 0.001, "{off} of the pixels black without the slice, {shown} with it");
+    assert!(harness.query_all_by_label_contains("z (axial)").count() > 0, "the axial slider");
 }

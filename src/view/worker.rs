@@ -31,7 +31,7 @@ use lineao::method::raytraced::RayProgress;
 use lineao::passes::lines::VertexAttributes;
 use lineao::timing::PassTime;
 use lineao::volume::VolumeAoOptions;
-use lineao::{AoChain, AoMethod, ChainSettings, Gpu, LineColor, RayScene};
+use lineao::{AoChain, AoMethod, ChainSettings, Gpu, LineColor, RayScene, SliceVolume};
 use lineao_tracts::ViewHint;
 
 use super::loading::{Opening, Preview, Step};
@@ -63,8 +63,9 @@ pub struct View {
 }
 
 pub enum ToWorker {
-    /// Open a source, sampling a volume at its vertices where one is given.
-    Load(Source, Option<Arc<Sampled>>),
+    /// Open a source, sampling a volume at its vertices where one is given, with the anatomy
+    /// its slices show (`--volume`) where one is given.
+    Load(Source, Option<Arc<Sampled>>, Option<Arc<lineao_tracts::Volume>>),
     Render(View),
 }
 
@@ -161,6 +162,8 @@ struct Scene {
 struct PanelChain {
     chain: AoChain,
     scene: Option<u64>,
+    /// The anatomy it was given.
+    anatomy: Option<Arc<SliceVolume>>,
     /// Geometry pixels of the ray-traced picture in progress (counted on its first frame).
     geometry_pixels: usize,
 }
@@ -186,6 +189,8 @@ pub struct Worker {
     continuing: Option<View>,
     /// [`Output::Textures`] with timings: the frame whose GPU times are awaited.
     timing: Option<Timing>,
+    /// The anatomy the slices show, as loaded and on the GPU.
+    anatomy: Option<(Arc<lineao_tracts::Volume>, Arc<SliceVolume>)>,
 }
 
 /// A frame whose GPU times are awaited, and how often its view was rendered again for them.
@@ -214,6 +219,7 @@ impl Worker {
             textures: Vec::new(),
             continuing: None,
             timing: None,
+            anatomy: None,
         }
     }
 
@@ -279,7 +285,23 @@ impl Worker {
         let render =
             pending.iter().rposition(|c| matches!(c, ToWorker::Render(_))).filter(|&r| last_load.is_none_or(|l| r > l));
         if let Some(l) = last_load {
-            let ToWorker::Load(source, sampled) = &pending[l] else { unreachable!() };
+            let ToWorker::Load(source, sampled, anatomy) = &pending[l] else { unreachable!() };
+            let same = match (anatomy, &self.anatomy) {
+                (Some(volume), Some((held, _))) => Arc::ptr_eq(volume, held),
+                (None, None) => true,
+                _ => false,
+            };
+            if !same {
+                self.anatomy = None;
+                if let Some(volume) = anatomy {
+                    let dims = volume.dims.map(|d| d as u32);
+                    let (d, q) = (&gpu.device, &gpu.queue);
+                    match SliceVolume::new(d, q, dims, &volume.values, volume.affine.as_mat4()) {
+                        Ok(slices) => self.anatomy = Some((volume.clone(), Arc::new(slices))),
+                        Err(e) => send(FromWorker::Error(format!("the anatomy's volume: {e}"))),
+                    }
+                }
+            }
             (self.scene, self.continuing, self.opening, self.announced) = (None, None, None, false);
             for panel in &mut self.chains {
                 // The old dataset's BVH is freed now, not when the next one replaces it.
@@ -373,7 +395,8 @@ impl Worker {
         if let (Some(view), Some(scene)) = (view, scene) {
             self.continuing = None;
             let outputs = (self.output, &mut self.textures);
-            match render_frame(gpu, scene, &mut self.chains, outputs, &view, send).await {
+            let anatomy = self.anatomy.as_ref().map(|(_, slices)| slices.clone());
+            match render_frame(gpu, scene, &mut self.chains, outputs, (&view, anatomy), send).await {
                 Ok(frame) => {
                     if self.output == Output::Textures && view.timings {
                         self.timing = Some(Timing { view: view.clone(), repeats, times: Vec::new() });
@@ -474,7 +497,7 @@ async fn render_frame(
     mut scene: SceneRef<'_>,
     chains: &mut Vec<PanelChain>,
     (output, textures): (Output, &mut Vec<lineao::targets::Target>),
-    view: &View,
+    (view, anatomy): (&View, Option<Arc<SliceVolume>>),
     send: &dyn Fn(FromWorker),
 ) -> Result<Frame, String> {
     let start = web_time::Instant::now();
@@ -482,6 +505,10 @@ async fn render_frame(
     let preview = view.preview && scene.lines.geometry.vertices > PREVIEW_VERTICES;
     let size = if preview { ((view.size.0 / 2).max(1), (view.size.1 / 2).max(1)) } else { view.size };
     let bounds = scene.lines.geometry.bounds.expect("checked at load");
+    // The anatomy's slices are framed with the lines.
+    let slices = view.panels.first().and_then(|p| p.settings.slices.as_ref());
+    let slice_bounds = anatomy.as_ref().zip(slices).and_then(|(volume, slices)| volume.slice_bounds(slices));
+    let bounds = slice_bounds.map_or(bounds, |s| bounds.union(&s));
     let format = wgpu::TextureFormat::Rgba8UnormSrgb;
     let readback = output == Output::Readback;
     let target = match output {
@@ -561,7 +588,7 @@ async fn render_frame(
         let traced = settings.method == AoMethod::RayTraced;
         if chains.len() <= i {
             let chain = AoChain::new_async(d, format, settings.clone()).await.map_err(|e| e.to_string())?;
-            chains.push(PanelChain { chain, scene: None, geometry_pixels: 0 });
+            chains.push(PanelChain { chain, scene: None, anatomy: None, geometry_pixels: 0 });
         } else if chains[i].chain.settings() != &settings {
             chains[i].chain.set_settings_async(d, settings).await.map_err(|e| e.to_string())?;
         }
@@ -590,6 +617,15 @@ async fn render_frame(
             }
         }
         let panel = &mut chains[i];
+        let same = match (&anatomy, &panel.anatomy) {
+            (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+            (None, None) => true,
+            _ => false,
+        };
+        if !same {
+            panel.chain.set_slice_volume(d, anatomy.clone());
+            panel.anatomy = anatomy.clone();
+        }
         let chain = &mut panel.chain;
         chain.set_timing(d, q, view.timings);
         chain.resize(size.0, size.1).map_err(|e| e.to_string())?;

@@ -141,6 +141,22 @@ impl Volume {
         self.values[i + self.dims[0] * (j + self.dims[1] * k)]
     }
 
+    /// The axis-aligned box (min, max) in RAS+ mm around the voxel centres.
+    pub fn world_box(&self) -> ([f32; 3], [f32; 3]) {
+        let last = self.dims.map(|d| d.saturating_sub(1) as f64);
+        let (mut lo, mut hi) = (DVec3::INFINITY, DVec3::NEG_INFINITY);
+        for c in 0..8 {
+            let corner = DVec3::new(
+                if c & 1 != 0 { last[0] } else { 0.0 },
+                if c & 2 != 0 { last[1] } else { 0.0 },
+                if c & 4 != 0 { last[2] } else { 0.0 },
+            );
+            let p = self.affine.transform_point3(corner);
+            (lo, hi) = (lo.min(p), hi.max(p));
+        }
+        (lo.as_vec3().to_array(), hi.as_vec3().to_array())
+    }
+
     /// RAS+ mm → voxel coordinates (voxel centres at whole numbers).
     pub fn to_voxel(&self, p: [f32; 3]) -> DVec3 {
         self.to_voxel.transform_point3(DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64))

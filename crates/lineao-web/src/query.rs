@@ -5,8 +5,9 @@
 //! so a link refuses what the command line refuses, with the same words.
 //!
 //! A key without a value is a flag (`?ortho&timings`). What a page cannot do is refused by
-//! name: a positional file (use `url=`), `screenshot`, `frames` and `size` (the page is the
-//! window), and object-space AO (CPU threads, see `lineao_cli::view::controls::WEB_LEAVES_OUT`).
+//! name: a positional file (use `url=`), `volume` and `slices` (a page reads no file by name),
+//! `screenshot`, `frames` and `size` (the page is the window), and object-space AO (CPU
+//! threads, see `lineao_cli::view::controls::WEB_LEAVES_OUT`).
 
 use clap::Parser;
 use lineao_cli::cli::ViewArgs;
@@ -29,7 +30,8 @@ struct PageCli {
 }
 
 /// Keys of `lineao view` that mean nothing in a page.
-const NOT_IN_A_PAGE: [&str; 3] = ["screenshot", "frames", "size"];
+/// `volume` and `slices`: a page reads no file by name (an anatomy from the page is to come).
+const NOT_IN_A_PAGE: [&str; 5] = ["screenshot", "frames", "size", "volume", "slices"];
 
 /// Parses a URL's query string (`search`, with or without its `?`).
 pub fn parse(search: &str) -> Result<PageArgs, String> {
