@@ -227,24 +227,17 @@ impl<'py> Streamlines<'py> {
     }
 }
 
-/// Saves streamlines (points, offsets, lengths) with their fields, groups and voxel space as
-/// `.tck`, `.trk` or `.trx` (by the extension); returns the names of fields the format dropped.
-#[pyfunction]
-#[pyo3(signature = (path, points, offsets, lengths, vertex_fields, streamline_fields, groups, affine=None, dimensions=None, voxel_sizes=None))]
-#[allow(clippy::too_many_arguments)]
-fn save(
+/// A tractogram from Python's arrays: the streamlines gathered in their order, their per-vertex
+/// and per-streamline fields and groups.
+fn tractogram_of(
     py: Python<'_>,
-    path: PathBuf,
     points: &Bound<'_, PyAny>,
     offsets: &Bound<'_, PyAny>,
     lengths: &Bound<'_, PyAny>,
     vertex_fields: &Bound<'_, PyDict>,
     streamline_fields: &Bound<'_, PyDict>,
     groups: &Bound<'_, PyDict>,
-    affine: Option<PyReadonlyArray2<'_, f64>>,
-    dimensions: Option<[u32; 3]>,
-    voxel_sizes: Option<[f32; 3]>,
-) -> PyResult<Vec<String>> {
+) -> PyResult<Tractogram> {
     let lines = Streamlines::extract(points, offsets, lengths)?;
     let (p, o, l) = (lines.points.as_slice()?, lines.offsets.as_slice()?, lines.lengths.as_slice()?);
     let mut t = py.detach(|| Streamlines::gather(p, o, l)).map_err(PyValueError::new_err)?;
@@ -277,6 +270,59 @@ fn save(
         let members: Vec<u32> = members.extract()?;
         t.groups.push(Group { name: name.extract()?, streamlines: members, data: Vec::new() });
     }
+    Ok(t)
+}
+
+/// Which of the streamlines `select`'s `rules` (keywords of `render`'s selection: `subset`,
+/// `subset_seed`, `length`, `field`, `groups`, `include`, `exclude`) keep, one bool each
+/// (`lineao_tracts::Selection::mask`: what `render` draws with the same keywords).
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+fn select<'py>(
+    py: Python<'py>,
+    points: &Bound<'py, PyAny>,
+    offsets: &Bound<'py, PyAny>,
+    lengths: &Bound<'py, PyAny>,
+    streamline_fields: &Bound<'py, PyDict>,
+    groups: &Bound<'py, PyDict>,
+    rules: &Bound<'py, PyDict>,
+) -> PyResult<Bound<'py, numpy::PyArray1<bool>>> {
+    let known = lineao_session::args::SelectArgs::keywords();
+    for key in rules.keys() {
+        let key: String = key.extract()?;
+        if !known.contains(&key) {
+            let message = format!("unexpected keyword argument '{key}'; the rules are: {}", known.join(", "));
+            return Err(PyTypeError::new_err(message));
+        }
+    }
+    let args = parse(rules, None)?;
+    let t = tractogram_of(py, points, offsets, lengths, &PyDict::new(py), streamline_fields, groups)?;
+    let mask = match args.select.selection() {
+        Some(selection) => py.detach(|| selection.mask(&t)).map_err(|e| PyValueError::new_err(e.to_string()))?,
+        None => vec![true; t.streamlines()],
+    };
+    Ok(mask.into_pyarray(py))
+}
+
+/// Saves streamlines (points, offsets, lengths) with their fields, groups and voxel space as
+/// `.tck`, `.trk` or `.trx` (by the extension); returns the names of fields the format dropped.
+#[pyfunction]
+#[pyo3(signature = (path, points, offsets, lengths, vertex_fields, streamline_fields, groups, affine=None, dimensions=None, voxel_sizes=None))]
+#[allow(clippy::too_many_arguments)]
+fn save(
+    py: Python<'_>,
+    path: PathBuf,
+    points: &Bound<'_, PyAny>,
+    offsets: &Bound<'_, PyAny>,
+    lengths: &Bound<'_, PyAny>,
+    vertex_fields: &Bound<'_, PyDict>,
+    streamline_fields: &Bound<'_, PyDict>,
+    groups: &Bound<'_, PyDict>,
+    affine: Option<PyReadonlyArray2<'_, f64>>,
+    dimensions: Option<[u32; 3]>,
+    voxel_sizes: Option<[f32; 3]>,
+) -> PyResult<Vec<String>> {
+    let mut t = tractogram_of(py, points, offsets, lengths, vertex_fields, streamline_fields, groups)?;
     if let (Some(affine), Some(dimensions)) = (affine, dimensions) {
         let a = affine.as_array();
         if a.shape() != [4, 4] {
@@ -569,6 +615,7 @@ fn _lineao(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(info, m)?)?;
     m.add_function(wrap_pyfunction!(sample_volume, m)?)?;
     m.add_function(wrap_pyfunction!(save, m)?)?;
+    m.add_function(wrap_pyfunction!(select, m)?)?;
     m.add_function(wrap_pyfunction!(settings, m)?)?;
     m.add_function(wrap_pyfunction!(methods, m)?)?;
     m.add_function(wrap_pyfunction!(encode_png, m)?)?;

@@ -7,6 +7,7 @@ import subprocess
 
 import nibabel as nib
 import numpy as np
+import pytest
 
 import lineao
 from conftest import DATA
@@ -66,6 +67,20 @@ def test_length_and_regions_select_what_numpy_counts(lineao_bin):
     assert selected(lineao_bin, STROKE, "--include", "sphere:0,-18,10,15", "--exclude", box) == int(
         (in_sphere & ~in_box).sum()
     )
+
+
+def test_select_gives_the_mask_render_draws():
+    t = lineao.load(STROKE)
+    lengths = np.array([np.linalg.norm(np.diff(s, axis=0), axis=1).sum() for s in stroke_streamlines()])
+    keep = lineao.select(t, length=(40, 120))
+    assert keep.dtype == bool and np.array_equal(keep, (lengths >= 40) & (lengths <= 120))
+    both = lineao.select(t, length=(40, 120), include=["sphere:0,-18,10,15"])
+    assert np.array_equal(both, keep & lineao.select(t, include="sphere:0,-18,10,15"))
+    assert lineao.select(t).all()
+    with pytest.raises(TypeError, match="the rules are: subset"):
+        lineao.select(t, includ="sphere:0,0,0,1")
+    with pytest.raises(ValueError, match="no per-streamline field 'fa'"):
+        lineao.select(t, field=("fa", 0, 1))
 
 
 def test_a_field_range_and_a_subset_select_what_numpy_counts(lineao_bin):

@@ -530,6 +530,12 @@ pub struct SelectArgs {
 }
 
 impl SelectArgs {
+    /// Its keywords (the options' ids, as `render` takes them from Python).
+    pub fn keywords() -> Vec<String> {
+        let command = SelectArgs::augment_args(clap::Command::new("select"));
+        command.get_arguments().map(|a| a.get_id().to_string()).collect()
+    }
+
     /// The selection these flags ask for, or none where they keep every streamline.
     pub fn selection(&self) -> Option<std::sync::Arc<lineao_tracts::Selection>> {
         let selection = lineao_tracts::Selection {

@@ -45,6 +45,7 @@ __all__ = [
     "load",
     "methods",
     "render",
+    "select",
     "save",
     "save_png",
     "score",
@@ -176,6 +177,28 @@ def sample_volume(streamlines: Any, path: "os.PathLike[str] | str") -> np.ndarra
     outside the volume — the numbers ``render(..., color="volume:FILE")`` colours by.
     """
     return _lineao.sample_volume(_tractogram(streamlines).points, os.fspath(path))
+
+
+def select(streamlines: Any, **rules: Any) -> np.ndarray:
+    """Which streamlines ``rules`` keep, one bool each — the selection ``render`` draws with the
+    same keywords: ``subset`` (a share, or ``"10%"``) with ``subset_seed``, ``length=(min,
+    max)`` (arc length, mm), ``field=("name", min, max)`` (a per-streamline field),
+    ``groups=[...]`` (any of them), ``include=[...]`` and ``exclude=[...]`` regions
+    (``"sphere:x,y,z,r"``, ``"box:x0,y0,z0,x1,y1,z1"``; kept when some segment passes through
+    every include region and none through an exclude one: mrview's rule). An unknown keyword is
+    a ``TypeError``, a bad value or a field the streamlines lack a ``ValueError``.
+
+    >>> keep = lineao.select(t, length=(40, 200), include="sphere:0,-18,10,15")
+    """
+    t = _tractogram(streamlines)
+    return _lineao.select(
+        t.points,
+        t.offsets,
+        t.lengths,
+        {k: np.ascontiguousarray(v, np.float32) for k, v in t.streamline_fields.items()},
+        {k: np.asarray(v, np.uint32) for k, v in t.groups.items()},
+        rules,
+    )
 
 
 def info(path: "os.PathLike[str] | str") -> dict:
