@@ -371,6 +371,7 @@ impl App {
                     self.controls.set_zoom_unit(dataset.hint.zoom_unit);
                     let distance = glam::Vec3::from(dataset.hint.eye).distance(glam::Vec3::from(dataset.hint.target));
                     self.controls.slab_reach = 0.5 * distance;
+                    self.controls.max_length = dataset.max_length;
                     if let ColorMode::Field(name) = &self.controls.color
                         && !dataset.fields.iter().any(|(f, _)| f == name)
                     {
@@ -436,6 +437,7 @@ impl App {
             preview: self.moving() && dataset.vertices > PREVIEW_VERTICES,
             timings: self.controls.timings,
             scalar_field: field.map(|(name, _)| name.clone()),
+            selection: self.controls.selection(),
         })
     }
 

@@ -144,6 +144,12 @@ pub struct Controls {
     pub slab_reach: f32,
     /// The world box of the anatomy's voxel centres (`--volume`), which its slices' sliders span.
     pub slice_box: Option<([f32; 3], [f32; 3])>,
+    /// The share of the streamlines shown (1: all), drawn at random but the same ones for a share.
+    pub subset: f32,
+    /// The arc length range shown (world units), or all.
+    pub length: Option<[f32; 2]>,
+    /// The dataset's longest streamline, which the length sliders reach.
+    pub max_length: f32,
 }
 
 impl Controls {
@@ -166,6 +172,18 @@ impl Controls {
             slab: Slab { axis: SlabAxis::Z, center: 0.0, thickness: 10.0 },
             slab_reach: 100.0,
             slice_box: None,
+            subset: 1.0,
+            length: None,
+            max_length: 0.0,
+        }
+    }
+
+    /// The streamlines shown: [`Controls::subset`] and [`Controls::length`].
+    pub fn selection(&self) -> lineao_tracts::Selection {
+        lineao_tracts::Selection {
+            subset: (self.subset < 1.0).then_some((self.subset as f64, 0)),
+            length: self.length,
+            ..Default::default()
         }
     }
 
@@ -288,6 +306,7 @@ impl Controls {
         ui.add(egui::Slider::new(&mut self.light_elevation, -89.0..=89.0).text("light elevation (°)"));
         self.slab_ui(ui);
         self.slices_ui(ui);
+        self.selection_ui(ui);
         ui.separator();
 
         ui.heading("Parameters");
@@ -387,6 +406,23 @@ impl Controls {
         ui.add(egui::Slider::new(&mut slab.center, -reach..=reach).text("centre"));
         ui.add(egui::Slider::new(&mut slab.thickness, (0.005 * reach).max(1e-3)..=reach).text("thickness"));
         self.slab = *slab;
+    }
+
+    /// The streamlines shown: a random share, a length range (the GPU selects: no upload).
+    fn selection_ui(&mut self, ui: &mut Ui) {
+        let mut percent = 100.0 * self.subset;
+        ui.add(egui::Slider::new(&mut percent, 1.0..=100.0).text("% of streamlines").logarithmic(true))
+            .on_hover_text("a random share, the same streamlines for the same share");
+        self.subset = percent / 100.0;
+        let max = self.max_length.max(1.0);
+        let mut on = self.length.is_some();
+        ui.checkbox(&mut on, "by length").on_hover_text("only the streamlines whose arc length lies in the range");
+        self.length = on.then(|| {
+            let [mut lo, mut hi] = self.length.unwrap_or([0.0, max]);
+            ui.add(egui::Slider::new(&mut lo, 0.0..=max).text("shortest"));
+            ui.add(egui::Slider::new(&mut hi, 0.0..=max).text("longest"));
+            [lo, hi.max(lo)]
+        });
     }
 
     /// The anatomy's slices (with `--volume`): each axis's on or off and where it cuts.

@@ -99,6 +99,8 @@ pub struct Opening {
     pub held: bool,
     /// Never built while the data arrives (the ray tracer waits for all of it).
     rays: Option<Arc<lineao::RayScene>>,
+    /// The selection on the GPU so far (`worker::SceneRef::selected`).
+    selected: Option<(lineao_tracts::Selection, usize)>,
     pub started: Instant,
     /// Bytes read of how many (files), for the progress bar.
     pub progress: (u64, Option<u64>),
@@ -117,7 +119,8 @@ impl Opening {
     /// every vertex as a field.
     pub fn start(source: Source, sampled: Option<Arc<Sampled>>, gpu: &Gpu) -> Result<Opening, String> {
         let error = |e: SourceError| format!("{e:#}");
-        let keep = Keep { fields: true, sampled, ..Keep::default() };
+        // The lengths: the side panel selects by them.
+        let keep = Keep { fields: true, sampled, lengths: true, ..Keep::default() };
         let lines = Lines::empty(source.name(), &keep, gpu).map_err(error)?;
         let chunks: Arc<Mutex<VecDeque<Tractogram>>> = Arc::default();
         let sink = {
@@ -182,6 +185,7 @@ impl Opening {
             first_ms: None,
             held: true,
             rays: None,
+            selected: None,
             started: Instant::now(),
             progress: (0, None),
         })
@@ -266,6 +270,7 @@ impl Opening {
             rays: &mut self.rays,
             source: &self.source,
             opening: true,
+            selected: &mut self.selected,
         }
     }
 

@@ -477,3 +477,30 @@ fn anatomy_slices_show_with_the_lines_and_each_axis_turns_off() {
     assert!(off < 0.001, "{off} of the pixels black without the slice, {shown} with it");
     assert!(harness.query_all_by_label_contains("z (axial)").count() > 0, "the axial slider");
 }
+
+#[test]
+fn a_share_and_a_length_range_select_streamlines_on_the_gpu() {
+    let path = data("niivue+niivue/packages/niivue/demos/images/stroke.trk.gz");
+    let mut harness = harness(options(Source::File(path), [methods()[0], methods()[4]], false));
+    settle(&mut harness);
+    let drawn = |harness: &Harness<'_, App>| non_background(&harness.state().shown.as_ref().unwrap().images[0]);
+    let all = drawn(&harness);
+    let max_length = harness.state().dataset.as_ref().unwrap().max_length;
+    assert!(max_length > 100.0, "the longest of stroke.trk.gz's streamlines: {max_length} mm");
+    // A hundredth of the streamlines (of these short, dense ones 5 % still cover 60 % of the
+    // pixels all of them cover).
+    harness.state_mut().controls.subset = 0.01;
+    settle(&mut harness);
+    let share = drawn(&harness);
+    assert!(share > 0.002 && share < 0.4 * all, "{share} of the pixels with 1 % of the streamlines, {all} with all");
+    // All of them again (but for a level of detail chosen another frame), then only the
+    // longest: a streamline or two.
+    harness.state_mut().controls.subset = 1.0;
+    settle(&mut harness);
+    assert!((drawn(&harness) - all).abs() < 1e-3, "{} of the pixels, {all} before", drawn(&harness));
+    harness.state_mut().controls.length = Some([0.99 * max_length, max_length]);
+    settle(&mut harness);
+    let longest = drawn(&harness);
+    assert!(longest > 0.0 && longest < 0.01, "{longest} of the pixels for the longest streamlines");
+    assert!(harness.query_all_by_label_contains("% of streamlines").count() > 0);
+}

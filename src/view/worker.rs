@@ -60,6 +60,9 @@ pub struct View {
     pub timings: bool,
     /// The per-vertex field colored by [`LineColor::Scalar`], if any.
     pub scalar_field: Option<String>,
+    /// The streamlines shown: the subset and length rules (`lineao_tracts::Selection`), which
+    /// the lengths kept on the CPU decide.
+    pub selection: lineao_tracts::Selection,
 }
 
 pub enum ToWorker {
@@ -84,6 +87,8 @@ pub struct Dataset {
     pub hint: ViewHint,
     /// One-column per-vertex fields, with their 2nd–98th percentile ranges.
     pub fields: Vec<(String, [f32; 2])>,
+    /// The longest streamline's arc length (world units).
+    pub max_length: f32,
     /// Milliseconds to the first picture's data on the GPU, and to all of it.
     pub first_ms: f64,
     pub load_ms: f64,
@@ -156,6 +161,8 @@ struct Scene {
     rays: Option<Arc<RayScene>>,
     /// Where the lines came from: read again for their points where a method needs them.
     source: Source,
+    /// The selection on the GPU ([`SceneRef::selected`]).
+    selected: Option<(lineao_tracts::Selection, usize)>,
 }
 
 /// A panel's chain, the ray scene it was given (its generation) and its geometry pixels.
@@ -346,7 +353,7 @@ impl Worker {
                     let opening = self.opening.take().expect("opening");
                     send(FromWorker::Loaded(dataset(&opening.lines, &opening, true)));
                     let (lines, preview, source) = opening.into_parts();
-                    self.scene = Some(Scene { lines, preview, rays: None, source });
+                    self.scene = Some(Scene { lines, preview, rays: None, source, selected: None });
                     more = true;
                 }
                 Err(e) => {
@@ -358,7 +365,7 @@ impl Worker {
                         let _ = opening.flush(gpu);
                         send(FromWorker::Loaded(dataset(&opening.lines, &opening, false)));
                         let (lines, preview, source) = opening.into_parts();
-                        self.scene = Some(Scene { lines, preview, rays: None, source });
+                        self.scene = Some(Scene { lines, preview, rays: None, source, selected: None });
                     }
                     send(FromWorker::Error(e));
                 }
@@ -388,6 +395,7 @@ impl Worker {
                 rays: &mut scene.rays,
                 source: &scene.source,
                 opening: false,
+                selected: &mut scene.selected,
             }),
             (None, Some(opening)) if opening.drawn() => Some(opening.scene()),
             _ => None,
@@ -477,6 +485,7 @@ fn dataset(lines: &Lines, opening: &Opening, complete: bool) -> Dataset {
         readable: opening.held,
         hint,
         fields,
+        max_length: lines.lengths.iter().copied().fold(0.0, f32::max),
         first_ms: opening.first_ms().unwrap_or(elapsed),
         load_ms: elapsed,
     }
@@ -490,6 +499,34 @@ pub(super) struct SceneRef<'a> {
     pub source: &'a Source,
     /// Still arriving: what needs every point on the CPU waits until it is all there.
     pub opening: bool,
+    /// The selection last written to the GPU, and the streamlines there were then.
+    pub selected: &'a mut Option<(lineao_tracts::Selection, usize)>,
+}
+
+/// Selects on the GPU (full detail and preview) what `selection` keeps, where it or the
+/// streamlines changed since the scene was last selected: a bit per cluster, no geometry.
+fn select(gpu: &Gpu, scene: &mut SceneRef<'_>, selection: &lineao_tracts::Selection) -> Result<(), String> {
+    let lines = &mut *scene.lines;
+    let count = lines.lengths.len();
+    if scene.selected.as_ref().is_some_and(|(s, n)| s == selection && *n == count) {
+        return Ok(());
+    }
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let error = |e: lineao::Error| format!("{}: {e}", lines.name);
+    if selection.is_everything() {
+        lines.geometry.set_selection(d, q, None).map_err(error)?;
+        scene.preview.geometry.set_selection(d, q, None).map_err(error)?;
+    } else if count == lines.geometry.streamlines {
+        let keep: Vec<bool> = lines.lengths.iter().enumerate().map(|(i, &l)| selection.keeps(i as u64, l)).collect();
+        lines.geometry.set_selection(d, q, Some(&keep)).map_err(error)?;
+        // The preview holds every k-th streamline.
+        let shown = scene.preview.geometry.streamlines;
+        let every = count.div_ceil(shown.max(1)).max(1);
+        let preview: Vec<bool> = (0..shown).map(|j| keep.get(j * every).copied().unwrap_or(true)).collect();
+        scene.preview.geometry.set_selection(d, q, Some(&preview)).map_err(error)?;
+    }
+    *scene.selected = Some((selection.clone(), count));
+    Ok(())
 }
 
 async fn render_frame(
@@ -505,6 +542,7 @@ async fn render_frame(
     let preview = view.preview && scene.lines.geometry.vertices > PREVIEW_VERTICES;
     let size = if preview { ((view.size.0 / 2).max(1), (view.size.1 / 2).max(1)) } else { view.size };
     let bounds = scene.lines.geometry.bounds.expect("checked at load");
+    select(gpu, &mut scene, &view.selection)?;
     // The anatomy's slices are framed with the lines.
     let slices = view.panels.first().and_then(|p| p.settings.slices.as_ref());
     let slice_bounds = anatomy.as_ref().zip(slices).and_then(|(volume, slices)| volume.slice_bounds(slices));

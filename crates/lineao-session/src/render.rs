@@ -279,6 +279,7 @@ impl Session {
             fields: false,
             sampled,
             selection: args.select.selection(),
+            lengths: false,
         };
         let bar = match &source {
             Source::File(path) => crate::source::progress_bar(path),

@@ -438,6 +438,8 @@ pub struct Lines {
     held: AttributeKey,
     /// With a selection, whether each streamline is shown (what has arrived so far).
     pub selected: Option<Vec<bool>>,
+    /// With [`Keep::lengths`], every streamline's arc length (what has arrived so far).
+    pub lengths: Vec<f32>,
 }
 
 /// What a stream keeps on the CPU beside the GPU's geometry.
@@ -457,6 +459,8 @@ pub struct Keep {
     /// The streamlines shown (`--subset`, `--length`, `--include`, …), judged as they arrive;
     /// the others stay on the GPU, selected out.
     pub selection: Option<std::sync::Arc<lineao_tracts::Selection>>,
+    /// Every streamline's arc length (4 bytes a streamline: a viewer selects by it).
+    pub lengths: bool,
 }
 
 /// A volume sampled at every vertex of a tractogram: a per-vertex field named `field`
@@ -498,6 +502,7 @@ impl Lines {
             volumes: VolumeCache::default(),
             held: AttributeKey::default(),
             selected: None,
+            lengths: Vec::new(),
         })
     }
 
@@ -546,6 +551,7 @@ impl Lines {
             volumes: VolumeCache::default(),
             held: AttributeKey { scalar: keep.scalar.clone(), radius: keep.radius.clone(), volume: None },
             selected: None,
+            lengths: Vec::new(),
         })
     }
 
@@ -570,6 +576,10 @@ impl Lines {
                 .chunk(&chunk, first)
                 .map_err(|source| SourceError::Selection { name: name.clone(), source })?;
             self.selected.get_or_insert_default().extend(chunk_selected);
+        }
+        if self.keep.lengths {
+            let lines = chunk.offsets.windows(2).map(|w| &chunk.positions[w[0] as usize..w[1] as usize]);
+            self.lengths.extend(lines.map(lineao_tracts::selection::arc_length));
         }
         let values = |field: &Option<String>| field.as_deref().map(|f| vertex_field(name, &chunk, f)).transpose();
         let attributes =

@@ -99,6 +99,12 @@ impl Selection {
         *self == Selection::default()
     }
 
+    /// Whether the rules that a streamline's index in its file and its arc length decide (the
+    /// subset, the length range) keep it: what a viewer that keeps only the lengths can change.
+    pub fn keeps(&self, index: u64, length: f32) -> bool {
+        self.in_subset(index) && self.length.is_none_or(|[lo, hi]| (lo..=hi).contains(&length))
+    }
+
     /// Whether streamline `index` (of its file) is in the subset.
     fn in_subset(&self, index: u64) -> bool {
         let Some((share, seed)) = self.subset else { return true };
@@ -123,8 +129,7 @@ impl Selection {
         Ok((0..chunk.streamlines())
             .map(|i| {
                 let points = &chunk.positions[chunk.offsets[i] as usize..chunk.offsets[i + 1] as usize];
-                self.in_subset(first + i as u64)
-                    && self.length.is_none_or(|[lo, hi]| (lo..=hi).contains(&arc_length(points)))
+                self.keeps(first + i as u64, arc_length(points))
                     && field.as_ref().is_none_or(|(values, [lo, hi])| (*lo..=*hi).contains(&values[i]))
                     && self.include.iter().all(|r| r.meets_polyline(points))
                     && !self.exclude.iter().any(|r| r.meets_polyline(points))

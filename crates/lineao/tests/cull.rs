@@ -358,3 +358,29 @@ fn a_selection_draws_what_the_selected_streamlines_alone_draw() {
     // A selection of the wrong length is refused.
     assert!(masked.set_selection(d, q, Some(&[true; 3])).is_err());
 }
+
+#[test]
+fn a_selection_changed_between_culled_frames_draws_at_once() {
+    let gpu = gpu();
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let (positions, offsets) = ball(600);
+    // Appended in three chunks, as a file streams in.
+    let mut geometry = LineGeometry::empty(d, Default::default()).unwrap();
+    for first in (0..600).step_by(200) {
+        let (a, b) = (offsets[first], offsets[first + 200]);
+        let local: Vec<u64> = offsets[first..=first + 200].iter().map(|o| o - a).collect();
+        geometry.append(d, q, &positions[a as usize..b as usize], &local).unwrap();
+    }
+    geometry.finish(d, q).unwrap();
+    for lod in [false, true] {
+        let culled = LineRenderer::new(d).culled(d, lod);
+        geometry.set_selection(d, q, None).unwrap();
+        draw(&gpu, &culled, &geometry, &outside());
+        let before = draw(&gpu, &culled, &geometry, &outside());
+        assert!(before[1].data.iter().any(|&nd| is_geometry(nd)));
+        geometry.set_selection(d, q, Some(&[false; 600])).unwrap();
+        let after = draw(&gpu, &culled, &geometry, &outside());
+        let left = after[1].data.iter().filter(|&&nd| is_geometry(nd)).count();
+        assert_eq!(left, 0, "lod {lod}: {left} pixels of streamlines selected out");
+    }
+}
