@@ -116,3 +116,36 @@ fn a_slab_leaves_no_line_outside_it() {
     let (session, chain) = render(&images("stroke.trk.gz"), serde_json::json!({"slab": "x,500,2", "method": "none"}));
     assert!(geometry_points(&session, &chain).is_empty());
 }
+
+#[test]
+fn groups_colour_their_streamlines_a_colour_each() {
+    // pyAFQ's arcuate bundles: 486 streamlines in ARC_L, 22 in ARC_R (FACTS.txt).
+    let afq = images("sub-01_ses-01_dwi_space-RASMM_model-probCSD_algo-AFQ_tractography.trx");
+    let table = lineao::Colormap::Categories.table();
+    let colours = |keywords: serde_json::Value| {
+        let (session, chain) = render(&afq, keywords);
+        let gpu = &session.gpu;
+        let color = read_texture(&gpu.device, &gpu.queue, &chain.targets().unwrap().color.texture).unwrap().to_vec4();
+        let mut counts = [0usize; 3];
+        for (i, _) in geometry_points(&session, &chain) {
+            let c = color[i];
+            let near = |k: usize| (0..3).all(|a| (c[a] - table[k][a]).abs() < 2e-3);
+            counts[if near(0) {
+                0
+            } else if near(1) {
+                1
+            } else {
+                2
+            }] += 1;
+        }
+        counts
+    };
+    let base = serde_json::json!({"color": "groups", "method": "none", "width": 320, "height": 256});
+    let [left, right, other] = colours(base.clone());
+    assert!(left > 10 * right && right > 50 && other == 0, "ARC_L {left}, ARC_R {right}, else {other} pixels");
+    // ARC_R alone: its colour only.
+    let mut only_right = base;
+    only_right["groups"] = "ARC_R".into();
+    let [left, right, other] = colours(only_right);
+    assert!(left == 0 && right > 50 && other == 0, "ARC_L {left}, ARC_R {right}, else {other} pixels");
+}

@@ -442,7 +442,7 @@ pub struct StyleArgs {
     /// Line color: `tangent` (|T| as RGB), R,G,B in [0, 1], `field:NAME` (the file's
     /// per-vertex field NAME, or per-streamline one over its vertices, through --colormap, its 2nd to 98th percentile spanning the map), or
     /// `volume:FILE` (a NIfTI volume sampled at every vertex, trilinear between voxel centres;
-    /// gray outside it).
+    /// gray outside it), or `groups` (TRX groups, a colour each; gray outside every group).
     #[arg(long, default_value = "tangent", value_parser = parse_color)]
     #[serde(deserialize_with = "crate::kwargs::color")]
     pub color: ColorArg,
@@ -873,7 +873,7 @@ defaults_from_render_args! {
     truth: TruthArgs,
 }
 
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum ColorArg {
     Tangent,
     Constant([f32; 3]),
@@ -881,7 +881,13 @@ pub enum ColorArg {
     Field(String),
     /// A NIfTI volume sampled at every vertex (trilinear, NaN outside: gray) through --colormap.
     Volume(std::path::PathBuf),
+    /// Each streamline by its (first) group, a colour each; gray outside every group.
+    Groups,
 }
+
+/// The per-vertex field `--color groups` colours by: each vertex's streamline's first group
+/// (its index among the file's groups, modulo 16), NaN outside every group.
+pub const GROUP_FIELD: &str = "groups:";
 
 impl ColorArg {
     /// The per-vertex field it colours by: the file's, or the volume's samples (named
@@ -890,6 +896,7 @@ impl ColorArg {
         match self {
             ColorArg::Field(name) => Some(name.clone()),
             ColorArg::Volume(path) => Some(format!("volume:{}", path.display())),
+            ColorArg::Groups => Some(GROUP_FIELD.to_string()),
             _ => None,
         }
     }
@@ -962,6 +969,7 @@ pub fn parse_color(s: &str) -> Result<ColorArg, String> {
     match s.strip_prefix("field:") {
         Some(name) if !name.is_empty() => Ok(ColorArg::Field(name.to_string())),
         _ if s == "tangent" => Ok(ColorArg::Tangent),
+        _ if s == "groups" => Ok(ColorArg::Groups),
         _ => parse_vec3(s).map(ColorArg::Constant),
     }
 }

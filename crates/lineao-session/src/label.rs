@@ -102,6 +102,32 @@ impl Rgba8 {
     }
 }
 
+impl Rgba8 {
+    /// The colours of `--color groups`, bottom left: a swatch and a name per group (the first
+    /// 16; a group k shares the colour of k mod 16), "no group" in gray.
+    pub fn group_legend(&mut self, names: &[&str]) {
+        let scale = self.label_scale() as i64;
+        let row = 14 * scale;
+        let shown = names.len().min(lineao::COLORMAP_ENTRIES);
+        let margin = 8 * scale;
+        let top = self.height as i64 - margin - row * (shown as i64 + 1);
+        let table = lineao::Colormap::Categories.table();
+        let swatch = |image: &mut Rgba8, y: i64, rgb: [f32; 3]| {
+            let [r, g, b] = rgb.map(srgb8);
+            image.fill(margin, y + 2 * scale, row - 4 * scale, row - 4 * scale, [r, g, b, 255]);
+        };
+        for (k, name) in names.iter().take(shown).enumerate() {
+            let y = top + k as i64 * row;
+            swatch(self, y, [table[k][0], table[k][1], table[k][2]]);
+            self.label(name, margin + row, y, false);
+        }
+        let y = top + shown as i64 * row;
+        // The shaders' colour for NaN: 50 % gray, linear.
+        swatch(self, y, [0.5; 3]);
+        self.label("no group", margin + row, y, false);
+    }
+}
+
 /// A linear RGB channel (clamped to [0, 1]) as an sRGB byte.
 pub fn srgb8(c: f32) -> u8 {
     let c = c.clamp(0.0, 1.0);

@@ -128,6 +128,11 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky, lon
             ColorArg::Field(_) | ColorArg::Volume(_) => {
                 LineColor::Scalar { colormap: args.style.colormap, range: [0.0, 1.0] }
             }
+            // A colour each, whatever --colormap says.
+            ColorArg::Groups => {
+                let last = (lineao::COLORMAP_ENTRIES - 1) as f32;
+                LineColor::Scalar { colormap: lineao::Colormap::Categories, range: [0.0, last] }
+            }
         },
         background: args.style.background,
         strength: 1.0,
@@ -272,9 +277,11 @@ impl Session {
         let base = base_attributes(args);
         let gpu = Gpu::headless()?;
         let sampled = Sampled::of(&args.style.color)?;
+        // The groups' colours are known once the file is read (its groups come last).
+        let groups = args.style.color == ColorArg::Groups;
         let keep = Keep {
-            points,
-            scalar: base.scalar.clone(),
+            points: points || groups,
+            scalar: base.scalar.clone().filter(|_| !groups),
             radius: base.radius.clone(),
             fields: false,
             sampled,
@@ -295,7 +302,14 @@ impl Session {
         if let Some(bar) = &bar {
             bar.finish_and_clear();
         }
-        Self::assemble(args, lines?, surfaces, base, gpu)
+        let mut lines = lines?;
+        if groups {
+            let values = lines.tracts.group_indices(lineao::COLORMAP_ENTRIES);
+            let field = lineao_tracts::Field { name: crate::args::GROUP_FIELD.into(), columns: 1, values };
+            lines.tracts.vertex_fields.push(field);
+            lines.hold((&gpu.device, &gpu.queue), &base, || {})?;
+        }
+        Self::assemble(args, lines, surfaces, base, gpu)
     }
 
     /// [`Session::open`] on streamlines already in memory (the Python package's).
@@ -304,6 +318,11 @@ impl Session {
         let base = base_attributes(args);
         if let Some(sampled) = Sampled::of(&args.style.color)? {
             sampled.add_to(&mut loaded.tracts);
+        }
+        if args.style.color == ColorArg::Groups {
+            let values = loaded.tracts.group_indices(lineao::COLORMAP_ENTRIES);
+            let field = lineao_tracts::Field { name: crate::args::GROUP_FIELD.into(), columns: 1, values };
+            loaded.tracts.vertex_fields.push(field);
         }
         for field in base.scalar.iter().chain(&base.radius) {
             loaded.tracts.spread_streamline_field(field);
@@ -368,6 +387,9 @@ impl Session {
 
     /// The colour range from the data, and the slices placed in the volume.
     fn fit_color_range(&self, settings: &mut ChainSettings) {
+        if self.base.scalar.as_deref() == Some(crate::args::GROUP_FIELD) {
+            return;
+        }
         if let (Some(volume), Some(slices)) = (&self.anatomy, settings.slices.take()) {
             settings.slices = Some(fit_slices(volume, slices));
         }
@@ -477,7 +499,13 @@ impl Session {
                 ColorArg::Volume(path) => path.file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned()),
                 _ => String::new(),
             };
-            image.legend(&title, colormap, range);
+            match args.style.color {
+                ColorArg::Groups => {
+                    let names: Vec<&str> = self.lines.tracts.groups.iter().map(|g| g.name.as_str()).collect();
+                    image.group_legend(&names);
+                }
+                _ => image.legend(&title, colormap, range),
+            }
         }
         Ok((image, panels))
     }

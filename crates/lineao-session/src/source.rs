@@ -531,6 +531,9 @@ impl Lines {
         let (hint, groups) = streamed?;
         lines.finish(hint, on)?;
         lines.apply_selection(&groups, on)?;
+        if lines.points_kept {
+            lines.tracts.groups = groups;
+        }
         Ok(lines)
     }
 

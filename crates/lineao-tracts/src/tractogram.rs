@@ -152,6 +152,20 @@ impl Tractogram {
         true
     }
 
+    /// Per vertex, the index among [`Tractogram::groups`] of its streamline's first group
+    /// (modulo `colors`: what a palette of that many colours shows), NaN outside every group.
+    pub fn group_indices(&self, colors: usize) -> Vec<f32> {
+        let mut first = vec![f32::NAN; self.streamlines()];
+        for (k, group) in self.groups.iter().enumerate().rev() {
+            for &s in &group.streamlines {
+                if let Some(slot) = first.get_mut(s as usize) {
+                    *slot = (k % colors.max(1)) as f32;
+                }
+            }
+        }
+        self.offsets.windows(2).zip(first).flat_map(|(w, v)| std::iter::repeat_n(v, (w[1] - w[0]) as usize)).collect()
+    }
+
     /// The streamlines `keep` marks (one entry per streamline), with their per-vertex and
     /// per-streamline fields; groups and the voxel grid are left out (their indices would not
     /// hold).

@@ -7,6 +7,7 @@ named!(Colormap {
     Viridis => "Perceptually uniform, dark blue to yellow",
     Gray => "Black to white",
     CoolWarm => "Moreland's diverging blue–white–red",
+    Categories => "Sixteen distinct colours for whole numbers 0–15 over the range [0, 15] (TRX groups)",
 });
 
 /// Colormaps for [`LineColor::Scalar`](crate::LineColor::Scalar), perceptually ordered where it matters.
@@ -20,16 +21,20 @@ pub enum Colormap {
     Gray,
     /// Blue through white to red (Moreland's diverging map), for signed values.
     CoolWarm,
+    /// Sixteen distinct colours (Tableau's 10, then 6 of its lighter 20), one per table entry:
+    /// over the range [0, 15] the whole number k takes colour k exactly (`--color groups`).
+    Categories,
 }
 
 impl Colormap {
-    pub const ALL: [Colormap; 3] = [Colormap::Viridis, Colormap::Gray, Colormap::CoolWarm];
+    pub const ALL: [Colormap; 4] = [Colormap::Viridis, Colormap::Gray, Colormap::CoolWarm, Colormap::Categories];
 
     pub fn name(self) -> &'static str {
         match self {
             Colormap::Viridis => "viridis",
             Colormap::Gray => "gray",
             Colormap::CoolWarm => "coolwarm",
+            Colormap::Categories => "categories",
         }
     }
 
@@ -53,6 +58,25 @@ impl Colormap {
             ],
             Colormap::Gray => &[[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]],
             Colormap::CoolWarm => &[[0.230, 0.299, 0.754], [0.865, 0.865, 0.865], [0.706, 0.016, 0.150]],
+            // As many control points as table entries, so that entry k is point k.
+            Colormap::Categories => &[
+                [0.122, 0.467, 0.706],
+                [1.000, 0.498, 0.055],
+                [0.173, 0.627, 0.173],
+                [0.839, 0.153, 0.157],
+                [0.580, 0.404, 0.741],
+                [0.549, 0.337, 0.294],
+                [0.890, 0.467, 0.761],
+                [0.498, 0.498, 0.498],
+                [0.737, 0.741, 0.133],
+                [0.090, 0.745, 0.812],
+                [0.682, 0.780, 0.910],
+                [1.000, 0.733, 0.471],
+                [0.596, 0.875, 0.541],
+                [1.000, 0.596, 0.588],
+                [0.773, 0.690, 0.835],
+                [0.769, 0.612, 0.580],
+            ],
         }
     }
 
@@ -78,3 +102,21 @@ impl Colormap {
 
 /// Entries of a colormap's table in the geometry passes' uniform.
 pub const COLORMAP_ENTRIES: usize = 16;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_category_is_its_own_table_entry() {
+        let table = Colormap::Categories.table();
+        let points = Colormap::Categories.control_points();
+        assert_eq!(points.len(), COLORMAP_ENTRIES);
+        for (entry, point) in table.iter().zip(points) {
+            let expected = point.map(|c| if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) });
+            for c in 0..3 {
+                assert!((entry[c] - expected[c]).abs() < 1e-6, "{entry:?} against {expected:?}");
+            }
+        }
+    }
+}

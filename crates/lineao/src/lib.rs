@@ -105,7 +105,7 @@ pub use wgpu;
 // What an embedding needs first, at the root.
 pub use camera::{Bounds, Camera, FrameView, Projection};
 pub use chain::{AoChain, HostAo, OverlayAo};
-pub use colormap::Colormap;
+pub use colormap::{COLORMAP_ENTRIES, Colormap};
 pub use gpu::{Gpu, check_adapter};
 pub use line_geometry::LineGeometry;
 pub use method::AoMethod;
