@@ -326,6 +326,7 @@ fn bench_json_is_the_contract() {
         "bvh-build-1m",
         "raytraced-cpu-64",
         "bvh-upload",
+        "select",
         "toy",
     ];
     expected.sort_unstable();
@@ -342,9 +343,16 @@ fn bench_json_is_the_contract() {
         "{pieces} of the pieces in {culled} of the clusters"
     );
     for p in passes {
-        let cpu_pass =
-            ["density-256", "sweep-256", "variance-volume-256", "bvh-build-1m", "raytraced-cpu-64", "bvh-upload"]
-                .contains(&p["name"].as_str().unwrap());
+        let cpu_pass = [
+            "density-256",
+            "sweep-256",
+            "variance-volume-256",
+            "bvh-build-1m",
+            "raytraced-cpu-64",
+            "bvh-upload",
+            "select",
+        ]
+        .contains(&p["name"].as_str().unwrap());
         assert_eq!(p["on"], if cpu_pass { "cpu" } else { on });
         let ms = |k: &str| p[k].as_f64().unwrap();
         assert!(0.0 <= ms("ms_min") && ms("ms_min") <= ms("ms_median") && ms("ms_median") <= ms("ms_max"), "{p}");
@@ -669,7 +677,7 @@ fn truth_options_are_checked() {
         (&["render", "--delta-scale", "x"], "invalid value"),
         // The library's own names, listed from it (lineao::Named).
         (&["render", "--variant", "authors"], "[possible values: paper, reference]"),
-        (&["render", "--colormap", "jet"], "[possible values: viridis, gray, coolwarm]"),
+        (&["render", "--colormap", "jet"], "[possible values: viridis, gray, coolwarm, categories]"),
         (&["render", "--ao-falloff", "cubic"], "[possible values: none, linear]"),
     ] {
         let out = lineao(bad);

@@ -482,7 +482,7 @@ impl LineGeometry {
             return Ok(());
         };
         let center = (lo + hi) * 0.5;
-        let radius = farthest::distance(device, queue, &self.pages, center).await?;
+        let radius = compute::distance(device, queue, &self.pages, center).await?;
         self.bounds = Some(Bounds { center, radius: radius.max(1e-6) });
         Ok(())
     }
@@ -627,6 +627,7 @@ impl LineGeometry {
             )));
         }
         self.flush(device, queue)?;
+        let pass = compute::Select::new(device);
         for page in &self.pages {
             let mut words = vec![0u32; page.streamlines.len().div_ceil(32).max(1)];
             if let Some(selected) = selected {
@@ -634,7 +635,7 @@ impl LineGeometry {
                     words[i / 32] |= (!selected[s as usize] as u32) << (i % 32);
                 }
             }
-            farthest::select(device, queue, page, &words);
+            pass.run(device, queue, page, &words);
         }
         self.selected = selected.map_or(self.streamlines, |s| s.iter().filter(|&&k| k).count());
         settle(device, queue, self.options.bounded_staging)
@@ -686,7 +687,7 @@ impl LineGeometry {
     pub fn decoded_points(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Vec<(u64, [f32; 3])>, Error> {
         let mut out = Vec::with_capacity(self.points());
         for page in &self.pages {
-            let decoded = farthest::decode(device, queue, page)?;
+            let decoded = compute::decode(device, queue, page)?;
             for run in &page.runs {
                 for k in 0..run.len {
                     out.push((run.input + k as u64, decoded[(run.first + k) as usize]));
@@ -716,7 +717,7 @@ impl LineGeometry {
                     .collect();
                 Ok(crate::reference::cull::PageContents {
                     records,
-                    points: farthest::decode(device, queue, page)?,
+                    points: compute::decode(device, queue, page)?,
                     groups,
                 })
             })
@@ -775,7 +776,7 @@ fn settle(device: &wgpu::Device, queue: &wgpu::Queue, bounded_staging: bool) -> 
 /// bounding sphere of [`LineGeometry::finish`]), the selection written into the records
 /// ([`LineGeometry::set_selection`]) and, for the tests, every point decoded
 /// (`shaders/line_geometry.wgsl`).
-mod farthest {
+mod compute {
     use super::Page;
     use crate::Error;
     use glam::Vec3;
@@ -849,41 +850,53 @@ mod farthest {
         queue.submit([encoder.finish()]);
     }
 
-    /// Marks the records of `page` whose bit in `deselected` is set (record i: word i / 32,
-    /// bit i % 32) with `flags::DESELECTED` and clears the others' (`select_clusters`).
-    pub fn select(device: &wgpu::Device, queue: &wgpu::Queue, page: &Page, deselected: &[u32]) {
-        use crate::binding::Slot;
-        use wgpu::util::DeviceExt;
-        let label = "lineao::LineGeometry::select";
-        let layout = crate::binding::layout(
-            device,
-            label,
-            wgpu::ShaderStages::COMPUTE,
-            &[Slot::Uniform, Slot::StorageReadWrite, Slot::Storage],
-        );
-        let pipeline =
-            crate::binding::compute_pipeline(device, label, &layout, "line_geometry.wgsl", "select_clusters", &[]);
-        let params = Params { center: [0.0; 3], clusters: page.records };
-        let init = |contents: &[u8], usage| {
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
-        };
-        let uniform = init(bytemuck::bytes_of(&params), wgpu::BufferUsages::UNIFORM);
-        let mask = init(bytemuck::cast_slice(deselected), wgpu::BufferUsages::STORAGE);
-        let group = crate::binding::group(
-            device,
-            label,
-            &layout,
-            &[uniform.as_entire_binding(), page.clusters.as_entire_binding(), mask.as_entire_binding()],
-        );
-        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some(label) });
-        {
-            let mut cpass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor::default());
-            cpass.set_pipeline(&pipeline);
-            cpass.set_bind_group(0, &group, &[]);
-            let groups = page.records.div_ceil(64);
-            cpass.dispatch_workgroups(groups.min(ROW), groups.div_ceil(ROW), 1);
+    /// The pass that writes a selection into a page's records (`select_clusters`).
+    pub struct Select {
+        pipeline: wgpu::ComputePipeline,
+        layout: wgpu::BindGroupLayout,
+    }
+
+    impl Select {
+        const LABEL: &str = "lineao::LineGeometry::select";
+
+        pub fn new(device: &wgpu::Device) -> Select {
+            use crate::binding::Slot;
+            let slots = [Slot::Uniform, Slot::StorageReadWrite, Slot::Storage];
+            let layout = crate::binding::layout(device, Self::LABEL, wgpu::ShaderStages::COMPUTE, &slots);
+            let pipeline = crate::binding::compute_pipeline(
+                device,
+                Self::LABEL,
+                &layout,
+                "line_geometry.wgsl",
+                "select_clusters",
+                &[],
+            );
+            Select { pipeline, layout }
         }
-        queue.submit([encoder.finish()]);
+
+        /// Marks the records of `page` whose bit in `deselected` is set (record i: word i / 32,
+        /// bit i % 32) with `flags::DESELECTED` and clears the others'.
+        pub fn run(&self, device: &wgpu::Device, queue: &wgpu::Queue, page: &Page, deselected: &[u32]) {
+            use wgpu::util::DeviceExt;
+            let label = Some(Self::LABEL);
+            let params = Params { center: [0.0; 3], clusters: page.records };
+            let init = |contents: &[u8], usage| {
+                device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label, contents, usage })
+            };
+            let uniform = init(bytemuck::bytes_of(&params), wgpu::BufferUsages::UNIFORM);
+            let mask = init(bytemuck::cast_slice(deselected), wgpu::BufferUsages::STORAGE);
+            let resources = [uniform.as_entire_binding(), page.clusters.as_entire_binding(), mask.as_entire_binding()];
+            let group = crate::binding::group(device, Self::LABEL, &self.layout, &resources);
+            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label });
+            {
+                let mut cpass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor::default());
+                cpass.set_pipeline(&self.pipeline);
+                cpass.set_bind_group(0, &group, &[]);
+                let groups = page.records.div_ceil(64);
+                cpass.dispatch_workgroups(groups.min(ROW), groups.div_ceil(ROW), 1);
+            }
+            queue.submit([encoder.finish()]);
+        }
     }
 
     /// The largest distance from `center` of any point of `pages`.
