@@ -268,6 +268,10 @@ fn recompute_from_dump(variant: &str, outer: &str, geometry: &str) {
     assert!(gpu_ao.data.iter().filter(|&&a| a > 0.1).count() > 1000);
 }
 
+/// The bench's passes timed on the CPU (CONTRACT.md's and `select`).
+const CPU_PASSES: [&str; 7] =
+    ["density-256", "sweep-256", "variance-volume-256", "bvh-build-1m", "raytraced-cpu-64", "bvh-upload", "select"];
+
 /// `lineao bench --json` on a small scene with `extra` options; the report.
 fn bench_report(extra: &[&str]) -> Value {
     let mut args = vec!["bench", "--json", "--vertices", "3000"];
@@ -320,15 +324,11 @@ fn bench_json_is_the_contract() {
         "raytraced-1spp",
         "raytraced-start-1spp",
         "ray-denoise",
-        "density-256",
-        "sweep-256",
-        "variance-volume-256",
-        "bvh-build-1m",
-        "raytraced-cpu-64",
-        "bvh-upload",
-        "select",
         "toy",
-    ];
+    ]
+    .into_iter()
+    .chain(CPU_PASSES)
+    .collect::<Vec<_>>();
     expected.sort_unstable();
     assert_eq!(sorted, expected);
     assert_eq!(names[..5], ["lines", "lines-native-1px", "lines-full-strip", "lines-strip", "nd-pyramid"]);
@@ -343,16 +343,7 @@ fn bench_json_is_the_contract() {
         "{pieces} of the pieces in {culled} of the clusters"
     );
     for p in passes {
-        let cpu_pass = [
-            "density-256",
-            "sweep-256",
-            "variance-volume-256",
-            "bvh-build-1m",
-            "raytraced-cpu-64",
-            "bvh-upload",
-            "select",
-        ]
-        .contains(&p["name"].as_str().unwrap());
+        let cpu_pass = CPU_PASSES.contains(&p["name"].as_str().unwrap());
         assert_eq!(p["on"], if cpu_pass { "cpu" } else { on });
         let ms = |k: &str| p[k].as_f64().unwrap();
         assert!(0.0 <= ms("ms_min") && ms("ms_min") <= ms("ms_median") && ms("ms_median") <= ms("ms_max"), "{p}");
