@@ -470,7 +470,8 @@ pub struct StyleArgs {
 #[serde(default)]
 pub struct ContextArgs {
     /// Anatomy: a NIfTI-1 volume (.nii, .nii.gz) placed by its sform (else qform, else voxel
-    /// sizes: nibabel's rule), shown as slices that occlude the lines and that their AO darkens.
+    /// sizes: nibabel's rule), shown as slices that occlude the lines and that their AO darkens
+    /// (the bilateral blur is then on: the occlusion's sampling noise is grain on a slice).
     #[arg(long, value_name = "NIFTI")]
     pub volume: Option<PathBuf>,
     /// Where the sagittal, coronal and axial slices cut x, y and z (world mm, RAS+), `-` for no

@@ -92,7 +92,9 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky, lon
             noise_seed: args.chain.noise_seed,
             kernel: args.ssao.ssao_kernel,
         },
-        blur: args.chain.bilateral.then_some(BilateralSettings {
+        // With anatomy slices the blur is on: a method's sampling noise, hidden in the lines,
+        // is grain on a smooth slice (docs/render.md).
+        blur: (args.chain.bilateral || args.context.volume.is_some()).then_some(BilateralSettings {
             radius_px: args.chain.bilateral_radius,
             depth_sigma_world: args.chain.bilateral_sigma,
         }),
