@@ -293,12 +293,7 @@ impl Worker {
             pending.iter().rposition(|c| matches!(c, ToWorker::Render(_))).filter(|&r| last_load.is_none_or(|l| r > l));
         if let Some(l) = last_load {
             let ToWorker::Load(source, sampled, anatomy) = &pending[l] else { unreachable!() };
-            let same = match (anatomy, &self.anatomy) {
-                (Some(volume), Some((held, _))) => Arc::ptr_eq(volume, held),
-                (None, None) => true,
-                _ => false,
-            };
-            if !same {
+            if !same(anatomy.as_ref(), self.anatomy.as_ref().map(|(held, _)| held)) {
                 self.anatomy = None;
                 if let Some(volume) = anatomy {
                     let dims = volume.dims.map(|d| d as u32);
@@ -503,6 +498,14 @@ pub(super) struct SceneRef<'a> {
     pub selected: &'a mut Option<(lineao_tracts::Selection, usize)>,
 }
 
+/// Whether both are the same allocation, or both none.
+fn same<T>(a: Option<&Arc<T>>, b: Option<&Arc<T>>) -> bool {
+    match (a, b) {
+        (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+        (a, b) => a.is_none() && b.is_none(),
+    }
+}
+
 /// Selects on the GPU (full detail and preview) what `selection` keeps, where it or the
 /// streamlines changed since the scene was last selected: a bit per cluster, no geometry.
 fn select(gpu: &Gpu, scene: &mut SceneRef<'_>, selection: &lineao_tracts::Selection) -> Result<(), String> {
@@ -655,12 +658,7 @@ async fn render_frame(
             }
         }
         let panel = &mut chains[i];
-        let same = match (&anatomy, &panel.anatomy) {
-            (Some(a), Some(b)) => Arc::ptr_eq(a, b),
-            (None, None) => true,
-            _ => false,
-        };
-        if !same {
+        if !same(anatomy.as_ref(), panel.anatomy.as_ref()) {
             panel.chain.set_slice_volume(d, anatomy.clone());
             panel.anatomy = anatomy.clone();
         }

@@ -128,11 +128,15 @@ impl Rgba8 {
     }
 }
 
+/// sRGB encoding of a linear value (clamped to [0, 1]).
+pub fn srgb(v: f32) -> f32 {
+    let v = v.clamp(0.0, 1.0);
+    if v <= 0.003_130_8 { 12.92 * v } else { 1.055 * v.powf(1.0 / 2.4) - 0.055 }
+}
+
 /// A linear RGB channel (clamped to [0, 1]) as an sRGB byte.
 pub fn srgb8(c: f32) -> u8 {
-    let c = c.clamp(0.0, 1.0);
-    let s = if c <= 0.003_130_8 { 12.92 * c } else { 1.055 * c.powf(1.0 / 2.4) - 0.055 };
-    (s * 255.0).round() as u8
+    (srgb(c) * 255.0).round() as u8
 }
 
 /// The numbers a colour bar over `range` shows under its start, middle and end: up to three

@@ -18,7 +18,7 @@ use lineao::{AoMethod, ChainSettings};
 use serde_json::json;
 
 use crate::args::{AoDistance, Method, ScoreArgs, ScoreMethod};
-use crate::label::Rgba8;
+use crate::label::{Rgba8, srgb};
 use crate::render::{Panel, Session};
 
 /// One method's scores.
@@ -260,12 +260,6 @@ pub fn read_frame(session: &Session, chain: &lineao::AoChain) -> Result<(NdImage
     let color = lineao::readback::read_texture(device, queue, &targets.color.texture)?.to_vec4();
     let specular = lineao::verify::read_f32(device, queue, &targets.specular)?;
     Ok((nd, Shading::new(&color, &specular.data)))
-}
-
-/// sRGB encoding of a linear value in [0, 1].
-fn srgb(v: f32) -> f32 {
-    let v = v.clamp(0.0, 1.0);
-    if v <= 0.003_130_8 { 12.92 * v } else { 1.055 * v.powf(1.0 / 2.4) - 0.055 }
 }
 
 pub fn run(args: &ScoreArgs) -> Result<()> {

@@ -303,7 +303,7 @@ fn culled_lines_at_levels_of_detail_stay_within_half_a_pixel() {
 /// The streamlines of (`positions`, `offsets`) that `keep` marks.
 fn subset(positions: &[[f32; 3]], offsets: &[u64], keep: &[bool]) -> (Vec<[f32; 3]>, Vec<u64>) {
     let (mut kept, mut kept_offsets) = (Vec::new(), vec![0u64]);
-    for (_, w) in offsets.windows(2).enumerate().filter(|(i, _)| keep[*i]) {
+    for (w, _) in offsets.windows(2).zip(keep).filter(|(_, kept)| **kept) {
         kept.extend_from_slice(&positions[w[0] as usize..w[1] as usize]);
         kept_offsets.push(kept.len() as u64);
     }
