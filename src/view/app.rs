@@ -169,7 +169,7 @@ impl App {
     }
 
     fn with_backend(backend: Backend, options: Options) -> App {
-        let extensions = vec!["trk", "tck", "trx", "tsf", "vtk", "vtp", "gz", "gltf", "glb", "obj"];
+        let extensions = vec!["trk", "tck", "trx", "tsf", "vtk", "vtp", "gz", "gltf", "glb", "obj", "nii"];
         let mut app = App {
             backend,
             controls: options.controls,
@@ -193,9 +193,9 @@ impl App {
             last_motion: None,
             image_rect: None,
             open_dialog: FileDialog::new()
-                .title("Open a tractogram")
-                .add_file_filter_extensions("Tractograms and meshes", extensions)
-                .default_file_filter("Tractograms and meshes"),
+                .title("Open a tractogram, a mesh or an anatomy (NIfTI)")
+                .add_file_filter_extensions("Tractograms, meshes and volumes", extensions)
+                .default_file_filter("Tractograms, meshes and volumes"),
             save_dialog: FileDialog::new().title("Save a screenshot (PNG)").default_file_name("lineao-view.png"),
             screenshot: options.screenshot,
             sampled: options.sampled,
@@ -205,6 +205,9 @@ impl App {
             frames: 0,
             open_file: None,
         };
+        if let Some(anatomy) = &app.anatomy {
+            app.send(ToWorker::Anatomy(Some(anatomy.clone())));
+        }
         if let Some(source) = options.source {
             app.load(source);
         }
@@ -255,7 +258,31 @@ impl App {
         self.load_failed = false;
         (self.camera, self.framed, self.first_picture, self.first_frame_ms) = (None, None, None, None);
         self.opened_at = Some(Instant::now());
-        self.send(ToWorker::Load(source, self.sampled.clone(), self.anatomy.clone()));
+        self.send(ToWorker::Load(source, self.sampled.clone()));
+    }
+
+    /// Shows `volume`'s slices with every dataset from now on, at `positions` (default: three
+    /// through its centre): a volume opened or dropped beside the tractogram, which stays.
+    pub fn set_anatomy(&mut self, volume: Arc<lineao_tracts::Volume>, positions: Option<[Option<f32>; 3]>) {
+        self.controls.set_anatomy(volume.world_box(), positions);
+        self.anatomy = Some(volume.clone());
+        self.send(ToWorker::Anatomy(Some(volume)));
+    }
+
+    /// The anatomy whose slices are shown, if any.
+    pub fn anatomy(&self) -> Option<&lineao_tracts::Volume> {
+        self.anatomy.as_deref()
+    }
+
+    /// Opens a file by its name: a NIfTI volume is the anatomy, anything else a dataset.
+    pub fn open_path(&mut self, path: PathBuf) {
+        if !lineao_tracts::Volume::is_nifti_name(&path.to_string_lossy()) {
+            return self.load(Source::File(path));
+        }
+        match lineao_tracts::Volume::load(&path) {
+            Ok(volume) => self.set_anatomy(Arc::new(volume), None),
+            Err(e) => self.error = Some(format!("{e}; the tractogram is shown without slices")),
+        }
     }
 
     fn send(&mut self, message: ToWorker) {
@@ -372,6 +399,7 @@ impl App {
                     let distance = glam::Vec3::from(dataset.hint.eye).distance(glam::Vec3::from(dataset.hint.target));
                     self.controls.slab_reach = 0.5 * distance;
                     self.controls.max_length = dataset.max_length;
+                    self.controls.set_groups(&dataset.groups, dataset.complete);
                     if let ColorMode::Field(name) = &self.controls.color
                         && !dataset.fields.iter().any(|(f, _)| f == name)
                     {
@@ -426,8 +454,10 @@ impl App {
     /// The view the controls and the camera describe, for an image of `size` pixels.
     fn view(&self, size: (u32, u32)) -> Option<View> {
         let (dataset, camera) = (self.dataset.as_ref()?, self.camera.as_ref()?);
+        let groups = (crate::args::GROUP_FIELD.to_string(), [0.0, (lineao::COLORMAP_ENTRIES - 1) as f32]);
         let field = match &self.controls.color {
             ColorMode::Field(name) => dataset.fields.iter().find(|(f, _)| f == name),
+            ColorMode::Groups if !dataset.groups.is_empty() => Some(&groups),
             _ => None,
         };
         Some(View {
@@ -737,15 +767,16 @@ impl App {
     fn files(&mut self, ctx: &egui::Context) {
         self.open_dialog.update(ctx);
         if let Some(path) = self.open_dialog.take_picked() {
-            self.load(Source::File(path));
+            self.open_path(path);
         }
         self.save_dialog.update(ctx);
         if let Some(path) = self.save_dialog.take_picked() {
             ctx.send_viewport_cmd(egui::ViewportCommand::Screenshot(egui::UserData::new(path)));
         }
-        let dropped = ctx.input(|i| i.raw.dropped_files.first().map(|f| f.path().to_path_buf()));
-        if let Some(path) = dropped {
-            self.load(Source::File(path));
+        // Several files at once: a volume and a tractogram dropped together are both opened.
+        let dropped: Vec<PathBuf> = ctx.input(|i| i.raw.dropped_files.iter().map(|f| f.path().to_path_buf()).collect());
+        for path in dropped {
+            self.open_path(path);
         }
         let shots: Vec<(PathBuf, Arc<ColorImage>)> = ctx.input(|i| {
             i.events

@@ -65,6 +65,8 @@ pub enum ColorMode {
     Field(String),
     /// One sRGB color.
     Constant([u8; 3]),
+    /// A colour per TRX group ([`Colormap::Categories`]), gray outside every group.
+    Groups,
 }
 
 /// The methods' parameters. World-space lengths are in the data's units (mm for tractograms).
@@ -150,6 +152,8 @@ pub struct Controls {
     pub length: Option<[f32; 2]>,
     /// The dataset's longest streamline, which the length sliders reach.
     pub max_length: f32,
+    /// The dataset's groups (TRX), each shown or not.
+    pub groups: Vec<(String, bool)>,
 }
 
 impl Controls {
@@ -175,15 +179,35 @@ impl Controls {
             subset: 1.0,
             length: None,
             max_length: 0.0,
+            groups: Vec::new(),
         }
     }
 
     /// The streamlines shown: [`Controls::subset`] and [`Controls::length`].
     pub fn selection(&self) -> lineao_tracts::Selection {
+        let shown = self.groups.iter().filter(|(_, on)| *on);
+        let groups = match shown.clone().count() {
+            n if n == self.groups.len() => Vec::new(),
+            _ => shown.map(|(name, _)| name.clone()).collect(),
+        };
+        // No group shown: no streamline (an empty list of groups would be every one).
+        let none = !self.groups.is_empty() && groups.is_empty() && self.groups.iter().all(|(_, on)| !on);
         lineao_tracts::Selection {
-            subset: (self.subset < 1.0).then_some((self.subset as f64, 0)),
+            subset: if none { Some((0.0, 0)) } else { (self.subset < 1.0).then_some((self.subset as f64, 0)) },
             length: self.length,
+            groups,
             ..Default::default()
+        }
+    }
+
+    /// A dataset's groups (known once all of it has arrived: `complete`), all shown; colour by
+    /// group only where it has some.
+    pub fn set_groups(&mut self, groups: &[String], complete: bool) {
+        if self.groups.iter().map(|(name, _)| name).ne(groups) {
+            self.groups = groups.iter().map(|name| (name.clone(), true)).collect();
+        }
+        if self.color == ColorMode::Groups && groups.is_empty() && complete {
+            self.color = ColorMode::Tangent;
         }
     }
 
@@ -248,6 +272,7 @@ impl Controls {
         settings.tubes = (self.geometry == Geometry::Tubes).then_some(TubeSettings { radius_world: p.tube_radius });
         settings.line_color = match (&self.color, range) {
             (ColorMode::Field(_), Some(range)) => LineColor::Scalar { colormap: self.colormap, range },
+            (ColorMode::Groups, Some(range)) => LineColor::Scalar { colormap: Colormap::Categories, range },
             (ColorMode::Constant(rgb), _) => LineColor::Constant(rgb.map(|c| srgb_to_linear(c as f32 / 255.0))),
             _ => LineColor::Tangent,
         };
@@ -313,6 +338,7 @@ impl Controls {
         self.slab_ui(ui);
         self.slices_ui(ui);
         self.selection_ui(ui);
+        self.groups_ui(ui);
         ui.separator();
 
         ui.heading("Parameters");
@@ -451,6 +477,7 @@ impl Controls {
             ColorMode::Tangent => "direction".to_string(),
             ColorMode::Field(name) => format!("field: {name}"),
             ColorMode::Constant(_) => "constant".into(),
+            ColorMode::Groups => "groups".into(),
         };
         ui.horizontal(|ui| {
             ui.label("Color");
@@ -460,6 +487,10 @@ impl Controls {
                 );
                 for (name, _) in fields {
                     ui.selectable_value(&mut self.color, ColorMode::Field(name.clone()), format!("field: {name}"));
+                }
+                if !self.groups.is_empty() {
+                    ui.selectable_value(&mut self.color, ColorMode::Groups, "groups")
+                        .on_hover_text("a colour per TRX group (16 colours in turn), gray outside every group");
                 }
                 if !matches!(self.color, ColorMode::Constant(_)) && ui.selectable_label(false, "constant").clicked() {
                     self.color = ColorMode::Constant([200, 170, 120]);
@@ -480,7 +511,27 @@ impl Controls {
             ColorMode::Constant(rgb) => {
                 ui.color_edit_button_srgb(rgb);
             }
-            ColorMode::Tangent => {}
+            ColorMode::Tangent | ColorMode::Groups => {}
+        }
+    }
+
+    /// The groups (TRX): each shown or not, with its colour when the lines are coloured by group.
+    fn groups_ui(&mut self, ui: &mut Ui) {
+        if self.groups.is_empty() {
+            return;
+        }
+        ui.label("groups");
+        let table = Colormap::Categories.table();
+        let coloured = self.color == ColorMode::Groups;
+        for (k, (name, on)) in self.groups.iter_mut().enumerate() {
+            ui.horizontal(|ui| {
+                if coloured {
+                    let [r, g, b] = [0, 1, 2].map(|c| crate::label::srgb8(table[k % table.len()][c]));
+                    let (rect, _) = ui.allocate_exact_size(egui::vec2(12.0, 12.0), egui::Sense::hover());
+                    ui.painter().rect_filled(rect, 2.0, egui::Color32::from_rgb(r, g, b));
+                }
+                ui.checkbox(on, name.as_str());
+            });
         }
     }
 }

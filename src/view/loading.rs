@@ -101,6 +101,8 @@ pub struct Opening {
     rays: Option<Arc<lineao::RayScene>>,
     /// The selection on the GPU so far (`worker::SceneRef::selected`).
     selected: Option<(lineao_tracts::Selection, usize)>,
+    /// The file's groups, once it is read.
+    groups: Vec<lineao_tracts::Group>,
     pub started: Instant,
     /// Bytes read of how many (files), for the progress bar.
     pub progress: (u64, Option<u64>),
@@ -186,6 +188,7 @@ impl Opening {
             held: true,
             rays: None,
             selected: None,
+            groups: Vec::new(),
             started: Instant::now(),
             progress: (0, None),
         })
@@ -232,6 +235,11 @@ impl Opening {
     /// the source, where it came as a feed whose bytes were kept, those bytes.
     pub async fn finish(&mut self, gpu: &Gpu) -> Result<(), String> {
         self.lines.finish_async(self.hint, gpu).await.map_err(|e| format!("{e:#}"))?;
+        // The groups: the side panel colours and selects by them.
+        if !self.groups.is_empty() {
+            self.lines.tracts.groups = std::mem::take(&mut self.groups);
+            crate::source::add_group_field(&mut self.lines.tracts);
+        }
         self.preview.geometry.finish_async(&gpu.device, &gpu.queue).await.map_err(|e| e.to_string())?;
         match std::mem::replace(&mut self.input, Input::Done) {
             Input::Feed { kept: Some(bytes), .. } => {
@@ -348,6 +356,8 @@ impl Opening {
                 let format = streamed.format.map_or("tsf", |f| f.name());
                 return Err(format!("{}: a .{format} holds values without points; open its .tck", self.source.name()));
             }
+            // A TRX file's groups (its chunks may still be queued: [`Opening::finish`]).
+            self.groups = streamed.groups;
         }
         Ok(piece_ended)
     }

@@ -68,10 +68,8 @@ pub fn options(args: &ViewArgs) -> app::Options {
         // Sampled at every vertex as the lines arrive: a field.
         ColorArg::Volume(_) if sampled.is_some() => ColorMode::Field(args.color.field().expect("a volume's field")),
         ColorArg::Volume(_) => ColorMode::Tangent,
-        ColorArg::Groups => {
-            eprintln!("lineao: view: --color groups is render's and Python's so far; the lines keep their directions");
-            ColorMode::Tangent
-        }
+        // Direction until the file's groups are known (`Controls::set_groups`).
+        ColorArg::Groups => ColorMode::Groups,
     };
     controls.colormap = args.colormap;
     controls.debug_view = args.debug_view;

@@ -449,16 +449,13 @@ fn a_slab_cuts_the_lines_and_the_brackets_move_it() {
 }
 
 #[test]
-fn anatomy_slices_show_with_the_lines_and_each_axis_turns_off() {
-    // `view stroke.trk.gz --volume MNI152_2009_template.nii.gz --slices -,-,10`: the axial slice
+fn a_volume_opened_beside_the_tractogram_shows_its_slices_and_each_axis_turns_off() {
+    // `view stroke.trk.gz`, then MNI152_2009_template.nii.gz dropped on the window (the page's
+    // drop and `view --volume` come to the same [`App::set_anatomy`]): the axial slice at z = 10
     // under the lines, black around the head (the template's zeros; no line is drawn black).
     let images = "niivue+niivue/packages/niivue/demos/images";
-    let volume = lineao_tracts::Volume::load(data(&format!("{images}/MNI152_2009_template.nii.gz"))).unwrap();
     // Without occlusion: the lines' own darkest pixels stay far from black.
-    let mut options =
-        options(Source::File(data(&format!("{images}/stroke.trk.gz"))), [methods()[0], methods()[4]], false);
-    options.controls.set_anatomy(volume.world_box(), Some([None, None, Some(10.0)]));
-    options.anatomy = Some(std::sync::Arc::new(volume));
+    let options = options(Source::File(data(&format!("{images}/stroke.trk.gz"))), [methods()[0], methods()[4]], false);
     let mut harness = harness(options);
     settle(&mut harness);
     let gray = |image: &[u8]| {
@@ -466,16 +463,58 @@ fn anatomy_slices_show_with_the_lines_and_each_axis_turns_off() {
         let count = pixels.clone().filter(|p| p[..3].iter().all(|&c| c < 8)).count();
         count as f64 / pixels.len() as f64
     };
+    let black = |harness: &Harness<'_, App>| gray(&harness.state().shown.as_ref().unwrap().images[0]);
+    let lines = black(&harness);
+    assert!(lines < 0.001, "{lines} of the pixels black with the lines alone");
+    harness.state_mut().open_path(data(&format!("{images}/MNI152_2009_template.nii.gz")));
+    harness.state_mut().controls.params.chain.slices.as_mut().unwrap().positions = [None, None, Some(10.0)];
+    settle(&mut harness);
     let app = harness.state();
     assert!(app.error.is_none(), "{:?}", app.error);
-    let shown = gray(&app.shown.as_ref().unwrap().images[0]);
+    assert!(app.dataset.as_ref().unwrap().name.ends_with("stroke.trk.gz"), "the tractogram stays");
+    let shown = black(&harness);
     assert!(shown > 0.05, "{shown} of the pixels black");
     // Its checkbox off: no slice, no black.
     harness.state_mut().controls.params.chain.slices.as_mut().unwrap().positions[2] = None;
     settle(&mut harness);
-    let off = gray(&harness.state().shown.as_ref().unwrap().images[0]);
+    let off = black(&harness);
     assert!(off < 0.001, "{off} of the pixels black without the slice, {shown} with it");
     assert!(harness.query_all_by_label_contains("z (axial)").count() > 0, "the axial slider");
+    // A volume that cannot be read is said; the tractogram stays.
+    harness.state_mut().open_path(PathBuf::from("/nonexistent/t1.nii.gz"));
+    let app = harness.state();
+    let error = app.error.as_deref().unwrap_or_default();
+    assert!(error.contains("t1.nii.gz") && error.contains("without slices"), "{error}");
+    assert!(app.dataset.is_some());
+}
+
+#[test]
+fn a_trx_files_groups_colour_and_select_its_streamlines() {
+    // pyAFQ's arcuate fasciculi: ARC_L (486 streamlines) and ARC_R (22), coloured a group each.
+    let path = data(
+        "niivue+niivue/packages/niivue/demos/images/sub-01_ses-01_dwi_space-RASMM_model-probCSD_algo-AFQ_tractography.trx",
+    );
+    let mut options = options(Source::File(path), [methods()[0], methods()[4]], false);
+    options.controls.color = super::controls::ColorMode::Groups;
+    let mut harness = harness(options);
+    settle(&mut harness);
+    let app = harness.state();
+    assert!(app.error.is_none(), "{:?}", app.error);
+    assert_eq!(app.dataset.as_ref().unwrap().groups, ["ARC_L", "ARC_R"]);
+    assert_eq!(app.controls.color, super::controls::ColorMode::Groups, "kept once the groups are known");
+    let settings = &app.shown.as_ref().unwrap().view.panels[0].settings;
+    assert!(matches!(settings.line_color, lineao::LineColor::Scalar { colormap: lineao::Colormap::Categories, .. }));
+    let drawn = |harness: &Harness<'_, App>| non_background(&harness.state().shown.as_ref().unwrap().images[0]);
+    let both = drawn(&harness);
+    // ARC_L's checkbox off: ARC_R's 22 streamlines alone; both off: the background.
+    harness.state_mut().controls.groups[0].1 = false;
+    settle(&mut harness);
+    let right = drawn(&harness);
+    assert!(right > 0.0005 && right < 0.5 * both, "{right} of the pixels with ARC_R, {both} with both");
+    harness.state_mut().controls.groups[1].1 = false;
+    settle(&mut harness);
+    assert_eq!(drawn(&harness), 0.0);
+    assert!(harness.query_all_by_label_contains("ARC_L").count() > 0, "ARC_L's checkbox");
 }
 
 #[test]

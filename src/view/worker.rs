@@ -66,9 +66,11 @@ pub struct View {
 }
 
 pub enum ToWorker {
-    /// Open a source, sampling a volume at its vertices where one is given, with the anatomy
-    /// its slices show (`--volume`) where one is given.
-    Load(Source, Option<Arc<Sampled>>, Option<Arc<lineao_tracts::Volume>>),
+    /// Open a source, sampling a volume at its vertices where one is given.
+    Load(Source, Option<Arc<Sampled>>),
+    /// The anatomy whose slices are shown (`--volume`, a volume opened or dropped), or none:
+    /// it stays on the GPU across datasets, and the newest view is drawn again with it.
+    Anatomy(Option<Arc<lineao_tracts::Volume>>),
     Render(View),
 }
 
@@ -87,6 +89,9 @@ pub struct Dataset {
     pub hint: ViewHint,
     /// One-column per-vertex fields, with their 2nd–98th percentile ranges.
     pub fields: Vec<(String, [f32; 2])>,
+    /// The names of its groups (TRX), in the file's order: the colours of
+    /// [`lineao::Colormap::Categories`] in turn.
+    pub groups: Vec<String>,
     /// The longest streamline's arc length (world units).
     pub max_length: f32,
     /// Milliseconds to the first picture's data on the GPU, and to all of it.
@@ -234,6 +239,24 @@ impl Worker {
         &self.gpu
     }
 
+    /// Shows `anatomy`'s slices from now on (uploaded once, whatever the datasets); whether it
+    /// changed. One that the GPU refuses is said, and the lines are shown without slices.
+    fn set_anatomy(&mut self, anatomy: Option<&Arc<lineao_tracts::Volume>>, send: &dyn Fn(FromWorker)) -> bool {
+        if same(anatomy, self.anatomy.as_ref().map(|(held, _)| held)) {
+            return false;
+        }
+        self.anatomy = None;
+        if let Some(volume) = anatomy {
+            let dims = volume.dims.map(|d| d as u32);
+            let (d, q) = (&self.gpu.device, &self.gpu.queue);
+            match SliceVolume::new(d, q, dims, &volume.values, volume.affine.as_mat4()) {
+                Ok(slices) => self.anatomy = Some((volume.clone(), Arc::new(slices))),
+                Err(e) => send(FromWorker::Error(format!("the anatomy's volume: {e}"))),
+            }
+        }
+        true
+    }
+
     /// Whether a picture is still accumulating, a dataset still arriving, or a frame's times
     /// are awaited (so a step has work without commands).
     pub fn continuing(&self) -> bool {
@@ -287,23 +310,18 @@ impl Worker {
             repeats = timing.repeats + 1;
             pending.push(ToWorker::Render(timing.view));
         }
+        // The newest anatomy asked for (in a web page a volume arrives while a dataset does).
+        let mut redraw = false;
+        if let Some(ToWorker::Anatomy(anatomy)) = pending.iter().rfind(|c| matches!(c, ToWorker::Anatomy(_))) {
+            redraw = self.set_anatomy(anatomy.as_ref(), send);
+        }
+        pending.retain(|c| !matches!(c, ToWorker::Anatomy(_)));
         let gpu = &self.gpu;
         let last_load = pending.iter().rposition(|c| matches!(c, ToWorker::Load(..)));
         let render =
             pending.iter().rposition(|c| matches!(c, ToWorker::Render(_))).filter(|&r| last_load.is_none_or(|l| r > l));
         if let Some(l) = last_load {
-            let ToWorker::Load(source, sampled, anatomy) = &pending[l] else { unreachable!() };
-            if !same(anatomy.as_ref(), self.anatomy.as_ref().map(|(held, _)| held)) {
-                self.anatomy = None;
-                if let Some(volume) = anatomy {
-                    let dims = volume.dims.map(|d| d as u32);
-                    let (d, q) = (&gpu.device, &gpu.queue);
-                    match SliceVolume::new(d, q, dims, &volume.values, volume.affine.as_mat4()) {
-                        Ok(slices) => self.anatomy = Some((volume.clone(), Arc::new(slices))),
-                        Err(e) => send(FromWorker::Error(format!("the anatomy's volume: {e}"))),
-                    }
-                }
-            }
+            let ToWorker::Load(source, sampled) = &pending[l] else { unreachable!() };
             (self.scene, self.continuing, self.opening, self.announced) = (None, None, None, false);
             for panel in &mut self.chains {
                 // The old dataset's BVH is freed now, not when the next one replaces it.
@@ -373,7 +391,7 @@ impl Worker {
                 self.last_view = Some(view.clone());
                 Some(view)
             }
-            None if pending.is_empty() && more => self.last_view.clone(),
+            None if pending.is_empty() && (more || redraw) => self.last_view.clone(),
             None if pending.is_empty() => self.continuing.take(),
             None => None,
         };
@@ -459,7 +477,7 @@ fn dataset(lines: &Lines, opening: &Opening, complete: bool) -> Dataset {
         .tracts
         .vertex_fields
         .iter()
-        .filter(|f| f.columns == 1)
+        .filter(|f| f.columns == 1 && f.name != crate::args::GROUP_FIELD)
         .map(|f| (f.name.clone(), crate::render::percentile_range(&f.values)))
         .collect();
     let (streamlines, vertices) = (lines.geometry.streamlines, lines.geometry.vertices);
@@ -480,6 +498,7 @@ fn dataset(lines: &Lines, opening: &Opening, complete: bool) -> Dataset {
         readable: opening.held,
         hint,
         fields,
+        groups: lines.tracts.groups.iter().map(|g| g.name.clone()).collect(),
         max_length: lines.lengths.iter().copied().fold(0.0, f32::max),
         first_ms: opening.first_ms().unwrap_or(elapsed),
         load_ms: elapsed,
@@ -520,7 +539,9 @@ fn select(gpu: &Gpu, scene: &mut SceneRef<'_>, selection: &lineao_tracts::Select
         lines.geometry.set_selection(d, q, None).map_err(error)?;
         scene.preview.geometry.set_selection(d, q, None).map_err(error)?;
     } else if count == lines.geometry.streamlines {
-        let keep: Vec<bool> = lines.lengths.iter().enumerate().map(|(i, &l)| selection.keeps(i as u64, l)).collect();
+        let mut keep: Vec<bool> =
+            lines.lengths.iter().enumerate().map(|(i, &l)| selection.keeps(i as u64, l)).collect();
+        selection.apply_groups(&mut keep, &lines.tracts.groups).map_err(|e| format!("{}: {e}", lines.name))?;
         lines.geometry.set_selection(d, q, Some(&keep)).map_err(error)?;
         // The preview holds every k-th streamline.
         let shown = scene.preview.geometry.streamlines;

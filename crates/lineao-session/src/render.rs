@@ -306,9 +306,7 @@ impl Session {
         }
         let mut lines = lines?;
         if groups {
-            let values = lines.tracts.group_indices(lineao::COLORMAP_ENTRIES);
-            let field = lineao_tracts::Field { name: crate::args::GROUP_FIELD.into(), columns: 1, values };
-            lines.tracts.vertex_fields.push(field);
+            crate::source::add_group_field(&mut lines.tracts);
             lines.hold((&gpu.device, &gpu.queue), &base, || {})?;
         }
         Self::assemble(args, lines, surfaces, base, gpu)
@@ -322,9 +320,7 @@ impl Session {
             sampled.add_to(&mut loaded.tracts);
         }
         if args.style.color == ColorArg::Groups {
-            let values = loaded.tracts.group_indices(lineao::COLORMAP_ENTRIES);
-            let field = lineao_tracts::Field { name: crate::args::GROUP_FIELD.into(), columns: 1, values };
-            loaded.tracts.vertex_fields.push(field);
+            crate::source::add_group_field(&mut loaded.tracts);
         }
         for field in base.scalar.iter().chain(&base.radius) {
             loaded.tracts.spread_streamline_field(field);

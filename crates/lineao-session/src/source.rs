@@ -452,7 +452,8 @@ pub struct Keep {
     pub scalar: Option<String>,
     /// The per-vertex field that gives tubes their radii, uploaded with each chunk.
     pub radius: Option<String>,
-    /// Every one-column per-vertex field (the viewer colours by any of them).
+    /// Every one-column per-vertex field and the offsets (the viewer colours by any of them,
+    /// and by group).
     pub fields: bool,
     /// A volume sampled at every vertex as it arrives, kept as a per-vertex field.
     pub sampled: Option<std::sync::Arc<Sampled>>,
@@ -485,6 +486,15 @@ impl Sampled {
         let values = self.volume.sample_points(&tracts.positions);
         tracts.vertex_fields.push(Field { name: self.field.clone(), columns: 1, values });
     }
+}
+
+/// Adds `tracts`' group of each vertex as the per-vertex field [`crate::args::GROUP_FIELD`]
+/// (`--color groups`): a colour index of [`lineao::Colormap::Categories`], NaN outside every group.
+pub fn add_group_field(tracts: &mut Tractogram) {
+    let name = crate::args::GROUP_FIELD;
+    let values = tracts.group_indices(lineao::COLORMAP_ENTRIES);
+    tracts.vertex_fields.retain(|f| f.name != name);
+    tracts.vertex_fields.push(Field { name: name.into(), columns: 1, values });
 }
 
 impl Lines {
@@ -770,9 +780,12 @@ fn append(kept: &mut Tractogram, chunk: Tractogram, keep: &Keep) {
             field.values.extend_from_slice(&from.values);
         }
     }
+    // The offsets with the fields: a per-streamline value (a group's colour) spread over them.
+    if keep.points || keep.fields {
+        kept.offsets.extend(chunk.offsets[1..].iter().map(|o| o + base));
+    }
     if keep.points {
         kept.positions.extend_from_slice(&chunk.positions);
-        kept.offsets.extend(chunk.offsets[1..].iter().map(|o| o + base));
         for (field, from) in kept.streamline_fields.iter_mut().zip(&chunk.streamline_fields) {
             field.values.extend_from_slice(&from.values);
         }

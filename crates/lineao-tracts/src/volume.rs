@@ -65,6 +65,13 @@ impl Volume {
         Volume::from_bytes(&bytes, limit).map_err(|kind| kind.at(path))
     }
 
+    /// Whether a file's name is a NIfTI volume's (`.nii`, `.nii.gz`, any case): what a viewer
+    /// that is handed files opens as the anatomy.
+    pub fn is_nifti_name(name: &str) -> bool {
+        let name = name.to_ascii_lowercase();
+        name.ends_with(".nii") || name.ends_with(".nii.gz")
+    }
+
     /// A NIfTI-1 file's bytes (gzip-wrapped or not), inflating at most `max_inflated` bytes.
     pub fn from_bytes(bytes: &[u8], max_inflated: u64) -> Result<Volume, ErrorKind> {
         let inflated;

@@ -14,6 +14,7 @@ import assert from 'node:assert/strict';
 const [base, out, lineao, data, WHOLE_BRAIN] = process.argv.slice(2);
 const STROKE = 'niivue+niivue/packages/niivue/demos/images/stroke.trk.gz';
 const SMALL = 'niivue+niivue/packages/niivue/demos/images/tract.SLF1_R.tck';
+const MNI = 'niivue+niivue/packages/niivue/demos/images/MNI152_2009_template.nii.gz';
 const results = {};
 fs.mkdirSync(out, { recursive: true });
 
@@ -183,6 +184,27 @@ await check('a file dropped on the page opens; a bad one is an error, and the pa
   status = await settle();
   assert.equal(status.state, 'ready', status.message);
   assert.equal(status.vertices, info(STROKE).vertices);
+});
+
+await check('an anatomy by ?volume= with ?slices=; a bad volume dropped is said, the tractogram stays', async () => {
+  const query = `?url=data/${encodeURIComponent(STROKE)}&volume=data/${encodeURIComponent(MNI)}&slices=-,-,10`;
+  let { status } = await open(query);
+  // The volume may arrive after the tractogram's first frame: ready with its slice.
+  await page.waitForFunction(() => window.lineaoStatus.slices && window.lineaoStatus.state === 'ready', null,
+    { timeout: 120_000 });
+  status = await page.evaluate(() => window.lineaoStatus);
+  assert.deepEqual(status.anatomy, [193, 229, 193], JSON.stringify(status));
+  assert.deepEqual(status.slices, [null, null, 10]);
+  assert.equal(status.vertices, info(STROKE).vertices);
+  await page.screenshot({ path: path.join(out, 'stroke-over-mni.png') });
+  const link = await page.evaluate(() => location.search);
+  assert.match(link, /volume=data%2F/, link);
+  await drop('t1.nii.gz', Buffer.from([0x1f, 0x8b, 8, 0, 1, 2, 3]));
+  status = await settle(['error']);
+  assert.match(status.message, /t1\.nii\.gz/);
+  assert.match(status.message, /without slices/, status.message);
+  assert.equal(status.vertices, info(STROKE).vertices, 'the tractogram stays');
+  results.anatomy = { link, badVolume: status.message };
 });
 
 await check('a file arrives in pieces: drawn while it loads, kept by the page only up to hold=', async () => {

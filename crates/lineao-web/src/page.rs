@@ -36,6 +36,8 @@ enum Inbound {
         from_url: bool,
     },
     Failed(String),
+    /// A NIfTI volume read whole, to show as slices (or why it cannot be).
+    Anatomy(Result<lineao_tracts::Volume, String>),
     Readback {
         panel: usize,
         resolve: js_sys::Function,
@@ -48,6 +50,8 @@ thread_local! {
     static CONTEXT: RefCell<Option<egui::Context>> = const { RefCell::new(None) };
     /// The most bytes of a file the page keeps to read it again (the URL's `hold`).
     static HOLD: std::cell::Cell<u64> = const { std::cell::Cell::new(crate::HOLD_BYTES) };
+    /// Where the URL's `slices=` puts the slices of a volume opened.
+    static SLICES: std::cell::Cell<Option<[Option<f32>; 3]>> = const { std::cell::Cell::new(None) };
 }
 
 /// Asks the UI for a frame (a piece of a file arrived).
@@ -90,6 +94,12 @@ pub async fn start(canvas_id: String, adapter: String) -> Result<(), JsValue> {
     let page = query::parse(&window.location().search()?).map_err(|e| JsValue::from(js_sys::Error::new(&e)))?;
     let mut options = lineao_cli::view::options(&page.view);
     HOLD.with(|h| h.set(page.hold_bytes));
+    SLICES.with(|s| s.set(page.view.slices));
+    if let Some(url) = page.volume.clone() {
+        wasm_bindgen_futures::spawn_local(async move {
+            post(Inbound::Anatomy(fetch_volume(&url).await));
+        });
+    }
     if let Some(url) = &page.url {
         options.source = None;
         let url = url.clone();
@@ -132,6 +142,7 @@ pub async fn start(canvas_id: String, adapter: String) -> Result<(), JsValue> {
                 Ok(Box::new(Page {
                     app,
                     source,
+                    volume: page.volume,
                     adapter,
                     requests: Vec::new(),
                     readbacks: Vec::new(),
@@ -146,12 +157,20 @@ pub async fn start(canvas_id: String, adapter: String) -> Result<(), JsValue> {
     Ok(())
 }
 
-/// Opens `file` (dropped on the page or picked in its file input).
+/// Opens `file` (dropped on the page or picked in its file input): a NIfTI volume is the
+/// anatomy, shown as slices with the tractogram; anything else is a dataset.
 #[wasm_bindgen]
 pub fn open_file(file: web_sys::File) {
     let (name, size) = (file.name(), file.size() as u64);
     if let Some(message) = crate::too_large(&name, size) {
         return post(Inbound::Failed(message));
+    }
+    if lineao_tracts::Volume::is_nifti_name(&name) {
+        return wasm_bindgen_futures::spawn_local(async move {
+            let bytes = JsFuture::from(file.array_buffer()).await;
+            let bytes = bytes.map(|b| Uint8Array::new(&b).to_vec()).map_err(|e| format!("{name}: {}", js_message(&e)));
+            post(Inbound::Anatomy(bytes.and_then(|b| crate::volume(&name, &b))));
+        });
     }
     let feed = SharedFeed::new(Some(size), HOLD.with(|h| h.get()));
     post(Inbound::Open { name: name.clone(), feed: feed.clone(), from_url: false });
@@ -173,6 +192,23 @@ fn pick_file() {
     if let Some(input) = input.and_then(|e| e.dyn_into::<web_sys::HtmlElement>().ok()) {
         input.click();
     }
+}
+
+/// Fetches the NIfTI volume at `url` (relative to the page), whole.
+async fn fetch_volume(url: &str) -> Result<lineao_tracts::Volume, String> {
+    let window = web_sys::window().ok_or("no window")?;
+    let cannot = |e: JsValue| format!("{url}: cannot fetch: {}", js_message(&e));
+    let response: web_sys::Response =
+        JsFuture::from(window.fetch_with_str(url)).await.map_err(cannot)?.unchecked_into();
+    if !response.ok() {
+        return Err(format!("{url}: HTTP {} {}", response.status(), response.status_text()));
+    }
+    let total = response.headers().get("content-length").ok().flatten().and_then(|v| v.parse::<u64>().ok());
+    if let Some(message) = total.and_then(|t| crate::too_large(url, t)) {
+        return Err(message);
+    }
+    let bytes = JsFuture::from(response.array_buffer().map_err(cannot)?).await.map_err(cannot)?;
+    crate::volume(url, &Uint8Array::new(&bytes).to_vec())
 }
 
 /// Fetches `url` (relative to the page) into a feed the viewer opens as it arrives.
@@ -269,6 +305,8 @@ struct PendingReadback {
 struct Page {
     app: App,
     source: LinkSource,
+    /// The URL's `volume=`, which the link keeps.
+    volume: Option<String>,
     adapter: String,
     /// Readbacks asked for, and those copying.
     requests: Vec<(usize, js_sys::Function, js_sys::Function)>,
@@ -289,6 +327,9 @@ impl eframe::App for Page {
                     self.app.load(Source::Feed { name, feed });
                 }
                 Inbound::Failed(message) => self.app.fail(message),
+                Inbound::Anatomy(Ok(volume)) => self.app.set_anatomy(Arc::new(volume), SLICES.with(|s| s.get())),
+                // The tractogram is still shown, without slices.
+                Inbound::Anatomy(Err(message)) => self.app.error = Some(message),
                 Inbound::Readback { panel, resolve, reject } => self.requests.push((panel, resolve, reject)),
             }
         }
@@ -432,6 +473,8 @@ impl Page {
             "gpuMs": gpu_ms,
             "passes": passes,
             "frames": app.frames_received,
+            "anatomy": app.anatomy().map(|v| v.dims),
+            "slices": frame.and_then(|f| f.view.panels[0].settings.slices.as_ref().map(|s| s.positions)),
             "raysPerPixel": frame.map(|f| f.rays.iter().map(|r| r.map(|r| r.progress.rays_per_pixel)).collect::<Vec<_>>()),
         })
         .to_string();
@@ -458,7 +501,7 @@ impl Page {
         let methods: Vec<&str> = frame.view.panels.iter().map(|p| p.settings.method.name()).collect();
         let orbit = app.camera.as_ref().map(|c| c.orbit_values());
         let ortho = app.camera.as_ref().is_some_and(|c| c.orthographic);
-        let link = query::link(&self.source, &methods, app.controls.preset, orbit, ortho);
+        let link = query::link((&self.source, self.volume.as_deref()), &methods, app.controls.preset, orbit, ortho);
         if self.link.as_ref() != Some(&link) {
             if let Some(history) = web_sys::window().and_then(|w| w.history().ok()) {
                 let _ = history.replace_state_with_url(&JsValue::NULL, "", Some(&link));

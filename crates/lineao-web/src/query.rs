@@ -5,9 +5,10 @@
 //! so a link refuses what the command line refuses, with the same words.
 //!
 //! A key without a value is a flag (`?ortho&timings`). What a page cannot do is refused by
-//! name: a positional file (use `url=`), `volume` and `slices` (a page reads no file by name),
-//! `screenshot`, `frames` and `size` (the page is the window), and object-space AO (CPU
-//! threads, see `lineao_cli::view::controls::WEB_LEAVES_OUT`).
+//! name: a positional file (use `url=`), `screenshot`, `frames` and `size` (the page is the
+//! window), and object-space AO (CPU threads, see `lineao_cli::view::controls::WEB_LEAVES_OUT`).
+//! `volume=` is an address, as `url=` is: the anatomy fetched beside the tractogram, its slices
+//! where `slices=` puts them.
 
 use clap::Parser;
 use lineao_cli::cli::ViewArgs;
@@ -16,6 +17,9 @@ use lineao_cli::cli::ViewArgs;
 #[derive(Debug)]
 pub struct PageArgs {
     pub url: Option<String>,
+    /// `volume=`: a NIfTI volume's address (relative to the page), shown as slices.
+    pub volume: Option<String>,
+    /// The viewer's options; its `volume` is `None` (a page reads no file by name).
     pub view: ViewArgs,
     /// `hold=MIB`: the most of a file the page keeps to read it again (for the methods that
     /// work on every point on the CPU); default [`crate::HOLD_BYTES`].
@@ -30,8 +34,7 @@ struct PageCli {
 }
 
 /// Keys of `lineao view` that mean nothing in a page.
-/// `volume` and `slices`: a page reads no file by name (an anatomy from the page is to come).
-const NOT_IN_A_PAGE: [&str; 5] = ["screenshot", "frames", "size", "volume", "slices"];
+const NOT_IN_A_PAGE: [&str; 3] = ["screenshot", "frames", "size"];
 
 /// Parses a URL's query string (`search`, with or without its `?`).
 pub fn parse(search: &str) -> Result<PageArgs, String> {
@@ -41,6 +44,7 @@ pub fn parse(search: &str) -> Result<PageArgs, String> {
         match &*key {
             "url" if value.is_empty() => return Err("url= needs a file's address".into()),
             "url" => url = Some(value.into_owned()),
+            "volume" if value.is_empty() => return Err("volume= needs a NIfTI volume's address".into()),
             "hold" => {
                 let mib: u64 = value.parse().map_err(|_| format!("hold= takes MiB, a whole number, got '{value}'"))?;
                 hold_bytes = mib << 20;
@@ -57,10 +61,13 @@ pub fn parse(search: &str) -> Result<PageArgs, String> {
     }
     let cli = PageCli::try_parse_from(&args).map_err(|e| {
         let text = e.render().to_string();
-        let first = text.lines().next().unwrap_or("invalid options").trim_start_matches("error: ").to_string();
-        format!("the page's URL: {first}")
+        // Its message, up to the usage (a missing option's name is on the lines after the first).
+        let message: Vec<&str> = text.lines().take_while(|l| !l.trim().is_empty()).map(str::trim).collect();
+        format!("the page's URL: {}", message.join(" ").trim_start_matches("error: "))
     })?;
-    let view = cli.view;
+    let mut view = cli.view;
+    // An address, which the page fetches (clap took it as `--volume`, for `slices`' sake).
+    let volume = view.volume.take().map(|path| path.to_string_lossy().into_owned());
     if url.is_some() && view.scene.is_some() {
         return Err("the page's URL: url= and scene= exclude each other".into());
     }
@@ -71,13 +78,13 @@ pub fn parse(search: &str) -> Result<PageArgs, String> {
     if methods.iter().any(|m| m.volume.is_some()) {
         return Err(format!("the page's URL: {}", lineao_cli::view::controls::WEB_LEAVES_OUT));
     }
-    Ok(PageArgs { url, view, hold_bytes })
+    Ok(PageArgs { url, volume, view, hold_bytes })
 }
 
 /// The query string of a view: the source and the options a link keeps (methods, preset,
 /// camera), in the form [`parse`] reads.
 pub fn link(
-    source: &LinkSource,
+    (source, volume): (&LinkSource, Option<&str>),
     methods: &[&str],
     preset: lineao::Preset,
     orbit: Option<[f32; 3]>,
@@ -89,6 +96,9 @@ pub fn link(
         LinkSource::Scene(name) => query.append_pair("scene", name),
         LinkSource::None => &mut query,
     };
+    if let Some(volume) = volume {
+        query.append_pair("volume", volume);
+    }
     match methods {
         [one] => query.append_pair("method", one),
         many => query.append_pair("compare", &many.join(",")),
@@ -131,6 +141,9 @@ mod tests {
         assert_eq!(scene.view.scene.map(|s| s.name()), Some("bundles"));
         assert_eq!(scene.view.method.screen, AoMethod::Ssao);
         assert_eq!(parse("").unwrap().view.method.screen, AoMethod::LineAo, "lineao view's defaults");
+        let anatomy = parse("url=stroke.trk.gz&volume=t1.nii.gz&slices=0,-,10").unwrap();
+        assert_eq!(anatomy.volume.as_deref(), Some("t1.nii.gz"));
+        assert_eq!(anatomy.view.slices, Some([Some(0.0), None, Some(10.0)]));
     }
 
     #[test]
@@ -145,12 +158,14 @@ mod tests {
         assert!(error("screenshot=a.png").contains("not an option of the web page"));
         assert!(error("url=").contains("needs a file"));
         assert!(error("url=a.trk&scene=bundles").contains("exclude each other"));
+        assert!(error("volume=").contains("needs a NIfTI"));
+        assert!(error("slices=0,0,0").contains("--volume"), "{}", error("slices=0,0,0"));
     }
 
     #[test]
     fn a_link_reads_back_as_the_view_it_describes() {
         let query = link(
-            &LinkSource::Url("data/a b.tck".into()),
+            (&LinkSource::Url("data/a b.tck".into()), Some("data/t1.nii.gz")),
             &["lineao", "ssao"],
             lineao::Preset::Sparse,
             Some([12.345, -3.0, 0.75]),
@@ -158,10 +173,13 @@ mod tests {
         );
         let page = parse(&query).unwrap();
         assert_eq!(page.url.as_deref(), Some("data/a b.tck"));
+        assert_eq!(page.volume.as_deref(), Some("data/t1.nii.gz"));
+        assert_eq!(page.view.volume, None, "an address, not a file the viewer reads");
         assert_eq!(page.view.preset, lineao::Preset::Sparse);
         assert_eq!(page.view.orbit, Some([12.3, -3.0, 0.75]));
         assert!(page.view.ortho);
-        let one = parse(&link(&LinkSource::Scene("spiral".into()), &["ssao"], lineao::Preset::Legible, None, false));
+        let one =
+            parse(&link((&LinkSource::Scene("spiral".into()), None), &["ssao"], lineao::Preset::Legible, None, false));
         assert_eq!(one.unwrap().view.method.screen, AoMethod::Ssao);
     }
 }
