@@ -60,7 +60,9 @@ use bevy::prelude::*;
 use lineao::{AoMethod, Bounds, ChainSettings, Preset};
 
 pub use lineao;
-pub use polylines::Polylines;
+#[cfg(feature = "tracts")]
+pub use polylines::ColorSource;
+pub use polylines::{PolylineSelection, Polylines};
 pub use render::{LineAoSystems, LineAoViews, ViewAo};
 
 // The README's code compiles as it stands: `cargo test --doc` checks it.

@@ -25,7 +25,7 @@ use lineao::glam as lg;
 use lineao::passes::nd_from_depth::{HostNormals, check_inputs};
 use lineao::{AoChain, Bounds, ChainSettings, FrameView, HostAo, HostConfig, HostInputs, LineGeometry, OverlayAo};
 
-use crate::{LineAo, Polylines};
+use crate::{LineAo, PolylineSelection, Polylines};
 
 /// Where the plugin's systems run, to order others around them.
 #[derive(SystemSet, Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -131,6 +131,8 @@ fn bounds_of_boxes(
 #[derive(Resource, Default)]
 struct RenderLines {
     pending: Option<MergedLines>,
+    /// The merged selection, when it changed (`None` inside: every polyline shown).
+    pending_selection: Option<Option<Vec<bool>>>,
     geometry: Option<LineGeometry>,
     /// A load that failed, said once.
     error: Option<String>,
@@ -144,22 +146,33 @@ struct MergedLines {
 
 fn extract_lines(
     mut lines: ResMut<RenderLines>,
-    polylines: Extract<Query<(Entity, Ref<Polylines>, Ref<GlobalTransform>, &InheritedVisibility)>>,
-    mut last: Local<Vec<Entity>>,
+    polylines: Extract<
+        Query<(Entity, Ref<Polylines>, Ref<GlobalTransform>, &InheritedVisibility, Option<Ref<PolylineSelection>>)>,
+    >,
+    mut last: Local<(Vec<Entity>, Vec<bool>)>,
 ) {
-    let visible: Vec<_> = polylines.iter().filter(|(.., v)| v.get()).collect();
+    let visible: Vec<_> = polylines.iter().filter(|(_, _, _, v, _)| v.get()).collect();
     let entities: Vec<Entity> = visible.iter().map(|(e, ..)| *e).collect();
-    if entities == *last && !visible.iter().any(|(_, p, t, _)| p.is_changed() || t.is_changed()) {
+    // The selections: merged again when one changed, came or went (no upload of the points).
+    let selected: Vec<bool> = visible.iter().map(|(.., s)| s.is_some()).collect();
+    let selection_changed =
+        selected != last.1 || visible.iter().any(|(.., s)| s.as_ref().is_some_and(|s| s.is_changed()));
+    let changed = entities != last.0 || visible.iter().any(|(_, p, t, ..)| p.is_changed() || t.is_changed());
+    if changed || selection_changed {
+        lines.pending_selection =
+            Some(merged_selection(&visible.iter().map(|(_, p, .., s)| (&**p, s.as_deref())).collect::<Vec<_>>()));
+    }
+    *last = (entities, selected);
+    if !changed {
         return;
     }
-    *last = entities;
     let points = visible.iter().map(|(_, p, ..)| p.positions().len()).sum();
     let mut merged = MergedLines {
         positions: Vec::with_capacity(points),
         offsets: vec![0],
         scalars: visible.iter().any(|(_, p, ..)| p.scalars().is_some()).then(|| Vec::with_capacity(points)),
     };
-    for (_, polylines, transform, _) in &visible {
+    for (_, polylines, transform, ..) in &visible {
         let base = merged.positions.len() as u64;
         let m = transform.affine();
         merged.positions.extend(polylines.positions().iter().map(|p| m.transform_point3(Vec3::from(*p)).to_array()));
@@ -172,6 +185,25 @@ fn extract_lines(
         }
     }
     lines.pending = Some(merged);
+}
+
+/// One flag per merged polyline, or `None` where every one is shown. A selection whose count is
+/// not its polylines' shows them all (and says so).
+fn merged_selection(visible: &[(&Polylines, Option<&PolylineSelection>)]) -> Option<Vec<bool>> {
+    visible.iter().any(|(_, s)| s.is_some()).then(|| {
+        let mut keep = Vec::with_capacity(visible.iter().map(|(p, _)| p.len()).sum());
+        for (polylines, selection) in visible {
+            match selection {
+                Some(PolylineSelection(flags)) if flags.len() == polylines.len() => keep.extend_from_slice(flags),
+                Some(PolylineSelection(flags)) => {
+                    warn!("a PolylineSelection of {} flags for {} polylines: all shown", flags.len(), polylines.len());
+                    keep.resize(keep.len() + polylines.len(), true);
+                }
+                None => keep.resize(keep.len() + polylines.len(), true),
+            }
+        }
+        keep
+    })
 }
 
 /// Each camera's chains, by its main-world entity: what tools and tests read (the AO of the
@@ -373,6 +405,13 @@ fn prepare(
                 lines.error = Some(error);
             }
         }
+    }
+    // The selection, on the GPU (a bit per cluster; the points stay).
+    if let Some(selection) = lines.pending_selection.take()
+        && let Some(geometry) = &mut lines.geometry
+        && let Err(error) = geometry.set_selection(device, queue, selection.as_deref())
+    {
+        warn!("PolylineSelection not applied: {error}");
     }
     let mut seen = HashSet::new();
     for (main, extracted, view, camera, target) in &cameras {

@@ -139,6 +139,9 @@ struct Probe {
     captured: Arc<Mutex<Option<Captured>>>,
     /// The standalone comparisons to run: the meshes' settings, and the lines' points.
     standalone: Arc<Mutex<Option<Standalone>>>,
+    /// The bounds the standalone lines are framed by, where not their own (the plugin frames
+    /// every polyline, shown or selected out).
+    bounds: Arc<Mutex<Option<Bounds>>>,
 }
 
 fn read_ao(d: &wgpu::Device, q: &wgpu::Queue, view: &wgpu::TextureView) -> AoImage<f32> {
@@ -205,7 +208,8 @@ fn capture(
                     up: lineao::glam::Vec3::Y,
                     projection: lineao::Projection::Perspective { fov_y_deg: FOV_Y.to_degrees() },
                 };
-                chain.prepare(d, q, &camera, &geometry.bounds.unwrap()).unwrap();
+                let bounds = probe.bounds.lock().unwrap().unwrap_or(geometry.bounds.unwrap());
+                chain.prepare(d, q, &camera, &bounds).unwrap();
                 let output = lineao::targets::Target::output(d, "test", SIZE, wgpu::TextureFormat::Rgba8UnormSrgb);
                 let mut encoder = d.create_command_encoder(&Default::default());
                 chain.encode(&mut encoder, &geometry, &output.view);
@@ -315,6 +319,27 @@ fn the_plugin_adds_no_error_to_lineaos_chains() {
     println!("lines: {agreement:?}");
     let lines = nd.data.iter().filter(|p| p[..3] != [0.0; 3]).count();
     assert!(lines > 500, "the helices cover {lines} pixels");
+
+    // The left six helices selected out: the frame is a standalone chain's of the other six
+    // alone (selected-out lines neither drawn nor occluding), no points uploaded again.
+    let keep: Vec<bool> = (0..12).map(|k| k >= 6).collect();
+    let (all_positions, all_offsets) = helices();
+    let kept: Vec<[f32; 3]> = all_offsets
+        .windows(2)
+        .enumerate()
+        .filter(|(k, _)| keep[*k])
+        .flat_map(|(_, w)| all_positions[w[0] as usize..w[1] as usize].to_vec())
+        .collect();
+    let kept_offsets: Vec<u64> = (0..=6).map(|i| i * 120).collect();
+    app.world_mut().entity_mut(polylines).insert(lineao_bevy::PolylineSelection::new(keep));
+    *probe.bounds.lock().unwrap() = Bounds::of_points(&all_positions);
+    *probe.standalone.lock().unwrap() = Some((ao.settings.clone(), Some((kept, kept_offsets))));
+    let captured = run(&mut app, 3);
+    let (plugin, nd, standalone) = captured.lines.as_ref().expect("the lines were drawn");
+    let agreement = lineao::verify::check_policy(plugin, standalone, nd, bound).unwrap();
+    println!("selected lines: {agreement:?}");
+    let half = nd.data.iter().filter(|p| p[..3] != [0.0; 3]).count();
+    assert!(half > 100 && half < lines * 3 / 4, "six helices cover {half} pixels, twelve {lines}");
 
     // The polylines despawned: the frame renders, nothing is said.
     app.world_mut().despawn(polylines);
