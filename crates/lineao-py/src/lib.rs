@@ -444,8 +444,13 @@ impl Renderer {
     /// Opens a session on `path` (a file `lineao info` reads; None: the built-in `scene`) or on
     /// streamlines (points, offsets, lengths) named `name`, with `settings` (a dict of
     /// render's keyword arguments). Device and upload run with the GIL released.
+    ///
+    /// Streamlines come with their fields and groups (`data`: per-vertex fields,
+    /// per-streamline fields, groups), which colour (`color="field:NAME"`, `"groups"`) and
+    /// select them.
     #[new]
-    #[pyo3(signature = (settings, path=None, points=None, offsets=None, lengths=None, name="streamlines".to_string()))]
+    #[pyo3(signature = (settings, path=None, points=None, offsets=None, lengths=None, name="streamlines".to_string(), data=None))]
+    #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
         settings: &Bound<'_, PyDict>,
@@ -454,14 +459,15 @@ impl Renderer {
         offsets: Option<&Bound<'_, PyAny>>,
         lengths: Option<&Bound<'_, PyAny>>,
         name: String,
+        data: Option<(Bound<'_, PyDict>, Bound<'_, PyDict>, Bound<'_, PyDict>)>,
     ) -> PyResult<Renderer> {
         let args = parse(settings, path.as_ref())?;
         let session = match (points, offsets, lengths) {
             (Some(points), Some(offsets), Some(lengths)) => {
-                let lines = Streamlines::extract(points, offsets, lengths)?;
-                let (p, o, l) = (lines.points.as_slice()?, lines.offsets.as_slice()?, lines.lengths.as_slice()?);
+                let empty = || PyDict::new(py);
+                let (vertex, streamline, groups) = data.unwrap_or_else(|| (empty(), empty(), empty()));
+                let tracts = tractogram_of(py, points, offsets, lengths, &vertex, &streamline, &groups)?;
                 py.detach(|| -> PyResult<Session> {
-                    let tracts = Streamlines::gather(p, o, l).map_err(PyValueError::new_err)?;
                     if !tracts.positions.iter().flatten().any(|c| c.is_finite()) {
                         return Err(PyValueError::new_err(format!("{name} has no finite points")));
                     }

@@ -132,3 +132,21 @@ def test_slices_and_a_slab_are_keywords():
     background = lambda image: (image[..., :3] == 255).all(axis=-1).mean()
     slab = np.asarray(lineao.render(t, width=200, height=160, slab="z,10,6"))
     assert background(slab) > background(alone) + 0.1
+
+
+def test_streamlines_in_memory_keep_their_groups_and_fields():
+    # pyAFQ's arcuate fasciculi, loaded into numpy and rendered from memory: coloured and
+    # selected by their groups as the file itself is.
+    afq = IMAGES / "sub-01_ses-01_dwi_space-RASMM_model-probCSD_algo-AFQ_tractography.trx"
+    t = lineao.load(afq)
+    assert sorted(t.groups) == ["ARC_L", "ARC_R"]
+    frame = {"width": 160, "height": 128, "method": "none"}
+    for rules in ({"color": "groups"}, {"color": "groups", "groups": ["ARC_R"]}):
+        from_memory = np.asarray(lineao.render(t, **frame, **rules))
+        from_file = np.asarray(lineao.render(str(afq), **frame, **rules))
+        assert np.array_equal(from_memory, from_file), rules
+    # A per-streamline field made here colours the lines: two values, two colours.
+    t.streamline_fields["side"] = np.array([float(i in set(t.groups["ARC_R"])) for i in range(len(t))], np.float32)
+    image = np.asarray(lineao.render(t, **frame, color="field:side", colormap="gray"))
+    drawn = image[(image[..., :3] != 255).any(axis=-1)][:, :3].astype(int)
+    assert (drawn.max(axis=1) - drawn.min(axis=1) <= 2).all(), "gray lines"

@@ -302,7 +302,14 @@ class Renderer:
         else:
             t = _tractogram(streamlines)
             name = getattr(streamlines, "name", None) or "streamlines"
-            self._native = _lineao.Renderer(opening, points=t.points, offsets=t.offsets, lengths=t.lengths, name=str(name))
+            data = (
+                {k: np.ascontiguousarray(v, np.float32) for k, v in t.vertex_fields.items()},
+                {k: np.ascontiguousarray(v, np.float32) for k, v in t.streamline_fields.items()},
+                {k: np.asarray(v, np.uint32) for k, v in t.groups.items()},
+            )
+            self._native = _lineao.Renderer(
+                opening, points=t.points, offsets=t.offsets, lengths=t.lengths, name=str(name), data=data
+            )
 
     def render(self, *, camera: Optional[dict] = None, **settings: Any) -> Image:
         """One frame with this renderer's settings, `settings` changed for this frame, seen by
