@@ -57,43 +57,53 @@ fn geometry_points(session: &Session, chain: &lineao::AoChain) -> Vec<(usize, Ve
 
 #[test]
 fn a_slice_shows_the_volume_where_its_affine_puts_it() {
-    let mni = images("MNI152_2009_template.nii.gz");
-    let keywords = serde_json::json!({
-        "volume": mni, "slices": "-,-18,-", "method": "none", "width": 320, "height": 256,
-        "eye": "60,-260,40", "target": "0,-18,10", "up": "0,0,1",
-    });
-    let (session, chain) = render(&images("stroke.trk.gz"), keywords);
-    let volume = lineao_tracts::Volume::load(&mni).unwrap();
-    let window = session.anatomy.as_ref().expect("the volume loads").percentiles();
-    let table = lineao::Colormap::Gray.table();
-    // The shader's colormap: 16 entries, linear between them.
-    let gray = |v: f32| {
-        let t = ((v - window[0]) / (window[1] - window[0])).clamp(0.0, 1.0) * 15.0;
-        let k = (t as usize).min(14);
-        table[k][0] + (table[k + 1][0] - table[k][0]) * (t - k as f32)
-    };
-    let gpu = &session.gpu;
-    let color = read_texture(&gpu.device, &gpu.queue, &chain.targets().unwrap().color.texture).unwrap().to_vec4();
-    let (mut on_slice, mut off, mut worst) = (0, 0, 0.0f32);
-    for (i, p) in geometry_points(&session, &chain) {
-        // The slice's pixels (the lines in front of it lie off its plane).
-        if (p.y + 18.0).abs() > 0.05 {
-            continue;
+    // The T1 template (a plain affine) cut coronally, and the z-map whose affine flips x cut
+    // sagittally, each seen from its slice's side.
+    for (name, slices, axis, at, eye) in [
+        ("MNI152_2009_template.nii.gz", "-,-18,-", 1, -18.0, "60,-260,40"),
+        ("strokez.nii.gz", "20,-,-", 0, 20.0, "260,-40,40"),
+    ] {
+        let path = images(name);
+        let keywords = serde_json::json!({
+            "volume": path, "slices": slices, "method": "none", "width": 320, "height": 256,
+            "eye": eye, "target": "0,-18,10", "up": "0,0,1",
+        });
+        let (session, chain) = render(&images("stroke.trk.gz"), keywords);
+        let volume = lineao_tracts::Volume::load(&path).unwrap();
+        let window = session.anatomy.as_ref().expect("the volume loads").percentiles();
+        let table = lineao::Colormap::Gray.table();
+        // The shader's colormap: 16 entries, linear between them.
+        let gray = |v: f32| {
+            let t = ((v - window[0]) / (window[1] - window[0])).clamp(0.0, 1.0) * 15.0;
+            let k = (t as usize).min(14);
+            table[k][0] + (table[k + 1][0] - table[k][0]) * (t - k as f32)
+        };
+        let gpu = &session.gpu;
+        let color = read_texture(&gpu.device, &gpu.queue, &chain.targets().unwrap().color.texture).unwrap().to_vec4();
+        let (mut on_slice, mut off, mut worst) = (0, 0, 0.0f32);
+        for (i, p) in geometry_points(&session, &chain) {
+            // The slice's pixels (the lines in front of it lie off its plane).
+            if (p[axis] - at).abs() > 0.05 {
+                continue;
+            }
+            let value = volume.sample(p.to_array());
+            if value.is_nan() {
+                continue;
+            }
+            on_slice += 1;
+            let error = (color[i][0] - gray(value)).abs();
+            worst = worst.max(error);
+            // Half floats hold 11 bits; a value gradient across the depth's rounding adds a little.
+            if error > 4e-3 {
+                off += 1;
+            }
         }
-        let value = volume.sample(p.to_array());
-        if value.is_nan() {
-            continue;
-        }
-        on_slice += 1;
-        let error = (color[i][0] - gray(value)).abs();
-        worst = worst.max(error);
-        // Half floats hold 11 bits; a value gradient across the depth's rounding adds a little.
-        if error > 4e-3 {
-            off += 1;
-        }
+        assert!(on_slice > 15_000, "{name}: only {on_slice} slice pixels");
+        assert!(
+            off * 1000 <= on_slice,
+            "{name}: {off} of {on_slice} slice pixels differ from the CPU's sample (worst {worst})"
+        );
     }
-    assert!(on_slice > 20_000, "only {on_slice} slice pixels");
-    assert!(off * 1000 <= on_slice, "{off} of {on_slice} slice pixels differ from the CPU's sample (worst {worst})");
 }
 
 #[test]
