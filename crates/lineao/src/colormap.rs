@@ -1,7 +1,7 @@
 //! Colormaps for per-vertex scalars ([`crate::settings::LineColor::Scalar`]): sRGB control
 //! points, decoded to linear RGB and tabulated for the geometry passes.
 
-use crate::settings::{Named, named};
+use crate::named::{Named, named};
 
 named!(Colormap {
     Viridis => "Perceptually uniform, dark blue to yellow",

@@ -70,9 +70,12 @@ mod chain;
 mod colormap;
 mod gbuffer;
 mod gpu;
+#[cfg(feature = "reference")]
+mod image;
 pub mod lighting;
 mod line_geometry;
 pub mod method;
+mod named;
 #[cfg(feature = "reference")]
 pub mod noise;
 #[cfg(not(feature = "reference"))]
@@ -113,14 +116,15 @@ pub use method::line_ao::settings::{LineAoOuter, LineAoSettings, LineAoVariant, 
 pub use method::raytraced::settings::{RayDenoiseSettings, RayTracedSettings};
 pub use method::ssao::settings::{SsaoKernel, SsaoSettings};
 pub use method::vo_line::settings::{VoCombine, VoSettings};
+pub use named::Named;
 pub use passes::composite::OverlayDepth;
 pub use passes::meshes::MeshGeometry;
 pub use passes::nd_from_depth::{HostConfig, HostInputs};
 pub use passes::slices::SliceVolume;
 pub use ray_scene::{RayGeometry, RayScene};
 pub use settings::{
-    BilateralSettings, ChainSettings, DebugView, LineColor, Named, Preset, Slab, SlabAxis, SliceSettings,
-    SurfaceSettings, TubeSettings, VolumeAoSettings,
+    BilateralSettings, ChainSettings, DebugView, LineColor, Preset, Slab, SlabAxis, SliceSettings, SurfaceSettings,
+    TubeSettings, VolumeAoSettings,
 };
 
 // docs/embedding.md's code compiles as it stands: `cargo test --doc` checks it.

@@ -27,7 +27,7 @@
 //! [`LineShading::CylinderAveraged`] colors a line base · (1 − kd + kd · Σ I · diffuse) — the
 //! same form as the Phong tubes — and adds Σ I · ks · specular.
 
-use crate::settings::Named;
+use crate::named::Named;
 use glam::Vec3;
 
 /// At most this many lights reach the shaders.
@@ -203,7 +203,7 @@ pub fn whole_pow(x: f32, n: u32) -> f32 {
     result
 }
 
-crate::settings::named!(LineShading {
+crate::named::named!(LineShading {
     Specular => "Zöckler's maximum-principle specular added to the AO-darkened color (the paper's §3.3)",
     CylinderAveraged => "Mallo et al.'s cylinder-averaged diffuse and specular",
 });

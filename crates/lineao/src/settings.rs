@@ -3,81 +3,15 @@
 //! LineAO's reach and every method's strength, as every front end does.
 
 use crate::lighting::Lighting;
+use crate::named::{Named, named};
 
 // Each method's settings are its folder's (and the crate root's); named here for the crate.
 pub(crate) use crate::colormap::{COLORMAP_ENTRIES, Colormap};
 pub(crate) use crate::method::AoMethod;
-pub(crate) use crate::method::line_ao::{LineAoSettings, LineAoVariant, R0};
-pub(crate) use crate::method::raytraced::{RayDenoiseSettings, RayTracedSettings};
+pub(crate) use crate::method::line_ao::{LineAoSettings, R0};
+pub(crate) use crate::method::raytraced::RayTracedSettings;
 pub(crate) use crate::method::ssao::SsaoSettings;
 pub(crate) use crate::method::vo_line::{VoCombine, VoSettings};
-
-/// A setting with a fixed set of values, each with the name the command line, `params.json` and
-/// CONTRACT.md use and a line of help: what a CLI or a binding (Python, a host's UI) parses and
-/// lists, so that it mirrors no enum of its own.
-pub trait Named: Copy + Send + Sync + 'static {
-    /// Every value, the default first.
-    const VALUES: &'static [Self];
-    fn name(self) -> &'static str;
-    /// What the value does, in one line.
-    fn help(self) -> &'static str;
-    fn from_name(name: &str) -> Option<Self> {
-        Self::VALUES.iter().copied().find(|v| v.name() == name)
-    }
-}
-
-/// `impl Named` from the inherent `name` and a help line per value, and (with the `serde`
-/// feature) (de)serialization by that name.
-macro_rules! named {
-    ($ty:ty { $($value:ident => $help:literal),+ $(,)? }) => {
-        crate::settings::serde_by_name!($ty);
-        impl Named for $ty {
-            const VALUES: &'static [Self] = &[$(<$ty>::$value),+];
-            fn name(self) -> &'static str {
-                <$ty>::name(self)
-            }
-            fn help(self) -> &'static str {
-                match self {
-                    $(<$ty>::$value => $help),+
-                }
-            }
-        }
-    };
-}
-pub(crate) use named;
-
-/// A [`Named`] setting (de)serializes as its name, as the command line and `params.json` write
-/// it; an unknown name is an error that lists the known ones.
-#[cfg(feature = "serde")]
-macro_rules! serde_by_name {
-    ($ty:ty) => {
-        impl serde::Serialize for $ty {
-            fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-                serializer.serialize_str(crate::settings::Named::name(*self))
-            }
-        }
-
-        impl<'de> serde::Deserialize<'de> for $ty {
-            fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-                let name = <String as serde::Deserialize>::deserialize(deserializer)?;
-                <$ty as crate::settings::Named>::from_name(&name)
-                    .ok_or_else(|| serde::de::Error::custom(crate::settings::unknown::<$ty>(&name)))
-            }
-        }
-    };
-}
-#[cfg(not(feature = "serde"))]
-macro_rules! serde_by_name {
-    ($ty:ty) => {};
-}
-pub(crate) use serde_by_name;
-
-/// What an unknown name of a [`Named`] setting is told: the names it could have been.
-#[cfg(feature = "serde")]
-pub(crate) fn unknown<T: Named>(name: &str) -> String {
-    let names: Vec<&str> = T::VALUES.iter().map(|v| v.name()).collect();
-    format!("unknown value '{name}' (one of {})", names.join(", "))
-}
 
 /// Object-space AO in the chain ([`crate::volume`], [`crate::passes::volume_ao`]): the
 /// geometry's per-vertex octant visibilities ([`crate::passes::lines::VertexAttributes`])
@@ -510,23 +444,15 @@ impl ChainSettings {
         R0 { px: self.r0_px(), per_zoom }
     }
 
-    /// Pyramid levels the chain needs: s_r for LineAO; one for plain lines and for the
-    /// `reference` variant (the authors' pyramid is off by default).
+    /// Pyramid levels the chain needs: what its method reads ([`crate::method::MethodInfo`]:
+    /// s_r for LineAO, one for the others and for LineAO's `reference` variant).
     pub fn levels(&self) -> u32 {
-        match (self.method, self.line_ao.variant) {
-            (AoMethod::LineAo, LineAoVariant::Paper) => self.line_ao.s_r,
-            _ => 1,
-        }
+        (self.method.info().levels)(self)
     }
 
     /// Checks every range documented above.
     pub fn validate(&self) -> Result<(), crate::Error> {
         let bad = |what: String| Err(crate::Error::InvalidSettings(what));
-        // Each method's own settings, then what the chain adds.
-        self.line_ao.validate()?;
-        self.ssao.validate()?;
-        self.vo.validate()?;
-        self.raytraced.validate()?;
         if let Some(blur) = &self.blur {
             blur.validate()?;
         }
@@ -538,8 +464,9 @@ impl ChainSettings {
         {
             return bad(format!("the tube radius must be > 0 world units, got {}", tubes.radius_world));
         }
-        if !(self.r0_px().is_finite() && self.r0_px() >= 0.0) {
-            return bad(format!("r0 must be a finite number of pixels >= 0, got {}", self.r0_px()));
+        // Each method's own settings (LineAO's r0 follows the width and the tubes checked above).
+        for method in AoMethod::REGISTRY {
+            (method.info().validate)(self)?;
         }
         if let Some(volume) = &self.volume
             && !volume.sky.iter().all(|w| (0.0..=1.0).contains(w))
@@ -585,6 +512,7 @@ impl ChainSettings {
 #[cfg(test)]
 mod preset_tests {
     use super::*;
+    use crate::method::line_ao::LineAoVariant;
 
     /// The fitted table (docs/ground-truth.md), written out here apart from the methods' own
     /// `preset` functions: (strength, s_r, r0 per width, δ scale, reference radius, the method's
@@ -643,6 +571,7 @@ mod preset_tests {
 #[cfg(all(test, feature = "serde"))]
 mod serde_tests {
     use super::*;
+    use crate::method::line_ao::LineAoVariant;
 
     #[test]
     fn settings_round_trip_through_json_with_names_as_the_command_line_writes_them() {

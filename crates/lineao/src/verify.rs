@@ -3,8 +3,8 @@
 //! 1e-3, and every pixel within a bound of a few flipped samples.
 
 use crate::Error;
+use crate::image::{Image, NdImage};
 use crate::readback::read_texture;
-use crate::reference::{Image, NdImage};
 use crate::targets::Target;
 
 /// A target of one f32 channel (zoom, specular, ao, depth) as an image.

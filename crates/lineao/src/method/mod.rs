@@ -51,6 +51,9 @@ pub struct MethodInfo {
     pub spans: &'static [&'static str],
     /// Its WGSL files, by the name its passes compose them under.
     pub shaders: &'static [(&'static str, &'static str)],
+    /// The numbers its WGSL shares with its CPU reference, which Rust writes into the WGSL
+    /// ([`crate::shader::CONSTANTS`]).
+    pub constants: &'static [(&'static str, crate::shader::Constant)],
     /// Its stage; `None` for a method that runs no pass (`none`).
     pub(crate) build: Option<BuildStage>,
     /// Whether what its stage allocates for a guard-banded frame of this size fits the device's
@@ -60,6 +63,13 @@ pub struct MethodInfo {
     pub(crate) fits: fn((u32, u32), &wgpu::Limits) -> Result<(), crate::Error>,
     /// Sets `preset`'s values of its own settings and the strength it is shown with.
     pub(crate) preset: fn(Preset, &mut ChainSettings),
+    /// Checks its own settings in a chain's (every method's, whichever runs: settings are
+    /// switched between methods), an [`crate::Error::InvalidSettings`] naming the one out of
+    /// range.
+    pub(crate) validate: fn(&ChainSettings) -> Result<(), crate::Error>,
+    /// The levels of the G-buffer's ND pyramid its stage reads under those settings (1: the
+    /// full-resolution maps alone).
+    pub(crate) levels: fn(&ChainSettings) -> u32,
     /// What `lineao bench` times of it, by CONTRACT.md's names.
     pub bench: &'static [BenchPass],
 }
@@ -169,9 +179,12 @@ const NONE: MethodInfo = MethodInfo {
     screen_space: true,
     spans: &[],
     shaders: &[],
+    constants: &[],
     build: None,
     fits: fits_always,
     preset: |_, settings| settings.strength = 1.0,
+    validate: valid_always,
+    levels: one_level,
     bench: &[],
 };
 
@@ -198,10 +211,10 @@ impl AoMethod {
     }
 }
 
-crate::settings::serde_by_name!(AoMethod);
+crate::named::serde_by_name!(AoMethod);
 
 /// The registry's names and help, as every other setting with a fixed set of values.
-impl crate::settings::Named for AoMethod {
+impl crate::named::Named for AoMethod {
     const VALUES: &'static [AoMethod] = AoMethod::REGISTRY;
 
     fn name(self) -> &'static str {
@@ -250,6 +263,16 @@ pub enum Reach {
 /// [`MethodInfo::fits`] of a method that allocates nothing the device could refuse.
 pub(crate) fn fits_always(_: (u32, u32), _: &wgpu::Limits) -> Result<(), crate::Error> {
     Ok(())
+}
+
+/// [`MethodInfo::validate`] of a method without settings.
+pub(crate) fn valid_always(_: &ChainSettings) -> Result<(), crate::Error> {
+    Ok(())
+}
+
+/// [`MethodInfo::levels`] of a method that reads the full-resolution maps alone.
+pub(crate) fn one_level(_: &ChainSettings) -> u32 {
+    1
 }
 
 /// What a method does in the chain: it reads the G-buffer in [`FrameTargets`] and writes `ao`,

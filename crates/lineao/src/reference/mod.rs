@@ -11,6 +11,7 @@ pub mod cull;
 pub mod tubes;
 mod volume_ao;
 
+pub use crate::image::{Image, NdImage};
 pub use crate::method::line_ao::reference::{
     LineAoParams, OUTER_DEPTH_TOLERANCE, delta, depth_weight, hermite, light_weight, line_ao, line_ao_pixel,
     representative_pixel, upsample_outer, whole_exponent, whole_pow,
@@ -26,44 +27,6 @@ pub use crate::method::vo_line::reference::{
 };
 pub use bilateral::bilateral;
 pub use volume_ao::{unpack_octants, volume_ao};
-
-/// A row-major image, `data[y * width + x]`.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Image<T> {
-    pub width: usize,
-    pub height: usize,
-    pub data: Vec<T>,
-}
-
-/// An ND map level: normal xyz, normalized depth w.
-pub type NdImage = Image<[f32; 4]>;
-
-impl<T: Copy> Image<T> {
-    pub fn filled(width: usize, height: usize, value: T) -> Image<T> {
-        Image { width, height, data: vec![value; width * height] }
-    }
-
-    pub fn from_fn(width: usize, height: usize, mut f: impl FnMut(usize, usize) -> T) -> Image<T> {
-        let mut data = Vec::with_capacity(width * height);
-        for y in 0..height {
-            for x in 0..width {
-                data.push(f(x, y));
-            }
-        }
-        Image { width, height, data }
-    }
-
-    pub fn get(&self, x: usize, y: usize) -> T {
-        self.data[y * self.width + x]
-    }
-
-    /// The texel at (x, y) clamped to the image.
-    pub fn clamped(&self, x: i64, y: i64) -> T {
-        let x = x.clamp(0, self.width as i64 - 1) as usize;
-        let y = y.clamp(0, self.height as i64 - 1) as usize;
-        self.get(x, y)
-    }
-}
 
 const BINOMIAL: [f32; 5] = [0.0625, 0.25, 0.375, 0.25, 0.0625];
 

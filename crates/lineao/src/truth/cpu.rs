@@ -9,7 +9,7 @@ use glam::{DVec3, Mat4, Vec3};
 use super::{Bvh, EPSILON_PER_DISTANCE, Falloff, Prim, Reach, RoundedCone, Triangle, TruthSettings, VoBall, sequence};
 use crate::Error;
 use crate::camera::FrameView;
-use crate::reference::{Image, NdImage};
+use crate::image::{Image, NdImage};
 
 impl Reach {
     /// A ray's value for a first hit at `t` (none: no hit within any reach traced).

@@ -27,8 +27,8 @@
 //! the same number; [`Pairs::exact`] enumerates every pair (small images, tests). A frame with
 //! fewer than [`MIN_PIXELS`] geometry pixels has no legibility ([`Absent`]), never a 0.
 
+use crate::image::Image;
 use crate::noise::pcg_hash;
-use crate::reference::Image;
 
 /// The pairs' disc radii as shares of the image width: local, bundle, global.
 pub const SCALES: [f64; 3] = [0.01, 0.04, 0.15];

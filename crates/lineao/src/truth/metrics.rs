@@ -13,7 +13,7 @@
 //! `structural_similarity(a, b, gaussian_weights=True, sigma=1.5, use_sample_covariance=False,
 //! data_range=1)` computes; the tests check numbers from it.
 
-use crate::reference::Image;
+use crate::image::Image;
 
 /// Half the SSIM window's side: ⌊3.5 σ + 0.5⌋ for σ = 1.5.
 pub const SSIM_RADIUS: usize = 5;

@@ -63,7 +63,7 @@ pub(crate) mod primitive;
 pub(crate) mod sequence;
 
 use crate::Error;
-use crate::settings::Named;
+use crate::named::Named;
 #[cfg(feature = "truth")]
 pub use bvh::{Bvh, Prim};
 #[cfg(feature = "truth")]
@@ -100,7 +100,7 @@ impl Falloff {
     }
 }
 
-crate::settings::named!(Falloff {
+crate::named::named!(Falloff {
     None => "Binary AO: the fraction of rays that hit within the distance",
     Linear => "Obscurance: the mean of 1 − t/R over hits",
 });

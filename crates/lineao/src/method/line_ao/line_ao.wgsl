@@ -11,7 +11,7 @@
 // The occlusion test departs from Eq. 8 on purpose (Δd > ε, not Δd >= 0): see CONTRACT.md.
 //
 // With REFERENCE the pass computes variant `reference` instead, the authors' own shader
-// (`lineao::passes::line_ao` documents it): `reference_ao` below.
+// (`lineao::method::line_ao` documents it): `reference_ao` below.
 //
 // With OUTER_LEVEL (`outer = level`) hemispheres j >= 1 come from `line_ao_outer`, run before
 // at level j's resolution, and are upsampled depth-aware here (`upsample_outer`).
@@ -38,13 +38,13 @@ override OUTER_LEVEL: bool = false;
 override SHININESS_WHOLE: u32 = 0u;
 override LEVEL: u32 = 1u;
 
-// Keep in sync with `lineao::reference::line_ao::OUTER_DEPTH_TOLERANCE`.
-const OUTER_DEPTH_TOLERANCE: f32 = 0.005;
+// OUTER_DEPTH_TOLERANCE: Rust's `lineao::method::line_ao::OUTER_DEPTH_TOLERANCE`.
+#import rust/constants.wgsl
 
 // The authors' falloff: occluded iff Δd >= 1e-5, also the lower edge of their smoothstep.
 const REFERENCE_FALLOFF: f32 = 1e-5;
 
-// Keep in sync with `lineao::passes::line_ao::LineAoUniform`.
+// Keep in sync with `lineao::method::line_ao::LineAoUniform`.
 struct LineAoUniform {
     levels: Levels,
     // Pixel coordinate of the visible viewport's top-left corner (the guard band's width).

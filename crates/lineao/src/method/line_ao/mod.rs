@@ -69,6 +69,10 @@ pub(crate) mod settings;
 pub(crate) use settings::{LineAoOuter, LineAoSettings, LineAoVariant, R0};
 
 /// LineAO in the registry ([`crate::method`]).
+/// Depth tolerance of the upsampling, in normalized depth: a level texel whose d_j differs from
+/// the pixel's own level texel by τ or more does not contribute (the shader's too).
+pub const OUTER_DEPTH_TOLERANCE: f32 = 0.005;
+
 pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     name: "lineao",
     label: "LineAO",
@@ -76,9 +80,12 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     screen_space: true,
     spans: &["nd-pyramid", "lineao"],
     shaders: &[("line_ao.wgsl", include_str!("line_ao.wgsl"))],
+    constants: &[("OUTER_DEPTH_TOLERANCE", crate::shader::Constant::F32(OUTER_DEPTH_TOLERANCE))],
     build: Some(|device, settings| Box::new(LineAoStage::new(device, settings))),
     fits: super::fits_always,
     preset: settings::preset,
+    validate: settings::validate,
+    levels: |s| if s.line_ao.variant == LineAoVariant::Paper { s.line_ao.s_r } else { 1 },
     bench: &[
         BenchPass::of("lineao", &["lineao"], |_, _| {}),
         BenchPass {

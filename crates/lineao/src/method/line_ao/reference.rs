@@ -6,8 +6,9 @@ use glam::Vec3;
 
 use super::{LineAoOuter, LineAoVariant};
 use crate::camera::FrameView;
+use crate::image::{Image, NdImage};
 use crate::lighting::Light;
-use crate::reference::{Image, NdImage, level_texel};
+use crate::reference::level_texel;
 use crate::settings::ChainSettings;
 
 /// Every number LineAO reads besides the images and the noise.
@@ -224,9 +225,7 @@ fn outer_level(inputs: &Inputs, p: &LineAoParams, j: u32) -> Image<[f32; 2]> {
     })
 }
 
-/// Depth tolerance of the upsampling, in normalized depth: a level texel whose d_j differs from
-/// the pixel's own level texel by τ or more does not contribute.
-pub const OUTER_DEPTH_TOLERANCE: f32 = 0.005;
+pub use super::OUTER_DEPTH_TOLERANCE;
 
 /// AO_j at full-resolution pixel (x, y) from the level image: bilinear over the four nearest
 /// texels, each weight scaled by max(0, 1 − |d_j(t) − d_j(t_P)| / τ), where t_P is the texel

@@ -1,7 +1,8 @@
 //! LineAO's settings: the paper's parameters (Eq. 7–15), the authors' variant, and where the
 //! outer hemispheres are evaluated.
 
-use crate::settings::{ChainSettings, Named, Preset, named};
+use crate::named::{Named, named};
+use crate::settings::{ChainSettings, Preset};
 
 /// Which LineAO: the paper's equations, or what the authors' own code does.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -110,6 +111,16 @@ impl Default for LineAoSettings {
             outer: LineAoOuter::Full,
         }
     }
+}
+
+/// LineAO's settings in a chain's: its own, and r0 as the line width or the tubes make it.
+pub(crate) fn validate(settings: &crate::ChainSettings) -> Result<(), crate::Error> {
+    settings.line_ao.validate()?;
+    let r0 = settings.r0_px();
+    if !(r0.is_finite() && r0 >= 0.0) {
+        return Err(crate::Error::InvalidSettings(format!("r0 must be a finite number of pixels >= 0, got {r0}")));
+    }
+    Ok(())
 }
 
 impl LineAoSettings {

@@ -22,10 +22,10 @@
 //! mean; [`crate::method::raytraced::RayTracedAo`] runs it after each frame's rays. The CPU
 //! reference is [`crate::reference::ray_denoise`].
 
+use super::settings::RayDenoiseSettings;
 use crate::binding::{self, Slot};
 use crate::camera::FrameView;
 use crate::passes::dispatch_full_screen;
-use crate::settings::RayDenoiseSettings;
 use crate::targets::{AO_FORMAT, FrameTargets};
 use crate::timing::Span;
 use crate::view_params::{ViewParams, ViewUniform};

@@ -28,9 +28,10 @@ use std::sync::{Arc, Mutex};
 
 use crate::binding::{self, Slot};
 use crate::camera::FrameView;
+use crate::method::AoMethod;
 use crate::passes::dispatch_full_screen;
 use crate::ray_scene::RayScene;
-use crate::settings::{AoMethod, ChainSettings};
+use crate::settings::ChainSettings;
 use denoise::RayDenoise;
 
 pub mod denoise;
@@ -52,9 +53,12 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
         ("raytraced_ao.wgsl", include_str!("raytraced_ao.wgsl")),
         ("ray_denoise.wgsl", include_str!("ray_denoise.wgsl")),
     ],
+    constants: &[],
     build: Some(|device, _| Box::new(RayTracedAo::new(device))),
     fits,
     preset: |_, settings| settings.strength = 1.0,
+    validate: |s| s.raytraced.validate(),
+    levels: super::one_level,
     bench: &[
         // One ray per pixel each frame, continuing one picture (started by the first warm-up
         // frame, over the G-buffer).

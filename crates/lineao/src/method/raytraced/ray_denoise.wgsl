@@ -1,4 +1,4 @@
-// The ray tracer's edge-aware denoiser (`lineao::passes::ray_denoise`): each geometry pixel's
+// The ray tracer's edge-aware denoiser (`lineao::method::raytraced::denoise`): each geometry pixel's
 // running mean sum/rays (every pixel of a picture has traced `rays`) averaged with its neighbours' in a (2r + 1)² window that see the same
 // surface — the same stretch of the same line (own segments at most `reach` vertices apart),
 // or for surfaces and tubes a depth within `depth_tolerance` of the pixel's — weighted by
@@ -7,7 +7,7 @@
 #import shared/nd.wgsl
 #import shared/view.wgsl
 
-// Keep in sync with `DenoiseUniform` in `passes/ray_denoise.rs`.
+// Keep in sync with `lineao::method::raytraced::denoise::DenoiseUniform`.
 struct Denoise {
     view: ViewParams,
     radius: i32,

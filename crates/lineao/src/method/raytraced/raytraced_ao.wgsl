@@ -27,7 +27,7 @@ override START: bool = true;
 // Tube pixels find their own segment too (the denoiser's "same tube"; rays ignore it).
 override TUBE_OWN: bool = false;
 
-// Keep in sync with `TraceUniform` in `passes/raytraced_ao.rs`.
+// Keep in sync with `lineao::method::raytraced::TraceUniform`.
 struct Trace {
     view: ViewParams,
     inv_view: mat4x4<f32>,

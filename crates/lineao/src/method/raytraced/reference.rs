@@ -1,7 +1,7 @@
 //! CPU reference of the ray tracer's edge-aware denoiser (`ray_denoise.wgsl`).
 
-use crate::reference::{Image, NdImage};
-use crate::settings::RayDenoiseSettings;
+use super::settings::RayDenoiseSettings;
+use crate::image::{Image, NdImage};
 use crate::view_params::ViewParams;
 
 /// The own segment of a pixel without one (surfaces, tubes).

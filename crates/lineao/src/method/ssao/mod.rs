@@ -33,6 +33,10 @@ pub(crate) use settings::{SsaoKernel, SsaoSettings};
 use crate::method::BenchPass;
 
 /// Crytek SSAO in the registry ([`crate::method`]).
+/// A sample counts as occluded only when the surface is in front of it by more than this
+/// fraction of the depth range (f32 noise on a flat surface stays unoccluded); the shader's too.
+pub const SSAO_EPSILON: f32 = 1e-5;
+
 pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     name: "ssao",
     label: "Crytek SSAO",
@@ -40,9 +44,12 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     screen_space: true,
     spans: &["ssao", "ssao-blur"],
     shaders: &[("ssao.wgsl", include_str!("ssao.wgsl")), ("ssao_blur.wgsl", include_str!("ssao_blur.wgsl"))],
+    constants: &[("SSAO_EPSILON", crate::shader::Constant::F32(SSAO_EPSILON))],
     build: Some(|device, settings| Box::new(SsaoStage::new(device, settings))),
     fits: super::fits_always,
     preset: settings::preset,
+    validate: |s| s.ssao.validate(),
+    levels: super::one_level,
     bench: &[
         BenchPass::of("ssao-12", &["ssao"], |s, _| s.ssao.samples = 12),
         BenchPass::of("ssao-16-chain", &["ssao", "ssao-blur"], |s, _| s.ssao.samples = 16),

@@ -1,12 +1,10 @@
 //! CPU reference of Crytek SSAO and its 4 × 4 blur (`ssao.wgsl`, `ssao_blur.wgsl`),
 //! in the shaders' f32 operation order.
 
-use crate::reference::{Image, NdImage};
+use crate::image::{Image, NdImage};
 pub use crate::view_params::ViewParams;
 
-/// A sample counts as occluded only when the surface is in front of it by more than this
-/// fraction of the depth range (f32 noise on a flat surface stays unoccluded).
-pub const SSAO_EPSILON: f32 = 1e-5;
+pub use super::SSAO_EPSILON;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SsaoParams {

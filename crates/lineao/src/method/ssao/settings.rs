@@ -1,6 +1,7 @@
 //! Crytek SSAO's settings: the kernel, its radius and range check in world units.
 
-use crate::settings::{ChainSettings, Named, Preset, named};
+use crate::named::{Named, named};
+use crate::settings::{ChainSettings, Preset};
 
 named!(SsaoKernel {
     Crytek => "Mittring's random kernel, denser near the centre",

@@ -11,10 +11,10 @@
 #import shared/view.wgsl
 
 override SAMPLES: u32 = 16u;
-// Keep in sync with `lineao::reference::SSAO_EPSILON`.
-const SSAO_EPSILON: f32 = 1e-5;
+// SSAO_EPSILON: Rust's `lineao::method::ssao::SSAO_EPSILON`.
+#import rust/constants.wgsl
 
-// Keep in sync with `lineao::passes::ssao::SsaoUniform`.
+// Keep in sync with `lineao::method::ssao::SsaoUniform`.
 struct SsaoUniform {
     view: ViewParams,
     noise_origin: vec2<i32>,

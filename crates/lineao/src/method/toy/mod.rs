@@ -18,9 +18,12 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     screen_space: false,
     spans: &["toy"],
     shaders: &[("toy.wgsl", include_str!("toy.wgsl"))],
+    constants: &[],
     build: Some(|device, _| Box::new(Toy::new(device))),
     fits: super::fits_always,
     preset: |_, settings| settings.strength = 1.0,
+    validate: super::valid_always,
+    levels: super::one_level,
     bench: &[super::BenchPass::of("toy", &["toy"], |_, _| {})],
 };
 

@@ -41,9 +41,12 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     screen_space: true,
     spans: &["moments", "vo-area"],
     shaders: &[("vo_area.wgsl", include_str!("vo_area.wgsl")), ("moments.wgsl", include_str!("moments.wgsl"))],
+    constants: &[("MAX_MOMENT_LEVELS", crate::shader::Constant::U32(moments::MAX_MOMENT_LEVELS as u32))],
     build: Some(|device, settings| Box::new(VoArea::new(device, &settings.vo))),
     fits: moments::fits,
     preset: |preset, settings| crate::method::vo_line::preset(preset, settings, 1.0, 1.0),
+    validate: |s| s.vo.validate(),
+    levels: super::one_level,
     bench: &[super::BenchPass::of("vo-area-1", &["moments", "vo-area"], |s, _| s.vo.area_samples = 1)],
 };
 use crate::targets::FrameTargets;

@@ -1,10 +1,11 @@
 //! CPU reference of VO area sampling: the moments pyramid (`moments.wgsl`) and the
 //! pass (`vo_area.wgsl`), in the shaders' f32 operation order.
 
+use crate::image::{Image, NdImage};
 use crate::method::vo_line::reference::{
     VoParams, tangent_plane_depth, vo_ao, vo_chord_half, vo_pixel, vo_reflect, vo_sample,
 };
-use crate::reference::{Image, NdImage, binomial_5x5};
+use crate::reference::binomial_5x5;
 use crate::view_params::ViewParams;
 
 /// A level of the moments pyramid: (E\[z\], E\[z²\]) of linear depth, world units.

@@ -13,20 +13,13 @@
 // The normal clamp cuts each chord where the sample's own view ray, through the sample's point
 // on screen, crosses P's tangent plane (`tangent_plane_depth`), as line sampling does.
 #import shared/nd.wgsl
-#import shared/vo.wgsl
+#import shared/vo_pass.wgsl
 #import shared/moments.wgsl
 
-override RADII: u32 = 1u;
-
-@group(0) @binding(0) var<uniform> params: VoUniform;
-// samples[0..16]: (x, y, A_i, ½ log2(π A_i/ΣA)); tile[16..32]: (u.x, u.y) unit 2D directions.
-@group(0) @binding(1) var<uniform> tables: array<vec4<f32>, 32>;
-@group(0) @binding(2) var nd0: texture_2d<f32>;
-@group(0) @binding(3) var zoom_map: texture_2d<f32>;
+// The tables' w: ½ log2(π A_i/ΣA), each sample's footprint.
 // The moments pyramid (`moments.wgsl`): its layout and (E[z], E[z²]) of every level.
-@group(0) @binding(4) var<uniform> levels: array<vec4<u32>, MAX_MOMENT_LEVELS>;
-@group(0) @binding(5) var<storage, read> moments: array<vec2<f32>>;
-@group(0) @binding(6) var ao_out: texture_storage_2d<r32float, write>;
+@group(0) @binding(5) var<uniform> levels: array<vec4<u32>, MAX_MOMENT_LEVELS>;
+@group(0) @binding(6) var<storage, read> moments: array<vec2<f32>>;
 
 // Bilinear read of one level at `at`, in level-0 pixels from the corner of pixel (0, 0)'s centre:
 // texel x of level l is centred on level-0 pixel 2^l x, clamp-to-edge.
@@ -81,26 +74,4 @@ fn obscurance(pixel: vec2<u32>, here: vec4<f32>, depth: f32, zoom: f32, u: vec2<
         sums += sample.z * vo_sample(chord, mu, sigma / radius, thickness);
     }
     return vo_ao(sums);
-}
-
-@compute @workgroup_size(8, 8)
-fn vo_area(@builtin(global_invocation_id) id: vec3<u32>) {
-    let size = textureDimensions(nd0);
-    if id.x >= size.x || id.y >= size.y {
-        return;
-    }
-    let pixel = id.xy;
-    let here = textureLoad(nd0, pixel, 0);
-    if nd_is_background(here) {
-        textureStore(ao_out, pixel, vec4<f32>(0.0));
-        return;
-    }
-    let depth = linear_depth(params.view, here.w);
-    let zoom = textureLoad(zoom_map, pixel, 0).x;
-    let u = tables[vo_tile_index(pixel, params.noise_origin)].xy;
-    var ao = obscurance(pixel, here, depth, zoom, u, params.radius.x);
-    if RADII == 2u {
-        ao = vo_combine(ao, obscurance(pixel, here, depth, zoom, u, params.radius.y), params.combine);
-    }
-    textureStore(ao_out, pixel, vec4<f32>(ao, 0.0, 0.0, 0.0));
 }

@@ -49,9 +49,12 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     screen_space: true,
     spans: &["vo-line"],
     shaders: &[("vo_line.wgsl", include_str!("vo_line.wgsl"))],
+    constants: &[],
     build: Some(|device, settings| Box::new(VoLine::new(device, &settings.vo))),
     fits: super::fits_always,
     preset: |preset, settings| settings::preset(preset, settings, 2.0, 1.5),
+    validate: |s| s.vo.validate(),
+    levels: super::one_level,
     bench: &[super::BenchPass::of("vo-line-5", &["vo-line"], |s, _| s.vo.samples = 5)],
 };
 use crate::method::vo_area::moments::Moments;
@@ -123,16 +126,16 @@ impl VoCore {
         settings: &VoSettings,
         reads_moments: bool,
     ) -> VoCore {
-        let mut slots = vec![Slot::Uniform, Slot::Uniform, Slot::Texture, Slot::Texture];
+        // `shared/vo_pass.wgsl`'s bindings, then the moments of area sampling.
+        let mut slots =
+            vec![Slot::Uniform, Slot::Uniform, Slot::Texture, Slot::Texture, Slot::StorageTexture(AO_FORMAT)];
         if reads_moments {
             slots.extend([Slot::Uniform, Slot::Storage]);
         }
-        slots.push(Slot::StorageTexture(AO_FORMAT));
         let layout = binding::layout(device, label, wgpu::ShaderStages::COMPUTE, &slots);
         let radii = 1 + settings.radius2_world.is_some() as u32;
-        let entry = shader.trim_end_matches(".wgsl");
         let constants = [("RADII", radii as f64)];
-        let pipeline = binding::compute_pipeline(device, label, &layout, shader, entry, &constants);
+        let pipeline = binding::compute_pipeline(device, label, &layout, shader, "vo", &constants);
         let tile: Vec<[f32; 4]> = noise::vo_noise(settings.noise_seed).iter().map(|u| [u[0], u[1], 0.0, 0.0]).collect();
         VoCore {
             label,
@@ -150,18 +153,18 @@ impl VoCore {
         self.key == (samples, settings.noise_seed, 1 + settings.radius2_world.is_some() as u32)
     }
 
-    /// Binds `nd[0]`, `zoom`, the moments when given, and `ao`.
+    /// Binds `nd[0]`, `zoom`, `ao`, and the moments when given.
     pub(crate) fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets, moments: Option<&Moments>) {
         let mut resources = vec![
             self.uniform.as_entire_binding(),
             self.tables.as_entire_binding(),
             wgpu::BindingResource::TextureView(&targets.nd[0].view),
             wgpu::BindingResource::TextureView(&targets.zoom.view),
+            wgpu::BindingResource::TextureView(&targets.ao.view),
         ];
         if let Some(m) = moments {
             resources.extend([m.layout.as_entire_binding(), m.buffer.as_entire_binding()]);
         }
-        resources.push(wgpu::BindingResource::TextureView(&targets.ao.view));
         self.group = Some(binding::group(device, self.label, &self.layout, &resources));
     }
 

@@ -2,9 +2,9 @@
 //! what VO's line and area sampling share (`shaders/shared/vo.wgsl`), in the shaders' f32
 //! operation order.
 
+use super::settings::{VoCombine, VoSettings};
 use crate::camera::FrameView;
-use crate::reference::{Image, NdImage};
-use crate::settings::{VoCombine, VoSettings};
+use crate::image::{Image, NdImage};
 use crate::view_params::ViewParams;
 
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -1,7 +1,8 @@
 //! Volumetric Obscurance's settings, shared by line and area sampling (`vo_area` builds on
 //! `vo_line`): the sample sets, the radii, the normal clamp and the thickness.
 
-use crate::settings::{ChainSettings, Named, Preset, named};
+use crate::named::{Named, named};
+use crate::settings::{ChainSettings, Preset};
 
 named!(VoCombine {
     Product => "Brightness multiplies: 1 − (1 − ao_a)(1 − ao_b)",

@@ -17,17 +17,9 @@
 // Each pixel reflects its samples about a 2D direction from a 4 x 4 tile. With RADII = 2 the
 // sphere is evaluated at two radii and the results combined (Fig. 8).
 #import shared/nd.wgsl
-#import shared/vo.wgsl
+#import shared/vo_pass.wgsl
 
-override RADII: u32 = 1u;
-
-@group(0) @binding(0) var<uniform> params: VoUniform;
-// samples[0..16]: (x, y, A_i, z_s = √(1 − x² − y²)); tile[16..32]: (u.x, u.y) unit 2D directions.
-@group(0) @binding(1) var<uniform> tables: array<vec4<f32>, 32>;
-@group(0) @binding(2) var nd0: texture_2d<f32>;
-@group(0) @binding(3) var zoom_map: texture_2d<f32>;
-@group(0) @binding(4) var ao_out: texture_storage_2d<r32float, write>;
-
+// The tables' w: z_s = √(1 − x² − y²), each sample's half chord.
 fn obscurance(pixel: vec2<u32>, here: vec4<f32>, depth: f32, zoom: f32, u: vec2<f32>, radius: f32) -> f32 {
     let v = params.view;
     let scale = radius * zoom / params.zoom_unit;
@@ -54,26 +46,4 @@ fn obscurance(pixel: vec2<u32>, here: vec4<f32>, depth: f32, zoom: f32, u: vec2<
         sums += sample.z * vo_sample(chord, d_r, 0.0, thickness);
     }
     return vo_ao(sums);
-}
-
-@compute @workgroup_size(8, 8)
-fn vo_line(@builtin(global_invocation_id) id: vec3<u32>) {
-    let size = textureDimensions(nd0);
-    if id.x >= size.x || id.y >= size.y {
-        return;
-    }
-    let pixel = id.xy;
-    let here = textureLoad(nd0, pixel, 0);
-    if nd_is_background(here) {
-        textureStore(ao_out, pixel, vec4<f32>(0.0));
-        return;
-    }
-    let depth = linear_depth(params.view, here.w);
-    let zoom = textureLoad(zoom_map, pixel, 0).x;
-    let u = tables[vo_tile_index(pixel, params.noise_origin)].xy;
-    var ao = obscurance(pixel, here, depth, zoom, u, params.radius.x);
-    if RADII == 2u {
-        ao = vo_combine(ao, obscurance(pixel, here, depth, zoom, u, params.radius.y), params.combine);
-    }
-    textureStore(ao_out, pixel, vec4<f32>(ao, 0.0, 0.0, 0.0));
 }
