@@ -35,7 +35,7 @@
 
 // Whether the pieces are drawn as tubes (`lineao::passes::cull::Shape`).
 override TUBES: bool = false;
-// Whether the pieces are drawn at a level of detail (`lineao::passes::cull::Lod`).
+// Whether the pieces are drawn at a level of detail (`lineao::passes::cull::LineCull::new`'s `lod`).
 override LOD: bool = false;
 
 // Keep in sync with `lineao::passes::depth_pyramid::PyramidUniform`.

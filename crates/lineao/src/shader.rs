@@ -21,6 +21,7 @@ const SHARED: &[(&str, &str)] = &[
     ("shared/pieces.wgsl", include_str!("../shaders/shared/pieces.wgsl")),
     ("shared/view.wgsl", include_str!("../shaders/shared/view.wgsl")),
     ("shared/vo.wgsl", include_str!("../shaders/shared/vo.wgsl")),
+    ("shared/vo_pass.wgsl", include_str!("../shaders/shared/vo_pass.wgsl")),
     ("bilateral.wgsl", include_str!("../shaders/bilateral.wgsl")),
     ("composite.wgsl", include_str!("../shaders/composite.wgsl")),
     ("cull.wgsl", include_str!("../shaders/cull.wgsl")),
@@ -41,6 +42,33 @@ const SHARED: &[(&str, &str)] = &[
 /// `gbuffer_line_normal`, `gbuffer_eye_direction` (`shaders/shared/gbuffer.wgsl`; no bindings,
 /// no imports).
 pub const GBUFFER_WGSL: &str = include_str!("../shaders/shared/gbuffer.wgsl");
+
+/// A number Rust and WGSL share, written into WGSL by Rust ([`CONSTANTS`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Constant {
+    F32(f32),
+    U32(u32),
+}
+
+/// The file, made by Rust, of the constants that the CPU reference and the shaders share: a
+/// shader that says `#import rust/constants.wgsl` gets every method's
+/// ([`crate::method::MethodInfo::constants`]) as WGSL `const`s, so no number is written twice.
+pub const CONSTANTS: &str = "rust/constants.wgsl";
+
+/// [`CONSTANTS`]' text: `const NAME: f32 = …;` per constant, each f32 written with as many
+/// digits as give it back exactly.
+pub fn constants() -> String {
+    let all = crate::AoMethod::REGISTRY.iter().flat_map(|m| m.info().constants.iter());
+    all.map(|(name, value)| match value {
+        Constant::F32(v) => format!("const {name}: f32 = {v:?};\n"),
+        Constant::U32(v) => format!("const {name}: u32 = {v}u;\n"),
+    })
+    .collect()
+}
+
+/// Files that are a pass's body rather than a module: they use what their importer defines (VO's
+/// entry point calls its method's `obscurance`), so they validate within their importers only.
+pub const FRAGMENTS: &[&str] = &["shared/vo_pass.wgsl"];
 
 /// Every embedded WGSL file, (name, source): the shared ones, then each method's.
 pub fn files() -> impl Iterator<Item = (&'static str, &'static str)> {
@@ -68,6 +96,9 @@ fn append(path: &str, out: &mut String, seen: &mut Vec<String>) {
         return;
     }
     seen.push(path.to_owned());
+    if path == CONSTANTS {
+        return out.push_str(&constants());
+    }
     let source = raw(path).unwrap_or_else(|| panic!("WGSL file {path} is not embedded"));
     for line in source.lines() {
         match line.trim().strip_prefix("#import ") {

@@ -13,9 +13,16 @@ fn validate(path: &str) -> Result<(), String> {
 
 #[test]
 fn every_wgsl_file_validates() {
+    let modules = lineao::shader::files().filter(|(path, _)| !lineao::shader::FRAGMENTS.contains(path));
     let failures: Vec<String> =
-        lineao::shader::files().filter_map(|(path, _)| validate(path).err().map(|e| format!("{path}:\n{e}"))).collect();
+        modules.filter_map(|(path, _)| validate(path).err().map(|e| format!("{path}:\n{e}"))).collect();
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+    // A fragment validates within the modules that import it: at least one does.
+    for fragment in lineao::shader::FRAGMENTS {
+        let import = format!("#import {fragment}");
+        let importers = lineao::shader::files().filter(|(_, source)| source.lines().any(|l| l.trim() == import));
+        assert!(importers.count() > 0, "{fragment} is imported by no module");
+    }
 }
 
 /// The shared passes' files under `shaders/` (by path relative to it) and each method's in its

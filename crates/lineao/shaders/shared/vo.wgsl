@@ -3,7 +3,7 @@
 // sphere's radius R; a disk point s is the vertical chord [−z_s, z_s], z_s = √(1 − |s|²).
 #import shared/view.wgsl
 
-// Keep in sync with `lineao::passes::vo_line::VoUniform`.
+// Keep in sync with `lineao::method::vo_line::VoUniform`.
 struct VoUniform {
     view: ViewParams,
     noise_origin: vec2<i32>,
