@@ -340,8 +340,8 @@ fn measure(r: &Rendered, reach: f32, rays: u32) -> Result<MeshScore, Box<dyn std
     use lineao::truth::{Bvh, Frame, TruthSettings};
     let (d, q) = (&r.device, &r.queue);
     let targets = r.host.chain().targets().ok_or("no frame")?;
-    let nd = lineao::verify::read_rgba(d, q, &targets.nd[0])?;
-    let ao = lineao::verify::read_f32(d, q, targets.shown())?;
+    let nd = lineao::readback::read_rgba(d, q, &targets.nd[0])?;
+    let ao = lineao::readback::read_f32(d, q, targets.shown())?;
     let positions: Vec<[f32; 3]> = r.vertices.iter().map(|v| v.position).collect();
     let bvh = Bvh::build(Vec::new(), lineao::truth::mesh_triangles(&positions, &r.indices));
     // The host's projection has an infinite far plane; the truth's rays need a finite one:
@@ -440,8 +440,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
 #[cfg(test)]
 mod tests {
+    use lineao::readback::{read_f32, read_rgba};
     use lineao::reference::{self, LineAoParams};
-    use lineao::verify::{check_policy, line_ao_flip_bound, read_f32, read_rgba};
+    use lineao::verify::{check_policy, line_ao_flip_bound};
 
     /// The example's AO against the CPU reference run on its own inputs (the G-buffer the chain
     /// derived from the host's buffers, read back).

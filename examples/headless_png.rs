@@ -44,7 +44,7 @@ fn render(file: Option<&Path>, width: u32, height: u32) -> Result<Vec<u8>, Box<d
 
     let target = lineao::targets::Target::output(&gpu.device, "example::target", (width, height), format);
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    chain.encode(&mut encoder, &geometry, &target.view);
+    chain.encode(&mut encoder, &geometry, &target.view)?;
     gpu.queue.submit([encoder.finish()]);
     Ok(lineao::readback::read_texture(&gpu.device, &gpu.queue, &target.texture)?.bytes)
 }

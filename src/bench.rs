@@ -415,7 +415,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         passes.push(summary("bvh-upload", "cpu", ms));
     }
     if let (true, Some(ray_scene)) = (selected("raytraced-1spp"), &ray_scene) {
-        let geometry_pixels = lineao::verify::read_rgba(device, queue, &targets.nd[0])?
+        let geometry_pixels = lineao::readback::read_rgba(device, queue, &targets.nd[0])?
             .data
             .iter()
             .filter(|texel| texel[..3] != [0.0; 3])
@@ -549,7 +549,7 @@ fn ray_tracing_times(
     }
     if selected("raytraced-cpu-64") {
         // The bench's G-buffer (the chain itself only sized the guard band and drew nothing).
-        let nd = lineao::verify::read_rgba(&gpu.device, &gpu.queue, &targets.nd[0])?;
+        let nd = lineao::readback::read_rgba(&gpu.device, &gpu.queue, &targets.nd[0])?;
         let frame = lineao::truth::Frame { nd: &nd, view, lines: true };
         let settings = TruthSettings { rays: 64, ..TruthSettings::default() };
         let cancel = std::sync::atomic::AtomicBool::new(false);

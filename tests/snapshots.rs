@@ -121,7 +121,7 @@ fn every_pass_on_every_scene() {
             chain.set_settings(&gpu.device, settings).unwrap();
             chain.prepare(&gpu.device, &gpu.queue, &camera, &geometry.bounds.unwrap()).unwrap();
             let mut encoder = gpu.device.create_command_encoder(&Default::default());
-            chain.encode(&mut encoder, &geometry, &target.view);
+            chain.encode(&mut encoder, &geometry, &target.view).unwrap();
             gpu.queue.submit([encoder.finish()]);
             let image = read_texture(&gpu.device, &gpu.queue, &target.texture).unwrap();
             failures.extend(check(&format!("{}_{view_name}", kind.name()), SIZE, &image.bytes));

@@ -138,7 +138,7 @@ fn the_viewer_renders_what_the_library_renders() {
     chain.prepare(&gpu.device, &gpu.queue, &frame.view.camera, &geometry.bounds.unwrap());
     let target = lineao::targets::Target::output(&gpu.device, "test", frame.size, format);
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    chain.encode(&mut encoder, &geometry, &target.view);
+    chain.encode(&mut encoder, &geometry, &target.view).unwrap();
     gpu.queue.submit([encoder.finish()]);
     let direct = lineao::readback::read_texture(&gpu.device, &gpu.queue, &target.texture).unwrap().bytes;
     let differing = direct.iter().zip(&frame.images[0]).filter(|(a, b)| a.abs_diff(**b) > 1).count();
@@ -402,7 +402,7 @@ fn the_ray_traced_method_accumulates_while_the_camera_rests_and_shows_lineao_whi
     for _ in 0..3 {
         chain.prepare(d, q, &frame.view.camera, &geometry.bounds.unwrap());
         let mut encoder = d.create_command_encoder(&Default::default());
-        chain.encode(&mut encoder, &geometry, &target.view);
+        chain.encode(&mut encoder, &geometry, &target.view).unwrap();
         q.submit([encoder.finish()]);
     }
     assert_eq!(chain.ray_progress().unwrap().rays_per_pixel, 12);

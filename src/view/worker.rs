@@ -690,7 +690,7 @@ async fn render_frame(
             Some(shared) => shared,
             None => &textures[i],
         };
-        submit_frame(gpu, chain, (geometry, &[]), (&view.camera, &bounds), &target.view);
+        submit_frame(gpu, chain, (geometry, &[]), (&view.camera, &bounds), &target.view).map_err(|e| e.to_string())?;
         if readback {
             times.push(if view.timings { chain.pass_times(d).map_err(|e| e.to_string())? } else { None });
             images.push(lineao::readback::read_texture(d, q, &target.texture).map_err(|e| e.to_string())?.bytes);
@@ -706,7 +706,7 @@ async fn render_frame(
                 if progress.rays_per_pixel <= progress.frame_rays || panel.geometry_pixels == 0 {
                     // A new picture: the pixels its rays start from.
                     let nd = &chain.targets().expect("rendered").nd[0];
-                    let nd = lineao::verify::read_rgba(d, q, nd).map_err(|e| e.to_string())?;
+                    let nd = lineao::readback::read_rgba(d, q, nd).map_err(|e| e.to_string())?;
                     panel.geometry_pixels = nd.data.iter().filter(|texel| texel[..3] != [0.0; 3]).count();
                 }
                 let rays = panel.geometry_pixels as f64 * progress.frame_rays as f64;

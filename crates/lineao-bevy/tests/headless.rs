@@ -150,7 +150,7 @@ fn read_ao(d: &wgpu::Device, q: &wgpu::Queue, view: &wgpu::TextureView) -> AoIma
 }
 
 fn read_nd(d: &wgpu::Device, q: &wgpu::Queue, chain: &AoChain) -> NdImage {
-    lineao::verify::read_rgba(d, q, &chain.targets().unwrap().nd[0]).unwrap()
+    lineao::readback::read_rgba(d, q, &chain.targets().unwrap().nd[0]).unwrap()
 }
 
 /// Runs after Bevy submitted the frame (between `Render` and `Cleanup`).
@@ -212,7 +212,7 @@ fn capture(
                 chain.prepare(d, q, &camera, &bounds).unwrap();
                 let output = lineao::targets::Target::output(d, "test", SIZE, wgpu::TextureFormat::Rgba8UnormSrgb);
                 let mut encoder = d.create_command_encoder(&Default::default());
-                chain.encode(&mut encoder, &geometry, &output.view);
+                chain.encode(&mut encoder, &geometry, &output.view).unwrap();
                 q.submit([encoder.finish()]);
                 let plugin = overlay.chain();
                 captured.lines = Some((

@@ -211,7 +211,7 @@ pub fn write(
         let tile: Vec<f32> = noise::vo_noise(vo.noise_seed).into_iter().flatten().collect();
         write_npy(dir, "vo_noise.npy", &[4, 4, 2], &tile)?;
         if let Some(moments) = chain.stage::<VoArea>().and_then(VoArea::moments) {
-            for (l, level) in lineao::verify::read_moments(&gpu.device, &gpu.queue, moments)?.iter().enumerate() {
+            for (l, level) in lineao::readback::read_moments(&gpu.device, &gpu.queue, moments)?.iter().enumerate() {
                 let shape = [level.height as u64, level.width as u64, 2];
                 write_npy(dir, &format!("moments_{l}.npy"), &shape, &level.data.concat())?;
             }
@@ -220,7 +220,8 @@ pub fn write(
     if let (Some(options), Some(settings), Some(octants), Some(volume_ao)) =
         (volume, &s.volume, &targets.octants, &targets.volume_ao)
     {
-        let packed: lineao::reference::Image<[u32; 2]> = lineao::verify::read_image(&gpu.device, &gpu.queue, octants)?;
+        let packed: lineao::reference::Image<[u32; 2]> =
+            lineao::readback::read_image(&gpu.device, &gpu.queue, octants)?;
         let unpacked: Vec<f32> = packed.data.iter().flat_map(|&p| lineao::reference::unpack_octants(p)).collect();
         write_npy(dir, "octants.npy", &[h, w, 8], &unpacked)?;
         write_npy(dir, "volume_ao.npy", &[h, w], &read(&volume_ao.texture)?.to_f32())?;

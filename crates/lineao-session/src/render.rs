@@ -520,6 +520,18 @@ pub fn percentile_range(values: &[f32]) -> [f32; 2] {
     [at(0.02), at(0.98)]
 }
 
+/// How [`Session::frame`] renders a frame.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FrameOptions {
+    /// The ray-traced method traces on the GPU (not `--cpu`): the scene is given, the rays
+    /// accumulate.
+    pub gpu_rays: bool,
+    /// Culled lines: the picture is a still camera's second frame.
+    pub settled: bool,
+    /// Times the picture's frame (`--timings`).
+    pub timings: bool,
+}
+
 /// One rendered panel: the image, and the chain that made it (its targets hold the frame).
 pub struct Rendered {
     pub image: Rgba8,
@@ -549,37 +561,13 @@ impl Session {
             }
             None => AoChain::new(&gpu.device, format, panel.settings.clone())?,
         };
-        // Culled, the second frame is timed (the timer skips a frame submitted while it reads
-        // the one before).
-        if args.image.timings && !panel.settings.cull {
-            chain.set_timing(&gpu.device, &gpu.queue, true);
-        }
         chain.resize(args.image.width, args.image.height)?;
         let size = (args.image.width, args.image.height);
         let target = lineao::targets::Target::output(&gpu.device, "lineao::render::output", size, format);
-        let meshes: Vec<&MeshGeometry> = self.meshes.iter().collect();
         let start = std::time::Instant::now();
-        let scene = (&self.lines.geometry, &meshes[..]);
         let gpu_rays = panel.settings.method == AoMethod::RayTraced && !args.truth.cpu;
-        if gpu_rays {
-            chain.set_ray_scene(&gpu.device, Some(self.ray_scene()?));
-        }
-        chain.set_slice_volume(&gpu.device, self.anatomy.clone());
-        submit_frame(gpu, &mut chain, scene, (&self.camera, &self.bounds), &target.view);
-        if panel.settings.cull {
-            // Culled, the picture (and its timings) is the view's second frame, what a viewer
-            // shows of a still camera: drawn from what the first found visible, at the levels of
-            // detail it found.
-            if args.image.timings {
-                chain.set_timing(&gpu.device, &gpu.queue, true);
-            }
-            submit_frame(gpu, &mut chain, scene, (&self.camera, &self.bounds), &target.view);
-        }
-        if gpu_rays {
-            crate::truth::accumulate(gpu, &mut chain, |chain| {
-                submit_frame(gpu, chain, scene, (&self.camera, &self.bounds), &target.view)
-            })?;
-        }
+        let options = FrameOptions { gpu_rays, settled: true, timings: args.image.timings };
+        self.frame(&mut chain, &target.view, options)?;
         if args.image.timings {
             gpu.wait()?;
             let wall_ms = start.elapsed().as_secs_f64() * 1e3;
@@ -598,10 +586,11 @@ impl Session {
                 eprintln!("lineao: {label}: cull: {counts}");
             }
         }
+        let truth_settings = crate::truth::settings(args, self.longest_side);
         let truth = if panel.settings.method == AoMethod::RayTraced && args.truth.cpu {
-            let truth = self.trace(&chain, &crate::truth::settings(args, self.longest_side))?;
+            let truth = self.trace(&chain, &truth_settings)?;
             let targets = chain.targets().context("nothing was rendered")?;
-            lineao::verify::write_target(&gpu.queue, &targets.ao, &truth.ao);
+            lineao::readback::write_target(&gpu.queue, &targets.ao, &truth.ao);
             let mut encoder = gpu
                 .device
                 .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::render::composite") });
@@ -621,11 +610,44 @@ impl Session {
                 crate::dump::write_selection(dir, selected)?;
             }
             if let Some(truth) = &truth {
-                crate::dump::write_truth(dir, truth, &crate::truth::settings(args, self.longest_side))?;
+                crate::dump::write_truth(dir, truth, &truth_settings)?;
             }
         }
         let image = Rgba8 { width: args.image.width, height: args.image.height, data: image.bytes };
         Ok(Rendered { image, chain })
+    }
+
+    /// One frame of `chain` (sized, with its settings) over the session's lines, surfaces and
+    /// anatomy, seen by its camera, into `target`: the one frame path of `render`, `score` and
+    /// Python. With `options.gpu_rays` the ray tracer gets the session's scene and its picture
+    /// accumulates until its rays per pixel; `options.settled` draws culled lines twice, the
+    /// picture being the second frame — what a viewer shows of a still camera, drawn from what
+    /// the first found visible at the levels of detail it found —, which `options.timings` times
+    /// (the timer skips a frame submitted while it reads the one before).
+    pub fn frame(&self, chain: &mut AoChain, target: &wgpu::TextureView, options: FrameOptions) -> Result<()> {
+        let gpu = &self.gpu;
+        let meshes: Vec<&MeshGeometry> = self.meshes.iter().collect();
+        let scene = (&self.lines.geometry, &meshes[..]);
+        let view = (&self.camera, &self.bounds);
+        let again = options.settled && chain.settings().cull;
+        if options.gpu_rays {
+            chain.set_ray_scene(&gpu.device, Some(self.ray_scene()?));
+        }
+        chain.set_slice_volume(&gpu.device, self.anatomy.clone());
+        if options.timings && !again {
+            chain.set_timing(&gpu.device, &gpu.queue, true);
+        }
+        submit_frame(gpu, chain, scene, view, target)?;
+        if again {
+            if options.timings {
+                chain.set_timing(&gpu.device, &gpu.queue, true);
+            }
+            submit_frame(gpu, chain, scene, view, target)?;
+        }
+        if options.gpu_rays {
+            crate::truth::accumulate(gpu, chain, |chain| submit_frame(gpu, chain, scene, view, target))?;
+        }
+        Ok(())
     }
 
     /// The ray tracer's scene on the GPU (built and uploaded once per session), with a line on

@@ -118,23 +118,13 @@ pub fn raw_ao(
         (width, height),
         wgpu::TextureFormat::Rgba8UnormSrgb,
     );
-    let meshes: Vec<&lineao::passes::meshes::MeshGeometry> = session.meshes.iter().collect();
-    let scene = (&session.lines.geometry, &meshes[..]);
-    let view = (&session.camera, &session.bounds);
-    let traced = chain.settings().method == AoMethod::RayTraced;
-    if traced {
-        chain.set_ray_scene(&gpu.device, Some(session.ray_scene()?));
-    }
-    crate::source::submit_frame(gpu, chain, scene, view, &target.view);
-    if traced {
-        crate::truth::accumulate(gpu, chain, |chain| {
-            crate::source::submit_frame(gpu, chain, scene, view, &target.view)
-        })?;
-    }
+    // One frame: the fit renders hundreds of settings, each exact after its first frame.
+    let gpu_rays = chain.settings().method == AoMethod::RayTraced;
+    session.frame(chain, &target.view, crate::render::FrameOptions { gpu_rays, ..Default::default() })?;
     let targets = chain.targets().context("nothing was rendered")?;
     let shown = targets.shown();
-    let raw = lineao::verify::read_f32(&gpu.device, &gpu.queue, shown)?;
-    let nd = lineao::verify::read_rgba(&gpu.device, &gpu.queue, &targets.nd[0])?;
+    let raw = lineao::readback::read_f32(&gpu.device, &gpu.queue, shown)?;
+    let nd = lineao::readback::read_rgba(&gpu.device, &gpu.queue, &targets.nd[0])?;
     let guard = targets.guard as usize;
     let (w, h) = (width as usize, height as usize);
     let ao = Image::from_fn(w, h, |x, y| raw.get(x + guard, y + guard));
@@ -256,9 +246,9 @@ pub fn score(
 pub fn read_frame(session: &Session, chain: &lineao::AoChain) -> Result<(NdImage, Shading)> {
     let (device, queue) = (&session.gpu.device, &session.gpu.queue);
     let targets = chain.targets().context("nothing was rendered")?;
-    let nd = lineao::verify::read_rgba(device, queue, &targets.nd[0])?;
+    let nd = lineao::readback::read_rgba(device, queue, &targets.nd[0])?;
     let color = lineao::readback::read_texture(device, queue, &targets.color.texture)?.to_vec4();
-    let specular = lineao::verify::read_f32(device, queue, &targets.specular)?;
+    let specular = lineao::readback::read_f32(device, queue, &targets.specular)?;
     Ok((nd, Shading::new(&color, &specular.data)))
 }
 

@@ -333,19 +333,21 @@ pub fn upload(name: &str, tracts: &Tractogram, on: &lineao::Gpu) -> Result<LineG
 }
 
 /// Records one frame of `chain` (already sized) over `geometry` and `meshes`, seen by
-/// `camera`, into `target` (the chain's size and format), and submits it.
+/// `camera`, into `target` (the chain's size and format), and submits it; a target the chain
+/// cannot draw into is its error, with nothing submitted.
 pub fn submit_frame(
     gpu: &lineao::Gpu,
     chain: &mut AoChain,
     (geometry, meshes): (&LineGeometry, &[&MeshGeometry]),
     (camera, bounds): (&Camera, &lineao::Bounds),
     target: &wgpu::TextureView,
-) {
+) -> std::result::Result<(), lineao::Error> {
     let (d, q) = (&gpu.device, &gpu.queue);
     chain.prepare(d, q, camera, bounds);
     let mut encoder = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::frame") });
-    chain.encode_with_meshes(&mut encoder, geometry, meshes, target);
+    chain.encode_with_meshes(&mut encoder, geometry, meshes, target)?;
     q.submit([encoder.finish()]);
+    Ok(())
 }
 
 /// A progress bar on stderr for loading `path` when stderr is a terminal and the file is

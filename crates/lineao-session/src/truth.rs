@@ -81,7 +81,11 @@ pub fn ray_scene(gpu: &Gpu, scene: &Scene) -> Result<lineao::RayScene> {
 
 /// Submits frames with `frame` until `chain`'s ray-traced picture has all its rays (the first
 /// frame submitted already), with a progress bar on a terminal; Ctrl-C stops it with an error.
-pub fn accumulate(gpu: &Gpu, chain: &mut AoChain, mut frame: impl FnMut(&mut AoChain)) -> Result<()> {
+pub fn accumulate(
+    gpu: &Gpu,
+    chain: &mut AoChain,
+    mut frame: impl FnMut(&mut AoChain) -> std::result::Result<(), lineao::Error>,
+) -> Result<()> {
     let start = std::time::Instant::now();
     let progress = |chain: &AoChain| chain.ray_progress().context("the ray-traced method is not active");
     let first = progress(chain)?;
@@ -106,7 +110,7 @@ pub fn accumulate(gpu: &Gpu, chain: &mut AoChain, mut frame: impl FnMut(&mut AoC
         if cancel.load(Ordering::Relaxed) {
             anyhow::bail!("ray tracing stopped (Ctrl-C)");
         }
-        frame(chain);
+        frame(chain)?;
         // One frame in flight: the bar and Ctrl-C follow the GPU, not the queue; a lost device
         // ends it here.
         gpu.wait().context("ray tracing stopped")?;
@@ -133,7 +137,7 @@ pub fn from_gpu(gpu: &Gpu, chain: &AoChain) -> Result<Truth> {
     let accumulation =
         chain.stage::<RayTracedAo>().and_then(RayTracedAo::accumulation).context("nothing was traced")?;
     let targets = chain.targets().context("nothing was rendered")?;
-    let nd = lineao::verify::read_rgba(d, q, &targets.nd[0])?;
+    let nd = lineao::readback::read_rgba(d, q, &targets.nd[0])?;
     let words: Vec<[u32; 4]> = bytemuck::cast_slice(&lineao::readback::read_buffer(d, q, accumulation)?).to_vec();
     let n = progress.rays_per_pixel as f64;
     let (mut ao, mut stderr) = (Image::filled(nd.width, nd.height, 0.0), Image::filled(nd.width, nd.height, 0.0));
@@ -211,7 +215,7 @@ pub fn bvh(chain: &AoChain, scene: &Scene) -> Result<Bvh> {
 pub fn trace(gpu: &Gpu, chain: &AoChain, bvh: &Bvh, settings: &TruthSettings) -> Result<Truth> {
     let targets = chain.targets().context("nothing was rendered")?;
     let view = chain.frame_view().context("nothing was rendered")?;
-    let nd = lineao::verify::read_rgba(&gpu.device, &gpu.queue, &targets.nd[0])?;
+    let nd = lineao::readback::read_rgba(&gpu.device, &gpu.queue, &targets.nd[0])?;
     let frame = lineao::truth::Frame { nd: &nd, view, lines: chain.settings().tubes.is_none() };
     let bar = std::io::stderr().is_terminal().then(|| {
         indicatif::ProgressBar::new(nd.height as u64).with_style(

@@ -2,8 +2,8 @@
 //! and an AO off by 0.5 on 1 % of the geometry pixels fails it — so the browser test's check
 //! can tell a wrong frame from a right one.
 
+use lineao::readback::{read_f32, read_rgba};
 use lineao::targets::Target;
-use lineao::verify::{read_f32, read_rgba};
 use lineao::{AoChain, AoMethod, Camera, ChainSettings, Gpu, LineGeometry, Preset};
 use lineao_web::check::{Meta, Readback, check};
 
@@ -26,7 +26,7 @@ fn frame(gpu: &Gpu, method: AoMethod) -> Readback {
     let view = chain.prepare(d, q, &camera, &geometry.bounds.unwrap()).unwrap();
     let output = Target::output(d, "test::output", (200, 150), format);
     let mut encoder = d.create_command_encoder(&Default::default());
-    chain.encode(&mut encoder, &geometry, &output.view);
+    chain.encode(&mut encoder, &geometry, &output.view).unwrap();
     q.submit([encoder.finish()]);
     let targets = chain.targets().unwrap();
     let raw = match method {

@@ -47,7 +47,7 @@
 //! chain.prepare(&gpu.device, &gpu.queue, &camera, &geometry.bounds.unwrap());
 //! # let target: wgpu::TextureView = todo!();
 //! let mut encoder = gpu.device.create_command_encoder(&Default::default());
-//! chain.encode(&mut encoder, &geometry, &target);
+//! chain.encode(&mut encoder, &geometry, &target)?;
 //! gpu.queue.submit([encoder.finish()]);
 //! # Ok(()) }
 //! ```

@@ -263,7 +263,7 @@ pub struct ChainSettings {
     /// Context surfaces drawn with the lines ([`crate::AoChain::encode_with_meshes`]), or none.
     /// Default none.
     pub surfaces: Option<SurfaceSettings>,
-    /// Anatomy slices drawn with the lines ([`crate::AoChain::encode_with_context`]), or none.
+    /// Anatomy slices drawn with the lines ([`crate::AoChain::set_slice_volume`] gives their volume), or none.
     /// Default none.
     pub slices: Option<SliceSettings>,
     /// Lines cut to a slab, or none. Default none.

@@ -1,73 +1,8 @@
-//! Proving the GPU against the CPU reference: read targets back as reference images, and the
+//! Proving the GPU against the CPU reference (its targets read back by [`crate::readback`]): the
 //! agreement check of CONTRACT.md ("GPU vs CPU agreement"): ≥ 99.5 % of geometry pixels within
 //! 1e-3, and every pixel within a bound of a few flipped samples.
 
-use crate::Error;
 use crate::image::{Image, NdImage};
-use crate::readback::read_texture;
-use crate::targets::Target;
-
-/// A target of one f32 channel (zoom, specular, ao, depth) as an image.
-pub fn read_f32(device: &wgpu::Device, queue: &wgpu::Queue, target: &Target) -> Result<Image<f32>, Error> {
-    let data = read_texture(device, queue, &target.texture)?;
-    Ok(Image { width: data.width as usize, height: data.height as usize, data: data.to_f32() })
-}
-
-/// An Rgba32Float or Rgba16Float target (an ND level, color) as an image.
-pub fn read_rgba(device: &wgpu::Device, queue: &wgpu::Queue, target: &Target) -> Result<NdImage, Error> {
-    let data = read_texture(device, queue, &target.texture)?;
-    Ok(Image { width: data.width as usize, height: data.height as usize, data: data.to_vec4() })
-}
-
-/// A target of any format as an image of `T` (one texel's bytes each), e.g. `[u32; 2]` for the
-/// `octants` target.
-pub fn read_image<T: bytemuck::Pod>(
-    device: &wgpu::Device,
-    queue: &wgpu::Queue,
-    target: &Target,
-) -> Result<Image<T>, Error> {
-    let data = read_texture(device, queue, &target.texture)?;
-    Ok(Image {
-        width: data.width as usize,
-        height: data.height as usize,
-        data: bytemuck::pod_collect_to_vec(&data.bytes),
-    })
-}
-
-/// The moments pyramid (`targets.moments`) as the CPU reference takes it: (E\[z\], E\[z²\]) per
-/// level.
-pub fn read_moments(
-    device: &wgpu::Device,
-    queue: &wgpu::Queue,
-    moments: &crate::method::vo_area::moments::Moments,
-) -> Result<Vec<crate::reference::MomentsImage>, Error> {
-    let all: Vec<[f32; 2]> =
-        bytemuck::pod_collect_to_vec(&crate::readback::read_buffer(device, queue, &moments.buffer)?);
-    Ok(moments
-        .levels
-        .iter()
-        .map(|l| {
-            let start = l.offset as usize;
-            let (width, height) = (l.width as usize, l.height as usize);
-            Image { width, height, data: all[start..start + width * height].to_vec() }
-        })
-        .collect())
-}
-
-/// Writes `image` into an Rgba32Float or R32Float target (a host's own G-buffer, or a test's).
-pub fn write_target<T: bytemuck::Pod>(queue: &wgpu::Queue, target: &Target, image: &Image<T>) {
-    let texel = std::mem::size_of::<T>() as u32;
-    queue.write_texture(
-        target.texture.as_image_copy(),
-        bytemuck::cast_slice(&image.data),
-        wgpu::TexelCopyBufferLayout {
-            offset: 0,
-            bytes_per_row: Some(image.width as u32 * texel),
-            rows_per_image: Some(image.height as u32),
-        },
-        target.texture.size(),
-    );
-}
 
 /// How two images differ.
 #[derive(Clone, Debug, PartialEq)]

@@ -6,9 +6,10 @@ mod common;
 
 use common::{cameras_for_polylines, flat_view, gpu, polylines, render};
 use lineao::passes::bilateral::Bilateral;
+use lineao::readback::{read_f32, write_target};
 use lineao::reference::{self, Image, ViewParams};
 use lineao::targets::FrameTargets;
-use lineao::verify::{check_policy, read_f32, write_target};
+use lineao::verify::check_policy;
 use lineao::{AoMethod, BilateralSettings, ChainSettings, Gpu};
 
 /// Runs the blur alone over `ao` on the G-buffer `nd0` (no guard band); returns the GPU's

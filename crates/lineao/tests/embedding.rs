@@ -9,9 +9,9 @@ use common::{cameras_for_polylines, gpu, host_depth, is_geometry, polylines, sph
 use glam::{Mat4, Vec3, Vec4Swizzles};
 use lineao::LineGeometry;
 use lineao::passes::nd_from_depth::{HostConfig, HostInputs, HostNormals};
+use lineao::readback::{read_f32, read_rgba};
 use lineao::reference::tubes::pixel_ray;
 use lineao::reference::{Image, NdImage};
-use lineao::verify::{read_f32, read_rgba};
 use lineao::{AoChain, AoMethod, ChainSettings, HostAo, OverlayAo, TubeSettings};
 use lineao::{Bounds, Camera, FrameView, Projection};
 
@@ -84,7 +84,7 @@ fn maps_derived_from_depth_match_the_ones_the_renderers_write() {
         assert_eq!(view.guard, 0);
         let output = lineao::targets::Target::output(d, "test::output", size, common::OUTPUT_FORMAT);
         let mut encoder = d.create_command_encoder(&Default::default());
-        chain.encode(&mut encoder, &geometry, &output.view);
+        chain.encode(&mut encoder, &geometry, &output.view).unwrap();
         q.submit([encoder.finish()]);
         let t = chain.targets().unwrap();
         let (nd, zoom) = (read_rgba(d, q, &t.nd[0]).unwrap(), read_f32(d, q, &t.zoom).unwrap());
@@ -125,7 +125,7 @@ fn maps_derived_from_depth_match_the_ones_the_renderers_write() {
                 wgpu::TextureFormat::Rgba32Float,
                 wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
             );
-            lineao::verify::write_target(q, &normals, &nd);
+            lineao::readback::write_target(q, &normals, &nd);
             let config =
                 HostConfig { normals: Some(HostNormals { world_space: false, unorm: false }), ..Default::default() };
             let given = run_host(&gpu, ChainSettings::default(), config, host_view, &t.depth.view, Some(&normals.view));
@@ -261,7 +261,7 @@ fn the_composite_writes_any_host_color_format() {
         chain.prepare(d, q, &camera, &bounds).unwrap();
         let target = lineao::targets::Target::output(d, "test::output", size, format);
         let mut encoder = d.create_command_encoder(&Default::default());
-        chain.encode(&mut encoder, &geometry, &target.view);
+        chain.encode(&mut encoder, &geometry, &target.view).unwrap();
         q.submit([encoder.finish()]);
         lineao::readback::read_texture(d, q, &target.texture).unwrap().bytes
     };
@@ -436,7 +436,7 @@ fn the_overlay_keeps_the_hosts_frame_and_writes_its_depth() {
     let view = chain.prepare(d, q, &camera, &bounds).unwrap();
     let plain = lineao::targets::Target::output(d, "test::plain", size, common::OUTPUT_FORMAT);
     let mut encoder = d.create_command_encoder(&Default::default());
-    chain.encode(&mut encoder, &geometry, &plain.view);
+    chain.encode(&mut encoder, &geometry, &plain.view).unwrap();
     q.submit([encoder.finish()]);
     let plain: Vec<[f32; 4]> = read_texture_vec4(&gpu, &plain.texture);
     let nd = read_rgba(d, q, &chain.targets().unwrap().nd[0]).unwrap();
@@ -532,6 +532,23 @@ fn the_overlay_keeps_the_hosts_frame_and_writes_its_depth() {
     assert!(matches!(overlay.set_depth(d, Some(bad)), Err(lineao::Error::Usage(_))));
     let fresh = AoChain::new(d, common::OUTPUT_FORMAT, ChainSettings::default()).unwrap();
     assert!(matches!(OverlayAo::new(d, fresh, Some(bad)), Err(lineao::Error::Usage(_))));
+
+    // The chain's own encode checks alike: a frame not prepared, a target of another size or
+    // format; a 0 × 0 chain records nothing.
+    let mut chain = AoChain::new(d, common::OUTPUT_FORMAT, ChainSettings::default()).unwrap();
+    chain.resize(size.0, size.1).unwrap();
+    let result = chain.encode(&mut encoder, &geometry, &output.view);
+    assert!(matches!(&result, Err(lineao::Error::Usage(t)) if t.contains("before AoChain::prepare")), "{result:?}");
+    chain.prepare(d, q, &camera, &bounds).unwrap();
+    let small = lineao::targets::Target::output(d, "test::small", (size.0 / 2, size.1), common::OUTPUT_FORMAT);
+    let result = chain.encode(&mut encoder, &geometry, &small.view);
+    assert!(matches!(&result, Err(lineao::Error::Usage(_))), "{result:?}");
+    let float = lineao::targets::Target::output(d, "test::float", size, wgpu::TextureFormat::Rgba16Float);
+    let result = chain.encode(&mut encoder, &geometry, &float.view);
+    assert!(matches!(&result, Err(lineao::Error::Usage(t)) if t.contains("Rgba16Float")), "{result:?}");
+    chain.encode(&mut encoder, &geometry, &output.view).unwrap();
+    chain.resize(0, 0).unwrap();
+    chain.encode(&mut encoder, &geometry, &small.view).unwrap();
 }
 
 fn read_texture_vec4(gpu: &lineao::Gpu, texture: &wgpu::Texture) -> Vec<[f32; 4]> {

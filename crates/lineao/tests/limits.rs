@@ -79,7 +79,7 @@ fn sizes_beyond_the_adapter_are_errors_and_zero_draws_nothing() {
     assert_eq!((empty.page_count(), empty.bounds), (0, None));
     let output = lineao::targets::Target::output(&gpu.device, "test::output", (8, 8), common::OUTPUT_FORMAT);
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    chain.encode(&mut encoder, &empty, &output.view);
+    chain.encode(&mut encoder, &empty, &output.view).unwrap();
     gpu.queue.submit([encoder.finish()]);
 
     // Back to a real size, empty geometry renders background only.
@@ -167,12 +167,12 @@ fn a_chain_switching_methods_renders_what_fresh_chains_do() {
         chain.prepare(d, q, &camera, &bounds).unwrap();
         let output = lineao::targets::Target::output(d, "test::output", (w, h), common::OUTPUT_FORMAT);
         let mut encoder = d.create_command_encoder(&Default::default());
-        chain.encode(&mut encoder, &geometry, &output.view);
+        chain.encode(&mut encoder, &geometry, &output.view).unwrap();
         q.submit([encoder.finish()]);
-        let switched = lineao::verify::read_rgba(d, q, &output).unwrap();
+        let switched = lineao::readback::read_rgba(d, q, &output).unwrap();
         let fresh = common::render_geometry(&gpu, &geometry, &camera, bounds, settings.clone(), (w, h)).output;
         assert_eq!(switched.data, fresh.data, "step {i}: {:?} at {w}×{h}", settings.method);
-        let ao = lineao::verify::read_f32(d, q, &chain.targets().unwrap().ao).unwrap();
+        let ao = lineao::readback::read_f32(d, q, &chain.targets().unwrap().ao).unwrap();
         if settings.method != AoMethod::None {
             assert!(ao.data.iter().any(|&a| a > 0.05), "step {i}: no occlusion at all");
         }
@@ -203,7 +203,7 @@ fn prepare_encode_and_upload_do_not_wait_for_the_device() {
     long.prepare(d, q, &camera, &bounds).unwrap();
     let output = lineao::targets::Target::output(d, "test::long", (1536, 1536), common::OUTPUT_FORMAT);
     let mut encoder = d.create_command_encoder(&Default::default());
-    long.encode(&mut encoder, &geometry, &output.view);
+    long.encode(&mut encoder, &geometry, &output.view).unwrap();
     q.submit([encoder.finish()]);
     let done = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&done);
@@ -220,7 +220,7 @@ fn prepare_encode_and_upload_do_not_wait_for_the_device() {
     chain.prepare(d, q, &camera, &bounds).unwrap();
     let small = lineao::targets::Target::output(d, "test::small", (256, 192), common::OUTPUT_FORMAT);
     let mut encoder = d.create_command_encoder(&Default::default());
-    chain.encode(&mut encoder, &uploaded, &small.view);
+    chain.encode(&mut encoder, &uploaded, &small.view).unwrap();
     assert_eq!(chain.try_pass_times(d).unwrap(), None, "no timed frame was submitted");
     let took = start.elapsed();
     assert!(!done.load(Ordering::Acquire), "the calls waited for the long frame ({took:?})");

@@ -474,7 +474,7 @@ fn chain_reports_gpu_time_per_pass() {
         chain.prepare(&gpu.device, &gpu.queue, &camera, &geometry.bounds.unwrap()).unwrap();
         let output = lineao::targets::Target::output(&gpu.device, "test::output", (64, 48), common::OUTPUT_FORMAT);
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        chain.encode(&mut encoder, &geometry, &output.view);
+        chain.encode(&mut encoder, &geometry, &output.view).unwrap();
         gpu.queue.submit([encoder.finish()]);
         let Some(times) = chain.pass_times(&gpu.device).unwrap() else {
             assert!(!has_timestamps);
@@ -512,7 +512,7 @@ fn pass_times_can_be_polled_without_waiting() {
     for _ in 0..1000 {
         chain.prepare(&gpu.device, &gpu.queue, &camera, &geometry.bounds.unwrap()).unwrap();
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
-        chain.encode(&mut encoder, &geometry, &output.view);
+        chain.encode(&mut encoder, &geometry, &output.view).unwrap();
         gpu.queue.submit([encoder.finish()]);
         if let Some(times) = chain.try_pass_times(&gpu.device).unwrap() {
             polled = Some(times);
@@ -522,7 +522,7 @@ fn pass_times_can_be_polled_without_waiting() {
     let polled = polled.expect("a finished frame's times within 1000 frames");
     // The next frame is timed again, and the blocking read waits for it.
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    chain.encode(&mut encoder, &geometry, &output.view);
+    chain.encode(&mut encoder, &geometry, &output.view).unwrap();
     gpu.queue.submit([encoder.finish()]);
     let blocking = chain.pass_times(&gpu.device).unwrap().unwrap();
     let names = |t: &[lineao::timing::PassTime]| t.iter().map(|t| t.name).collect::<Vec<_>>();

@@ -333,7 +333,7 @@ fn native_lines_are_one_pixel() {
         let mut encoder = d.create_command_encoder(&Default::default());
         renderer.encode(&mut encoder, &targets, &geometry, lineao::passes::Load::Clear(s.background), None);
         q.submit([encoder.finish()]);
-        let nd = lineao::verify::read_rgba(d, q, &targets.nd[0]).unwrap();
+        let nd = lineao::readback::read_rgba(d, q, &targets.nd[0]).unwrap();
         (60..140).map(|x| (0..SIZE.1 as usize).filter(|&y| is_geometry(nd.get(x, y))).count()).collect::<Vec<_>>()
     };
     // Two horizontal polylines, one pixel high each whatever the line width.
@@ -487,7 +487,7 @@ fn draw(
     let mut encoder = d.create_command_encoder(&Default::default());
     renderer.encode(&mut encoder, &targets, geometry, lineao::passes::Load::Clear(s.background), None);
     q.submit([encoder.finish()]);
-    (lineao::verify::read_rgba(d, q, &targets.nd[0]).unwrap(), renderer.alternates(geometry))
+    (lineao::readback::read_rgba(d, q, &targets.nd[0]).unwrap(), renderer.alternates(geometry))
 }
 
 #[test]

@@ -9,10 +9,10 @@ use std::sync::Arc;
 use common::{OUTPUT_FORMAT, gpu};
 use glam::Vec3;
 use lineao::passes::meshes::MeshGeometry;
+use lineao::readback::{read_f32, read_rgba};
 use lineao::reference::{Image, NdImage};
 use lineao::targets::Target;
 use lineao::truth::{self, Bvh, Falloff};
-use lineao::verify::{read_f32, read_rgba};
 use lineao::{AoChain, AoMethod, ChainSettings, Gpu, LineGeometry, RayGeometry, RayScene, SurfaceSettings};
 use lineao::{Bounds, Camera, FrameView, Projection};
 
@@ -86,7 +86,7 @@ impl Tracer {
         self.chain.prepare(d, q, camera, &self.bounds).unwrap();
         let mut encoder = d.create_command_encoder(&Default::default());
         let meshes: Vec<&MeshGeometry> = self.mesh.iter().collect();
-        self.chain.encode_with_meshes(&mut encoder, &self.lines, &meshes, &self.output.view);
+        self.chain.encode_with_meshes(&mut encoder, &self.lines, &meshes, &self.output.view).unwrap();
         q.submit([encoder.finish()]);
         let t = self.chain.targets().unwrap();
         (read_rgba(d, q, &t.nd[0]).unwrap(), read_f32(d, q, &t.ao).unwrap())
@@ -170,7 +170,7 @@ fn lines_accumulate_to_the_cpu_truth_with_the_same_rays_and_restart_when_the_cam
     // A second encode without a prepare records nothing: the same rays are not added twice.
     let (d, q) = (&tracer.gpu.device, &tracer.gpu.queue);
     let mut encoder = d.create_command_encoder(&Default::default());
-    tracer.chain.encode(&mut encoder, &tracer.lines, &tracer.output.view);
+    tracer.chain.encode(&mut encoder, &tracer.lines, &tracer.output.view).unwrap();
     q.submit([encoder.finish()]);
     assert_eq!(tracer.chain.ray_progress().unwrap().rays_per_pixel, 20);
     assert_eq!(read_f32(d, q, &tracer.chain.targets().unwrap().ao).unwrap().data, fourth.data);
@@ -271,7 +271,7 @@ fn a_lost_device_is_an_error_to_stop_on_never_a_panic() {
     let (d, q) = (&tracer.gpu.device, &tracer.gpu.queue);
     tracer.chain.prepare(d, q, &camera(), &tracer.bounds);
     let mut encoder = d.create_command_encoder(&Default::default());
-    tracer.chain.encode(&mut encoder, &tracer.lines, &tracer.output.view);
+    tracer.chain.encode(&mut encoder, &tracer.lines, &tracer.output.view).unwrap();
     q.submit([encoder.finish()]);
     // … and the next wait says the device is gone: what a loop of frames stops on.
     match tracer.gpu.wait() {

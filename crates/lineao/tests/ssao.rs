@@ -6,9 +6,10 @@ mod common;
 use common::{cameras_for_polylines, flat_view, gpu, is_geometry, polylines, render};
 use lineao::method::ssao::Ssao;
 use lineao::method::ssao::blur::SsaoBlur;
+use lineao::readback::{read_f32, write_target};
 use lineao::reference::{self, Image, NdImage, SsaoParams, ViewParams};
 use lineao::targets::{FrameTargets, Target};
-use lineao::verify::{check_policy, compare, read_f32, write_target};
+use lineao::verify::{check_policy, compare};
 use lineao::{AoMethod, ChainSettings, Gpu, SsaoKernel, SsaoSettings, noise};
 
 /// Runs SSAO and its blur alone on a G-buffer written from the CPU; returns (raw, blurred).

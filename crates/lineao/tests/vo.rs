@@ -10,12 +10,13 @@ use common::{cameras_for_polylines, flat_view, gpu, polylines, render};
 use lineao::method::vo_area::VoArea;
 use lineao::method::vo_area::moments::MomentsPyramid;
 use lineao::method::vo_line::VoLine;
+use lineao::readback::{read_f32, read_moments, write_target};
 use lineao::reference::{self, Image, NdImage, ViewParams, VoParams, vo_line_sample, vo_sample, vo_visible};
 use lineao::sample_sets::{
     VO_AREA_SAMPLE_COUNTS, VO_SAMPLE_COUNTS, vo_area_lod_offsets, vo_area_samples, vo_disk_samples,
 };
 use lineao::targets::FrameTargets;
-use lineao::verify::{check_policy, compare, read_f32, read_moments, write_target};
+use lineao::verify::{check_policy, compare};
 use lineao::{AoMethod, ChainSettings, Gpu, VoCombine, VoSettings, noise};
 use lineao::{Bounds, Camera, FrameView, Projection};
 

@@ -469,10 +469,17 @@ impl AoChain {
         Some(&targets.shown().view)
     }
 
-    /// Records the frame into `encoder`, compositing into `target` (the visible size, the format
-    /// given to `new`). Does nothing before the first `prepare` with a non-zero size.
-    pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, geometry: &LineGeometry, target: &wgpu::TextureView) {
-        self.encode_with_meshes(encoder, geometry, &[], target);
+    /// Records the frame into `encoder`, compositing into `target`: `RENDER_ATTACHMENT`, the
+    /// visible size, the format given to `new` (or its sRGB twin), one sample. A mismatch, or a
+    /// frame not prepared, is an [`Error::Usage`] with nothing recorded; a 0 × 0 chain records
+    /// nothing — as [`crate::HostAo::encode`] and [`crate::OverlayAo::encode`].
+    pub fn encode(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        geometry: &LineGeometry,
+        target: &wgpu::TextureView,
+    ) -> Result<(), Error> {
+        self.encode_with_meshes(encoder, geometry, &[], target)
     }
 
     /// [`AoChain::encode`] with context surfaces drawn after the lines into the same G-buffer
@@ -484,12 +491,20 @@ impl AoChain {
         geometry: &LineGeometry,
         meshes: &[&MeshGeometry],
         target: &wgpu::TextureView,
-    ) {
+    ) -> Result<(), Error> {
+        if self.size.0 == 0 || self.size.1 == 0 {
+            return Ok(());
+        }
+        if self.targets.is_none() || self.view.is_none() {
+            return Err(Error::Usage("AoChain::encode before AoChain::prepare: prepare the frame first".into()));
+        }
+        self.check_target(target)?;
         self.record(
             encoder,
             |encoder, targets, span| self.draw_geometry(encoder, targets, geometry, meshes, span),
             |composite, encoder, span| composite.encode(encoder, target, span),
         );
+        Ok(())
     }
 
     /// Records a frame: `gbuffer` writes the G-buffer, then the method, its blur and

@@ -81,7 +81,7 @@ pub struct ClusterRecord {
     pub scale: f32,
     /// Its first point in the page's point arrays.
     pub first: u32,
-    /// Point count and flags ([`flags`]).
+    /// Point count and flags (the bits of `flags`: a run's start and end, selected out).
     pub flags: u32,
     /// The cluster holding the run's point before `first` (with `JOINS_PREVIOUS`).
     pub previous: u32,

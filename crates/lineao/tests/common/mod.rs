@@ -6,9 +6,9 @@ use lineao::LineGeometry;
 use lineao::method::line_ao::LineAo;
 use lineao::passes::meshes::MeshGeometry;
 use lineao::passes::nd_pyramid::NdPyramid;
+use lineao::readback::{read_f32, read_rgba, write_target};
 use lineao::reference::{Image, NdImage};
 use lineao::targets::{FrameTargets, Target};
-use lineao::verify::{read_f32, read_rgba, write_target};
 use lineao::{AoChain, ChainSettings, Gpu};
 use lineao::{Bounds, Camera, FrameView};
 
@@ -86,7 +86,7 @@ pub fn render_scene(
     let view = chain.prepare(&gpu.device, &gpu.queue, camera, &bounds).unwrap();
     let output = Target::output(&gpu.device, "test::output", (width, height), OUTPUT_FORMAT);
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    chain.encode_with_meshes(&mut encoder, geometry, meshes, &output.view);
+    chain.encode_with_meshes(&mut encoder, geometry, meshes, &output.view).unwrap();
     gpu.queue.submit([encoder.finish()]);
     let t = chain.targets().unwrap();
     let (d, q) = (&gpu.device, &gpu.queue);
@@ -108,10 +108,10 @@ pub fn render_scene(
             .map(|b| read_f32(d, q, b).unwrap())
             .unwrap_or_else(|| Image::from_fn(0, 0, |_, _| 0.0)),
         moments: (chain.stage::<lineao::method::vo_area::VoArea>().and_then(|s| s.moments()))
-            .map(|m| lineao::verify::read_moments(d, q, m).unwrap())
+            .map(|m| lineao::readback::read_moments(d, q, m).unwrap())
             .unwrap_or_default(),
         output: read_rgba(d, q, &output).unwrap(),
-        octants: t.octants.as_ref().map(|o| lineao::verify::read_image(d, q, o).unwrap()),
+        octants: t.octants.as_ref().map(|o| lineao::readback::read_image(d, q, o).unwrap()),
         volume_ao: t.volume_ao.as_ref().map(|v| read_f32(d, q, v).unwrap()),
     }
 }

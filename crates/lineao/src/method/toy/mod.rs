@@ -118,7 +118,7 @@ mod tests {
             view_formats: &[],
         });
         let mut encoder = device.create_command_encoder(&Default::default());
-        chain.encode(&mut encoder, &geometry, &target.create_view(&Default::default()));
+        chain.encode(&mut encoder, &geometry, &target.create_view(&Default::default())).unwrap();
         queue.submit([encoder.finish()]);
         let targets = chain.targets().unwrap();
         let ao = crate::readback::read_texture(device, queue, &targets.ao.texture).unwrap().to_f32();

@@ -85,7 +85,7 @@ impl VoArea {
         self.max_level = moments.levels.len() as u32 - 1;
     }
 
-    /// The moments pyramid of the last frame (for readback: [`crate::verify::read_moments`]).
+    /// The moments pyramid of the last frame (for readback: [`crate::readback::read_moments`]).
     pub fn moments(&self) -> Option<&moments::Moments> {
         self.moments.moments()
     }
