@@ -158,10 +158,13 @@ pub(crate) fn allocating<T>(
         let value = create();
         match pollster::block_on(scope.pop()) {
             None => Ok(value),
-            Some(error) => Err(Error::TooLarge(format!(
-                "{what}: {size} bytes do not fit the device's memory (its largest buffer: {} bytes): {error}",
-                device.limits().max_buffer_size
-            ))),
+            Some(error) => {
+                let max = device.limits().max_buffer_size;
+                let message = format!(
+                    "{what}: {size} bytes do not fit the device's memory (its largest buffer: {max} bytes): {error}"
+                );
+                Err(Error::TooLarge { limit: crate::Limit::Memory, value: size, max, message })
+            }
         }
     }
     #[cfg(target_arch = "wasm32")]

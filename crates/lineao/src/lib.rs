@@ -135,6 +135,27 @@ pub struct EmbeddingGuide;
 /// Pyramid levels (and so LineAO hemispheres) the shaders can bind.
 pub const MAX_LEVELS: u32 = 5;
 
+/// The limit an [`Error::TooLarge`] names: wgpu's `Limits` field, or lineao's own.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Limit {
+    /// `max_texture_dimension_2d` (less the guard band, for the chain's frame).
+    TextureDimension2d,
+    /// `max_texture_dimension_3d`: an anatomy volume's voxels a side.
+    TextureDimension3d,
+    /// Texels of the largest 2-D texture array (`max_texture_array_layers` ×
+    /// `max_texture_dimension_2d`²): the ray tracer's scene.
+    TextureArrayTexels,
+    /// `max_buffer_size`.
+    BufferSize,
+    /// The largest storage buffer bound (`max_storage_buffer_binding_size`, at most
+    /// `max_buffer_size`).
+    StorageBuffer,
+    /// The device's memory (it refused an allocation; `max` is its largest buffer).
+    Memory,
+    /// The points of a line geometry's page (`GeometryOptions::page_bytes`).
+    PagePoints,
+}
+
 /// Errors at the crate boundary: device creation, settings, sizes, geometry, readback.
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
@@ -146,8 +167,10 @@ pub enum Error {
     InvalidSettings(String),
     #[error("invalid line geometry: {0}")]
     InvalidGeometry(String),
-    #[error("too large for this adapter: {0}")]
-    TooLarge(String),
+    /// More than the device allows: which limit, how much was asked and the most it takes (what
+    /// a host matches on to shrink the frame or the data), and what was being made.
+    #[error("too large for this adapter: {message}")]
+    TooLarge { limit: Limit, value: u64, max: u64, message: String },
     #[error("GPU operation failed: {0}")]
     Gpu(String),
     #[error("the GPU cannot run lineao: {0}")]

@@ -124,7 +124,7 @@ impl RayScene {
         // Before building the tree: a vertex is a texel, a segment up to two.
         let capacity = limits.texels();
         if vertex_count >= TRIANGLE_BIT as usize || 2 * vertex_count as u64 > capacity {
-            return Err(too_large("vertices", vertex_count as u64, &limits));
+            return Err(too_large("vertices", vertex_count as u64, 2 * vertex_count as u64, &limits));
         }
         let flat = flatten(geometry);
         Ok(RayScene {
@@ -184,14 +184,16 @@ impl Limits {
     }
 }
 
-fn too_large(what: &str, count: u64, limits: &Limits) -> Error {
-    Error::TooLarge(format!(
+/// `count` `what` need `texels` texels, more than the textures hold.
+fn too_large(what: &str, count: u64, texels: u64, limits: &Limits) -> Error {
+    let message = format!(
         "the ray tracer's scene has {count} {what}, more than a texture of this adapter holds: {} layers of \
          {w} × {w} texels (max_texture_array_layers, max_texture_dimension_2d), {} texels",
         limits.max_layers,
         limits.texels(),
         w = limits.max_width,
-    ))
+    );
+    Error::TooLarge { limit: crate::Limit::TextureArrayTexels, value: texels, max: limits.texels(), message }
 }
 
 /// Uploads `data` (`texel_words` words a texel) as a texture array of square layers, padded
@@ -206,7 +208,7 @@ fn upload(
 ) -> Result<SceneTexture, Error> {
     let texels = (data.len() / texel_words).max(1) as u64;
     if texels > limits.texels() {
-        return Err(too_large(&format!("texels of {region}"), texels, limits));
+        return Err(too_large(&format!("texels of {region}"), texels, texels, limits));
     }
     // The least width whose square layer holds every texel, within the limit.
     let mut shift = 0;

@@ -56,10 +56,11 @@ pub fn read_texture(device: &wgpu::Device, queue: &wgpu::Queue, texture: &wgpu::
     let band = (device.limits().max_buffer_size / padded_row as u64).min(height as u64) as u32;
     // Depth can only be copied whole.
     if band == 0 || (format.is_depth_stencil_format() && band < height) {
-        return Err(Error::TooLarge(format!(
-            "reading {width} x {height} {format:?} needs a larger buffer than the device's {} bytes",
-            device.limits().max_buffer_size
-        )));
+        let max = device.limits().max_buffer_size;
+        let message =
+            format!("reading {width} x {height} {format:?} needs a larger buffer than the device's {max} bytes");
+        let value = padded_row as u64 * if format.is_depth_stencil_format() { height as u64 } else { 1 };
+        return Err(Error::TooLarge { limit: crate::Limit::BufferSize, value, max, message });
     }
     let mut bytes = Vec::with_capacity((row * height) as usize);
     for first in (0..height).step_by(band as usize) {

@@ -68,7 +68,10 @@ fn sizes_beyond_the_adapter_are_errors_and_zero_draws_nothing() {
     let mut chain = AoChain::new(&gpu.device, common::OUTPUT_FORMAT, ChainSettings::default()).unwrap();
     let max = gpu.device.limits().max_texture_dimension_2d;
     match chain.resize(max, 16) {
-        Err(Error::TooLarge(message)) => assert!(message.contains(&max.to_string()), "{message}"),
+        Err(Error::TooLarge { limit, message, .. }) => {
+            assert_eq!(limit, lineao::Limit::TextureDimension2d);
+            assert!(message.contains(&max.to_string()), "{message}");
+        }
         other => panic!("expected TooLarge, got {other:?}"),
     }
     // A minimized window: no targets, no view, encoding records nothing.
@@ -98,14 +101,17 @@ fn a_moments_pyramid_beyond_the_storage_limit_is_an_error() {
     // 640 × 480 with the guard band needs about 4 MiB of moments.
     let mut chain = AoChain::new(&device, common::OUTPUT_FORMAT, area.clone()).unwrap();
     match chain.resize(640, 480) {
-        Err(Error::TooLarge(message)) => assert!(message.contains("moments"), "{message}"),
+        Err(Error::TooLarge { limit, value, max, message }) => {
+            assert_eq!(limit, lineao::Limit::StorageBuffer);
+            assert!(value > max && message.contains("moments"), "{message}");
+        }
         other => panic!("expected TooLarge, got {other:?}"),
     }
     chain.resize(64, 48).unwrap();
     // Switching to VO area at a size it cannot hold is refused the same way; LineAO is fine.
     let mut chain = AoChain::new(&device, common::OUTPUT_FORMAT, ChainSettings::default()).unwrap();
     chain.resize(640, 480).unwrap();
-    assert!(matches!(chain.set_settings(&device, area), Err(Error::TooLarge(_))));
+    assert!(matches!(chain.set_settings(&device, area), Err(Error::TooLarge { .. })));
 }
 
 #[test]

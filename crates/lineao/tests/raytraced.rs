@@ -248,7 +248,10 @@ fn a_scene_beyond_the_adapters_texture_arrays_is_too_large_and_no_scene_is_no_oc
     let scene = Scene::lines(layers / 20 + 1);
     let geometry = RayGeometry { positions: &scene.positions, offsets: &scene.offsets, ..Default::default() };
     match RayScene::with_max_width(d, q, &geometry, 2) {
-        Err(lineao::Error::TooLarge(message)) => {
+        Err(lineao::Error::TooLarge { limit, value, max, message }) => {
+            // Two texels a vertex (a segment up to two).
+            assert_eq!((limit, value), (lineao::Limit::TextureArrayTexels, 2 * scene.positions.len() as u64));
+            assert!(value > max, "{value} of at most {max}");
             assert!(message.contains(&format!("{} vertices", scene.positions.len())), "{message}");
             assert!(message.contains("max_texture_array_layers"), "{message}");
         }

@@ -300,10 +300,12 @@ impl AoChain {
         let guard = settings.guard_max_px;
         let limit = self.limits.max_texture_dimension_2d.saturating_sub(2 * guard);
         if width > limit || height > limit {
-            return Err(Error::TooLarge(format!(
+            let message = format!(
                 "{width} x {height} px exceeds the adapter's {} px textures less the guard band",
                 self.limits.max_texture_dimension_2d
-            )));
+            );
+            let (value, max) = (width.max(height) as u64, limit as u64);
+            return Err(Error::TooLarge { limit: crate::Limit::TextureDimension2d, value, max, message });
         }
         let banded = (width + 2 * guard, height + 2 * guard);
         (settings.method.info().fits)(banded, &self.limits)?;

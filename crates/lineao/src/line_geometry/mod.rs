@@ -430,11 +430,13 @@ impl LineGeometry {
                 self.flush(device, queue)?;
             }
             if run.len() > self.page_points {
-                return Err(Error::TooLarge(format!(
+                let message = format!(
                     "a polyline of {} points exceeds a page of {} points (GeometryOptions::page_bytes)",
                     run.len(),
                     self.page_points
-                )));
+                );
+                let (value, max) = (run.len() as u64, self.page_points as u64);
+                return Err(Error::TooLarge { limit: crate::Limit::PagePoints, value, max, message });
             }
             self.pending.add_run(run, base + input, streamline as u32, per_cluster, tolerance);
             if let Some(pending) = &mut self.pending_attributes {
@@ -737,9 +739,8 @@ fn storage_buffer(
     let limits = device.limits();
     let limit = limits.max_buffer_size.min(limits.max_storage_buffer_binding_size);
     if size > limit {
-        return Err(Error::TooLarge(format!(
-            "{label}: {size} bytes, over the device's largest storage buffer ({limit} bytes)"
-        )));
+        let message = format!("{label}: {size} bytes, over the device's largest storage buffer ({limit} bytes)");
+        return Err(Error::TooLarge { limit: crate::Limit::StorageBuffer, value: size, max: limit, message });
     }
     let buffer = crate::gpu::allocating(device, label, size, || {
         device.create_buffer(&wgpu::BufferDescriptor {

@@ -52,10 +52,9 @@ impl MeshGeometry {
             positions.iter().zip(normals).map(|(&position, &normal)| MeshVertex { position, normal }).collect();
         let bytes = (vertices.len() * std::mem::size_of::<MeshVertex>()).max(indices.len() * 4) as u64;
         if bytes > device.limits().max_buffer_size {
-            return Err(Error::TooLarge(format!(
-                "a mesh of {bytes} bytes exceeds the device's {} byte buffers",
-                device.limits().max_buffer_size
-            )));
+            let max = device.limits().max_buffer_size;
+            let message = format!("a mesh of {bytes} bytes exceeds the device's {max} byte buffers");
+            return Err(Error::TooLarge { limit: crate::Limit::BufferSize, value: bytes, max, message });
         }
         let upload = |label, usage, contents: &[u8]| {
             let buffer = device.create_buffer(&wgpu::BufferDescriptor {

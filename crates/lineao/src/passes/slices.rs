@@ -57,9 +57,9 @@ impl SliceVolume {
         }
         let limit = device.limits().max_texture_dimension_3d;
         if dims.iter().any(|&d| d > limit) {
-            return Err(Error::TooLarge(format!(
-                "a {dims:?} volume exceeds the device's 3-D textures of {limit} voxels a side"
-            )));
+            let message = format!("a {dims:?} volume exceeds the device's 3-D textures of {limit} voxels a side");
+            let value = dims.into_iter().max().unwrap_or(0) as u64;
+            return Err(Error::TooLarge { limit: crate::Limit::TextureDimension3d, value, max: limit as u64, message });
         }
         let det = voxel_to_world.determinant();
         if !(det.is_finite() && det.abs() > 1e-12 && voxel_to_world.is_finite()) {

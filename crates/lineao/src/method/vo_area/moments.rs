@@ -89,11 +89,17 @@ pub(crate) fn fits(size: (u32, u32), limits: &wgpu::Limits) -> Result<(), crate:
     let max_storage = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
     let bytes = Moments::bytes(size);
     if bytes > max_storage {
-        return Err(crate::Error::TooLarge(format!(
+        let message = format!(
             "VO area's moments pyramid for {} x {} px (with the guard band) needs {bytes} bytes, more than the \
              adapter's {max_storage} byte storage buffers",
             size.0, size.1
-        )));
+        );
+        return Err(crate::Error::TooLarge {
+            limit: crate::Limit::StorageBuffer,
+            value: bytes,
+            max: max_storage,
+            message,
+        });
     }
     Ok(())
 }
