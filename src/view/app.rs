@@ -400,6 +400,7 @@ impl App {
                     self.controls.slab_reach = 0.5 * distance;
                     self.controls.max_length = dataset.max_length;
                     self.controls.set_groups(&dataset.groups, dataset.complete);
+                    self.controls.set_streamline_fields(&dataset.streamline_fields);
                     if let ColorMode::Field(name) = &self.controls.color
                         && !dataset.fields.iter().any(|(f, _)| f == name)
                     {

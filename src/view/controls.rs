@@ -154,6 +154,10 @@ pub struct Controls {
     pub max_length: f32,
     /// The dataset's groups (TRX), each shown or not.
     pub groups: Vec<(String, bool)>,
+    /// The dataset's one-column per-streamline fields and their ranges.
+    pub streamline_fields: Vec<(String, [f32; 2])>,
+    /// The per-streamline field and the range of it shown, or every value.
+    pub field: Option<(String, [f32; 2])>,
 }
 
 impl Controls {
@@ -180,6 +184,8 @@ impl Controls {
             length: None,
             max_length: 0.0,
             groups: Vec::new(),
+            streamline_fields: Vec::new(),
+            field: None,
         }
     }
 
@@ -195,8 +201,17 @@ impl Controls {
         lineao_tracts::Selection {
             subset: if none { Some((0.0, 0)) } else { (self.subset < 1.0).then_some((self.subset as f64, 0)) },
             length: self.length,
+            field: self.field.clone(),
             groups,
             ..Default::default()
+        }
+    }
+
+    /// A dataset's per-streamline fields; a field rule on one it lacks is dropped.
+    pub fn set_streamline_fields(&mut self, fields: &[(String, [f32; 2])]) {
+        self.streamline_fields = fields.to_vec();
+        if self.field.as_ref().is_some_and(|(name, _)| !fields.iter().any(|(f, _)| f == name)) {
+            self.field = None;
         }
     }
 
@@ -455,6 +470,33 @@ impl Controls {
             ui.add(egui::Slider::new(&mut hi, 0.0..=max).text("longest"));
             [lo, hi.max(lo)]
         });
+        self.field_ui(ui);
+    }
+
+    /// A range of a per-streamline field (.trk properties, TRX dps): the streamlines within it.
+    fn field_ui(&mut self, ui: &mut Ui) {
+        let Some((first, first_range)) = self.streamline_fields.first().cloned() else { return };
+        let mut on = self.field.is_some();
+        ui.checkbox(&mut on, "by field")
+            .on_hover_text("only the streamlines whose per-streamline value lies in the range");
+        if !on {
+            self.field = None;
+            return;
+        }
+        let (mut name, mut range) = self.field.clone().unwrap_or((first, first_range));
+        egui::ComboBox::from_id_salt("streamline-field").selected_text(name.clone()).show_ui(ui, |ui| {
+            for (field, _) in &self.streamline_fields {
+                ui.selectable_value(&mut name, field.clone(), field.as_str());
+            }
+        });
+        let [lo, hi] = self.streamline_fields.iter().find(|(f, _)| *f == name).map_or(first_range, |(_, r)| *r);
+        if self.field.as_ref().is_some_and(|(old, _)| *old != name) {
+            range = [lo, hi];
+        }
+        ui.add(egui::Slider::new(&mut range[0], lo..=hi).text("from"));
+        ui.add(egui::Slider::new(&mut range[1], lo..=hi).text("to"));
+        range[1] = range[1].max(range[0]);
+        self.field = Some((name, range));
     }
 
     /// The anatomy's slices (with `--volume`): each axis's on or off and where it cuts.

@@ -518,6 +518,31 @@ fn a_trx_files_groups_colour_and_select_its_streamlines() {
 }
 
 #[test]
+fn a_per_streamline_field_range_selects_streamlines() {
+    // dpsv.trx's dps DataSetID: 74 of its 460 streamlines hold 0 (`lineao info --field
+    // DataSetID,-0.5,0.5` counts them).
+    let path = data("niivue+niivue/packages/niivue/demos/images/dpsv.trx");
+    let mut harness = harness(options(Source::File(path), [methods()[0], methods()[4]], false));
+    settle(&mut harness);
+    let app = harness.state();
+    assert!(app.error.is_none(), "{:?}", app.error);
+    let fields = &app.dataset.as_ref().unwrap().streamline_fields;
+    let (_, [lo, hi]) = fields.iter().find(|(name, _)| name == "DataSetID").expect("the dps field").clone();
+    assert!(lo == 0.0 && hi > 1.0, "DataSetID's range {lo}..{hi}");
+    let drawn = |harness: &Harness<'_, App>| non_background(&harness.state().shown.as_ref().unwrap().images[0]);
+    let all = drawn(&harness);
+    harness.state_mut().controls.field = Some(("DataSetID".into(), [0.0, 0.0]));
+    settle(&mut harness);
+    let zero = drawn(&harness);
+    assert!(zero > 0.001 && zero < 0.6 * all, "{zero} of the pixels with DataSetID 0, {all} with all");
+    // Between two of its whole numbers: none.
+    harness.state_mut().controls.field = Some(("DataSetID".into(), [0.25, 0.75]));
+    settle(&mut harness);
+    assert_eq!(drawn(&harness), 0.0, "no streamline in the range");
+    assert!(harness.query_all_by_label_contains("by field").count() > 0, "the checkbox");
+}
+
+#[test]
 fn a_share_and_a_length_range_select_streamlines_on_the_gpu() {
     let path = data("niivue+niivue/packages/niivue/demos/images/stroke.trk.gz");
     let mut harness = harness(options(Source::File(path), [methods()[0], methods()[4]], false));

@@ -89,6 +89,9 @@ pub struct Dataset {
     pub hint: ViewHint,
     /// One-column per-vertex fields, with their 2nd–98th percentile ranges.
     pub fields: Vec<(String, [f32; 2])>,
+    /// One-column per-streamline fields (.trk properties, TRX dps), with their smallest and
+    /// largest finite values: what the side panel selects by.
+    pub streamline_fields: Vec<(String, [f32; 2])>,
     /// The names of its groups (TRX), in the file's order: the colours of
     /// [`lineao::Colormap::Categories`] in turn.
     pub groups: Vec<String>,
@@ -499,6 +502,17 @@ fn dataset(lines: &Lines, opening: &Opening, complete: bool) -> Dataset {
         hint,
         fields,
         groups: lines.tracts.groups.iter().map(|g| g.name.clone()).collect(),
+        streamline_fields: lines
+            .tracts
+            .streamline_fields
+            .iter()
+            .filter(|f| f.columns == 1)
+            .map(|f| {
+                let finite = f.values.iter().copied().filter(|v| v.is_finite());
+                let range = finite.fold([f32::INFINITY, f32::NEG_INFINITY], |[lo, hi], v| [lo.min(v), hi.max(v)]);
+                (f.name.clone(), if range[0] <= range[1] { range } else { [0.0, 0.0] })
+            })
+            .collect(),
         max_length: lines.lengths.iter().copied().fold(0.0, f32::max),
         first_ms: opening.first_ms().unwrap_or(elapsed),
         load_ms: elapsed,
@@ -542,6 +556,7 @@ fn select(gpu: &Gpu, scene: &mut SceneRef<'_>, selection: &lineao_tracts::Select
         let mut keep: Vec<bool> =
             lines.lengths.iter().enumerate().map(|(i, &l)| selection.keeps(i as u64, l)).collect();
         selection.apply_groups(&mut keep, &lines.tracts.groups).map_err(|e| format!("{}: {e}", lines.name))?;
+        selection.apply_field(&mut keep, &lines.tracts).map_err(|e| format!("{}: {e}", lines.name))?;
         lines.geometry.set_selection(d, q, Some(&keep)).map_err(error)?;
         // The preview holds every k-th streamline.
         let shown = scene.preview.geometry.streamlines;

@@ -454,8 +454,8 @@ pub struct Keep {
     pub scalar: Option<String>,
     /// The per-vertex field that gives tubes their radii, uploaded with each chunk.
     pub radius: Option<String>,
-    /// Every one-column per-vertex field and the offsets (the viewer colours by any of them,
-    /// and by group).
+    /// Every one-column per-vertex and per-streamline field, and the offsets (the viewer colours
+    /// by the first, selects by the second, and colours by group).
     pub fields: bool,
     /// A volume sampled at every vertex as it arrives, kept as a per-vertex field.
     pub sampled: Option<std::sync::Arc<Sampled>>,
@@ -773,9 +773,8 @@ fn append(kept: &mut Tractogram, chunk: Tractogram, keep: &Keep) {
         };
         let empty = |f: &Field| Field { name: f.name.clone(), columns: f.columns, values: Vec::new() };
         kept.vertex_fields = chunk.vertex_fields.iter().filter(wanted).map(empty).collect();
-        if keep.points {
-            kept.streamline_fields = chunk.streamline_fields.iter().map(empty).collect();
-        }
+        let per_streamline = |f: &&Field| keep.points || (keep.fields && f.columns == 1);
+        kept.streamline_fields = chunk.streamline_fields.iter().filter(per_streamline).map(empty).collect();
     }
     for field in &mut kept.vertex_fields {
         if let Some(from) = chunk.vertex_fields.iter().find(|f| f.name == field.name) {
@@ -786,10 +785,12 @@ fn append(kept: &mut Tractogram, chunk: Tractogram, keep: &Keep) {
     if keep.points || keep.fields {
         kept.offsets.extend(chunk.offsets[1..].iter().map(|o| o + base));
     }
-    if keep.points {
-        kept.positions.extend_from_slice(&chunk.positions);
-        for (field, from) in kept.streamline_fields.iter_mut().zip(&chunk.streamline_fields) {
+    for field in &mut kept.streamline_fields {
+        if let Some(from) = chunk.streamline_fields.iter().find(|f| f.name == field.name) {
             field.values.extend_from_slice(&from.values);
         }
+    }
+    if keep.points {
+        kept.positions.extend_from_slice(&chunk.positions);
     }
 }

@@ -164,6 +164,18 @@ impl Selection {
         Ok(())
     }
 
+    /// Leaves out of `mask` (one entry per streamline of `t`) the streamlines whose
+    /// per-streamline field is outside the field rule's range: what a viewer that keeps the
+    /// fields but not the points changes ([`Selection::chunk`] judges it with the others).
+    pub fn apply_field(&self, mask: &mut [bool], t: &Tractogram) -> Result<(), SelectionError> {
+        let Some((name, [lo, hi])) = &self.field else { return Ok(()) };
+        let values = field_values(t, name)?;
+        for (kept, value) in mask.iter_mut().zip(values) {
+            *kept &= (*lo..=*hi).contains(value);
+        }
+        Ok(())
+    }
+
     /// Every rule on a whole tractogram: one entry per streamline.
     pub fn mask(&self, t: &Tractogram) -> Result<Vec<bool>, SelectionError> {
         let mut mask = self.chunk(t, 0)?;
@@ -224,10 +236,12 @@ mod tests {
         let mask = |s: Selection| s.mask(&t).unwrap();
         assert_eq!(mask(Selection::default()), [true; 3]);
         assert_eq!(mask(Selection { length: Some([3.0, 10.0]), ..Default::default() }), [false, true, true]);
-        assert_eq!(
-            mask(Selection { field: Some(("weight".into(), [1.5, 3.0])), ..Default::default() }),
-            [false, true, true]
-        );
+        let weight = Selection { field: Some(("weight".into(), [1.5, 3.0])), ..Default::default() };
+        assert_eq!(mask(weight.clone()), [false, true, true]);
+        // The field rule alone on the fields (a viewer without the points): the same.
+        let mut alone = [true; 3];
+        weight.apply_field(&mut alone, &Tractogram { positions: Vec::new(), ..t.clone() }).unwrap();
+        assert_eq!(alone, [false, true, true]);
         assert_eq!(mask(Selection { groups: vec!["top".into()], ..Default::default() }), [false, false, true]);
         // A sphere the middle line passes near, a box the last one crosses at its end.
         let sphere = Region::Sphere { center: [3.5, 11.0, 0.0], radius: 1.2 };
