@@ -36,8 +36,12 @@ enum Inbound {
         from_url: bool,
     },
     Failed(String),
-    /// A NIfTI volume read whole, to show as slices (or why it cannot be).
-    Anatomy(Result<lineao_tracts::Volume, String>),
+    /// A NIfTI volume read whole, to show as slices (or why it cannot be); whether it came from
+    /// the URL's `volume=` (a link can name it) or was dropped or picked (no link can).
+    Anatomy {
+        volume: Result<lineao_tracts::Volume, String>,
+        from_url: bool,
+    },
     Readback {
         panel: usize,
         resolve: js_sys::Function,
@@ -97,7 +101,7 @@ pub async fn start(canvas_id: String, adapter: String) -> Result<(), JsValue> {
     SLICES.with(|s| s.set(page.view.slices));
     if let Some(url) = page.volume.clone() {
         wasm_bindgen_futures::spawn_local(async move {
-            post(Inbound::Anatomy(fetch_volume(&url).await));
+            post(Inbound::Anatomy { volume: fetch_volume(&url).await, from_url: true });
         });
     }
     if let Some(url) = &page.url {
@@ -169,7 +173,7 @@ pub fn open_file(file: web_sys::File) {
         return wasm_bindgen_futures::spawn_local(async move {
             let bytes = JsFuture::from(file.array_buffer()).await;
             let bytes = bytes.map(|b| Uint8Array::new(&b).to_vec()).map_err(|e| format!("{name}: {}", js_message(&e)));
-            post(Inbound::Anatomy(bytes.and_then(|b| crate::volume(&name, &b))));
+            post(Inbound::Anatomy { volume: bytes.and_then(|b| crate::volume(&name, &b)), from_url: false });
         });
     }
     let feed = SharedFeed::new(Some(size), HOLD.with(|h| h.get()));
@@ -305,7 +309,7 @@ struct PendingReadback {
 struct Page {
     app: App,
     source: LinkSource,
-    /// The URL's `volume=`, which the link keeps.
+    /// The URL's `volume=`, which the link keeps while its volume is shown.
     volume: Option<String>,
     adapter: String,
     /// Readbacks asked for, and those copying.
@@ -327,9 +331,14 @@ impl eframe::App for Page {
                     self.app.load(Source::Feed { name, feed });
                 }
                 Inbound::Failed(message) => self.app.fail(message),
-                Inbound::Anatomy(Ok(volume)) => self.app.set_anatomy(Arc::new(volume), SLICES.with(|s| s.get())),
+                Inbound::Anatomy { volume: Ok(volume), from_url } => {
+                    if !from_url {
+                        self.volume = None;
+                    }
+                    self.app.set_anatomy(Arc::new(volume), SLICES.with(|s| s.get()));
+                }
                 // The tractogram is still shown, without slices.
-                Inbound::Anatomy(Err(message)) => self.app.error = Some(message),
+                Inbound::Anatomy { volume: Err(message), .. } => self.app.error = Some(message),
                 Inbound::Readback { panel, resolve, reject } => self.requests.push((panel, resolve, reject)),
             }
         }
