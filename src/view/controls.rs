@@ -191,13 +191,10 @@ impl Controls {
 
     /// The streamlines shown: [`Controls::subset`] and [`Controls::length`].
     pub fn selection(&self) -> lineao_tracts::Selection {
-        let shown = self.groups.iter().filter(|(_, on)| *on);
-        let groups = match shown.clone().count() {
-            n if n == self.groups.len() => Vec::new(),
-            _ => shown.map(|(name, _)| name.clone()).collect(),
-        };
-        // No group shown: no streamline (an empty list of groups would be every one).
-        let none = !self.groups.is_empty() && groups.is_empty() && self.groups.iter().all(|(_, on)| !on);
+        // Every group shown: no rule. None shown: no streamline (an empty list would be all).
+        let all = self.groups.iter().all(|(_, on)| *on);
+        let none = !self.groups.is_empty() && self.groups.iter().all(|(_, on)| !on);
+        let groups = if all { Vec::new() } else { self.groups.iter().filter(|g| g.1).map(|g| g.0.clone()).collect() };
         lineao_tracts::Selection {
             subset: if none { Some((0.0, 0)) } else { (self.subset < 1.0).then_some((self.subset as f64, 0)) },
             length: self.length,

@@ -198,26 +198,9 @@ fn pick_file() {
     }
 }
 
-/// Fetches the NIfTI volume at `url` (relative to the page), whole.
-async fn fetch_volume(url: &str) -> Result<lineao_tracts::Volume, String> {
-    let window = web_sys::window().ok_or("no window")?;
-    let cannot = |e: JsValue| format!("{url}: cannot fetch: {}", js_message(&e));
-    let response: web_sys::Response =
-        JsFuture::from(window.fetch_with_str(url)).await.map_err(cannot)?.unchecked_into();
-    if !response.ok() {
-        return Err(format!("{url}: HTTP {} {}", response.status(), response.status_text()));
-    }
-    let total = response.headers().get("content-length").ok().flatten().and_then(|v| v.parse::<u64>().ok());
-    if let Some(message) = total.and_then(|t| crate::too_large(url, t)) {
-        return Err(message);
-    }
-    let bytes = JsFuture::from(response.array_buffer().map_err(cannot)?).await.map_err(cannot)?;
-    crate::volume(url, &Uint8Array::new(&bytes).to_vec())
-}
-
-/// Fetches `url` (relative to the page) into a feed the viewer opens as it arrives.
-async fn fetch(url: &str) -> Result<(), String> {
-    post(Inbound::Progress { name: url.to_string(), bytes: 0, total: None });
+/// The response to a GET of `url` (relative to the page) and its stated size: an error for a
+/// failed request, an HTTP error status, or a size over what the page reads of the format.
+async fn get(url: &str) -> Result<(web_sys::Response, Option<u64>), String> {
     let window = web_sys::window().ok_or("no window")?;
     let response = JsFuture::from(window.fetch_with_str(url))
         .await
@@ -230,6 +213,21 @@ async fn fetch(url: &str) -> Result<(), String> {
     if let Some(message) = total.and_then(|t| crate::too_large(url, t)) {
         return Err(message);
     }
+    Ok((response, total))
+}
+
+/// Fetches the NIfTI volume at `url` (relative to the page), whole.
+async fn fetch_volume(url: &str) -> Result<lineao_tracts::Volume, String> {
+    let (response, _) = get(url).await?;
+    let cannot = |e: JsValue| format!("{url}: cannot read: {}", js_message(&e));
+    let bytes = JsFuture::from(response.array_buffer().map_err(cannot)?).await.map_err(cannot)?;
+    crate::volume(url, &Uint8Array::new(&bytes).to_vec())
+}
+
+/// Fetches `url` (relative to the page) into a feed the viewer opens as it arrives.
+async fn fetch(url: &str) -> Result<(), String> {
+    post(Inbound::Progress { name: url.to_string(), bytes: 0, total: None });
+    let (response, total) = get(url).await?;
     let body = response.body().ok_or_else(|| format!("{url}: the response has no body"))?;
     let feed = SharedFeed::new(total, HOLD.with(|h| h.get()));
     post(Inbound::Open { name: url.to_string(), feed: feed.clone(), from_url: true });
