@@ -116,6 +116,9 @@ pub struct ViewArgs {
     /// With --screenshot: UI frames to run at least before saving.
     #[arg(long, default_value_t = 3, requires = "screenshot")]
     pub frames: u32,
+    /// The methods' own settings, from their descriptions (as `render`'s).
+    #[command(flatten)]
+    pub methods: lineao_session::method_args::MethodArgs,
 }
 
 fn parse_orbit(s: &str) -> Result<[f32; 3], String> {

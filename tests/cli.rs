@@ -930,3 +930,92 @@ fn a_method_of_the_registry_alone_is_listed_everywhere() {
     let render = lineao(&[&["render", "--method", "toy", "-o", png.to_str().unwrap()][..], &small].concat());
     assert_eq!(render.status.code(), Some(0), "{}", stderr(&render));
 }
+
+/// The toy's two settings, described in its folder alone (`lineao::method::setting`): flags in
+/// `render --help` under its heading with unit, range and default; values that reach its pass
+/// (the dump's `ao.npy`) and `params.json`; `--settings` JSON under its registry line's key; a
+/// value out of range refused by flag, from the command line and from the JSON. (Python's
+/// keywords: test_render.py; the viewer's controls and the page's URL keys: their tests.)
+#[test]
+fn a_methods_settings_are_flags_from_their_description() {
+    let help = lineao(&["render", "--help"]);
+    let help = String::from_utf8_lossy(&help.stdout);
+    let toy = &help[help.find("\ntoy:").expect("the toy's heading")..];
+    assert!(toy.contains("--toy-radius <ZOOM UNITS>"), "{toy}");
+    assert!(toy.contains("(0.25..=4 zoom units)") && toy.contains("[default: 1]"), "{toy}");
+    assert!(toy.contains("--toy-invert") && toy.contains("one minus that occlusion"), "{toy}");
+
+    let small = ["--vertices", "2000", "--width", "64", "--height", "48", "--method", "toy"];
+    let dump = scratch("toy-settings");
+    let given = ["--toy-radius", "1.5", "--toy-invert", "--dump", dump.to_str().unwrap()];
+    let render = lineao(&[&["render", "-o", dump.join("toy.png").to_str().unwrap()][..], &small, &given].concat());
+    assert_eq!(render.status.code(), Some(0), "{}", stderr(&render));
+    let params: Value = serde_json::from_str(&std::fs::read_to_string(dump.join("params.json")).unwrap()).unwrap();
+    assert_eq!((params["toy_radius"].as_f64(), params["toy_invert"].as_bool()), (Some(1.5), Some(true)), "{params}");
+    let (_, ao) = read_npy(&dump.join("ao.npy"));
+    assert!(ao.iter().all(|&a| a == 0.0 || a == 1.0 - 0.25 * 1.5), "the toy's occlusion or the background");
+    assert!(ao.contains(&0.625));
+
+    let json = lineao(
+        &[
+            &["render", "--settings", r#"{"toy": {"radius_zoom": 2}}"#, "-o"][..],
+            &[dump.join("j.png").to_str().unwrap()],
+            &small[..],
+        ]
+        .concat(),
+    );
+    assert_eq!(json.status.code(), Some(0), "{}", stderr(&json));
+    for refused in [
+        lineao(&[&["render", "--toy-radius", "9"][..], &small].concat()),
+        lineao(&[&["render", "--settings", r#"{"toy": {"radius_zoom": 9}}"#][..], &small].concat()),
+    ] {
+        assert_ne!(refused.status.code(), Some(0));
+        assert!(
+            stderr(&refused).contains("--toy-radius must be in 0.25..=4 zoom units, got 9"),
+            "{}",
+            stderr(&refused)
+        );
+    }
+}
+
+/// No source file names the toy outside its folder and its registry line (tests — files under
+/// `tests/`, a module `tests.rs`, a file's `#[cfg(test)]` module —, test scripts and the feature's lines in the
+/// manifests aside): a method owns everything about itself.
+#[test]
+fn only_its_folder_and_its_registry_line_name_the_toy() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut named = Vec::new();
+    let mut stack = vec![root.to_path_buf()];
+    while let Some(dir) = stack.pop() {
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            let name = path.file_name().unwrap().to_string_lossy().into_owned();
+            let skipped = ["target", "tests", "node_modules", ".git", "toy", "docs", "browser"];
+            if path.is_dir() {
+                if !skipped.contains(&name.as_str()) && !name.starts_with('.') {
+                    stack.push(path);
+                }
+                continue;
+            }
+            let source = ["rs", "wgsl", "py", "js", "html"].iter().any(|e| name.ends_with(&format!(".{e}")));
+            let source = source && name != "tests.rs";
+            if !source {
+                continue;
+            }
+            let text = std::fs::read_to_string(&path).unwrap_or_default();
+            // A file's own tests (its `#[cfg(test)]` module, at its end) are tests.
+            let source_lines = text.lines().take_while(|l| l.trim() != "#[cfg(test)]");
+            for (k, line) in source_lines.enumerate() {
+                // The registry's line and the module's declaration, each under the feature.
+                let registry = line.contains("Toy => crate::method::toy::METHOD")
+                    || line.trim() == "pub mod toy;"
+                    || line.contains(r#"feature = "toy-method""#)
+                    || line.contains("(feature `toy-method`");
+                if line.to_lowercase().contains("toy") && !registry {
+                    named.push(format!("{}:{}: {}", path.strip_prefix(root).unwrap().display(), k + 1, line.trim()));
+                }
+            }
+        }
+    }
+    assert!(named.is_empty(), "the toy is named outside its folder:\n{}", named.join("\n"));
+}

@@ -8,6 +8,7 @@
 use egui::Ui;
 use glam::Vec3;
 use lineao::lighting::LineShading;
+use lineao::method::setting::{Kind, Setting, Value};
 use lineao::volume::{ScalarForm, Sky, VolumeAoOptions, VolumeMethod};
 use lineao::{
     AoMethod, BilateralSettings, ChainSettings, Colormap, DebugView, LineAoOuter, LineAoVariant, LineColor, Named,
@@ -394,6 +395,13 @@ impl Controls {
                 .default_open(true)
                 .show(ui, |ui| ray_ui(ui, &mut p.chain, &mut self.moving_method));
         }
+        // Every other method's panel: its settings' descriptions.
+        for method in AoMethod::REGISTRY.iter().copied().filter(|&m| screen(m) && !m.info().settings.is_empty()) {
+            let info = method.info();
+            egui::CollapsingHeader::new(info.label)
+                .default_open(true)
+                .show(ui, |ui| described_ui(ui, info.settings, &mut p.chain));
+        }
         let mut blur = p.chain.blur.is_some();
         ui.checkbox(&mut blur, "Bilateral blur");
         if blur != p.chain.blur.is_some() {
@@ -617,6 +625,36 @@ fn choice<T: PartialEq + Copy + std::fmt::Display>(ui: &mut Ui, label: &str, val
             ui.selectable_value(value, option, option.to_string());
         }
     });
+}
+
+/// A method's panel from its settings' descriptions ([`lineao::method::setting`]): a slider for
+/// each number (moving by factors where the description says so), a checkbox for each switch,
+/// each with its flag's help on hover.
+pub fn described_ui(ui: &mut Ui, settings: &[Setting], chain: &mut ChainSettings) {
+    for setting in settings {
+        let label = if setting.unit.is_empty() {
+            setting.label.to_string()
+        } else {
+            format!("{} ({})", setting.label, setting.unit)
+        };
+        let changed = match (setting.kind, (setting.get)(chain)) {
+            (Kind::Number { min, max, log }, Value::Number(mut x)) => {
+                let slider = egui::Slider::new(&mut x, min..=max).logarithmic(log).text(label);
+                ui.add(slider).on_hover_text(setting.help).changed().then_some(Value::Number(x))
+            }
+            (Kind::Count { min, max }, Value::Count(mut n)) => {
+                let slider = egui::Slider::new(&mut n, min..=max).text(label);
+                ui.add(slider).on_hover_text(setting.help).changed().then_some(Value::Count(n))
+            }
+            (_, value) => {
+                let mut on = value.is_on();
+                ui.checkbox(&mut on, label).on_hover_text(setting.help).changed().then_some(Value::Switch(on))
+            }
+        };
+        if let Some(value) = changed {
+            (setting.set)(chain, value);
+        }
+    }
 }
 
 fn line_ao_ui(ui: &mut Ui, chain: &mut ChainSettings) {

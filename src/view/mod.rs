@@ -77,6 +77,7 @@ pub fn options(args: &ViewArgs) -> app::Options {
     controls.params.chain.raytraced.max_rays = args.rays;
     controls.params.chain.cull = args.cull;
     controls.params.chain.lod = args.lod;
+    args.methods.apply(&mut controls.params.chain);
     if let Some(slab) = args.slab {
         (controls.slab, controls.params.chain.slab) = (slab, Some(slab));
     }

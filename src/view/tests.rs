@@ -208,6 +208,23 @@ fn the_method_selector_switches_the_method() {
     );
 }
 
+/// A method's panel made from its settings' descriptions (the registry's test method `toy`):
+/// its slider and checkbox are there, and the checkbox changes the picture.
+#[test]
+fn a_methods_described_settings_are_its_controls() {
+    let toy = crate::cli::Method { screen: AoMethod::from_name("toy").expect("the tests' build has it"), volume: None };
+    let mut harness = harness(options(scene(SceneKind::Bundles, 20_000), [toy, methods()[4]], false));
+    settle(&mut harness);
+    let quarter = harness.state().shown.as_ref().unwrap().images[0].clone();
+    assert!(harness.query_all_by_label_contains("radius (zoom units)").count() > 0, "the slider");
+    harness.get_by_label("invert").click();
+    settle(&mut harness);
+    let frame = harness.state().shown.as_ref().unwrap();
+    assert!(frame.view.panels[0].settings.toy.invert, "the checkbox sets the toy's switch");
+    // Three quarters of occlusion instead of one.
+    assert!(mean_luminance(&frame.images[0]) < mean_luminance(&quarter) - 0.005);
+}
+
 #[test]
 fn a_volume_colours_the_lines_it_is_sampled_at() {
     // `--color volume:strokez.nii.gz` on stroke.trk.gz: the z-map sampled at every vertex as it

@@ -432,7 +432,12 @@ struct Renderer {
 /// or a `ValueError` for settings the library refuses.
 fn render_error(e: anyhow::Error) -> PyErr {
     let text = format!("{e:#}");
-    if e.chain().any(|c| matches!(c.downcast_ref::<lineao::Error>(), Some(lineao::Error::InvalidSettings(_)))) {
+    if e.chain().any(|c| {
+        matches!(
+            c.downcast_ref::<lineao::Error>(),
+            Some(lineao::Error::InvalidSettings(_) | lineao::Error::OutOfRange { .. })
+        )
+    }) {
         PyValueError::new_err(text)
     } else {
         PyRuntimeError::new_err(text)

@@ -89,6 +89,30 @@ def test_a_method_of_the_registry_alone_is_listed_and_renders():
     assert image.shape == (16, 32, 4)
 
 
+def test_a_methods_settings_are_keywords_from_their_description():
+    # The toy's two settings, described in its folder alone: keywords with their defaults, the
+    # values reaching its pass, a value out of range refused with the keyword named.
+    settings = lineao.settings()
+    assert settings["toy_radius"][1] == "1" and "zoom units" in settings["toy_radius"][0]
+    assert "toy_invert" in settings
+    line = np.array([[-4, 0, 0], [4, 0, 0]], dtype=np.float32)
+    small = dict(method="toy", width=32, height=16, strength=1.0)
+    plain = lineao.render([line], **small).astype(int)
+    darker = lineao.render([line], toy_radius=3.0, **small).astype(int)
+    inverted = lineao.render([line], toy_radius=3.0, toy_invert=True, **small).astype(int)
+    lit = plain[..., :3].sum(axis=-1) < 3 * 250
+    assert lit.any()
+    brightness = lambda image: image[lit][:, :3].sum(axis=-1).mean()
+    # Occlusion 0.25 (the default), 0.75, and 1 − 0.75: the default's picture again.
+    assert brightness(darker) < brightness(plain) - 1
+    assert (inverted == plain).all()
+
+    with pytest.raises(ValueError, match="toy_radius.*0.25..=4 zoom units"):
+        lineao.render([line], toy_radius=9, **small)
+    with pytest.raises(ValueError, match="--toy-radius must be in"):
+        lineao.render([line], settings={"toy": {"radius_zoom": 9}}, **small)
+
+
 def test_a_renderer_keeps_its_session_for_many_frames():
     t = lineao.load(TRK)
     r = lineao.Renderer(t, **SMALL)

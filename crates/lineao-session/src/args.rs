@@ -310,6 +310,10 @@ pub struct RenderArgs {
     #[command(flatten)]
     #[serde(flatten)]
     pub truth: TruthArgs,
+    /// The methods' own settings, from their descriptions (last: what is left of the keywords).
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub methods: crate::method_args::MethodArgs,
 }
 
 /// Where the streamlines come from: a built-in scene (the file is the positional argument).

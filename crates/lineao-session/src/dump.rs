@@ -23,6 +23,7 @@ use std::io::BufWriter;
 use std::path::Path;
 
 use anyhow::{Context, Result};
+use lineao::method::setting::Value;
 use lineao::method::ssao::SsaoStage;
 use lineao::method::vo_area::VoArea;
 use lineao::readback::read_texture;
@@ -262,6 +263,16 @@ pub fn write(
             json!({"bilateral": {"radius_px": blur.radius_px, "depth_sigma_world": blur.depth_sigma_world}}),
         );
     }
+    // A method's described settings (`lineao::method::setting`), by their keywords.
+    let described = s.method.info().settings.iter().map(|d| {
+        let value = match (d.get)(s) {
+            Value::Number(x) => json!(x),
+            Value::Count(n) => json!(n),
+            Value::Switch(on) => json!(on),
+        };
+        (d.keyword(), value)
+    });
+    merge(&mut params, serde_json::Value::Object(described.collect()));
     let path = dir.join("params.json");
     let text = serde_json::to_string_pretty(&params)?;
     std::fs::write(&path, text + "\n").with_context(|| format!("cannot write {}", path.display()))?;

@@ -155,7 +155,7 @@ const REQUIRES: [(&str, &str); 5] = [
 
 /// A value as the command line's text: a string as it is, a number or bool as written, a
 /// sequence of them joined by commas (`(0, 0, 0)` → `0,0,0`, `("lineao", "ssao")` → `lineao,ssao`).
-struct Text(String);
+pub(crate) struct Text(pub(crate) String);
 
 impl<'de> Deserialize<'de> for Text {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Text, D::Error> {

@@ -11,6 +11,7 @@ pub mod dump;
 pub mod info;
 pub mod kwargs;
 pub mod label;
+pub mod method_args;
 pub mod output;
 pub mod render;
 pub mod score;

@@ -143,6 +143,7 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky, lon
         guard_max_px: args.chain.guard_max,
         cull: args.style.cull.unwrap_or(false),
         lod: args.style.lod.unwrap_or(true),
+        ..ChainSettings::papers()
     }
     .with_preset(args.shown.preset);
     // What the command line names explicitly wins over the preset.
@@ -171,6 +172,7 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky, lon
     if let Some(range) = args.ssao.ssao_range {
         settings.ssao.range_world = range;
     }
+    args.methods.apply(&mut settings);
     match &args.shown.settings {
         // Checked against the same types when parsed: it applies to any settings.
         Some(patch) => patch.apply(&settings).expect("--settings was checked when parsed"),

@@ -162,6 +162,22 @@ mod tests {
         assert!(error("slices=0,0,0").contains("--volume"), "{}", error("slices=0,0,0"));
     }
 
+    /// A method's described settings are URL keys, as they are flags (the registry's test
+    /// method `toy`, which this crate's tests build with): given, applied to the chain; out of
+    /// range, refused by the flag's words.
+    #[test]
+    fn a_methods_settings_are_url_keys() {
+        let page = parse("method=toy&toy-radius=1.5&toy-invert").unwrap();
+        let mut chain = lineao::ChainSettings::default();
+        page.view.methods.apply(&mut chain);
+        let given: Vec<&str> = page.view.methods.given.iter().map(|(flag, _)| *flag).collect();
+        assert_eq!(given, ["toy-radius", "toy-invert"]);
+        let described = AoMethod::from_name("toy").unwrap().info().settings;
+        let values: Vec<String> = described.iter().map(|s| (s.get)(&chain).to_string()).collect();
+        assert_eq!(values, ["1.5", "on"]);
+        assert!(parse("toy-radius=9").unwrap_err().contains("--toy-radius must be in 0.25..=4 zoom units, got 9"));
+    }
+
     #[test]
     fn a_link_reads_back_as_the_view_it_describes() {
         let query = link(

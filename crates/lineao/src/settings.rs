@@ -8,10 +8,8 @@ use crate::named::{Named, named};
 // Each method's settings are its folder's (and the crate root's); named here for the crate.
 pub(crate) use crate::colormap::{COLORMAP_ENTRIES, Colormap};
 pub(crate) use crate::method::AoMethod;
-pub(crate) use crate::method::line_ao::{LineAoSettings, R0};
-pub(crate) use crate::method::raytraced::RayTracedSettings;
-pub(crate) use crate::method::ssao::SsaoSettings;
-pub(crate) use crate::method::vo_line::{VoCombine, VoSettings};
+pub(crate) use crate::method::line_ao::R0;
+pub(crate) use crate::method::vo_line::VoCombine;
 
 /// Object-space AO in the chain ([`crate::volume`], [`crate::passes::volume_ao`]): the
 /// geometry's per-vertex octant visibilities ([`crate::passes::lines::VertexAttributes`])
@@ -239,58 +237,103 @@ impl Slab {
     }
 }
 
-/// Everything the pass chain needs to know besides the camera.
-#[derive(Clone, Debug, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-#[cfg_attr(feature = "serde", serde(default))]
-#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
-pub struct ChainSettings {
-    pub method: AoMethod,
-    pub line_ao: LineAoSettings,
-    pub ssao: SsaoSettings,
-    pub vo: VoSettings,
-    pub raytraced: RayTracedSettings,
-    /// The bilateral blur after the method, or none. Default none. After the ray tracer it is
-    /// its denoiser for low ray counts (`lineao score` scores the rays undenoised).
-    pub blur: Option<BilateralSettings>,
-    /// Object-space AO from the geometry's attributes, or none. Default none.
-    pub volume: Option<VolumeAoSettings>,
-    pub lighting: Lighting,
-    /// Line width in pixels, > 0. Default 2.
-    pub line_width_px: f32,
-    /// Tubes instead of lines, or none. Default none.
-    pub tubes: Option<TubeSettings>,
-    /// Context surfaces drawn with the lines ([`crate::AoChain::encode_with_meshes`]), or none.
-    /// Default none.
-    pub surfaces: Option<SurfaceSettings>,
-    /// Anatomy slices drawn with the lines ([`crate::AoChain::set_slice_volume`] gives their volume), or none.
-    /// Default none.
-    pub slices: Option<SliceSettings>,
-    /// Lines cut to a slab, or none. Default none.
-    pub slab: Option<Slab>,
-    pub line_color: LineColor,
-    /// Linear RGB of the background.
-    pub background: [f32; 3],
-    /// AO strength in the composite, ≥ 0. Default 1.
-    pub strength: f32,
-    pub debug_view: DebugView,
-    /// World units per zoom unit (1 mm for tractography). Default 1.
-    pub zoom_unit: f32,
-    /// Upper bound of the guard band in pixels, whatever the method. Default 128.
-    pub guard_max_px: u32,
-    /// Draw only the lines (or tubes) that can be seen, culled on the GPU against the last frame's depth
-    /// ([`crate::passes::cull`]): the full strip's G-buffer exactly, a fraction of the cost
-    /// where lines hide lines (a whole brain) from the second frame of a view on. Default on:
-    /// a chain draws frames one after another. A single picture has no frame before it, and
-    /// culled it costs the full strip and the tests (`lineao render` turns it off).
-    pub cull: bool,
-    /// Where it culls lines, draw each visible piece at the coarsest level of detail that lies
-    /// within half a pixel of it on screen ([`crate::passes::cull`]'s level of detail): fewer
-    /// vertices for lines seen from afar, a G-buffer that differs from the full strip's by
-    /// sub-pixel shifts. Off: the full strip exactly. Default on (but for the ray tracer:
-    /// [`ChainSettings::levels_of_detail`]).
-    pub lod: bool,
+/// Makes [`ChainSettings`] of the registry ([`crate::method`]'s `for_each_method!`): one field
+/// per method with settings of its own, which its registry line names (`LineAo => … { line_ao:
+/// LineAoSettings }`), so that a method's settings are in the chain's — and in its
+/// `--settings` JSON under that key — without this file naming them.
+macro_rules! chain_settings {
+    // The registry's lines: keep those with a field, with their `cfg`.
+    ($( $(#[doc = $doc:literal])* $(#[cfg($cfg:meta)])? $variant:ident => $info:path $({ $field:ident: $ty:ty })? ),+ $(,)?) => {
+        chain_settings!(@own [] $( [$(cfg($cfg))?] $variant [$($field: $ty)?] )+);
+    };
+    (@own [$($own:tt)*] [$($cfg:tt)*] $variant:ident [] $($rest:tt)*) => {
+        chain_settings!(@own [$($own)*] $($rest)*);
+    };
+    (@own [$($own:tt)*] [$($cfg:tt)*] $variant:ident [$field:ident: $ty:ty] $($rest:tt)*) => {
+        chain_settings!(@own [$($own)* ([$($cfg)*] $variant $field: $ty)] $($rest)*);
+    };
+    (@own [$( ([$($attr:meta)?] $variant:ident $field:ident: $ty:ty) )*]) => {
+        /// Everything the pass chain needs to know besides the camera.
+        #[derive(Clone, Debug, PartialEq)]
+        #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+        #[cfg_attr(feature = "serde", serde(default))]
+        #[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+        pub struct ChainSettings {
+            pub method: AoMethod,
+            $( $(#[$attr])? #[doc = concat!("The settings of [`AoMethod::", stringify!($variant), "`] (its registry line's field).")] pub $field: $ty, )*
+            /// The bilateral blur after the method, or none. Default none. After the ray tracer it is
+            /// its denoiser for low ray counts (`lineao score` scores the rays undenoised).
+            pub blur: Option<BilateralSettings>,
+            /// Object-space AO from the geometry's attributes, or none. Default none.
+            pub volume: Option<VolumeAoSettings>,
+            pub lighting: Lighting,
+            /// Line width in pixels, > 0. Default 2.
+            pub line_width_px: f32,
+            /// Tubes instead of lines, or none. Default none.
+            pub tubes: Option<TubeSettings>,
+            /// Context surfaces drawn with the lines ([`crate::AoChain::encode_with_meshes`]), or none.
+            /// Default none.
+            pub surfaces: Option<SurfaceSettings>,
+            /// Anatomy slices drawn with the lines ([`crate::AoChain::set_slice_volume`] gives their volume), or none.
+            /// Default none.
+            pub slices: Option<SliceSettings>,
+            /// Lines cut to a slab, or none. Default none.
+            pub slab: Option<Slab>,
+            pub line_color: LineColor,
+            /// Linear RGB of the background.
+            pub background: [f32; 3],
+            /// AO strength in the composite, ≥ 0. Default 1.
+            pub strength: f32,
+            pub debug_view: DebugView,
+            /// World units per zoom unit (1 mm for tractography). Default 1.
+            pub zoom_unit: f32,
+            /// Upper bound of the guard band in pixels, whatever the method. Default 128.
+            pub guard_max_px: u32,
+            /// Draw only the lines (or tubes) that can be seen, culled on the GPU against the last frame's depth
+            /// ([`crate::passes::cull`]): the full strip's G-buffer exactly, a fraction of the cost
+            /// where lines hide lines (a whole brain) from the second frame of a view on. Default on:
+            /// a chain draws frames one after another. A single picture has no frame before it, and
+            /// culled it costs the full strip and the tests (`lineao render` turns it off).
+            pub cull: bool,
+            /// Where it culls lines, draw each visible piece at the coarsest level of detail that lies
+            /// within half a pixel of it on screen ([`crate::passes::cull`]'s level of detail): fewer
+            /// vertices for lines seen from afar, a G-buffer that differs from the full strip's by
+            /// sub-pixel shifts. Off: the full strip exactly. Default on (but for the ray tracer:
+            /// [`ChainSettings::levels_of_detail`]).
+            pub lod: bool,
+        }
+
+        impl ChainSettings {
+            /// The papers' values for every setting (LineAO s_r 3, r0 1.5 × the line width, δ
+            /// scale 1, strength 1; VO and SSAO spheres of 2 world units): `ChainSettings::default()`
+            /// before the default preset is applied, and what [`Preset::Paper`] restores.
+            pub fn papers() -> Self {
+                ChainSettings {
+                    method: AoMethod::LineAo,
+                    $( $(#[$attr])? $field: <$ty>::default(), )*
+                    blur: None,
+                    volume: None,
+                    lighting: Lighting::default(),
+                    line_width_px: 2.0,
+                    tubes: None,
+                    surfaces: None,
+                    slices: None,
+                    slab: None,
+                    line_color: LineColor::Tangent,
+                    background: [1.0, 1.0, 1.0],
+                    strength: 1.0,
+                    debug_view: DebugView::Final,
+                    zoom_unit: 1.0,
+                    guard_max_px: 128,
+                    cull: true,
+                    lod: true,
+                }
+            }
+        }
+    };
 }
+
+crate::method::for_each_method!(chain_settings);
 
 impl Default for ChainSettings {
     /// The default preset's settings ([`Preset::Legible`], what every front end starts from):
@@ -306,35 +349,6 @@ impl ChainSettings {
     /// where the scene it traces has them.
     pub fn levels_of_detail(&self) -> bool {
         self.lod && self.method != AoMethod::RayTraced
-    }
-
-    /// The papers' values for every setting (LineAO s_r 3, r0 1.5 × the line width, δ scale 1,
-    /// strength 1; VO and SSAO spheres of 2 world units): `ChainSettings::default()` before the
-    /// default preset is applied, and what [`Preset::Paper`] restores.
-    pub fn papers() -> Self {
-        ChainSettings {
-            method: AoMethod::LineAo,
-            line_ao: LineAoSettings::default(),
-            ssao: SsaoSettings::default(),
-            vo: VoSettings::default(),
-            raytraced: RayTracedSettings::default(),
-            blur: None,
-            volume: None,
-            lighting: Lighting::default(),
-            line_width_px: 2.0,
-            tubes: None,
-            surfaces: None,
-            slices: None,
-            slab: None,
-            line_color: LineColor::Tangent,
-            background: [1.0, 1.0, 1.0],
-            strength: 1.0,
-            debug_view: DebugView::Final,
-            zoom_unit: 1.0,
-            guard_max_px: 128,
-            cull: true,
-            lod: true,
-        }
     }
 }
 
@@ -466,6 +480,7 @@ impl ChainSettings {
         }
         // Each method's own settings (LineAO's r0 follows the width and the tubes checked above).
         for method in AoMethod::REGISTRY {
+            crate::method::setting::check_all(method.info().settings, self)?;
             (method.info().validate)(self)?;
         }
         if let Some(volume) = &self.volume
@@ -572,6 +587,7 @@ mod preset_tests {
 mod serde_tests {
     use super::*;
     use crate::method::line_ao::LineAoVariant;
+    use crate::method::ssao::SsaoSettings;
 
     #[test]
     fn settings_round_trip_through_json_with_names_as_the_command_line_writes_them() {

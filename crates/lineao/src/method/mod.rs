@@ -27,9 +27,10 @@ use crate::timing::Span;
 
 pub mod line_ao;
 pub mod raytraced;
+pub mod setting;
 pub mod ssao;
 #[cfg(any(test, feature = "toy-method"))]
-mod toy;
+pub mod toy;
 pub mod vo_area;
 pub mod vo_line;
 
@@ -70,6 +71,11 @@ pub struct MethodInfo {
     /// The levels of the G-buffer's ND pyramid its stage reads under those settings (1: the
     /// full-resolution maps alone).
     pub(crate) levels: fn(&ChainSettings) -> u32,
+    /// Its settings as they describe themselves, from which the front ends make their flags,
+    /// keywords, controls and URL keys ([`setting`]); [`ChainSettings::validate`] checks each
+    /// value's range before the method's own validation runs. Empty for a method whose settings
+    /// its front ends still list by hand.
+    pub settings: &'static [setting::Setting],
     /// What `lineao bench` times of it, by CONTRACT.md's names.
     pub bench: &'static [BenchPass],
 }
@@ -119,10 +125,41 @@ pub fn bench_passes() -> impl Iterator<Item = (AoMethod, &'static BenchPass)> {
     AoMethod::REGISTRY.iter().flat_map(|&m| m.info().bench.iter().map(move |pass| (m, pass)))
 }
 
-/// The registry: the methods, in the order front ends list them. A method is its folder and
-/// one line here.
+/// The registry: the methods, in the order front ends list them, each by its [`MethodInfo`]
+/// and — when it has settings of its own — the field of [`ChainSettings`] that holds them
+/// (`{ field: Type }`, the `--settings` JSON's key). A method is its folder and one line here.
+///
+/// The list is handed to a macro (`for_each_method!(callback)`): here `registry!` makes
+/// [`AoMethod`] of it, and [`crate::settings`] makes [`ChainSettings`]'s fields.
+macro_rules! for_each_method {
+    ($callback:ident) => {
+        $callback! {
+            /// Plain lines (with the illuminated-lines specular), no occlusion.
+            None => crate::method::NONE,
+            /// LineAO (Eichelbaum et al. 2013).
+            LineAo => crate::method::line_ao::METHOD { line_ao: crate::method::line_ao::LineAoSettings },
+            /// Volumetric Obscurance with line samples (Loos & Sloan 2010, §4.1).
+            VoLine => crate::method::vo_line::METHOD { vo: crate::method::vo_line::VoSettings },
+            /// Volumetric Obscurance with area samples over a pyramid of depth moments (§4.2),
+            /// with VO line's settings.
+            VoArea => crate::method::vo_area::METHOD,
+            /// Crytek SSAO (Mittring 2007), the LineAO paper's baseline, with its 4 × 4 blur.
+            Ssao => crate::method::ssao::METHOD { ssao: crate::method::ssao::SsaoSettings },
+            /// Ray-traced AO on the GPU, progressive: the ground truth ([`crate::truth`]) where
+            /// the view rests. Rays go through the scene, not the screen, so it needs no guard band.
+            RayTraced => crate::method::raytraced::METHOD { raytraced: crate::method::raytraced::RayTracedSettings },
+            /// A method made by the registry alone, which the tests find everywhere methods are
+            /// listed (feature `toy-method`, for tests only).
+            #[cfg(any(test, feature = "toy-method"))]
+            Toy => crate::method::toy::METHOD { toy: crate::method::toy::ToySettings },
+        }
+    };
+}
+pub(crate) use for_each_method;
+
+/// Makes [`AoMethod`] of the registry.
 macro_rules! registry {
-    ($( $(#[doc = $doc:literal])* $(#[cfg($cfg:meta)])? $variant:ident => $info:path ),+ $(,)?) => {
+    ($( $(#[doc = $doc:literal])* $(#[cfg($cfg:meta)])? $variant:ident => $info:path $({ $($own:tt)* })? ),+ $(,)?) => {
         /// Which ambient occlusion the chain computes: one variant per method of the registry
         /// ([`crate::method`]), each described by [`AoMethod::info`].
         #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -144,25 +181,7 @@ macro_rules! registry {
     };
 }
 
-registry! {
-    /// Plain lines (with the illuminated-lines specular), no occlusion.
-    None => NONE,
-    /// LineAO (Eichelbaum et al. 2013).
-    LineAo => line_ao::METHOD,
-    /// Volumetric Obscurance with line samples (Loos & Sloan 2010, §4.1).
-    VoLine => vo_line::METHOD,
-    /// Volumetric Obscurance with area samples over a pyramid of depth moments (§4.2).
-    VoArea => vo_area::METHOD,
-    /// Crytek SSAO (Mittring 2007), the LineAO paper's baseline, with its 4 × 4 blur.
-    Ssao => ssao::METHOD,
-    /// Ray-traced AO on the GPU, progressive: the ground truth ([`crate::truth`]) where the view
-    /// rests. Rays go through the scene, not the screen, so it needs no guard band.
-    RayTraced => raytraced::METHOD,
-    /// A method made by the registry alone, which the tests find everywhere methods are listed
-    /// (feature `toy-method`, for tests only).
-    #[cfg(any(test, feature = "toy-method"))]
-    Toy => toy::METHOD,
-}
+for_each_method!(registry);
 
 impl Default for AoMethod {
     /// LineAO.
@@ -185,6 +204,7 @@ const NONE: MethodInfo = MethodInfo {
     preset: |_, settings| settings.strength = 1.0,
     validate: valid_always,
     levels: one_level,
+    settings: &[],
     bench: &[],
 };
 

@@ -86,6 +86,7 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     preset: settings::preset,
     validate: settings::validate,
     levels: |s| if s.line_ao.variant == LineAoVariant::Paper { s.line_ao.s_r } else { 1 },
+    settings: &[],
     bench: &[
         BenchPass::of("lineao", &["lineao"], |_, _| {}),
         BenchPass {

@@ -59,6 +59,7 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     preset: |_, settings| settings.strength = 1.0,
     validate: |s| s.raytraced.validate(),
     levels: super::one_level,
+    settings: &[],
     bench: &[
         // One ray per pixel each frame, continuing one picture (started by the first warm-up
         // frame, over the G-buffer).

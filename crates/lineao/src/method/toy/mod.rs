@@ -1,6 +1,8 @@
 //! A method made by the registry alone, for the tests: this folder and its line in
-//! [`crate::method`]'s `registry!` are all it took. It darkens every geometry pixel by a
-//! quarter, so a test can tell that the chain ran it.
+//! [`crate::method`]'s registry are all it took — its two settings included, which the front
+//! ends show as flags, keywords, controls and URL keys from their descriptions here. It darkens
+//! every geometry pixel by a quarter per zoom unit of its "radius" (the complement when
+//! inverted), so a test can tell that the chain ran it with its settings.
 
 use crate::binding::{self, Slot};
 use crate::camera::FrameView;
@@ -8,6 +10,63 @@ use crate::passes::dispatch_full_screen;
 use crate::settings::ChainSettings;
 use crate::targets::{AO_FORMAT, FrameTargets};
 use crate::timing::Span;
+
+use super::setting::{Kind, Setting, Value};
+
+/// The toy's settings: the `toy` field of [`ChainSettings`] (its registry line's).
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct ToySettings {
+    /// A quarter of occlusion per zoom unit, 0.25..=4. Default 1.
+    pub radius_zoom: f32,
+    /// One minus that instead. Default off.
+    pub invert: bool,
+}
+
+impl Default for ToySettings {
+    fn default() -> Self {
+        ToySettings { radius_zoom: 1.0, invert: false }
+    }
+}
+
+impl ToySettings {
+    /// The occlusion of every geometry pixel.
+    pub fn occlusion(&self) -> f32 {
+        let quarter = (0.25 * self.radius_zoom).min(1.0);
+        if self.invert { 1.0 - quarter } else { quarter }
+    }
+}
+
+/// `ToyUniform` in toy.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct ToyUniform {
+    occlusion: f32,
+    _pad: [f32; 3],
+}
+
+const SETTINGS: &[Setting] = &[
+    Setting {
+        flag: "toy-radius",
+        label: "radius",
+        help: "Toy: a quarter of occlusion per zoom unit",
+        unit: "zoom units",
+        kind: Kind::Number { min: 0.25, max: 4.0, log: true },
+        get: |s| Value::Number(s.toy.radius_zoom),
+        set: |s, v| s.toy.radius_zoom = v.as_f32(),
+    },
+    Setting {
+        flag: "toy-invert",
+        label: "invert",
+        help: "Toy: one minus that occlusion",
+        unit: "",
+        kind: Kind::Switch { given: true },
+        get: |s| Value::Switch(s.toy.invert),
+        set: |s, v| s.toy.invert = v.is_on(),
+    },
+];
 
 pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     name: "toy",
@@ -24,21 +83,24 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     preset: |_, settings| settings.strength = 1.0,
     validate: super::valid_always,
     levels: super::one_level,
+    settings: SETTINGS,
     bench: &[super::BenchPass::of("toy", &["toy"], |_, _| {})],
 };
 
 struct Toy {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
+    uniform: wgpu::Buffer,
     group: Option<wgpu::BindGroup>,
 }
 
 impl Toy {
     fn new(device: &wgpu::Device) -> Toy {
-        let slots = [Slot::Texture, Slot::StorageTexture(AO_FORMAT)];
+        let slots = [Slot::Uniform, Slot::Texture, Slot::StorageTexture(AO_FORMAT)];
         let layout = binding::layout(device, "lineao::Toy", wgpu::ShaderStages::COMPUTE, &slots);
         let pipeline = binding::compute_pipeline(device, "lineao::Toy", &layout, "toy.wgsl", "toy", &[]);
-        Toy { pipeline, layout, group: None }
+        let uniform = binding::uniform_buffer::<ToyUniform>(device, "lineao::Toy");
+        Toy { pipeline, layout, uniform, group: None }
     }
 }
 
@@ -57,13 +119,20 @@ impl super::Stage for Toy {
 
     fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets) {
         let resources = [
+            self.uniform.as_entire_binding(),
             wgpu::BindingResource::TextureView(&targets.nd[0].view),
             wgpu::BindingResource::TextureView(&targets.ao.view),
         ];
         self.group = Some(binding::group(device, "lineao::Toy", &self.layout, &resources));
     }
 
-    fn prepare(&self, _: &wgpu::Queue, _: &FrameTargets, _: &FrameView, _: &ChainSettings) {}
+    fn prepare(&self, queue: &wgpu::Queue, _: &FrameTargets, _: &FrameView, settings: &ChainSettings) {
+        queue.write_buffer(
+            &self.uniform,
+            0,
+            bytemuck::bytes_of(&ToyUniform { occlusion: settings.toy.occlusion(), _pad: [0.0; 3] }),
+        );
+    }
 
     fn encode<'t>(
         &self,
@@ -83,6 +152,11 @@ mod tests {
     use crate::{AoChain, AoMethod, ChainSettings, Gpu, LineGeometry};
 
     #[test]
+    fn the_uniform_is_laid_out_as_the_wgsl_reads_it() {
+        crate::shader::assert_wgsl_layout!(super::ToyUniform, "toy.wgsl", "ToyUniform", [occlusion]);
+    }
+
+    #[test]
     fn the_registry_alone_puts_a_method_in_the_chain() {
         let toy = AoMethod::from_name("toy").expect("the registry lists it");
         assert!(AoMethod::REGISTRY.contains(&toy));
@@ -90,9 +164,19 @@ mod tests {
         assert!(crate::method::pass_names().contains(&"toy"));
         assert!(crate::shader::raw("toy.wgsl").is_some());
         // Its preset and validation come through the registry too.
-        let settings = ChainSettings { method: toy, ..ChainSettings::default() }.with_preset(crate::Preset::Legible);
+        let mut settings =
+            ChainSettings { method: toy, ..ChainSettings::default() }.with_preset(crate::Preset::Legible);
         settings.validate().unwrap();
         assert_eq!(settings.strength, 1.0);
+        // Its settings too, checked by their descriptions with the flag named.
+        settings.toy.radius_zoom = 5.0;
+        let refused = settings.validate().unwrap_err();
+        assert!(
+            matches!(refused, crate::Error::OutOfRange { setting: "toy-radius", value: 5.0, min: 0.25, max: 4.0, .. }),
+            "{refused:?}"
+        );
+        assert_eq!(refused.to_string(), "invalid settings: --toy-radius must be in 0.25..=4 zoom units, got 5");
+        settings.toy = super::ToySettings { radius_zoom: 1.5, invert: true };
 
         let gpu = Gpu::headless().unwrap();
         let (device, queue) = (&gpu.device, &gpu.queue);
@@ -126,7 +210,7 @@ mod tests {
         let background = |nd: &[f32; 4]| nd[..3] == [0.0; 3];
         assert!(nd.iter().any(|n| !background(n)), "the line is in view");
         for (ao, nd) in ao.iter().zip(&nd) {
-            let expected = if background(nd) { 0.0 } else { 0.25 };
+            let expected = if background(nd) { 0.0 } else { 1.0 - 0.25 * 1.5 };
             assert_eq!(*ao, expected);
         }
     }

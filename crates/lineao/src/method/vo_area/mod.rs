@@ -47,6 +47,7 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     preset: |preset, settings| crate::method::vo_line::preset(preset, settings, 1.0, 1.0),
     validate: |s| s.vo.validate(),
     levels: super::one_level,
+    settings: &[],
     bench: &[super::BenchPass::of("vo-area-1", &["moments", "vo-area"], |s, _| s.vo.area_samples = 1)],
 };
 use crate::targets::FrameTargets;
