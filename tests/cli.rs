@@ -42,6 +42,10 @@ fn exit_codes() {
         (&["score", "--ao-distance=-2"], "positive"),
         // Library ranges the command line knows: a bad command line, and the option named.
         (&["render", "--s-h", "0"], "--s-h"),
+        // A described setting's range (`lineao::method::setting`), whichever method is shown.
+        (&["render", "--s-r", "9"], "--s-r must be in 1..=5, got 9"),
+        (&["render", "--method", "vo-line", "--ssao-samples", "40"], "--ssao-samples must be in 8..=32"),
+        (&["render", "--method", "ssao", "--vo-samples", "6"], "--vo-samples must be 5, 7, 9, 12, 13 or 16, got 6"),
         (&["render", "--delta-scale", "0"], "(0, 1]"),
         (&["render", "--method", "vo-line", "--radius", "0"], "--radius"),
         (&["render", "--method", "vo-line", "--vo-radius", "0"], "--vo-radius"),
@@ -63,15 +67,11 @@ fn exit_codes() {
     let png = dir.join("x.png");
     let png = png.to_str().unwrap();
     for (bad, needle) in [
-        (&["render", "--s-r", "9", "-o", png][..], "s_r"),
-        (&["render", "--line-width", "0", "-o", png], "line width"),
+        (&["render", "--line-width", "0", "-o", png][..], "line width"),
         (&["render", "--debug-view", "level:3", "-o", png], "debug level 3"),
         (&["render", "--eye", "0,0,0", "--target", "0,0,0", "-o", png], "coincide"),
         (&["render", "--method", "ssao", "--ssao-kernel", "sphere", "--samples", "10", "-o", png], "sphere kernel"),
         (&["render", "--variant", "reference", "--outer", "level", "-o", png], "outer = level"),
-        // Each method's samples have a flag of their own, whichever method is shown.
-        (&["render", "--method", "ssao", "--vo-samples", "6", "-o", png], "VO samples must be one of"),
-        (&["render", "--method", "vo-line", "--ssao-samples", "40", "-o", png], "SSAO samples must be in 8..=32"),
         (&["render", "--surface", "/nonexistent/hull.obj", "-o", png], "/nonexistent/hull.obj"),
         (&["render", "--geometry", "tubes", "--tube-radius=-1", "-o", png], "tube radius"),
         (
@@ -933,7 +933,7 @@ fn a_method_of_the_registry_alone_is_listed_everywhere() {
 
 /// The toy's two settings, described in its folder alone (`lineao::method::setting`): flags in
 /// `render --help` under its heading with unit, range and default; values that reach its pass
-/// (the dump's `ao.npy`) and `params.json`; `--settings` JSON under its registry line's key; a
+/// (the dump's `ao.npy`) and `params.json` (`flags`); `--settings` JSON under its registry line's key; a
 /// value out of range refused by flag, from the command line and from the JSON. (Python's
 /// keywords: test_render.py; the viewer's controls and the page's URL keys: their tests.)
 #[test]
@@ -942,7 +942,7 @@ fn a_methods_settings_are_flags_from_their_description() {
     let help = String::from_utf8_lossy(&help.stdout);
     let toy = &help[help.find("\ntoy:").expect("the toy's heading")..];
     assert!(toy.contains("--toy-radius <ZOOM UNITS>"), "{toy}");
-    assert!(toy.contains("(0.25..=4 zoom units)") && toy.contains("[default: 1]"), "{toy}");
+    assert!(toy.contains("(in [0.25, 4] zoom units)") && toy.contains("[default: 1]"), "{toy}");
     assert!(toy.contains("--toy-invert") && toy.contains("one minus that occlusion"), "{toy}");
 
     let small = ["--vertices", "2000", "--width", "64", "--height", "48", "--method", "toy"];
@@ -951,7 +951,8 @@ fn a_methods_settings_are_flags_from_their_description() {
     let render = lineao(&[&["render", "-o", dump.join("toy.png").to_str().unwrap()][..], &small, &given].concat());
     assert_eq!(render.status.code(), Some(0), "{}", stderr(&render));
     let params: Value = serde_json::from_str(&std::fs::read_to_string(dump.join("params.json")).unwrap()).unwrap();
-    assert_eq!((params["toy_radius"].as_f64(), params["toy_invert"].as_bool()), (Some(1.5), Some(true)), "{params}");
+    let flags = &params["flags"];
+    assert_eq!((flags["toy_radius"].as_f64(), flags["toy_invert"].as_bool()), (Some(1.5), Some(true)), "{params}");
     let (_, ao) = read_npy(&dump.join("ao.npy"));
     assert!(ao.iter().all(|&a| a == 0.0 || a == 1.0 - 0.25 * 1.5), "the toy's occlusion or the background");
     assert!(ao.contains(&0.625));
@@ -971,7 +972,7 @@ fn a_methods_settings_are_flags_from_their_description() {
     ] {
         assert_ne!(refused.status.code(), Some(0));
         assert!(
-            stderr(&refused).contains("--toy-radius must be in 0.25..=4 zoom units, got 9"),
+            stderr(&refused).contains("--toy-radius must be in [0.25, 4] zoom units, got 9"),
             "{}",
             stderr(&refused)
         );

@@ -8,11 +8,11 @@
 use egui::Ui;
 use glam::Vec3;
 use lineao::lighting::LineShading;
-use lineao::method::setting::{Kind, Setting, Value};
+use lineao::method::setting::{Kind, Unit, Value};
 use lineao::volume::{ScalarForm, Sky, VolumeAoOptions, VolumeMethod};
 use lineao::{
-    AoMethod, BilateralSettings, ChainSettings, Colormap, DebugView, LineAoOuter, LineAoVariant, LineColor, Named,
-    Preset, Slab, SlabAxis, SliceSettings, SsaoKernel, TubeSettings, VoCombine, VolumeAoSettings,
+    AoMethod, BilateralSettings, ChainSettings, Colormap, DebugView, LineAoVariant, LineColor, Named, Preset, Slab,
+    SlabAxis, SliceSettings, TubeSettings, VoCombine, VolumeAoSettings,
 };
 
 use super::worker::Panel;
@@ -376,16 +376,12 @@ impl Controls {
         let volume = shown.iter().any(|s| s.volume.is_some());
         let p = &mut self.params;
         ui.add(egui::Slider::new(&mut p.chain.strength, 0.0..=2.0).text("strength"));
-        if screen(AoMethod::LineAo) {
-            egui::CollapsingHeader::new("LineAO").default_open(true).show(ui, |ui| line_ao_ui(ui, &mut p.chain));
-        }
-        if screen(AoMethod::Ssao) {
-            egui::CollapsingHeader::new("Crytek SSAO").default_open(true).show(ui, |ui| ssao_ui(ui, &mut p.chain));
-        }
-        if screen(AoMethod::VoLine) || screen(AoMethod::VoArea) {
-            egui::CollapsingHeader::new("Volumetric Obscurance")
+        // Each method's panel: its settings' descriptions (the ray tracer's and object-space
+        // AO's below are written out).
+        for method in AoMethod::REGISTRY.iter().copied().filter(|&m| screen(m) && !m.info().settings.is_empty()) {
+            egui::CollapsingHeader::new(method.info().label)
                 .default_open(true)
-                .show(ui, |ui| vo_ui(ui, &mut p.chain));
+                .show(ui, |ui| described_ui(ui, method, &mut p.chain));
         }
         if volume {
             egui::CollapsingHeader::new("Object-space AO").default_open(true).show(ui, |ui| volume_ui(ui, p));
@@ -394,13 +390,6 @@ impl Controls {
             egui::CollapsingHeader::new("Ray tracing")
                 .default_open(true)
                 .show(ui, |ui| ray_ui(ui, &mut p.chain, &mut self.moving_method));
-        }
-        // Every other method's panel: its settings' descriptions.
-        for method in AoMethod::REGISTRY.iter().copied().filter(|&m| screen(m) && !m.info().settings.is_empty()) {
-            let info = method.info();
-            egui::CollapsingHeader::new(info.label)
-                .default_open(true)
-                .show(ui, |ui| described_ui(ui, info.settings, &mut p.chain));
         }
         let mut blur = p.chain.blur.is_some();
         ui.checkbox(&mut blur, "Bilateral blur");
@@ -617,34 +606,45 @@ fn method_combo(ui: &mut Ui, id: &str, method: &mut Method) {
     });
 }
 
-/// A choice among a few values, as a row of buttons.
-fn choice<T: PartialEq + Copy + std::fmt::Display>(ui: &mut Ui, label: &str, value: &mut T, options: &[T]) {
-    ui.horizontal(|ui| {
-        ui.label(label);
-        for &option in options {
-            ui.selectable_value(value, option, option.to_string());
-        }
-    });
-}
-
 /// A method's panel from its settings' descriptions ([`lineao::method::setting`]): a slider for
-/// each number (moving by factors where the description says so), a checkbox for each switch,
-/// each with its flag's help on hover.
-pub fn described_ui(ui: &mut Ui, settings: &[Setting], chain: &mut ChainSettings) {
-    for setting in settings {
-        let label = if setting.unit.is_empty() {
-            setting.label.to_string()
-        } else {
-            format!("{} ({})", setting.label, setting.unit)
+/// each number (by factors where the description says so; lengths in the data's units span
+/// the description's range times the zoom unit), buttons for each set of values, a checkbox
+/// for each switch, each with its flag's help on hover — those that apply under the settings
+/// shown. After a control moves, the method keeps the others valid ([`MethodInfo::conform`]).
+///
+/// [`MethodInfo::conform`]: lineao::method::MethodInfo::conform
+pub fn described_ui(ui: &mut Ui, method: AoMethod, chain: &mut ChainSettings) {
+    let info = method.info();
+    let scale = chain.zoom_unit;
+    for setting in info.settings {
+        if !(setting.applies)(chain) {
+            continue;
+        }
+        let label = match setting.unit {
+            Unit::None => setting.label.to_string(),
+            unit => format!("{} ({})", setting.label, unit.name()),
         };
+        let world = if setting.unit == Unit::WorldUnits { scale } else { 1.0 };
         let changed = match (setting.kind, (setting.get)(chain)) {
-            (Kind::Number { min, max, log }, Value::Number(mut x)) => {
-                let slider = egui::Slider::new(&mut x, min..=max).logarithmic(log).text(label);
+            (Kind::Number { min, max, log, .. }, Value::Number(mut x)) => {
+                let slider = egui::Slider::new(&mut x, min * world..=max * world).logarithmic(log).text(label);
+                ui.add(slider).on_hover_text(setting.help).changed().then_some(Value::Number(x))
+            }
+            (Kind::Above { slider: [min, max], log, .. }, Value::Number(mut x)) => {
+                let slider = egui::Slider::new(&mut x, min * world..=max * world).logarithmic(log).text(label);
                 ui.add(slider).on_hover_text(setting.help).changed().then_some(Value::Number(x))
             }
             (Kind::Count { min, max }, Value::Count(mut n)) => {
                 let slider = egui::Slider::new(&mut n, min..=max).text(label);
                 ui.add(slider).on_hover_text(setting.help).changed().then_some(Value::Count(n))
+            }
+            (Kind::Counts(counts), Value::Count(n)) => {
+                let options: Vec<Value> = counts.iter().map(|&c| Value::Count(c)).collect();
+                values_ui(ui, &label, setting.help, Value::Count(n), &options)
+            }
+            (Kind::Choice(names), value) => {
+                let options: Vec<Value> = names.iter().map(|&name| Value::Choice(name)).collect();
+                values_ui(ui, &label, setting.help, value, &options)
             }
             (_, value) => {
                 let mut on = value.is_on();
@@ -653,72 +653,20 @@ pub fn described_ui(ui: &mut Ui, settings: &[Setting], chain: &mut ChainSettings
         };
         if let Some(value) = changed {
             (setting.set)(chain, value);
+            (info.conform)(chain);
         }
     }
 }
 
-fn line_ao_ui(ui: &mut Ui, chain: &mut ChainSettings) {
-    let ao = &mut chain.line_ao;
+/// A row of buttons, one per value: the one clicked, if any.
+fn values_ui(ui: &mut Ui, label: &str, help: &str, current: Value, options: &[Value]) -> Option<Value> {
     ui.horizontal(|ui| {
-        ui.label("variant");
-        ui.selectable_value(&mut ao.variant, LineAoVariant::Paper, "paper");
-        ui.selectable_value(&mut ao.variant, LineAoVariant::Reference, "authors' code");
-    });
-    ui.add(egui::Slider::new(&mut ao.s_r, 1..=lineao::MAX_LEVELS).text("s_r hemispheres"));
-    ui.add(egui::Slider::new(&mut ao.s_h, 4..=128).logarithmic(true).text("s_h samples"));
-    let mut r0 = ao.r0_px.unwrap_or(ao.r0_per_width * chain.line_width_px);
-    if ui.add(egui::Slider::new(&mut r0, 0.5..=16.0).text("r0 (px)")).changed() {
-        ao.r0_px = Some(r0);
-    }
-    ui.add(egui::Slider::new(&mut ao.delta_scale, 1e-3..=1.0).logarithmic(true).text("δ scale"));
-    // δ0 < δ scale · (1/s_r)² (ChainSettings::validate).
-    let max = 0.9 * ao.delta_scale / (ao.s_r * ao.s_r) as f32;
-    ao.delta0 = ao.delta0.min(max);
-    ui.add(egui::Slider::new(&mut ao.delta0, 1e-6..=max.min(1e-2)).logarithmic(true).text("δ0"));
-    ui.add(egui::Slider::new(&mut ao.epsilon, 1e-8..=1e-3).logarithmic(true).text("ε"));
-    ui.checkbox(&mut ao.light_attenuation, "light attenuation g_light");
-    if ao.variant == LineAoVariant::Paper {
-        ui.horizontal(|ui| {
-            ui.label("outer hemispheres");
-            ui.selectable_value(&mut ao.outer, LineAoOuter::Full, "every pixel");
-            ui.selectable_value(&mut ao.outer, LineAoOuter::Level, "level resolution");
-        });
-    } else {
-        ao.outer = LineAoOuter::Full;
-        ui.add(egui::Slider::new(&mut ao.reference_radius_px, 0.5..=8.0).text("base radius (px)"));
-    }
-}
-
-fn ssao_ui(ui: &mut Ui, chain: &mut ChainSettings) {
-    let (s, z) = (&mut chain.ssao, chain.zoom_unit);
-    ui.horizontal(|ui| {
-        ui.label("kernel");
-        ui.selectable_value(&mut s.kernel, SsaoKernel::Crytek, "Crytek");
-        ui.selectable_value(&mut s.kernel, SsaoKernel::Sphere, "VO sphere set");
-    });
-    match s.kernel {
-        SsaoKernel::Crytek => {
-            ui.add(egui::Slider::new(&mut s.samples, 8..=32).text("samples"));
-        }
-        SsaoKernel::Sphere => {
-            let counts = lineao::sample_sets::VO_SPHERE_SAMPLE_COUNTS;
-            if !counts.contains(&s.samples) {
-                s.samples = 16;
-            }
-            choice(ui, "samples", &mut s.samples, &counts);
-        }
-    }
-    ui.add(egui::Slider::new(&mut s.radius_world, 0.1 * z..=20.0 * z).logarithmic(true).text("radius"));
-    ui.add(egui::Slider::new(&mut s.range_world, 0.1 * z..=20.0 * z).logarithmic(true).text("range check"));
-}
-
-fn vo_ui(ui: &mut Ui, chain: &mut ChainSettings) {
-    let (vo, z) = (&mut chain.vo, chain.zoom_unit);
-    choice(ui, "line samples", &mut vo.samples, &lineao::sample_sets::VO_SAMPLE_COUNTS);
-    choice(ui, "area samples", &mut vo.area_samples, &lineao::sample_sets::VO_AREA_SAMPLE_COUNTS);
-    ui.add(egui::Slider::new(&mut vo.radius_world, 0.1 * z..=20.0 * z).logarithmic(true).text("radius"));
-    ui.checkbox(&mut vo.normal_clamp, "normal clamp (half sphere)");
-    ui.add(egui::Slider::new(&mut vo.thickness_world, 0.0..=10.0 * z).text("thickness (0 = off)"));
+        ui.label(label).on_hover_text(help);
+        let clicked =
+            options.iter().filter(|&&option| ui.selectable_label(option == current, option.to_string()).clicked());
+        clicked.last().copied()
+    })
+    .inner
 }
 
 fn ray_ui(ui: &mut Ui, chain: &mut ChainSettings, moving: &mut Method) {

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use clap::{Args, ValueEnum};
 use lineao::lighting::LineShading;
 use lineao::truth::Falloff;
-use lineao::{Colormap, LineAoOuter, LineAoVariant, Named, SsaoKernel, VoCombine};
+use lineao::{Colormap, Named, VoCombine};
 use lineao_tracts::SceneKind;
 
 #[derive(Args, Debug)]
@@ -101,15 +101,6 @@ pub fn parse_positive(s: &str) -> Result<f32, String> {
     match s.trim().parse::<f32>() {
         Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
         Ok(v) => Err(format!("must be positive and finite, got {v}")),
-        Err(e) => Err(format!("'{s}': {e}")),
-    }
-}
-
-/// LineAO's δ scale, in (0, 1].
-pub fn parse_delta_scale(s: &str) -> Result<f32, String> {
-    match s.trim().parse::<f32>() {
-        Ok(v) if v > 0.0 && v <= 1.0 => Ok(v),
-        Ok(v) => Err(format!("the δ scale must be in (0, 1], got {v}")),
         Err(e) => Err(format!("'{s}': {e}")),
     }
 }
@@ -292,15 +283,10 @@ pub struct RenderArgs {
     #[command(flatten)]
     #[serde(flatten)]
     pub camera: CameraArgs,
+    /// The methods' settings that describe themselves (`lineao::method::setting`).
     #[command(flatten)]
     #[serde(flatten)]
-    pub line_ao: LineAoArgs,
-    #[command(flatten)]
-    #[serde(flatten)]
-    pub ssao: SsaoArgs,
-    #[command(flatten)]
-    #[serde(flatten)]
-    pub vo: VoArgs,
+    pub methods: crate::method_args::MethodArgs,
     #[command(flatten)]
     #[serde(flatten)]
     pub chain: ChainArgs,
@@ -310,10 +296,6 @@ pub struct RenderArgs {
     #[command(flatten)]
     #[serde(flatten)]
     pub truth: TruthArgs,
-    /// The methods' own settings, from their descriptions (last: what is left of the keywords).
-    #[command(flatten)]
-    #[serde(flatten)]
-    pub methods: crate::method_args::MethodArgs,
 }
 
 /// Where the streamlines come from: a built-in scene (the file is the positional argument).
@@ -676,98 +658,6 @@ pub struct CameraArgs {
     pub zoom_unit: Option<f32>,
 }
 
-/// LineAO (Eichelbaum et al. 2013).
-#[derive(Args, Clone, Debug, serde::Deserialize)]
-#[command(next_help_heading = "LineAO")]
-#[serde(default)]
-pub struct LineAoArgs {
-    /// LineAO variant.
-    #[arg(long, value_parser = named::<LineAoVariant>(), default_value = "paper")]
-    pub variant: LineAoVariant,
-    /// LineAO (variant paper): hemispheres j ≥ 1 at every pixel (`full`) or at their pyramid
-    /// level's resolution, upsampled depth-aware (`level`: faster).
-    #[arg(long, value_parser = named::<LineAoOuter>(), default_value = "full")]
-    pub outer: LineAoOuter,
-    /// LineAO s_r: hemispheres and pyramid levels (1..=5) [default: the preset's; paper 3].
-    #[arg(long)]
-    pub s_r: Option<u32>,
-    /// LineAO s_h: samples on the first hemisphere (1..=256).
-    #[arg(long, default_value_t = 32, value_parser = clap::value_parser!(u32).range(1..=256))]
-    pub s_h: u32,
-    /// LineAO r0 in pixels [default: 1.5 × line width].
-    #[arg(long)]
-    pub r0: Option<f32>,
-    /// Variant `reference`: base radius in pixels at the home zoom (the authors' u_lineAORadius).
-    /// [default: the preset's; paper 2]
-    #[arg(long)]
-    pub reference_radius: Option<f32>,
-    /// LineAO δ0.
-    #[arg(long, default_value_t = 1e-4)]
-    pub delta0: f32,
-    /// LineAO: scale of the falloff δ(j) = scale · (1 − j/s_r)², in (0, 1]; below 1 occluders
-    /// far in front (in normalized depth) stop counting [default: the preset's; paper 1].
-    #[arg(long, value_parser = parse_delta_scale)]
-    #[serde(deserialize_with = "crate::kwargs::opt_delta_scale")]
-    pub delta_scale: Option<f32>,
-    /// LineAO ε: occluded iff Δd > ε.
-    #[arg(long, default_value_t = 1e-6)]
-    pub epsilon: f32,
-    /// Disable LineAO's light attenuation (g_light = 1).
-    #[arg(long)]
-    pub no_light_attenuation: bool,
-}
-
-/// Crytek SSAO.
-#[derive(Args, Clone, Debug, serde::Deserialize)]
-#[command(next_help_heading = "Crytek SSAO")]
-#[serde(default)]
-pub struct SsaoArgs {
-    /// SSAO: point samples in the sphere (8..=32) [default: 16].
-    #[arg(long)]
-    pub ssao_samples: Option<u32>,
-    /// SSAO: sphere radius in world units (mm for tractograms) [default: the preset's; paper 2].
-    #[arg(long, value_parser = parse_positive)]
-    #[serde(deserialize_with = "crate::kwargs::opt_positive")]
-    pub ssao_radius: Option<f32>,
-    /// SSAO: range check in world units [default: the radius].
-    #[arg(long, value_parser = parse_positive)]
-    #[serde(deserialize_with = "crate::kwargs::opt_positive")]
-    pub ssao_range: Option<f32>,
-    /// SSAO: the kernel's points.
-    #[arg(long, value_parser = named::<SsaoKernel>(), default_value = "crytek")]
-    pub ssao_kernel: SsaoKernel,
-}
-
-/// Volumetric Obscurance (line and area sampling).
-#[derive(Args, Clone, Debug, serde::Deserialize)]
-#[command(next_help_heading = "Volumetric Obscurance")]
-#[serde(default)]
-pub struct VoArgs {
-    /// VO line sampling: line samples (5, 7, 9, 12, 13 or 16) [default: 9].
-    #[arg(long)]
-    pub vo_samples: Option<u32>,
-    /// VO area sampling: area samples (1 or a line count) [default: 1].
-    #[arg(long)]
-    pub vo_area_samples: Option<u32>,
-    /// VO (line and area sampling): sphere radius in world units [default: the preset's; paper 2].
-    #[arg(long, value_parser = parse_positive)]
-    #[serde(deserialize_with = "crate::kwargs::opt_positive")]
-    pub vo_radius: Option<f32>,
-    /// VO: a second sphere radius in world units, combined with --radius (VO paper, Fig. 8).
-    #[arg(long, value_parser = parse_positive)]
-    #[serde(deserialize_with = "crate::kwargs::opt_positive")]
-    pub radius2: Option<f32>,
-    /// VO with two radii: how they combine.
-    #[arg(long, value_parser = named::<VoCombine>(), default_value = "product", requires = "radius2")]
-    pub combine: VoCombine,
-    /// VO: no normal clamp (the whole sphere, not the half above the surface).
-    #[arg(long)]
-    pub no_normal_clamp: bool,
-    /// VO: thickness model, world units (0 = off).
-    #[arg(long, default_value_t = 0.0)]
-    pub thickness: f32,
-}
-
 /// What every screen-space method shares: the noise, the guard band, the bilateral blur.
 #[derive(Args, Clone, Debug, serde::Deserialize)]
 #[command(next_help_heading = "Noise, guard band, blur")]
@@ -870,9 +760,6 @@ defaults_from_render_args! {
     context: ContextArgs,
     select: SelectArgs,
     camera: CameraArgs,
-    line_ao: LineAoArgs,
-    ssao: SsaoArgs,
-    vo: VoArgs,
     chain: ChainArgs,
     volume: VolumeArgs,
     truth: TruthArgs,

@@ -23,7 +23,7 @@ use std::io::BufWriter;
 use std::path::Path;
 
 use anyhow::{Context, Result};
-use lineao::method::setting::Value;
+use lineao::method::setting::{Kind, Value};
 use lineao::method::ssao::SsaoStage;
 use lineao::method::vo_area::VoArea;
 use lineao::readback::read_texture;
@@ -263,16 +263,19 @@ pub fn write(
             json!({"bilateral": {"radius_px": blur.radius_px, "depth_sigma_world": blur.depth_sigma_world}}),
         );
     }
-    // A method's described settings (`lineao::method::setting`), by their keywords.
-    let described = s.method.info().settings.iter().map(|d| {
-        let value = match (d.get)(s) {
-            Value::Number(x) => json!(x),
-            Value::Count(n) => json!(n),
-            Value::Switch(on) => json!(on),
+    // Our extension of CONTRACT.md: the method's described settings (`lineao::method::setting`)
+    // by their keywords, as `render` takes them (a switch: whether its flag is in force).
+    let flags = s.method.info().settings.iter().map(|d| {
+        let value = match ((d.get)(s), d.kind) {
+            (Value::Number(x), _) => json!(x),
+            (Value::Count(n), _) => json!(n),
+            (Value::Choice(name), _) => json!(name),
+            (Value::Switch(on), Kind::Switch { given }) => json!(on == given),
+            (Value::Switch(on), _) => json!(on),
         };
         (d.keyword(), value)
     });
-    merge(&mut params, serde_json::Value::Object(described.collect()));
+    merge(&mut params, json!({ "flags": serde_json::Map::from_iter(flags) }));
     let path = dir.join("params.json");
     let text = serde_json::to_string_pretty(&params)?;
     std::fs::write(&path, text + "\n").with_context(|| format!("cannot write {}", path.display()))?;

@@ -111,7 +111,6 @@ impl RenderArgs {
         let ranges = [
             ("width", self.image.width, 1, 8192),
             ("height", self.image.height, 1, 8192),
-            ("s_h", self.line_ao.s_h, 1, 256),
             ("volume_resolution", self.volume.volume_resolution, 8, 1024),
             ("rays", self.truth.rays, 1, 1_048_576),
         ];
@@ -215,7 +214,6 @@ optional! {
     opt_pair: [crate::args::Method; 2] = crate::args::parse_pair;
     opt_vec3: [f32; 3] = crate::args::parse_vec3;
     opt_positive: f32 = crate::args::parse_positive;
-    opt_delta_scale: f32 = crate::args::parse_delta_scale;
     opt_slices: [Option<f32>; 3] = crate::args::parse_slices;
     opt_window: [f32; 2] = crate::args::parse_window;
     opt_slab: lineao::Slab = crate::args::parse_slab;

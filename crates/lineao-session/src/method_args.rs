@@ -7,9 +7,10 @@
 //! Only what was given is kept ([`MethodArgs::given`]), and [`MethodArgs::apply`] writes it
 //! over the preset's values, as every explicit option wins over the preset.
 
+use clap::builder::TypedValueParser;
 use clap::parser::ValueSource;
 use clap::{Arg, ArgAction, ArgMatches, Command};
-use lineao::method::setting::{Kind, Setting, Value};
+use lineao::method::setting::{Kind, Role, Setting, Value};
 use lineao::{AoMethod, ChainSettings};
 
 /// The described settings given explicitly, by flag, in the order of the registry.
@@ -18,12 +19,38 @@ pub struct MethodArgs {
     pub given: Vec<(&'static str, Value)>,
 }
 
-/// Every method's described settings, in the registry's order.
+/// Every method's described settings, in the registry's order, each once (the first method
+/// that lists it: VO area lists VO line's sphere).
 pub fn described() -> impl Iterator<Item = (AoMethod, &'static Setting)> {
-    AoMethod::REGISTRY.iter().flat_map(|&m| m.info().settings.iter().map(move |s| (m, s)))
+    let mut seen = std::collections::BTreeSet::new();
+    let all = AoMethod::REGISTRY.iter().flat_map(|&m| m.info().settings.iter().map(move |s| (m, s)));
+    all.filter(move |(_, s)| seen.insert(s.flag))
 }
 
 impl MethodArgs {
+    /// Writes every given value into `settings`, after the shorthands' (`--samples` and
+    /// `--radius`: [`Role`]) where a setting's own flag is not given: `samples` to the shown
+    /// method's (`shown`), `radius` to every method's.
+    pub fn apply_with(&self, settings: &mut ChainSettings, shown: AoMethod, samples: Option<u32>, radius: Option<f32>) {
+        for (method, setting) in described() {
+            let value = match setting.role {
+                Some(Role::Samples) if method == shown => samples.map(Value::Count),
+                Some(Role::Radius) => radius.map(Value::Number),
+                _ => None,
+            };
+            if let Some(value) = value.filter(|_| !self.given.iter().any(|(flag, _)| *flag == setting.flag)) {
+                (setting.set)(settings, value);
+            }
+        }
+        self.apply(settings);
+    }
+
+    /// Gives `flag` the value `value`, as the command line would (replacing what it had).
+    pub fn give(&mut self, flag: &'static str, value: Value) {
+        self.given.retain(|(f, _)| *f != flag);
+        self.given.push((flag, value));
+    }
+
     /// Writes every given value into `settings`.
     pub fn apply(&self, settings: &mut ChainSettings) {
         for (flag, value) in &self.given {
@@ -34,12 +61,13 @@ impl MethodArgs {
     }
 
     /// The value given for a setting by Python's keyword `keyword` as the command line's text
-    /// (`true`/`false` for a switch: given or not), or an error that names the keyword.
+    /// (`true`/`false` for a switch: given or not), or what is wrong with it (which `kwargs`
+    /// says of the keyword).
     fn keyword(&mut self, keyword: &str, text: &str) -> Result<(), String> {
         let Some((_, setting)) = described().find(|(_, s)| s.keyword() == keyword) else {
             return Ok(());
         };
-        let value = setting.parse(text).map_err(|e| format!("{keyword}: {e}"))?;
+        let value = setting.parse(text)?;
         match (setting.kind, value) {
             (Kind::Switch { given }, Value::Switch(true)) => self.given.push((setting.flag, Value::Switch(given))),
             (Kind::Switch { .. }, _) => {}
@@ -49,35 +77,48 @@ impl MethodArgs {
     }
 }
 
-/// The flag of `setting` (of `method`), its id Python's keyword.
+/// The flag of `setting` (of `method`), its id Python's keyword: its help with the values it
+/// takes (`(> 0 world units)`) and its default.
 fn arg(method: AoMethod, setting: &'static Setting) -> Arg {
-    let default = setting.default_value(method);
-    let arg = Arg::new(setting.keyword()).long(setting.flag);
-    match setting.kind {
-        Kind::Switch { .. } => arg.action(ArgAction::SetTrue).help(setting.help),
-        Kind::Number { .. } | Kind::Count { .. } => {
-            let range = setting.range().unwrap_or_default();
-            let name = if setting.unit.is_empty() { "N".to_string() } else { setting.unit.to_uppercase() };
-            arg.value_name(name)
-                .help(format!("{} ({range})", setting.help))
-                .default_value(default.to_string())
-                .value_parser(move |text: &str| setting.parse(text))
-        }
+    let mut arg = Arg::new(setting.keyword()).long(setting.flag);
+    if let Some(flag) = setting.requires {
+        arg = arg.requires(flag.replace('-', "_"));
+    }
+    if let Kind::Switch { .. } = setting.kind {
+        return arg.action(ArgAction::SetTrue).help(setting.help);
+    }
+    let name = match (setting.kind, setting.unit.name()) {
+        (Kind::Choice(names), _) => names.join("|"),
+        (_, "") => "N".to_string(),
+        (_, unit) => unit.to_uppercase(),
+    };
+    let help = match setting.kind {
+        Kind::Choice(_) => setting.help.to_string(),
+        _ => match setting.range().unwrap_or_default() {
+            interval if interval.starts_with(['[', '(']) => format!("{} (in {interval})", setting.help),
+            range => format!("{} ({range})", setting.help),
+        },
+    };
+    let arg = match setting.kind {
+        // clap's own list of the names: the help and the error list them.
+        Kind::Choice(names) => arg.value_name(name).value_parser(
+            clap::builder::PossibleValuesParser::new(names.iter().copied())
+                .map(move |name| Value::Choice(names.iter().copied().find(|n| *n == name).unwrap_or_default())),
+        ),
+        _ => arg.value_name(name).value_parser(move |text: &str| setting.parse(text)),
+    };
+    match setting.default {
+        // Not one value: said, and nothing given unless the flag is.
+        Some(default) => arg.help(format!("{help} [default: {default}]")),
+        None => arg.help(help).default_value(setting.default_value(method).to_string()),
     }
 }
 
 impl clap::Args for MethodArgs {
     fn augment_args(mut command: Command) -> Command {
         let heading = command.get_next_help_heading().map(str::to_owned);
-        for &method in AoMethod::REGISTRY {
-            let info = method.info();
-            if info.settings.is_empty() {
-                continue;
-            }
-            command = command.next_help_heading(info.label);
-            for setting in info.settings {
-                command = command.arg(arg(method, setting));
-            }
+        for (method, setting) in described() {
+            command = command.next_help_heading(method.info().label).arg(arg(method, setting));
         }
         match heading {
             Some(heading) => command.next_help_heading(heading),

@@ -7,13 +7,14 @@ use std::sync::Arc;
 
 use anyhow::{Context, Result};
 use glam::Vec3;
+use lineao::method::setting::Value;
 use lineao::passes::meshes::MeshGeometry;
 use lineao::volume::density::DensityOptions;
 use lineao::volume::sweep::SweepSettings;
 use lineao::volume::{ScalarForm, Sky, VolumeAoOptions, VolumeMethod};
 use lineao::{
-    AoChain, AoMethod, BilateralSettings, ChainSettings, Gpu, LineAoSettings, LineAoVariant, LineColor, SliceSettings,
-    SliceVolume, SsaoSettings, SurfaceSettings, TubeSettings, VoSettings, VolumeAoSettings,
+    AoChain, AoMethod, BilateralSettings, ChainSettings, Gpu, LineAoVariant, LineColor, SliceSettings, SliceVolume,
+    SurfaceSettings, TubeSettings, VolumeAoSettings,
 };
 use lineao::{Bounds, Camera, Projection};
 use lineao_tracts::scenes::ViewHint;
@@ -67,51 +68,15 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky, lon
         combine: args.volume.volume_combine,
     });
     let method = method.screen;
-    // Each method's own flag, else --samples where it is the method shown, else its default.
-    let samples = |m: AoMethod, own: Option<u32>, default: u32| {
-        own.or(args.shown.samples.filter(|_| method == m)).unwrap_or(default)
-    };
-    let vo_default = VoSettings::default();
     let mut settings = ChainSettings {
         method,
         volume,
-        vo: VoSettings {
-            samples: samples(AoMethod::VoLine, args.vo.vo_samples, vo_default.samples),
-            area_samples: samples(AoMethod::VoArea, args.vo.vo_area_samples, vo_default.area_samples),
-            radius_world: vo_default.radius_world,
-            radius2_world: args.vo.radius2,
-            combine: args.vo.combine,
-            normal_clamp: !args.vo.no_normal_clamp,
-            thickness_world: args.vo.thickness,
-            noise_seed: args.chain.noise_seed,
-        },
-        ssao: SsaoSettings {
-            samples: samples(AoMethod::Ssao, args.ssao.ssao_samples, SsaoSettings::default().samples),
-            radius_world: SsaoSettings::default().radius_world,
-            range_world: SsaoSettings::default().range_world,
-            noise_seed: args.chain.noise_seed,
-            kernel: args.ssao.ssao_kernel,
-        },
         // With anatomy slices the blur is on: a method's sampling noise, hidden in the lines,
         // is grain on a smooth slice (docs/render.md).
         blur: (args.chain.bilateral || args.context.volume.is_some()).then_some(BilateralSettings {
             radius_px: args.chain.bilateral_radius,
             depth_sigma_world: args.chain.bilateral_sigma,
         }),
-        line_ao: LineAoSettings {
-            s_r: LineAoSettings::default().s_r,
-            s_h: args.line_ao.s_h,
-            r0_px: args.line_ao.r0,
-            r0_per_width: LineAoSettings::default().r0_per_width,
-            delta0: args.line_ao.delta0,
-            delta_scale: LineAoSettings::default().delta_scale,
-            epsilon: args.line_ao.epsilon,
-            light_attenuation: !args.line_ao.no_light_attenuation,
-            noise_seed: args.chain.noise_seed,
-            variant: args.line_ao.variant,
-            reference_radius_px: LineAoSettings::default().reference_radius_px,
-            outer: args.line_ao.outer,
-        },
         raytraced: crate::truth::gpu_settings(args, longest_side),
         line_width_px: args.style.line_width,
         lighting: lineao::lighting::Lighting {
@@ -144,35 +109,18 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky, lon
         cull: args.style.cull.unwrap_or(false),
         lod: args.style.lod.unwrap_or(true),
         ..ChainSettings::papers()
-    }
-    .with_preset(args.shown.preset);
+    };
+    let seed = args.chain.noise_seed;
+    (settings.line_ao.noise_seed, settings.ssao.noise_seed, settings.vo.noise_seed) = (seed, seed, seed);
+    // The described settings (LineAO's, SSAO's, …) before the preset, which depends on some of
+    // them (LineAO's variant), and again after it: what is given wins.
+    args.methods.apply(&mut settings);
+    let mut settings = settings.with_preset(args.shown.preset);
     // What the command line names explicitly wins over the preset.
     if let Some(strength) = args.shown.strength {
         settings.strength = strength;
     }
-    if let Some(s_r) = args.line_ao.s_r {
-        settings.line_ao.s_r = s_r;
-    }
-    if let Some(r0) = args.line_ao.r0 {
-        settings.line_ao.r0_px = Some(r0);
-    }
-    if let Some(scale) = args.line_ao.delta_scale {
-        settings.line_ao.delta_scale = scale;
-    }
-    if let Some(radius) = args.line_ao.reference_radius {
-        settings.line_ao.reference_radius_px = radius;
-    }
-    if let Some(radius) = args.vo.vo_radius.or(args.shown.radius) {
-        settings.vo.radius_world = radius;
-    }
-    if let Some(radius) = args.ssao.ssao_radius.or(args.shown.radius) {
-        settings.ssao.radius_world = radius;
-        settings.ssao.range_world = radius;
-    }
-    if let Some(range) = args.ssao.ssao_range {
-        settings.ssao.range_world = range;
-    }
-    args.methods.apply(&mut settings);
+    args.methods.apply_with(&mut settings, method, args.shown.samples, args.shown.radius);
     match &args.shown.settings {
         // Checked against the same types when parsed: it applies to any settings.
         Some(patch) => patch.apply(&settings).expect("--settings was checked when parsed"),
@@ -220,10 +168,10 @@ fn panels(args: &RenderArgs, zoom_unit: f32, sky: Sky, longest_side: f32) -> Vec
     let mut all: Vec<Panel> = grid_methods().into_iter().map(panel).collect();
     // The third tile: LineAO as the authors' code computes it, next to the paper's.
     let lineao = Method { screen: AoMethod::LineAo, volume: None };
-    let variant =
-        if args.line_ao.variant == LineAoVariant::Reference { LineAoVariant::Paper } else { LineAoVariant::Reference };
+    let shown = settings(args, lineao, zoom_unit, sky, longest_side).line_ao.variant;
+    let variant = if shown == LineAoVariant::Reference { LineAoVariant::Paper } else { LineAoVariant::Reference };
     let mut other = args.clone();
-    other.line_ao.variant = variant;
+    other.methods.give("variant", Value::Choice(variant.name()));
     let reference = settings(&other, lineao, zoom_unit, sky, longest_side);
     all.insert(2, Panel::new(lineao, reference));
     all

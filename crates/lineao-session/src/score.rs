@@ -75,7 +75,7 @@ pub fn method_settings(session: &Session, args: &crate::args::RenderArgs, m: Sco
     // The variant first, so that the preset gives this variant's values and explicit options
     // still win.
     let mut args = args.clone();
-    args.line_ao.variant = m.variant;
+    args.methods.give("variant", lineao::method::setting::Value::Choice(m.variant.name()));
     let mut settings = session.settings(&args, Method { screen: m.method, volume: None });
     settings.blur = None;
     settings.raytraced.denoise = None;
@@ -146,7 +146,8 @@ pub fn score(
     bundle_distance: AoDistance,
 ) -> Result<Report> {
     let (w, h) = (args.image.width as usize, args.image.height as usize);
-    let vo_ball = if args.vo.no_normal_clamp { VoBall::Whole } else { VoBall::Half };
+    let clamped = !args.methods.given.iter().any(|(flag, _)| *flag == "no-normal-clamp");
+    let vo_ball = if clamped { VoBall::Half } else { VoBall::Whole };
     let wants_vo = methods.iter().any(|m| matches!(m.method, AoMethod::VoLine | AoMethod::VoArea));
     let local = crate::truth::settings(args, session.longest_side);
     let bundle_settings = TruthSettings {

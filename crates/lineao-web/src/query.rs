@@ -175,7 +175,7 @@ mod tests {
         let described = AoMethod::from_name("toy").unwrap().info().settings;
         let values: Vec<String> = described.iter().map(|s| (s.get)(&chain).to_string()).collect();
         assert_eq!(values, ["1.5", "on"]);
-        assert!(parse("toy-radius=9").unwrap_err().contains("--toy-radius must be in 0.25..=4 zoom units, got 9"));
+        assert!(parse("toy-radius=9").unwrap_err().contains("--toy-radius must be in [0.25, 4] zoom units, got 9"));
     }
 
     #[test]

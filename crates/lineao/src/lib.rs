@@ -166,9 +166,10 @@ pub enum Error {
     #[error("invalid settings: {0}")]
     InvalidSettings(String),
     /// A method's setting outside its range ([`method::setting::Setting`]): its flag (without
-    /// the dashes), the value and the range, in its unit — what a host matches on to clamp it.
-    #[error("invalid settings: --{setting} must be in {min}..={max}{}, got {value}", if unit.is_empty() { String::new() } else { format!(" {unit}") })]
-    OutOfRange { setting: &'static str, value: f64, min: f64, max: f64, unit: &'static str },
+    /// the dashes), the value and what it takes, in its unit (`[0.25, 4] zoom units`, `> 0
+    /// world units`, `5, 7 or 9`) — what a host matches on to say which setting to change.
+    #[error("invalid settings: --{setting} must be {}{expected}, got {value}", if expected.contains("..=") || expected.ends_with(']') || expected.contains("] ") { "in " } else { "" })]
+    OutOfRange { setting: &'static str, value: String, expected: String },
     #[error("invalid line geometry: {0}")]
     InvalidGeometry(String),
     /// More than the device allows: which limit, how much was asked and the most it takes (what

@@ -11,14 +11,14 @@
 //!
 //! ```text
 //!   method/<name>/mod.rs        the passes, the Stage, `pub(crate) const METHOD: MethodInfo`
-//!   method/<name>/settings.rs   the settings and their validation
+//!   method/<name>/settings.rs   the settings, their descriptions (`setting::Setting`), presets
 //!   method/<name>/reference.rs  the CPU reference, line by line the WGSL's arithmetic
 //!   method/<name>/*.wgsl        the shaders
 //! ```
 //!
-//! Adding a method: its folder, its line in `registry!`, and — when it has settings of its
-//! own — their field in [`ChainSettings`] (the compiler asks for its default in
-//! [`ChainSettings::papers`]).
+//! Adding a method: its folder and its line in `for_each_method!` (with its settings' field of
+//! [`ChainSettings`] when it has settings of its own). Its settings' descriptions
+//! ([`MethodInfo::settings`]) give the front ends its flags, keywords, controls and URL keys.
 
 use crate::camera::FrameView;
 use crate::settings::{ChainSettings, Preset};
@@ -76,6 +76,10 @@ pub struct MethodInfo {
     /// value's range before the method's own validation runs. Empty for a method whose settings
     /// its front ends still list by hand.
     pub settings: &'static [setting::Setting],
+    /// What a panel calls after one of its controls moved a value: the others changed so that
+    /// the settings stay valid (SSAO's sphere kernel takes only its sample counts). The command
+    /// line calls nothing: what it is given is checked, not changed.
+    pub conform: fn(&mut ChainSettings),
     /// What `lineao bench` times of it, by CONTRACT.md's names.
     pub bench: &'static [BenchPass],
 }
@@ -205,6 +209,7 @@ const NONE: MethodInfo = MethodInfo {
     validate: valid_always,
     levels: one_level,
     settings: &[],
+    conform: conform_always,
     bench: &[],
 };
 
@@ -284,6 +289,9 @@ pub enum Reach {
 pub(crate) fn fits_always(_: (u32, u32), _: &wgpu::Limits) -> Result<(), crate::Error> {
     Ok(())
 }
+
+/// [`MethodInfo::conform`] of a method whose values are valid apart.
+pub(crate) fn conform_always(_: &mut ChainSettings) {}
 
 /// [`MethodInfo::validate`] of a method without settings.
 pub(crate) fn valid_always(_: &ChainSettings) -> Result<(), crate::Error> {

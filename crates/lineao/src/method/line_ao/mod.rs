@@ -86,7 +86,8 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     preset: settings::preset,
     validate: settings::validate,
     levels: |s| if s.line_ao.variant == LineAoVariant::Paper { s.line_ao.s_r } else { 1 },
-    settings: &[],
+    settings: settings::SETTINGS,
+    conform: settings::conform,
     bench: &[
         BenchPass::of("lineao", &["lineao"], |_, _| {}),
         BenchPass {

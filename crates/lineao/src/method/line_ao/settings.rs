@@ -1,8 +1,125 @@
 //! LineAO's settings: the paper's parameters (Eq. 7–15), the authors' variant, and where the
 //! outer hemispheres are evaluated.
 
+use crate::method::setting::{Kind, Setting, Unit, Value};
 use crate::named::{Named, named};
 use crate::settings::{ChainSettings, Preset};
+
+/// LineAO's settings as the front ends show them (CONTRACT.md's flags). The variant first: a
+/// preset's values depend on it.
+pub(crate) const SETTINGS: &[Setting] = &[
+    Setting {
+        flag: "variant",
+        label: "variant",
+        help: "LineAO: the paper's equations (paper) or what the authors' OpenWalnut shader does (reference)",
+        kind: Kind::Choice(&["paper", "reference"]),
+        get: |s| Value::Choice(s.line_ao.variant.name()),
+        set: |s, v| s.line_ao.variant = v.named(),
+        ..Setting::BASE
+    },
+    Setting {
+        flag: "outer",
+        label: "outer hemispheres",
+        help: "LineAO (variant paper): hemispheres j ≥ 1 at every pixel (full) or at their pyramid level's resolution, upsampled depth-aware (level: faster)",
+        kind: Kind::Choice(&["full", "level"]),
+        applies: |s| s.line_ao.variant == LineAoVariant::Paper,
+        get: |s| Value::Choice(s.line_ao.outer.name()),
+        set: |s, v| s.line_ao.outer = v.named(),
+        ..Setting::BASE
+    },
+    Setting {
+        flag: "s-r",
+        label: "s_r hemispheres",
+        help: "LineAO s_r: hemispheres and pyramid levels",
+        kind: Kind::Count { min: 1, max: crate::MAX_LEVELS },
+        default: Some("the preset's; paper 3"),
+        applies: |s| s.line_ao.variant == LineAoVariant::Paper,
+        get: |s| Value::Count(s.line_ao.s_r),
+        set: |s, v| s.line_ao.s_r = v.as_u32(),
+        ..Setting::BASE
+    },
+    Setting {
+        flag: "s-h",
+        label: "s_h samples",
+        help: "LineAO s_h: samples on the first hemisphere",
+        kind: Kind::Count { min: 1, max: 256 },
+        get: |s| Value::Count(s.line_ao.s_h),
+        set: |s, v| s.line_ao.s_h = v.as_u32(),
+        ..Setting::BASE
+    },
+    Setting {
+        flag: "r0",
+        label: "r0",
+        help: "LineAO r0, the first hemisphere's radius",
+        unit: Unit::Px,
+        kind: Kind::Above { min: 0.0, open: false, slider: [0.5, 16.0], log: false },
+        default: Some("the preset's × the line width; paper 1.5 ×"),
+        applies: |s| s.line_ao.variant == LineAoVariant::Paper,
+        get: |s| Value::Number(s.r0_px()),
+        set: |s, v| s.line_ao.r0_px = Some(v.as_f32()),
+        ..Setting::BASE
+    },
+    Setting {
+        flag: "reference-radius",
+        label: "base radius",
+        help: "LineAO (variant reference): the base radius at the home zoom (the authors' u_lineAORadius)",
+        unit: Unit::Px,
+        kind: Kind::Above { min: 0.0, open: false, slider: [0.5, 8.0], log: false },
+        default: Some("the preset's; paper 2"),
+        applies: |s| s.line_ao.variant == LineAoVariant::Reference,
+        get: |s| Value::Number(s.line_ao.reference_radius_px),
+        set: |s, v| s.line_ao.reference_radius_px = v.as_f32(),
+        ..Setting::BASE
+    },
+    Setting {
+        flag: "delta0",
+        label: "δ0",
+        help: "LineAO δ0: occluders nearer than this in normalized depth count fully; below δ scale · (1/s_r)²",
+        kind: Kind::Number { min: 0.0, max: 1.0, open: false, log: true },
+        get: |s| Value::Number(s.line_ao.delta0),
+        set: |s, v| s.line_ao.delta0 = v.as_f32(),
+        ..Setting::BASE
+    },
+    Setting {
+        flag: "delta-scale",
+        label: "δ scale",
+        help: "LineAO: scale of the falloff δ(j) = scale · (1 − j/s_r)²; below 1 occluders far in front (in normalized depth) stop counting",
+        kind: Kind::Number { min: 0.0, max: 1.0, open: true, log: true },
+        default: Some("the preset's; paper 1"),
+        get: |s| Value::Number(s.line_ao.delta_scale),
+        set: |s, v| s.line_ao.delta_scale = v.as_f32(),
+        ..Setting::BASE
+    },
+    Setting {
+        flag: "epsilon",
+        label: "ε",
+        help: "LineAO ε: occluded iff Δd > ε",
+        kind: Kind::Above { min: 0.0, open: false, slider: [1e-8, 1e-3], log: true },
+        get: |s| Value::Number(s.line_ao.epsilon),
+        set: |s, v| s.line_ao.epsilon = v.as_f32(),
+        ..Setting::BASE
+    },
+    Setting {
+        flag: "no-light-attenuation",
+        label: "light attenuation g_light",
+        help: "Disable LineAO's light attenuation (g_light = 1)",
+        kind: Kind::Switch { given: false },
+        get: |s| Value::Switch(s.line_ao.light_attenuation),
+        set: |s, v| s.line_ao.light_attenuation = v.is_on(),
+        ..Setting::BASE
+    },
+];
+
+/// What a panel's control leaves valid: δ0 below the last hemisphere's δ, the full-resolution
+/// outer hemispheres for the authors' variant.
+pub(crate) fn conform(settings: &mut ChainSettings) {
+    let ao = &mut settings.line_ao;
+    let last_delta = ao.delta_scale / (ao.s_r * ao.s_r) as f32;
+    ao.delta0 = ao.delta0.min(0.9 * last_delta);
+    if ao.variant == LineAoVariant::Reference {
+        ao.outer = LineAoOuter::Full;
+    }
+}
 
 /// Which LineAO: the paper's equations, or what the authors' own code does.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]

@@ -60,6 +60,7 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     validate: |s| s.raytraced.validate(),
     levels: super::one_level,
     settings: &[],
+    conform: super::conform_always,
     bench: &[
         // One ray per pixel each frame, continuing one picture (started by the first warm-up
         // frame, over the G-buffer).

@@ -50,7 +50,8 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     preset: settings::preset,
     validate: |s| s.ssao.validate(),
     levels: super::one_level,
-    settings: &[],
+    settings: settings::SETTINGS,
+    conform: settings::conform,
     bench: &[
         BenchPass::of("ssao-12", &["ssao"], |s, _| s.ssao.samples = 12),
         BenchPass::of("ssao-16-chain", &["ssao", "ssao-blur"], |s, _| s.ssao.samples = 16),

@@ -1,7 +1,63 @@
 //! Crytek SSAO's settings: the kernel, its radius and range check in world units.
 
+use crate::method::setting::{Kind, Role, Setting, Unit, Value};
 use crate::named::{Named, named};
 use crate::settings::{ChainSettings, Preset};
+
+/// SSAO's settings as the front ends show them (CONTRACT.md's flags).
+pub(crate) const SETTINGS: &[Setting] = &[
+    Setting {
+        flag: "ssao-kernel",
+        label: "kernel",
+        help: "SSAO: the kernel's points: Mittring's random kernel, denser near the centre (crytek), or the VO paper's generated point set (sphere)",
+        kind: Kind::Choice(&["crytek", "sphere"]),
+        get: |s| Value::Choice(s.ssao.kernel.name()),
+        set: |s, v| s.ssao.kernel = v.named(),
+        ..Setting::BASE
+    },
+    Setting {
+        flag: "ssao-samples",
+        label: "samples",
+        help: "SSAO: point samples in the sphere; the sphere kernel takes 8, 12, 16, 24 or 32",
+        kind: Kind::Count { min: 8, max: 32 },
+        role: Some(Role::Samples),
+        get: |s| Value::Count(s.ssao.samples),
+        set: |s, v| s.ssao.samples = v.as_u32(),
+        ..Setting::BASE
+    },
+    Setting {
+        flag: "ssao-radius",
+        label: "radius",
+        help: "SSAO: sphere radius (the range check's too, unless --ssao-range gives it)",
+        unit: Unit::WorldUnits,
+        kind: Kind::Above { min: 0.0, open: true, slider: [0.1, 20.0], log: true },
+        default: Some("the preset's; paper 2"),
+        role: Some(Role::Radius),
+        get: |s| Value::Number(s.ssao.radius_world),
+        set: |s, v| (s.ssao.radius_world, s.ssao.range_world) = (v.as_f32(), v.as_f32()),
+        ..Setting::BASE
+    },
+    Setting {
+        flag: "ssao-range",
+        label: "range check",
+        help: "SSAO: a sample occludes only where the surface in front of it is nearer than this",
+        unit: Unit::WorldUnits,
+        kind: Kind::Above { min: 0.0, open: true, slider: [0.1, 20.0], log: true },
+        default: Some("the radius"),
+        get: |s| Value::Number(s.ssao.range_world),
+        set: |s, v| s.ssao.range_world = v.as_f32(),
+        ..Setting::BASE
+    },
+];
+
+/// What a panel's control leaves valid: the sphere kernel's sample counts only (the nearest).
+pub(crate) fn conform(settings: &mut ChainSettings) {
+    let ssao = &mut settings.ssao;
+    if ssao.kernel == SsaoKernel::Sphere {
+        let counts = crate::sample_sets::VO_SPHERE_SAMPLE_COUNTS;
+        ssao.samples = counts.iter().copied().min_by_key(|&n| n.abs_diff(ssao.samples)).unwrap_or(16);
+    }
+}
 
 named!(SsaoKernel {
     Crytek => "Mittring's random kernel, denser near the centre",

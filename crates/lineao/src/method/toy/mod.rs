@@ -11,7 +11,7 @@ use crate::settings::ChainSettings;
 use crate::targets::{AO_FORMAT, FrameTargets};
 use crate::timing::Span;
 
-use super::setting::{Kind, Setting, Value};
+use super::setting::{Kind, Setting, Unit, Value};
 
 /// The toy's settings: the `toy` field of [`ChainSettings`] (its registry line's).
 #[derive(Clone, Debug, PartialEq)]
@@ -52,19 +52,20 @@ const SETTINGS: &[Setting] = &[
         flag: "toy-radius",
         label: "radius",
         help: "Toy: a quarter of occlusion per zoom unit",
-        unit: "zoom units",
-        kind: Kind::Number { min: 0.25, max: 4.0, log: true },
+        unit: Unit::ZoomUnits,
+        kind: Kind::Number { min: 0.25, max: 4.0, open: false, log: true },
         get: |s| Value::Number(s.toy.radius_zoom),
         set: |s, v| s.toy.radius_zoom = v.as_f32(),
+        ..Setting::BASE
     },
     Setting {
         flag: "toy-invert",
         label: "invert",
         help: "Toy: one minus that occlusion",
-        unit: "",
         kind: Kind::Switch { given: true },
         get: |s| Value::Switch(s.toy.invert),
         set: |s, v| s.toy.invert = v.is_on(),
+        ..Setting::BASE
     },
 ];
 
@@ -84,6 +85,7 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     validate: super::valid_always,
     levels: super::one_level,
     settings: SETTINGS,
+    conform: super::conform_always,
     bench: &[super::BenchPass::of("toy", &["toy"], |_, _| {})],
 };
 
@@ -172,10 +174,10 @@ mod tests {
         settings.toy.radius_zoom = 5.0;
         let refused = settings.validate().unwrap_err();
         assert!(
-            matches!(refused, crate::Error::OutOfRange { setting: "toy-radius", value: 5.0, min: 0.25, max: 4.0, .. }),
+            matches!(&refused, crate::Error::OutOfRange { setting: "toy-radius", value, .. } if value == "5"),
             "{refused:?}"
         );
-        assert_eq!(refused.to_string(), "invalid settings: --toy-radius must be in 0.25..=4 zoom units, got 5");
+        assert_eq!(refused.to_string(), "invalid settings: --toy-radius must be in [0.25, 4] zoom units, got 5");
         settings.toy = super::ToySettings { radius_zoom: 1.5, invert: true };
 
         let gpu = Gpu::headless().unwrap();

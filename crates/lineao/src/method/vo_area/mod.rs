@@ -47,7 +47,8 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     preset: |preset, settings| crate::method::vo_line::preset(preset, settings, 1.0, 1.0),
     validate: |s| s.vo.validate(),
     levels: super::one_level,
-    settings: &[],
+    settings: crate::method::vo_line::settings::AREA_SETTINGS,
+    conform: super::conform_always,
     bench: &[super::BenchPass::of("vo-area-1", &["moments", "vo-area"], |s, _| s.vo.area_samples = 1)],
 };
 use crate::targets::FrameTargets;

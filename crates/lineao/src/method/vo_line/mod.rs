@@ -55,7 +55,8 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     preset: |preset, settings| settings::preset(preset, settings, 2.0, 1.5),
     validate: |s| s.vo.validate(),
     levels: super::one_level,
-    settings: &[],
+    settings: settings::SETTINGS,
+    conform: super::conform_always,
     bench: &[super::BenchPass::of("vo-line-5", &["vo-line"], |s, _| s.vo.samples = 5)],
 };
 use crate::method::vo_area::moments::Moments;
