@@ -25,26 +25,49 @@ const FORMAT_NEEDS: [(wgpu::TextureFormat, wgpu::TextureUsages); 4] = {
     ]
 };
 
-/// Whether `adapter` can run lineao's passes; the error lists everything it lacks.
-pub fn check_adapter(adapter: &wgpu::Adapter) -> Result<(), Error> {
-    let mut missing = Vec::new();
-    if !adapter.get_downlevel_capabilities().flags.contains(wgpu::DownlevelFlags::COMPUTE_SHADERS) {
-        missing.push("compute shaders".to_string());
-    }
-    for (format, usages) in FORMAT_NEEDS {
-        let lacking = usages - adapter.get_texture_format_features(format).allowed_usages;
-        if !lacking.is_empty() {
-            missing.push(format!("{format:?} for {lacking:?}"));
+/// What an adapter lacks that lineao's passes need ([`check_adapter`],
+/// [`Error::AdapterLacks`]).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Lacking {
+    /// Compute shaders (WebGL2's downlevel adapters).
+    ComputeShaders,
+    /// A G-buffer format without these usages.
+    Format { format: wgpu::TextureFormat, usages: wgpu::TextureUsages },
+    /// Fewer color attachments than the G-buffer's four.
+    ColorAttachments { has: u32 },
+}
+
+impl std::fmt::Display for Lacking {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Lacking::ComputeShaders => f.write_str("compute shaders"),
+            Lacking::Format { format, usages } => write!(f, "{format:?} for {usages:?}"),
+            Lacking::ColorAttachments { has } => write!(f, "4 color attachments (has {has})"),
         }
     }
-    if adapter.limits().max_color_attachments < 4 {
-        missing.push(format!("4 color attachments (has {})", adapter.limits().max_color_attachments));
+}
+
+/// Whether `adapter` can run lineao's passes; the error lists everything it lacks.
+pub fn check_adapter(adapter: &wgpu::Adapter) -> Result<(), Error> {
+    let mut lacking = Vec::new();
+    if !adapter.get_downlevel_capabilities().flags.contains(wgpu::DownlevelFlags::COMPUTE_SHADERS) {
+        lacking.push(Lacking::ComputeShaders);
     }
-    if missing.is_empty() {
+    for (format, usages) in FORMAT_NEEDS {
+        let usages = usages - adapter.get_texture_format_features(format).allowed_usages;
+        if !usages.is_empty() {
+            lacking.push(Lacking::Format { format, usages });
+        }
+    }
+    let has = adapter.limits().max_color_attachments;
+    if has < 4 {
+        lacking.push(Lacking::ColorAttachments { has });
+    }
+    if lacking.is_empty() {
         return Ok(());
     }
     let info = adapter.get_info();
-    Err(Error::Unsupported(format!("{} ({:?}) lacks {}", info.name, info.backend, missing.join(", "))))
+    Err(Error::AdapterLacks { adapter: format!("{} ({:?})", info.name, info.backend), lacking })
 }
 
 /// Runs `create` inside a validation error scope of `device`: what wgpu would report to its
@@ -171,5 +194,27 @@ pub(crate) fn allocating<T>(
     {
         let _ = (device, what, size);
         Ok(create())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn what_an_adapter_lacks_is_listed_by_name() {
+        let error = Error::AdapterLacks {
+            adapter: "WebGL2 (Gl)".into(),
+            lacking: vec![
+                Lacking::ComputeShaders,
+                Lacking::Format { format: wgpu::TextureFormat::R32Float, usages: wgpu::TextureUsages::STORAGE_BINDING },
+                Lacking::ColorAttachments { has: 2 },
+            ],
+        };
+        assert_eq!(
+            error.to_string(),
+            "the GPU cannot run lineao: WebGL2 (Gl) lacks compute shaders, R32Float for TextureUsages(STORAGE_BINDING), \
+             4 color attachments (has 2)"
+        );
     }
 }

@@ -109,7 +109,7 @@ pub use wgpu;
 pub use camera::{Bounds, Camera, FrameView, Projection};
 pub use chain::{AoChain, HostAo, OverlayAo};
 pub use colormap::{COLORMAP_ENTRIES, Colormap};
-pub use gpu::{Gpu, check_adapter};
+pub use gpu::{Gpu, Lacking, check_adapter};
 pub use line_geometry::LineGeometry;
 pub use method::AoMethod;
 pub use method::line_ao::settings::{LineAoOuter, LineAoSettings, LineAoVariant, R0};
@@ -178,6 +178,11 @@ pub enum Error {
     TooLarge { limit: Limit, value: u64, max: u64, message: String },
     #[error("GPU operation failed: {0}")]
     Gpu(String),
+    /// An adapter without what lineao's passes need ([`check_adapter`]): its name and backend,
+    /// and each thing it lacks — what a host matches on to fall back or say which.
+    #[error("the GPU cannot run lineao: {adapter} lacks {}", lacking.iter().map(|l| l.to_string()).collect::<Vec<_>>().join(", "))]
+    AdapterLacks { adapter: String, lacking: Vec<Lacking> },
+    /// What the device refused to make (a validation error wgpu would panic with).
     #[error("the GPU cannot run lineao: {0}")]
     Unsupported(String),
     #[error("stopped before it finished")]

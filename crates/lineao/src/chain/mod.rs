@@ -95,8 +95,8 @@ pub struct AoChain {
 
 impl AoChain {
     /// A chain that composites into targets of `format`. A device that cannot run the passes
-    /// (see [`crate::gpu::check_adapter`]) or a `format` that cannot be rendered to is an
-    /// [`Error::Unsupported`], not wgpu's panic.
+    /// (whose adapter [`crate::gpu::check_adapter`] refuses) or a `format` that cannot be
+    /// rendered to is an [`Error::Unsupported`], not wgpu's panic.
     ///
     /// Blocks on wgpu's validation answer, which native wgpu gives at once; a host that must
     /// never block (the web, an async runtime) awaits [`AoChain::new_async`].
