@@ -170,6 +170,82 @@ pub(crate) fn check_layout(file: &str, wgsl: &str, size: usize, fields: &[(&str,
     assert_eq!(size, span as usize, "{wgsl} in {file}: size, Rust then WGSL");
 }
 
+/// In a test: asserts that a vertex buffer of `$rust` with `$attributes` (the pipeline's
+/// `VertexBufferLayout`, stride the struct's size) is what the WGSL vertex input `$wgsl` of the
+/// composed shader `$file` reads: attribute k at field k's offset and as wide as it, and each
+/// attribute's location a member of the WGSL struct holding as many floats as its format.
+/// List the fields in location order.
+#[cfg(test)]
+macro_rules! assert_vertex_layout {
+    ($rust:ty, $file:literal, $wgsl:literal, $attributes:expr, [$($field:ident),+ $(,)?]) => {{
+        fn width<T, F>(_: fn(&T) -> &F) -> usize {
+            std::mem::size_of::<F>()
+        }
+        $crate::shader::check_vertex_layout(
+            $file,
+            $wgsl,
+            std::mem::size_of::<$rust>(),
+            &$attributes,
+            &[$((std::mem::offset_of!($rust, $field), width(|v: &$rust| &v.$field))),+],
+        )
+    }};
+}
+#[cfg(test)]
+pub(crate) use assert_vertex_layout;
+
+/// [`assert_vertex_layout`]'s check: `fields` (offset, size) against `attributes`, and those
+/// against the locations of `wgsl` in the composed `file`.
+#[cfg(test)]
+pub(crate) fn check_vertex_layout(
+    file: &str,
+    wgsl: &str,
+    size: usize,
+    attributes: &[wgpu::VertexAttribute],
+    fields: &[(usize, usize)],
+) {
+    let floats = |format: wgpu::VertexFormat| match format {
+        wgpu::VertexFormat::Float32 => 1,
+        wgpu::VertexFormat::Float32x2 => 2,
+        wgpu::VertexFormat::Float32x3 => 3,
+        wgpu::VertexFormat::Float32x4 | wgpu::VertexFormat::Snorm16x4 | wgpu::VertexFormat::Unorm8x4 => 4,
+        other => panic!("{other:?}: add its float count"),
+    };
+    let rust: Vec<(u64, u64)> = fields.iter().map(|&(offset, width)| (offset as u64, width as u64)).collect();
+    let declared: Vec<(u64, u64)> = attributes.iter().map(|a| (a.offset, a.format.size())).collect();
+    assert_eq!(declared, rust, "{wgsl}'s attributes (offset, size), then the Rust fields'");
+    let end = attributes.iter().map(|a| a.offset + a.format.size()).max().unwrap_or(0);
+    assert!(end as usize <= size, "{wgsl}: the attributes end at {end}, past the struct's {size} bytes");
+    let source = compose(file);
+    let module =
+        naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| panic!("{file}: {}", e.emit_to_string(&source)));
+    let members = module
+        .types
+        .iter()
+        .find_map(|(_, ty)| match (&ty.name, &ty.inner) {
+            (Some(name), naga::TypeInner::Struct { members, .. }) if name == wgsl => Some(members.clone()),
+            _ => None,
+        })
+        .unwrap_or_else(|| panic!("no struct {wgsl} in {file}"));
+    let read: Vec<(u32, u32)> = members
+        .iter()
+        .filter_map(|m| match (&m.binding, &module.types[m.ty].inner) {
+            (Some(naga::Binding::Location { location, .. }), naga::TypeInner::Vector { size, scalar })
+                if scalar.kind == naga::ScalarKind::Float =>
+            {
+                Some((*location, *size as u32))
+            }
+            (Some(naga::Binding::Location { location, .. }), naga::TypeInner::Scalar(scalar))
+                if scalar.kind == naga::ScalarKind::Float =>
+            {
+                Some((*location, 1))
+            }
+            _ => None,
+        })
+        .collect();
+    let given: Vec<(u32, u32)> = attributes.iter().map(|a| (a.shader_location, floats(a.format))).collect();
+    assert_eq!(given, read, "{wgsl} in {file}: (location, floats) given, then read");
+}
+
 #[cfg(test)]
 mod tests {
     /// The check fails on a reordered field: a Rust struct whose first two fields are swapped
@@ -183,5 +259,18 @@ mod tests {
             scale: [[f32; 4]; 5],
         }
         assert_wgsl_layout!(Swapped, "shared/nd.wgsl", "Levels", [size, scale]);
+    }
+
+    /// The vertex check fails on an attribute at another field's offset.
+    #[test]
+    #[should_panic(expected = "attributes (offset, size)")]
+    fn a_vertex_attribute_at_the_wrong_offset_fails() {
+        #[repr(C)]
+        struct Vertex {
+            normal: [f32; 3],
+            position: [f32; 3],
+        }
+        let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3];
+        assert_vertex_layout!(Vertex, "meshes.wgsl", "MeshVertex", attributes, [position, normal]);
     }
 }

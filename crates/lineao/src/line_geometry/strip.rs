@@ -28,6 +28,8 @@ struct StripVertex {
 }
 
 const VERTEX_SIZE: u64 = std::mem::size_of::<StripVertex>() as u64;
+/// [`StripVertex`] as the pipeline reads it.
+const ATTRIBUTES: [wgpu::VertexAttribute; 2] = wgpu::vertex_attr_array![0 => Float32x3, 1 => Snorm16x4];
 /// τ over the bounding radius: a view that shows the whole bounding sphere across 2 000 px
 /// covers about 2 000 / (2 radius) px per world unit, so τ is about 0.12 px there.
 const TOLERANCE_PER_RADIUS: f32 = 1.0 / 8192.0;
@@ -141,11 +143,10 @@ impl StripRenderer {
     pub fn new(device: &wgpu::Device, full: bool) -> StripRenderer {
         let bindings = GeometryBindings::new(device, "lineao::StripRenderer::bindings");
         let module = crate::shader::module(device, "strip.wgsl");
-        let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Snorm16x4];
         let buffers = [Some(wgpu::VertexBufferLayout {
             array_stride: VERTEX_SIZE,
             step_mode: wgpu::VertexStepMode::Vertex,
-            attributes: &attributes,
+            attributes: &ATTRIBUTES,
         })];
         let pipeline = gbuffer::pipeline(
             device,
@@ -195,4 +196,10 @@ impl StripRenderer {
             pass.draw(0..geometry.count, 0..1);
         }
     }
+}
+
+#[cfg(test)]
+#[test]
+fn the_strip_vertex_is_what_strip_wgsl_reads() {
+    crate::shader::assert_vertex_layout!(StripVertex, "strip.wgsl", "StripVertex", ATTRIBUTES, [position, tangent]);
 }

@@ -19,6 +19,9 @@ pub struct MeshVertex {
     pub normal: [f32; 3],
 }
 
+/// [`MeshVertex`] as the pipeline reads it.
+const ATTRIBUTES: [wgpu::VertexAttribute; 2] = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3];
+
 /// An indexed triangle mesh on the GPU.
 pub struct MeshGeometry {
     vertices: wgpu::Buffer,
@@ -92,11 +95,10 @@ impl MeshRenderer {
     pub fn new(device: &wgpu::Device, octants: bool) -> MeshRenderer {
         let bindings = GeometryBindings::new(device, "lineao::MeshRenderer::bindings");
         let module = crate::shader::module(device, "meshes.wgsl");
-        let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3];
         let buffers = [Some(wgpu::VertexBufferLayout {
             array_stride: std::mem::size_of::<MeshVertex>() as u64,
             step_mode: wgpu::VertexStepMode::Vertex,
-            attributes: &attributes,
+            attributes: &ATTRIBUTES,
         })];
         let pipeline = gbuffer::pipeline(
             device,
@@ -146,4 +148,10 @@ impl MeshRenderer {
             pass.draw_indexed(0..mesh.count, 0, 0..1);
         }
     }
+}
+
+#[cfg(test)]
+#[test]
+fn the_mesh_vertex_is_what_meshes_wgsl_reads() {
+    crate::shader::assert_vertex_layout!(MeshVertex, "meshes.wgsl", "MeshVertex", ATTRIBUTES, [position, normal]);
 }
