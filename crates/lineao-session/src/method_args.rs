@@ -4,8 +4,10 @@
 //! the same name as a key of the web page's URL (its query is the viewer's command line), and
 //! with `_` as a keyword argument of Python's `render` (serde, [`crate::kwargs`]).
 //!
-//! Only what was given is kept ([`MethodArgs::given`]), and [`MethodArgs::apply`] writes it
-//! over the preset's values, as every explicit option wins over the preset.
+//! Only what was given is kept ([`MethodArgs::given`]). `render` writes it twice
+//! ([`MethodArgs::apply`]): before the preset, which depends on some of it (LineAO's variant),
+//! and after it with the shorthands ([`MethodArgs::apply_with`]), so that every explicit option
+//! wins over the preset.
 
 use clap::builder::TypedValueParser;
 use clap::parser::ValueSource;
