@@ -30,7 +30,7 @@ pub enum Command {
     /// Time every pass on a built-in scene (CONTRACT.md `lineao bench --json`).
     Bench(BenchArgs),
     /// Open a window: orbit a tractogram and compare LineAO with the other methods side by side.
-    View(ViewArgs),
+    View(Box<ViewArgs>),
     /// Score AO methods against the ray-traced truth on one G-buffer (table, --json, -o grid).
     Score(Box<ScoreArgs>),
 }
@@ -119,6 +119,9 @@ pub struct ViewArgs {
     /// The methods' own settings, from their descriptions (as `render`'s).
     #[command(flatten)]
     pub methods: lineao_session::method_args::MethodArgs,
+    /// The streamlines shown (as `render`'s; the side panel changes them).
+    #[command(flatten)]
+    pub select: SelectArgs,
 }
 
 fn parse_orbit(s: &str) -> Result<[f32; 3], String> {

@@ -26,7 +26,7 @@ use egui_file_dialog::FileDialog;
 use lineao_tracts::SceneKind;
 
 use super::camera::OrbitCamera;
-use super::controls::{ColorMode, Controls, method_label};
+use super::controls::{ColorMode, Controls, RegionRule, method_label};
 use super::worker::{self, Dataset, Frame, FromWorker, Output, PREVIEW_VERTICES, Source, ToWorker, View, Worker};
 
 /// How long after the last camera motion frames stay previews.
@@ -398,6 +398,7 @@ impl App {
                     self.controls.set_zoom_unit(dataset.hint.zoom_unit);
                     let distance = glam::Vec3::from(dataset.hint.eye).distance(glam::Vec3::from(dataset.hint.target));
                     self.controls.slab_reach = 0.5 * distance;
+                    self.controls.region_home = (dataset.hint.target, 0.1 * distance);
                     self.controls.max_length = dataset.max_length;
                     self.controls.set_groups(&dataset.groups, dataset.complete);
                     self.controls.set_streamline_fields(&dataset.streamline_fields);
@@ -581,6 +582,10 @@ impl App {
                     let (w, h) = frame.size;
                     let what = if frame.images.is_empty() { "recorded" } else { "render and read back" };
                     ui.label(format!("{w} × {h} px · {:.0} ms ({what})", frame.render_ms));
+                    if let Some((kept, all)) = frame.selected {
+                        ui.separator();
+                        ui.label(format!("{kept} of {all} streamlines selected"));
+                    }
                     for status in frame.rays.iter().flatten() {
                         ui.separator();
                         if !status.progress.converged() {
@@ -665,6 +670,7 @@ impl App {
                     badge(&painter, Pos2::new(x, rect.bottom() - 8.0), align, &text);
                 }
             }
+            regions_overlay(&painter, rect, &frame.view.camera, &self.controls.regions);
             if frame.view.preview {
                 badge(
                     &painter,
@@ -888,6 +894,48 @@ pub fn ray_status(status: &worker::RayStatus) -> String {
 }
 
 /// Monospace text on a dark rounded box, `align`ed at `anchor`.
+/// The selection's regions outlined over the picture seen by `camera` in `rect`: spheres as
+/// circles, boxes as their edges; include regions green, exclude red.
+fn regions_overlay(painter: &egui::Painter, rect: Rect, camera: &lineao::Camera, regions: &[RegionRule]) {
+    let view = camera.view_matrix();
+    let half = 0.5 * rect.height();
+    // Pixels per world unit at view depth z (< 0), as the frame's projection has them.
+    let scale = |z: f32| match camera.projection {
+        lineao::Projection::Perspective { fov_y_deg } => half / ((0.5 * fov_y_deg).to_radians().tan() * -z),
+        lineao::Projection::Orthographic { height } => half / (0.5 * height),
+    };
+    let project = |p: glam::Vec3| {
+        let v = view.transform_point3(p);
+        (v.z < -1e-6 * camera.eye.distance(camera.target)).then(|| rect.center() + scale(v.z) * egui::vec2(v.x, -v.y))
+    };
+    for rule in regions {
+        let color = if rule.include { Color32::from_rgb(40, 170, 60) } else { Color32::from_rgb(210, 50, 40) };
+        let stroke = egui::Stroke::new(2.0, color);
+        match rule.region {
+            lineao_tracts::Region::Sphere { center, radius } => {
+                let center = glam::Vec3::from(center);
+                if let Some(at) = project(center) {
+                    let z = view.transform_point3(center).z;
+                    painter.circle_stroke(at, radius * scale(z), stroke);
+                }
+            }
+            lineao_tracts::Region::Box { min, max } => {
+                let corner =
+                    |i: usize| glam::Vec3::from(std::array::from_fn(|a| if i >> a & 1 == 1 { max[a] } else { min[a] }));
+                for i in 0..8 {
+                    for bit in [1, 2, 4] {
+                        if i & bit == 0
+                            && let (Some(a), Some(b)) = (project(corner(i)), project(corner(i | bit)))
+                        {
+                            painter.line_segment([a, b], stroke);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
 fn badge(painter: &egui::Painter, anchor: Pos2, align: Align2, text: &str) {
     let galley = painter.layout_no_wrap(text.to_string(), FontId::monospace(12.0), Color32::WHITE);
     let rect = align.anchor_size(anchor, galley.size() + Vec2::new(12.0, 8.0));

@@ -159,6 +159,26 @@ pub struct Controls {
     pub streamline_fields: Vec<(String, [f32; 2])>,
     /// The per-streamline field and the range of it shown, or every value.
     pub field: Option<(String, [f32; 2])>,
+    /// The seed of [`Controls::subset`] (`--subset-seed`).
+    pub subset_seed: u64,
+    /// Include and exclude regions (mrview's rule), in world units.
+    pub regions: Vec<RegionRule>,
+    /// `--group`: the groups shown once a dataset's groups are known (none named: all).
+    pub shown_groups: Vec<String>,
+    /// Where a new region goes and how large it starts: the dataset's centre and a tenth of its
+    /// viewing distance.
+    pub region_home: ([f32; 3], f32),
+    /// The methods' settings the command line gave (`view --ssao-samples 8`): kept over the
+    /// preset's values when a dataset sets the zoom unit.
+    pub given: lineao_session::method_args::MethodArgs,
+}
+
+/// An include or exclude region of the selection.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RegionRule {
+    /// A kept streamline passes through every include region and through no exclude region.
+    pub include: bool,
+    pub region: lineao_tracts::Region,
 }
 
 impl Controls {
@@ -187,21 +207,43 @@ impl Controls {
             groups: Vec::new(),
             streamline_fields: Vec::new(),
             field: None,
+            subset_seed: 0,
+            regions: Vec::new(),
+            shown_groups: Vec::new(),
+            region_home: ([0.0; 3], 10.0),
+            given: Default::default(),
         }
     }
 
-    /// The streamlines shown: [`Controls::subset`] and [`Controls::length`].
+    /// The selection `render`'s flags ask for (`view --subset`, `--include`, …).
+    pub fn set_selection(&mut self, select: &crate::cli::SelectArgs) {
+        if let Some(share) = select.subset {
+            self.subset = share as f32;
+        }
+        (self.subset_seed, self.length, self.field) = (select.subset_seed, select.length, select.field.clone());
+        self.shown_groups = select.groups.clone();
+        let rule = |include| move |&region| RegionRule { include, region };
+        self.regions = select.include.iter().map(rule(true)).chain(select.exclude.iter().map(rule(false))).collect();
+    }
+
+    /// The streamlines shown: [`Controls::subset`], [`Controls::length`], the field's range, the
+    /// groups and the regions.
     pub fn selection(&self) -> lineao_tracts::Selection {
         // Every group shown: no rule. None shown: no streamline (an empty list would be all).
         let all = self.groups.iter().all(|(_, on)| *on);
         let none = !self.groups.is_empty() && self.groups.iter().all(|(_, on)| !on);
         let groups = if all { Vec::new() } else { self.groups.iter().filter(|g| g.1).map(|g| g.0.clone()).collect() };
         lineao_tracts::Selection {
-            subset: if none { Some((0.0, 0)) } else { (self.subset < 1.0).then_some((self.subset as f64, 0)) },
+            subset: if none {
+                Some((0.0, 0))
+            } else {
+                (self.subset < 1.0).then_some((self.subset as f64, self.subset_seed))
+            },
             length: self.length,
             field: self.field.clone(),
             groups,
-            ..Default::default()
+            include: self.regions.iter().filter(|r| r.include).map(|r| r.region).collect(),
+            exclude: self.regions.iter().filter(|r| !r.include).map(|r| r.region).collect(),
         }
     }
 
@@ -217,7 +259,8 @@ impl Controls {
     /// group only where it has some.
     pub fn set_groups(&mut self, groups: &[String], complete: bool) {
         if self.groups.iter().map(|(name, _)| name).ne(groups) {
-            self.groups = groups.iter().map(|name| (name.clone(), true)).collect();
+            let shown = |name: &String| self.shown_groups.is_empty() || self.shown_groups.contains(name);
+            self.groups = groups.iter().map(|name| (name.clone(), shown(name))).collect();
         }
         if self.color == ColorMode::Groups && groups.is_empty() && complete {
             self.color = ColorMode::Tangent;
@@ -257,6 +300,54 @@ impl Controls {
         }
         let r = &mut self.params.chain.raytraced;
         (r.rays_per_frame, r.max_rays, r.denoise) = (rays.rays_per_frame, rays.max_rays, rays.denoise);
+        self.given.apply(&mut self.params.chain);
+    }
+
+    /// What a link keeps of the controls, as `lineao view`'s options (flag without dashes,
+    /// value; empty for a switch): the shown methods' described settings that differ from the
+    /// preset's, and the selection's rules.
+    pub fn link_flags(&self) -> Vec<(String, String)> {
+        let mut flags = Vec::new();
+        // The preset's values with the flags so far written in, as the page will open them (a
+        // setting may set another: SSAO's radius its range check).
+        let mut opened = Params::preset(self.preset, self.params.chain.zoom_unit).chain;
+        let shown = if self.compare { &self.methods[..] } else { &self.methods[..1] };
+        for (method, setting) in lineao_session::method_args::described() {
+            let chain = &self.params.chain;
+            let value = (setting.get)(chain);
+            if shown.iter().any(|m| m.screen == method) && (setting.applies)(chain) && value != (setting.get)(&opened) {
+                let text = if matches!(setting.kind, Kind::Switch { .. }) { String::new() } else { value.to_string() };
+                flags.push((setting.flag.to_string(), text));
+                (setting.set)(&mut opened, value);
+            }
+        }
+        let selection = self.selection();
+        let pair = |[a, b]: [f32; 2]| format!("{a},{b}");
+        if let Some((share, seed)) = selection.subset {
+            flags.push(("subset".into(), share.to_string()));
+            if seed != 0 {
+                flags.push(("subset-seed".into(), seed.to_string()));
+            }
+        }
+        if let Some(range) = selection.length {
+            flags.push(("length".into(), pair(range)));
+        }
+        if let Some((name, range)) = &selection.field {
+            flags.push(("field".into(), format!("{name},{}", pair(*range))));
+        }
+        flags.extend(selection.groups.iter().map(|g| ("group".to_string(), g.clone())));
+        for rule in &self.regions {
+            let key = if rule.include { "include" } else { "exclude" };
+            let numbers = |values: &[f32]| values.iter().map(f32::to_string).collect::<Vec<_>>().join(",");
+            let text = match rule.region {
+                lineao_tracts::Region::Sphere { center, radius } => {
+                    format!("sphere:{}", numbers(&[center[0], center[1], center[2], radius]))
+                }
+                lineao_tracts::Region::Box { min, max } => format!("box:{}", numbers(&[min, max].concat())),
+            };
+            flags.push((key.to_string(), text));
+        }
+        flags
     }
 
     /// The panels to render: one, or two in compare mode. `up` is the camera's (a cloudy sky
@@ -465,6 +556,63 @@ impl Controls {
             [lo, hi.max(lo)]
         });
         self.field_ui(ui);
+        self.regions_ui(ui);
+    }
+
+    /// Include and exclude regions: each a sphere or a box placed in world units, a button to
+    /// add one at the data's centre, one to remove each (outlined over the picture).
+    fn regions_ui(&mut self, ui: &mut Ui) {
+        let (home, size) = self.region_home;
+        ui.horizontal(|ui| {
+            ui.label("regions").on_hover_text(
+                "a streamline is kept when it passes through every include region and no exclude region (mrview's rule)",
+            );
+            if ui.button("+ sphere").clicked() {
+                let region = lineao_tracts::Region::Sphere { center: home, radius: size };
+                self.regions.push(RegionRule { include: true, region });
+            }
+            if ui.button("+ box").clicked() {
+                let (min, max) = (home.map(|c| c - size), home.map(|c| c + size));
+                self.regions.push(RegionRule { include: true, region: lineao_tracts::Region::Box { min, max } });
+            }
+        });
+        let step = f64::from(0.01 * size);
+        let mut removed = None;
+        for (i, rule) in self.regions.iter_mut().enumerate() {
+            ui.push_id(("region", i), |ui| {
+                ui.horizontal(|ui| {
+                    ui.selectable_value(&mut rule.include, true, "include");
+                    ui.selectable_value(&mut rule.include, false, "exclude");
+                    if ui.small_button("remove").clicked() {
+                        removed = Some(i);
+                    }
+                });
+                let xyz = |ui: &mut Ui, label: &str, p: &mut [f32; 3]| {
+                    ui.horizontal(|ui| {
+                        ui.label(label);
+                        for c in p.iter_mut() {
+                            ui.add(egui::DragValue::new(c).speed(step).max_decimals(1));
+                        }
+                    });
+                };
+                match &mut rule.region {
+                    lineao_tracts::Region::Sphere { center, radius } => {
+                        xyz(ui, "centre", center);
+                        ui.add(egui::Slider::new(radius, 0.01 * size..=10.0 * size).logarithmic(true).text("radius"));
+                    }
+                    lineao_tracts::Region::Box { min, max } => {
+                        xyz(ui, "from", min);
+                        xyz(ui, "to", max);
+                        for axis in 0..3 {
+                            max[axis] = max[axis].max(min[axis]);
+                        }
+                    }
+                }
+            });
+        }
+        if let Some(i) = removed {
+            self.regions.remove(i);
+        }
     }
 
     /// A range of a per-streamline field (.trk properties, TRX dps): the streamlines within it.
@@ -728,6 +876,20 @@ fn volume_ui(ui: &mut Ui, p: &mut Params) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_command_lines_settings_outlast_a_datasets_zoom_unit() {
+        // `view --ssao-samples 8 --ssao-radius 7`: the panel shows them once a file has set the
+        // zoom unit (which takes the preset's values in it).
+        let ssao = methods().into_iter().find(|m| m.screen == AoMethod::Ssao).unwrap();
+        let mut controls = Controls::new([ssao, ssao], false, Preset::Legible);
+        controls.given.give("ssao-samples", Value::Count(8));
+        controls.given.give("ssao-radius", Value::Number(7.0));
+        controls.given.apply(&mut controls.params.chain);
+        controls.set_zoom_unit(2.0);
+        let ssao = &controls.params.chain.ssao;
+        assert_eq!((ssao.samples, ssao.radius_world, controls.params.chain.zoom_unit), (8, 7.0, 2.0));
+    }
 
     #[test]
     fn every_preset_and_method_gives_valid_settings() {

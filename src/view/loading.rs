@@ -19,7 +19,7 @@ use lineao::{Gpu, LineGeometry};
 use lineao_tracts::{ChunkDecoder, SceneKind, Tractogram};
 use web_time::Instant;
 
-use super::worker::{PREVIEW_VERTICES, Source};
+use super::worker::{PREVIEW_VERTICES, Selected, Source};
 use crate::source::{CHUNK_VERTICES, Keep, Lines, Sampled, SourceError};
 
 /// How long a step reads and uploads before it lets the worker draw and listen, at least; a
@@ -100,7 +100,7 @@ pub struct Opening {
     /// Never built while the data arrives (the ray tracer waits for all of it).
     rays: Option<Arc<lineao::RayScene>>,
     /// The selection on the GPU so far (`worker::SceneRef::selected`).
-    selected: Option<(lineao_tracts::Selection, usize)>,
+    selected: Option<Selected>,
     /// The file's groups, once it is read.
     groups: Vec<lineao_tracts::Group>,
     pub started: Instant,

@@ -78,6 +78,8 @@ pub fn options(args: &ViewArgs) -> app::Options {
     controls.params.chain.cull = args.cull;
     controls.params.chain.lod = args.lod;
     args.methods.apply(&mut controls.params.chain);
+    controls.given = args.methods.clone();
+    controls.set_selection(&args.select);
     if let Some(slab) = args.slab {
         (controls.slab, controls.params.chain.slab) = (slab, Some(slab));
     }

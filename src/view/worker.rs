@@ -124,6 +124,17 @@ pub struct Frame {
     /// Per panel: how far its ray-traced picture is (`None`: another method).
     pub rays: Vec<Option<RayStatus>>,
     pub render_ms: f64,
+    /// The streamlines selected and all of them, where a rule leaves some out.
+    pub selected: Option<(usize, usize)>,
+}
+
+/// A selection on the GPU: its rules, the streamlines there were, and how many it kept (`None`:
+/// every one).
+#[derive(Clone, Debug)]
+pub struct Selected {
+    pub selection: lineao_tracts::Selection,
+    pub streamlines: usize,
+    pub kept: Option<usize>,
 }
 
 impl Frame {
@@ -170,7 +181,7 @@ struct Scene {
     /// Where the lines came from: read again for their points where a method needs them.
     source: Source,
     /// The selection on the GPU ([`SceneRef::selected`]).
-    selected: Option<(lineao_tracts::Selection, usize)>,
+    selected: Option<Selected>,
 }
 
 /// A panel's chain, the ray scene it was given (its generation) and its geometry pixels.
@@ -528,7 +539,7 @@ pub(super) struct SceneRef<'a> {
     /// Still arriving: what needs every point on the CPU waits until it is all there.
     pub opening: bool,
     /// The selection last written to the GPU, and the streamlines there were then.
-    pub selected: &'a mut Option<(lineao_tracts::Selection, usize)>,
+    pub selected: &'a mut Option<Selected>,
 }
 
 /// Whether both are the same allocation, or both none.
@@ -541,30 +552,51 @@ fn same<T>(a: Option<&Arc<T>>, b: Option<&Arc<T>>) -> bool {
 
 /// Selects on the GPU (full detail and preview) what `selection` keeps, where it or the
 /// streamlines changed since the scene was last selected: a bit per cluster, no geometry.
-fn select(gpu: &Gpu, scene: &mut SceneRef<'_>, selection: &lineao_tracts::Selection) -> Result<(), String> {
+/// Regions need every point: the file is read again for them (the first time, busy meanwhile)
+/// once all of it has arrived; while it arrives they wait.
+fn select(
+    gpu: &Gpu,
+    scene: &mut SceneRef<'_>,
+    selection: &lineao_tracts::Selection,
+    send: &dyn Fn(FromWorker),
+) -> Result<(), String> {
     let lines = &mut *scene.lines;
     let count = lines.lengths.len();
-    if scene.selected.as_ref().is_some_and(|(s, n)| s == selection && *n == count) {
+    if scene.selected.as_ref().is_some_and(|s| s.selection == *selection && s.streamlines == count) {
         return Ok(());
     }
+    let mut kept = None;
     let (d, q) = (&gpu.device, &gpu.queue);
-    let error = |e: lineao::Error| format!("{}: {e}", lines.name);
+    let name = lines.name.clone();
+    let error = |e: lineao::Error| format!("{name}: {e}");
     if selection.is_everything() {
         lines.geometry.set_selection(d, q, None).map_err(error)?;
         scene.preview.geometry.set_selection(d, q, None).map_err(error)?;
     } else if count == lines.geometry.streamlines {
-        let mut keep: Vec<bool> =
-            lines.lengths.iter().enumerate().map(|(i, &l)| selection.keeps(i as u64, l)).collect();
-        selection.apply_groups(&mut keep, &lines.tracts.groups).map_err(|e| format!("{}: {e}", lines.name))?;
-        selection.apply_field(&mut keep, &lines.tracts).map_err(|e| format!("{}: {e}", lines.name))?;
+        let rule = |e: lineao_tracts::selection::SelectionError| format!("{name}: {e}");
+        let regions = !(selection.include.is_empty() && selection.exclude.is_empty());
+        let mut keep: Vec<bool> = if regions && !scene.opening {
+            if !lines.points_kept() {
+                send(FromWorker::Busy(format!("reading {name} again for its points (regions) …")));
+                lines.load_points(scene.source).map_err(|e| format!("{e:#}"))?;
+            }
+            selection.chunk(&lines.tracts, 0).map_err(rule)?
+        } else {
+            let mut keep: Vec<bool> =
+                lines.lengths.iter().enumerate().map(|(i, &l)| selection.keeps(i as u64, l)).collect();
+            selection.apply_field(&mut keep, &lines.tracts).map_err(rule)?;
+            keep
+        };
+        selection.apply_groups(&mut keep, &lines.tracts.groups).map_err(rule)?;
         lines.geometry.set_selection(d, q, Some(&keep)).map_err(error)?;
+        kept = Some(keep.iter().filter(|&&k| k).count());
         // The preview holds every k-th streamline.
         let shown = scene.preview.geometry.streamlines;
         let every = count.div_ceil(shown.max(1)).max(1);
         let preview: Vec<bool> = (0..shown).map(|j| keep.get(j * every).copied().unwrap_or(true)).collect();
         scene.preview.geometry.set_selection(d, q, Some(&preview)).map_err(error)?;
     }
-    *scene.selected = Some((selection.clone(), count));
+    *scene.selected = Some(Selected { selection: selection.clone(), streamlines: count, kept });
     Ok(())
 }
 
@@ -581,7 +613,7 @@ async fn render_frame(
     let preview = view.preview && scene.lines.geometry.vertices > PREVIEW_VERTICES;
     let size = if preview { ((view.size.0 / 2).max(1), (view.size.1 / 2).max(1)) } else { view.size };
     let bounds = scene.lines.geometry.bounds.expect("checked at load");
-    select(gpu, &mut scene, &view.selection)?;
+    select(gpu, &mut scene, &view.selection, send)?;
     // The anatomy's slices are framed with the lines.
     let slices = view.panels.first().and_then(|p| p.settings.slices.as_ref());
     let slice_bounds = anatomy.as_ref().zip(slices).and_then(|(volume, slices)| volume.slice_bounds(slices));
@@ -731,5 +763,6 @@ async fn render_frame(
         });
     }
     let render_ms = start.elapsed().as_secs_f64() * 1e3;
-    Ok(Frame { view: view.clone(), images, textures: views, size, times, rays, render_ms })
+    let selected = scene.selected.as_ref().and_then(|s| Some((s.kept?, s.streamlines)));
+    Ok(Frame { view: view.clone(), images, textures: views, size, times, rays, render_ms, selected })
 }

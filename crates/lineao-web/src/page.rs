@@ -508,7 +508,9 @@ impl Page {
         let methods: Vec<&str> = frame.view.panels.iter().map(|p| p.settings.method.name()).collect();
         let orbit = app.camera.as_ref().map(|c| c.orbit_values());
         let ortho = app.camera.as_ref().is_some_and(|c| c.orthographic);
-        let link = query::link((&self.source, self.volume.as_deref()), &methods, app.controls.preset, orbit, ortho);
+        let flags = app.controls.link_flags();
+        let link =
+            query::link((&self.source, self.volume.as_deref()), &methods, app.controls.preset, (orbit, ortho), &flags);
         if self.link.as_ref() != Some(&link) {
             if let Some(history) = web_sys::window().and_then(|w| w.history().ok()) {
                 let _ = history.replace_state_with_url(&JsValue::NULL, "", Some(&link));

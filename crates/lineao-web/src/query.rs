@@ -82,13 +82,14 @@ pub fn parse(search: &str) -> Result<PageArgs, String> {
 }
 
 /// The query string of a view: the source and the options a link keeps (methods, preset,
-/// camera), in the form [`parse`] reads.
+/// camera, and `flags`: the methods' settings and the selection as `lineao view` takes them,
+/// an empty value for a switch), in the form [`parse`] reads.
 pub fn link(
     (source, volume): (&LinkSource, Option<&str>),
     methods: &[&str],
     preset: lineao::Preset,
-    orbit: Option<[f32; 3]>,
-    ortho: bool,
+    (orbit, ortho): (Option<[f32; 3]>, bool),
+    flags: &[(String, String)],
 ) -> String {
     let mut query = form_urlencoded::Serializer::new(String::new());
     match source {
@@ -109,6 +110,12 @@ pub fn link(
     }
     if ortho {
         query.append_key_only("ortho");
+    }
+    for (flag, value) in flags {
+        match value.as_str() {
+            "" => query.append_key_only(flag),
+            value => query.append_pair(flag, value),
+        };
     }
     format!("?{}", query.finish())
 }
@@ -184,8 +191,8 @@ mod tests {
             (&LinkSource::Url("data/a b.tck".into()), Some("data/t1.nii.gz")),
             &["lineao", "ssao"],
             lineao::Preset::Sparse,
-            Some([12.345, -3.0, 0.75]),
-            true,
+            (Some([12.345, -3.0, 0.75]), true),
+            &[],
         );
         let page = parse(&query).unwrap();
         assert_eq!(page.url.as_deref(), Some("data/a b.tck"));
@@ -194,8 +201,48 @@ mod tests {
         assert_eq!(page.view.preset, lineao::Preset::Sparse);
         assert_eq!(page.view.orbit, Some([12.3, -3.0, 0.75]));
         assert!(page.view.ortho);
-        let one =
-            parse(&link((&LinkSource::Scene("spiral".into()), None), &["ssao"], lineao::Preset::Legible, None, false));
+        let one = parse(&link(
+            (&LinkSource::Scene("spiral".into()), None),
+            &["ssao"],
+            lineao::Preset::Legible,
+            (None, false),
+            &[],
+        ));
         assert_eq!(one.unwrap().view.method.screen, AoMethod::Ssao);
+    }
+
+    #[test]
+    fn a_link_keeps_the_methods_settings_and_the_selection() {
+        use lineao::method::setting::Value;
+        use lineao_cli::view::controls::{Controls, RegionRule, methods};
+        use lineao_tracts::Region;
+        let ssao = methods().into_iter().find(|m| m.screen == AoMethod::Ssao && m.volume.is_none()).unwrap();
+        let mut controls = Controls::new([ssao, ssao], false, lineao::Preset::Legible);
+        // As the panel moves them: the radius sets the range check too, which then moves back.
+        let described = AoMethod::Ssao.info().settings;
+        for (flag, value) in [("ssao-samples", Value::Count(8)), ("ssao-radius", Value::Number(3.3))] {
+            (described.iter().find(|s| s.flag == flag).unwrap().set)(&mut controls.params.chain, value);
+        }
+        controls.params.chain.ssao.range_world = 8.0;
+        (controls.subset, controls.length) = (0.3, Some([20.0, 80.5]));
+        controls.regions = vec![
+            RegionRule { include: true, region: Region::Sphere { center: [1.5, -2.0, 0.1], radius: 7.25 } },
+            RegionRule { include: false, region: Region::Box { min: [-1.0, -2.0, -3.0], max: [4.0, 5.0, 6.5] } },
+        ];
+        let flags = controls.link_flags();
+        let keys: Vec<&str> = flags.iter().map(|(flag, _)| flag.as_str()).collect();
+        assert_eq!(keys, ["ssao-samples", "ssao-radius", "ssao-range", "subset", "length", "include", "exclude"]);
+        let query = link(
+            (&LinkSource::Scene("bundles".into()), None),
+            &["ssao"],
+            lineao::Preset::Legible,
+            (None, false),
+            &flags,
+        );
+        let page = parse(&query).unwrap();
+        let opened = lineao_cli::view::options(&page.view).controls;
+        assert_eq!(opened.selection(), controls.selection());
+        assert_eq!(opened.params.chain.ssao, controls.params.chain.ssao);
+        assert_eq!(opened.link_flags(), flags, "the link of the page it opens is the same");
     }
 }
