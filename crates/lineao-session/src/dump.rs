@@ -212,7 +212,7 @@ pub fn write(
         let tile: Vec<f32> = noise::vo_noise(vo.noise_seed).into_iter().flatten().collect();
         write_npy(dir, "vo_noise.npy", &[4, 4, 2], &tile)?;
         if let Some(moments) = chain.stage::<VoArea>().and_then(VoArea::moments) {
-            for (l, level) in lineao::readback::read_moments(&gpu.device, &gpu.queue, moments)?.iter().enumerate() {
+            for (l, level) in moments.read(&gpu.device, &gpu.queue)?.iter().enumerate() {
                 let shape = [level.height as u64, level.width as u64, 2];
                 write_npy(dir, &format!("moments_{l}.npy"), &shape, &level.data.concat())?;
             }

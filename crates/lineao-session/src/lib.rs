@@ -16,4 +16,5 @@ pub mod output;
 pub mod render;
 pub mod score;
 pub mod source;
+mod text;
 pub mod truth;

@@ -170,7 +170,7 @@ impl<'de> serde::Deserialize<'de> for MethodArgs {
                 let mut args = MethodArgs::default();
                 while let Some(key) = map.next_key::<String>()? {
                     if described().any(|(_, s)| s.keyword() == key) {
-                        let text: crate::kwargs::Text = map.next_value()?;
+                        let text: crate::text::Text = map.next_value()?;
                         args.keyword(&key, &text.0).map_err(serde::de::Error::custom)?;
                     } else {
                         map.next_value::<serde::de::IgnoredAny>()?;

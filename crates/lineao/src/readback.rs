@@ -3,7 +3,7 @@
 use crate::Error;
 
 #[cfg(feature = "reference")]
-pub use images::{read_f32, read_image, read_moments, read_rgba, write_target};
+pub use images::{read_f32, read_image, read_rgba, write_target};
 
 /// A texture's texels, rows tightly packed.
 pub struct TextureData {
@@ -277,25 +277,6 @@ mod images {
             height: data.height as usize,
             data: bytemuck::pod_collect_to_vec(&data.bytes),
         })
-    }
-
-    /// The moments pyramid (`targets.moments`) as the CPU reference takes it: (E\[z\], E\[z²\]) per
-    /// level.
-    pub fn read_moments(
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        moments: &crate::method::vo_area::moments::Moments,
-    ) -> Result<Vec<crate::reference::MomentsImage>, Error> {
-        let all: Vec<[f32; 2]> = bytemuck::pod_collect_to_vec(&super::read_buffer(device, queue, &moments.buffer)?);
-        Ok(moments
-            .levels
-            .iter()
-            .map(|l| {
-                let start = l.offset as usize;
-                let (width, height) = (l.width as usize, l.height as usize);
-                Image { width, height, data: all[start..start + width * height].to_vec() }
-            })
-            .collect())
     }
 
     /// Writes `image` into an Rgba32Float or R32Float target (a host's own G-buffer, or a test's).

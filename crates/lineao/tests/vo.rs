@@ -10,7 +10,7 @@ use common::{cameras_for_polylines, flat_view, gpu, polylines, render};
 use lineao::method::vo_area::VoArea;
 use lineao::method::vo_area::moments::MomentsPyramid;
 use lineao::method::vo_line::VoLine;
-use lineao::readback::{read_f32, read_moments, write_target};
+use lineao::readback::{read_f32, write_target};
 use lineao::reference::{self, Image, NdImage, ViewParams, VoParams, vo_line_sample, vo_sample, vo_visible};
 use lineao::sample_sets::{
     VO_AREA_SAMPLE_COUNTS, VO_SAMPLE_COUNTS, vo_area_lod_offsets, vo_area_samples, vo_disk_samples,
@@ -72,7 +72,7 @@ fn vo_on(
     let cpu = if sampling == Sampling::Line {
         reference::vo_line(nd0, zoom, vo_disk_samples(settings.samples).unwrap(), &noise, &params)
     } else {
-        let moments = read_moments(d, q, area.as_ref().and_then(VoArea::moments).unwrap()).unwrap();
+        let moments = area.as_ref().and_then(VoArea::moments).unwrap().read(d, q).unwrap();
         let samples = vo_area_samples(settings.area_samples).unwrap();
         reference::vo_area(nd0, zoom, &moments, &samples, &vo_area_lod_offsets(&samples), &noise, &params)
     };
@@ -250,7 +250,7 @@ fn the_moments_pyramid_is_the_cpu_reference() {
     let mut encoder = d.create_command_encoder(&Default::default());
     moments.encode(&mut encoder, None);
     q.submit([encoder.finish()]);
-    let gpu_levels = read_moments(d, q, moments.moments().unwrap()).unwrap();
+    let gpu_levels = moments.moments().unwrap().read(d, q).unwrap();
     let cpu_levels = reference::moments_pyramid(&nd0, &ViewParams::of(&view));
     assert_eq!(gpu_levels.len(), cpu_levels.len());
     assert_eq!(gpu_levels.len(), 6, "63 x 47 has mips down to 1 x 1");

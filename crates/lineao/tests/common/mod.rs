@@ -108,7 +108,7 @@ pub fn render_scene(
             .map(|b| read_f32(d, q, b).unwrap())
             .unwrap_or_else(|| Image::from_fn(0, 0, |_, _| 0.0)),
         moments: (chain.stage::<lineao::method::vo_area::VoArea>().and_then(|s| s.moments()))
-            .map(|m| lineao::readback::read_moments(d, q, m).unwrap())
+            .map(|m| m.read(d, q).unwrap())
             .unwrap_or_default(),
         output: read_rgba(d, q, &output).unwrap(),
         octants: t.octants.as_ref().map(|o| lineao::readback::read_image(d, q, o).unwrap()),

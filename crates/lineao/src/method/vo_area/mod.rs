@@ -87,7 +87,7 @@ impl VoArea {
         self.max_level = moments.levels.len() as u32 - 1;
     }
 
-    /// The moments pyramid of the last frame (for readback: [`crate::readback::read_moments`]).
+    /// The moments pyramid of the last frame (for readback: [`Moments::read`](moments::Moments::read)).
     pub fn moments(&self) -> Option<&moments::Moments> {
         self.moments.moments()
     }

@@ -40,6 +40,22 @@ pub struct Moments {
 }
 
 impl Moments {
+    /// The pyramid read back as the CPU reference takes it: (E\[z\], E\[z²\]) per level.
+    #[cfg(feature = "reference")]
+    pub fn read(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+    ) -> Result<Vec<crate::reference::MomentsImage>, crate::Error> {
+        let all: Vec<[f32; 2]> =
+            bytemuck::pod_collect_to_vec(&crate::readback::read_buffer(device, queue, &self.buffer)?);
+        let level = |l: &MomentsLevel| {
+            let (start, width, height) = (l.offset as usize, l.width as usize, l.height as usize);
+            crate::image::Image { width, height, data: all[start..start + width * height].to_vec() }
+        };
+        Ok(self.levels.iter().map(level).collect())
+    }
+
     /// Level l is ⌊W_{l−1}/2⌋ × ⌊H_{l−1}/2⌋ (at least 1) down to 1 × 1, as a mip chain.
     pub fn levels((width, height): (u32, u32)) -> Vec<MomentsLevel> {
         let mut levels = vec![MomentsLevel { offset: 0, width, height }];
