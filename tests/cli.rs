@@ -851,6 +851,24 @@ fn score_ranks_the_truth_first() {
     assert_eq!(report["methods"][0]["truth_mean"], again["methods"][0]["truth_mean"]);
 }
 
+/// VO is scored against the share of the ball it samples: the half ball where it clamps to the
+/// normal's side, the whole ball where the flag or the `--settings` JSON turns that off.
+#[test]
+fn score_takes_vos_ball_from_the_settings_vo_renders_with() {
+    let truth = |extra: &[&str]| {
+        let mut args = vec!["score", "--vertices", "2000", "--width", "40", "--height", "32", "--rays", "4"];
+        args.extend(["--methods", "vo-line", "--json"]);
+        args.extend(extra);
+        let out = lineao(&args);
+        assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+        let report: Value = serde_json::from_slice(&out.stdout).unwrap();
+        report["methods"][0]["truth"].as_str().unwrap().to_string()
+    };
+    assert_eq!(truth(&[]), "vo-half");
+    assert_eq!(truth(&["--no-normal-clamp"]), "vo-whole");
+    assert_eq!(truth(&["--settings", r#"{"vo": {"normal_clamp": false}}"#]), "vo-whole");
+}
+
 /// A frame with fewer than 100 geometry pixels has no legibility, said with the reason, not 0.
 #[test]
 fn legibility_of_a_tiny_frame_is_absent_with_the_reason() {

@@ -146,8 +146,10 @@ pub fn score(
     bundle_distance: AoDistance,
 ) -> Result<Report> {
     let (w, h) = (args.image.width as usize, args.image.height as usize);
-    let clamped = !args.methods.given.iter().any(|(flag, _)| *flag == "no-normal-clamp");
-    let vo_ball = if clamped { VoBall::Half } else { VoBall::Whole };
+    // VO's truth: the half ball where VO clamps to it (`--no-normal-clamp` or `--settings`
+    // turn it off), as the settings VO's rows render with say.
+    let vo = ScoreMethod { method: AoMethod::VoLine, variant: Default::default() };
+    let vo_ball = if method_settings(session, args, vo).vo.normal_clamp { VoBall::Half } else { VoBall::Whole };
     let wants_vo = methods.iter().any(|m| matches!(m.method, AoMethod::VoLine | AoMethod::VoArea));
     let local = crate::truth::settings(args, session.longest_side);
     let bundle_settings = TruthSettings {
