@@ -102,10 +102,6 @@ pub struct ViewArgs {
     /// Show each pass's GPU time over the image.
     #[arg(long)]
     pub timings: bool,
-    /// The ray-traced method (`--method raytraced`): rays per pixel after which its picture is
-    /// complete (and `--screenshot` is taken).
-    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..))]
-    pub rays: u32,
     /// Window size in points, WIDTHxHEIGHT.
     #[arg(long, default_value = "1400x900", value_parser = parse_size)]
     pub size: [u32; 2],

@@ -39,7 +39,7 @@ fn exit_codes() {
         (&["score", "--ao-distance", "120%"], "(0 %, 100 %]"),
         (&["render", "--ao-distance", "x%"], "a share such as 20%"),
         (&["score", "--bundle-distance=-5%"], "(0 %, 100 %]"),
-        (&["score", "--ao-distance=-2"], "positive"),
+        (&["score", "--ao-distance=-2"], "must be > 0 world units"),
         // Library ranges the command line knows: a bad command line, and the option named.
         (&["render", "--s-h", "0"], "--s-h"),
         // A described setting's range (`lineao::method::setting`), whichever method is shown.
@@ -659,10 +659,10 @@ fn surfaces_and_tubes_render() {
 fn truth_options_are_checked() {
     for (bad, needle) in [
         (&["render", "--method", "raytraced", "--rays", "0"][..], "rays"),
-        (&["render", "--method", "raytraced", "--ao-distance=-1"], "positive"),
-        (&["render", "--method", "raytraced", "--ao-distance", "nan"], "positive"),
-        (&["render", "--method", "raytraced", "--ao-distance", "inf"], "positive"),
-        (&["score", "--ao-distance", "0"], "positive"),
+        (&["render", "--method", "raytraced", "--ao-distance=-1"], "must be > 0 world units, or a share"),
+        (&["render", "--method", "raytraced", "--ao-distance", "nan"], "must be > 0 world units"),
+        (&["render", "--method", "raytraced", "--ao-distance", "inf"], "must be > 0 world units"),
+        (&["score", "--ao-distance", "0"], "must be > 0 world units"),
         (&["score", "--methods", "magic"], "unknown method"),
         (&["render", "--preset", "fancy"], "unknown preset"),
         (&["render", "--delta-scale", "x"], "invalid value"),

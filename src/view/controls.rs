@@ -92,6 +92,8 @@ impl Params {
         chain.ssao.range_world *= zoom_unit;
         chain.vo.radius_world *= zoom_unit;
         chain.raytraced.distance_world *= zoom_unit;
+        // The picture keeps refining while the view rests (render's 256 is a reference's count).
+        chain.raytraced.max_rays = 1024;
         // Few rays per pixel while the picture builds up: the edge-aware denoiser takes the
         // error of the first frames to about half (docs/ground-truth.md) and fades out.
         chain.raytraced.denoise = Some(lineao::RayDenoiseSettings::default());
@@ -467,8 +469,8 @@ impl Controls {
         let volume = shown.iter().any(|s| s.volume.is_some());
         let p = &mut self.params;
         ui.add(egui::Slider::new(&mut p.chain.strength, 0.0..=2.0).text("strength"));
-        // Each method's panel: its settings' descriptions (the ray tracer's and object-space
-        // AO's below are written out).
+        // Each method's panel: its settings' descriptions (object-space AO's, not a method of
+        // the registry, below is written out).
         for method in AoMethod::REGISTRY.iter().copied().filter(|&m| screen(m) && !m.info().settings.is_empty()) {
             egui::CollapsingHeader::new(method.info().label)
                 .default_open(true)
@@ -478,9 +480,7 @@ impl Controls {
             egui::CollapsingHeader::new("Object-space AO").default_open(true).show(ui, |ui| volume_ui(ui, p));
         }
         if screen(AoMethod::RayTraced) {
-            egui::CollapsingHeader::new("Ray tracing")
-                .default_open(true)
-                .show(ui, |ui| ray_ui(ui, &mut p.chain, &mut self.moving_method));
+            moving_ui(ui, &mut self.moving_method);
         }
         let mut blur = p.chain.blur.is_some();
         ui.checkbox(&mut blur, "Bilateral blur");
@@ -783,8 +783,25 @@ pub fn described_ui(ui: &mut Ui, method: AoMethod, chain: &mut ChainSettings) {
                 ui.add(slider).on_hover_text(setting.help).changed().then_some(Value::Number(x))
             }
             (Kind::Count { min, max }, Value::Count(mut n)) => {
-                let slider = egui::Slider::new(&mut n, min..=max).text(label);
-                ui.add(slider).on_hover_text(setting.help).changed().then_some(Value::Count(n))
+                // Wide ranges by factors, the slider spanning at most 65536 (typed beyond it).
+                let span = max.min(min.saturating_add(1 << 16));
+                let slider = egui::Slider::new(&mut n, min..=span)
+                    .logarithmic(span >= 64 * min.max(1))
+                    .clamping(if span < max { egui::SliderClamping::Never } else { egui::SliderClamping::Always })
+                    .text(label);
+                let changed = ui.add(slider).on_hover_text(setting.help).changed();
+                changed.then_some(Value::Count(n.clamp(min, max)))
+            }
+            (Kind::Reach { slider: [min, max] }, Value::Number(mut x)) => {
+                let slider = egui::Slider::new(&mut x, min * world..=max * world).logarithmic(true).text(label);
+                ui.add(slider).on_hover_text(setting.help).changed().then_some(Value::Number(x))
+            }
+            (Kind::Reach { .. }, Value::Share(share)) => {
+                let mut percent = 100.0 * share;
+                let slider =
+                    egui::Slider::new(&mut percent, 1.0..=100.0).logarithmic(true).suffix(" %").text(setting.label);
+                let changed = ui.add(slider).on_hover_text(setting.help).changed();
+                changed.then_some(Value::Share(percent / 100.0))
             }
             (Kind::Counts(counts), Value::Count(n)) => {
                 let options: Vec<Value> = counts.iter().map(|&c| Value::Count(c)).collect();
@@ -817,25 +834,8 @@ fn values_ui(ui: &mut Ui, label: &str, help: &str, current: Value, options: &[Va
     .inner
 }
 
-fn ray_ui(ui: &mut Ui, chain: &mut ChainSettings, moving: &mut Method) {
-    let (r, z) = (&mut chain.raytraced, chain.zoom_unit);
-    ui.add(egui::Slider::new(&mut r.rays_per_frame, 1..=64).logarithmic(true).text("rays per frame"))
-        .on_hover_text("Rays per pixel each frame adds; fewer keep a slow GPU responsive");
-    ui.add(egui::Slider::new(&mut r.max_rays, 1..=65536).logarithmic(true).text("rays per pixel"))
-        .on_hover_text("The picture is complete after this many rays (the cap)");
-    ui.add(egui::Slider::new(&mut r.distance_world, 0.1 * z..=20.0 * z).logarithmic(true).text("reach"))
-        .on_hover_text("How far a ray looks for an occluder (the ground truth's R)");
-    ui.horizontal(|ui| {
-        ui.label("falloff");
-        ui.selectable_value(&mut r.falloff, lineao::truth::Falloff::None, "binary");
-        ui.selectable_value(&mut r.falloff, lineao::truth::Falloff::Linear, "linear");
-    });
-    let mut denoise = r.denoise.is_some();
-    ui.checkbox(&mut denoise, "denoise (edge-aware)")
-        .on_hover_text("Averages each pixel with its neighbours on the same line or surface; fades out as rays add up");
-    if denoise != r.denoise.is_some() {
-        r.denoise = denoise.then(lineao::RayDenoiseSettings::default);
-    }
+/// What a ray-traced panel shows while the camera moves (the viewer's own choice).
+fn moving_ui(ui: &mut Ui, moving: &mut Method) {
     egui::ComboBox::from_label("while moving").selected_text(method_label(*moving)).show_ui(ui, |ui| {
         for m in methods().into_iter().filter(|m| m.volume.is_none() && *m != RAY_TRACED) {
             ui.selectable_value(moving, m, method_label(m));

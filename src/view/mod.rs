@@ -74,7 +74,6 @@ pub fn options(args: &ViewArgs) -> app::Options {
     controls.colormap = args.colormap;
     controls.debug_view = args.debug_view;
     controls.timings = args.timings;
-    controls.params.chain.raytraced.max_rays = args.rays;
     controls.params.chain.cull = args.cull;
     controls.params.chain.lod = args.lod;
     args.methods.apply(&mut controls.params.chain);

@@ -36,7 +36,7 @@ use lineao_tracts::ViewHint;
 
 use super::loading::{Opening, Preview, Step};
 pub use crate::source::Source;
-use crate::source::{AttributeKey, Lines, Sampled, submit_frame};
+use crate::source::{AttributeKey, FrameScene, Lines, Sampled};
 
 /// Vertices of a preview frame at most.
 pub const PREVIEW_VERTICES: usize = 250_000;
@@ -184,12 +184,9 @@ struct Scene {
     selected: Option<Selected>,
 }
 
-/// A panel's chain, the ray scene it was given (its generation) and its geometry pixels.
+/// A panel's chain and the geometry pixels of its ray-traced picture.
 struct PanelChain {
     chain: AoChain,
-    scene: Option<u64>,
-    /// The anatomy it was given.
-    anatomy: Option<Arc<SliceVolume>>,
     /// Geometry pixels of the ray-traced picture in progress (counted on its first frame).
     geometry_pixels: usize,
 }
@@ -340,7 +337,6 @@ impl Worker {
             for panel in &mut self.chains {
                 // The old dataset's BVH is freed now, not when the next one replaces it.
                 panel.chain.set_ray_scene(&gpu.device, None);
-                panel.scene = None;
             }
             match Opening::start(source.clone(), sampled.clone(), gpu) {
                 Ok(opening) => self.opening = Some(opening),
@@ -697,13 +693,13 @@ async fn render_frame(
         let traced = settings.method == AoMethod::RayTraced;
         if chains.len() <= i {
             let chain = AoChain::new_async(d, format, settings.clone()).await.map_err(|e| e.to_string())?;
-            chains.push(PanelChain { chain, scene: None, anatomy: None, geometry_pixels: 0 });
+            chains.push(PanelChain { chain, geometry_pixels: 0 });
         } else if chains[i].chain.settings() != &settings {
             chains[i].chain.set_settings_async(d, settings).await.map_err(|e| e.to_string())?;
         }
-        if traced {
-            // The ray tracer's scene: the full detail, whatever this frame draws.
-            let rays = match &scene.rays {
+        // The ray tracer's scene: the full detail, whatever this frame draws.
+        let ray_scene = if traced {
+            Some(match &scene.rays {
                 Some(rays) => rays.clone(),
                 None => {
                     send(FromWorker::Busy("building the ray tracer's BVH …".into()));
@@ -718,18 +714,19 @@ async fn render_frame(
                     let rays = Arc::new(rays);
                     scene.rays.get_or_insert(rays).clone()
                 }
-            };
-            let panel = &mut chains[i];
-            if panel.scene != Some(rays.generation()) {
-                panel.chain.set_ray_scene(d, Some(rays.clone()));
-                panel.scene = Some(rays.generation());
-            }
-        }
+            })
+        } else {
+            None
+        };
+        let frame = FrameScene {
+            geometry,
+            meshes: &[],
+            camera: &view.camera,
+            bounds: &bounds,
+            rays: ray_scene,
+            anatomy: anatomy.clone(),
+        };
         let panel = &mut chains[i];
-        if !same(anatomy.as_ref(), panel.anatomy.as_ref()) {
-            panel.chain.set_slice_volume(d, anatomy.clone());
-            panel.anatomy = anatomy.clone();
-        }
         let chain = &mut panel.chain;
         chain.set_timing(d, q, view.timings);
         chain.resize(size.0, size.1).map_err(|e| e.to_string())?;
@@ -737,7 +734,7 @@ async fn render_frame(
             Some(shared) => shared,
             None => &textures[i],
         };
-        submit_frame(gpu, chain, (geometry, &[]), (&view.camera, &bounds), &target.view).map_err(|e| e.to_string())?;
+        frame.submit(gpu, chain, &target.view).map_err(|e| e.to_string())?;
         if readback {
             times.push(if view.timings { chain.pass_times(d).map_err(|e| e.to_string())? } else { None });
             images.push(lineao::readback::read_texture(d, q, &target.texture).map_err(|e| e.to_string())?.bytes);

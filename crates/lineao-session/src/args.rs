@@ -6,7 +6,6 @@ use std::path::PathBuf;
 
 use clap::{Args, ValueEnum};
 use lineao::lighting::LineShading;
-use lineao::truth::Falloff;
 use lineao::{Colormap, Named, VoCombine};
 use lineao_tracts::SceneKind;
 
@@ -709,36 +708,17 @@ pub struct VolumeArgs {
     pub volume_combine: VoCombine,
 }
 
-/// The ray-traced truth (`--method raytraced`, `score`).
+/// How the ray-traced truth is traced (`--method raytraced`, `score`); its rays, reach,
+/// falloff and seed are the ray-traced method's described settings (`--rays`, `--ao-distance`,
+/// …: [`crate::method_args`]), which the CPU truth reads too.
 #[derive(Args, Clone, Debug, serde::Deserialize)]
 #[command(next_help_heading = "Ray-traced truth")]
 #[serde(default)]
 pub struct TruthArgs {
-    /// Ray-traced AO (`--method raytraced`, `score`): rays per geometry pixel. 256 is LineVis's
-    /// reference count: a standard error of at most 0.03 per pixel.
-    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=1_048_576))]
-    pub rays: u32,
-    /// Ray-traced AO: how far a ray looks, in world units, or as a share of the longest side of
-    /// the scene's bounds (`20%`, LineVis's default reach; `score`'s bundle-scale truth). 2 is
-    /// the reach VO and SSAO sample by default and that of LineAO's widest hemisphere
-    /// (r0 + 2 z(P) px).
-    #[arg(long, default_value = "2", value_parser = parse_ao_distance)]
-    #[serde(deserialize_with = "crate::kwargs::ao_distance")]
-    pub ao_distance: AoDistance,
-    /// Ray-traced AO: binary (`none`) or obscurance with a linear falloff (`linear`).
-    #[arg(long, value_parser = named::<Falloff>(), default_value = "none")]
-    pub ao_falloff: Falloff,
-    /// Ray-traced AO: seed of the per-pixel scrambled ray sequence.
-    #[arg(long, default_value_t = 1)]
-    pub ray_seed: u32,
     /// Ray-traced AO: trace on the CPU (the reference, f64, all cores) instead of the GPU.
     /// The reference is shown as traced: `--denoise` and `--bilateral` are the GPU tracer's.
     #[arg(long, conflicts_with_all = ["bilateral", "denoise"])]
     pub cpu: bool,
-    /// Ray-traced AO on the GPU: the edge-aware denoiser after the rays (same line or surface,
-    /// a window narrowing as 1/√rays; `lineao::method::raytraced::denoise`), for low `--rays`.
-    #[arg(long)]
-    pub denoise: bool,
 }
 
 /// Each group's defaults are the command line's (`RenderArgs::default`).

@@ -268,6 +268,7 @@ pub fn write(
     let flags = s.method.info().settings.iter().map(|d| {
         let value = match ((d.get)(s), d.kind) {
             (Value::Number(x), _) => json!(x),
+            (share @ Value::Share(_), _) => json!(share.to_string()),
             (Value::Count(n), _) => json!(n),
             (Value::Choice(name), _) => json!(name),
             (Value::Switch(on), Kind::Switch { given }) => json!(on == given),

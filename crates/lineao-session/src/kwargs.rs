@@ -113,7 +113,6 @@ impl RenderArgs {
             ("width", self.image.width, 1, 8192),
             ("height", self.image.height, 1, 8192),
             ("volume_resolution", self.volume.volume_resolution, 8, 1024),
-            ("rays", self.truth.rays, 1, 1_048_576),
         ];
         for (name, value, lo, hi) in ranges {
             if !(lo..=hi).contains(&value) {
@@ -180,7 +179,6 @@ parsed! {
     preset: lineao::Preset = crate::args::parse_preset;
     color: crate::args::ColorArg = crate::args::parse_color;
     debug_view: lineao::DebugView = crate::args::parse_debug_view;
-    ao_distance: crate::args::AoDistance = crate::args::parse_ao_distance;
     geometry: crate::args::GeometryArg = crate::args::parse_value_enum::<crate::args::GeometryArg>;
     sky: crate::args::SkyArg = crate::args::parse_value_enum::<crate::args::SkyArg>;
     volume_normal: crate::args::VolumeNormal = crate::args::parse_value_enum::<crate::args::VolumeNormal>;

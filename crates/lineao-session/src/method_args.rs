@@ -53,6 +53,11 @@ impl MethodArgs {
         self.given.push((flag, value));
     }
 
+    /// Whether the setting of `flag` was given.
+    pub fn gives(&self, flag: &str) -> bool {
+        self.given.iter().any(|(f, _)| *f == flag)
+    }
+
     /// Writes every given value into `settings`.
     pub fn apply(&self, settings: &mut ChainSettings) {
         for (flag, value) in &self.given {

@@ -21,7 +21,7 @@ use lineao_tracts::scenes::ViewHint;
 
 use crate::args::{ColorArg, GeometryArg, Method, RenderArgs, SkyArg, VolumeNormal};
 use crate::label::Rgba8;
-use crate::source::{AttributeKey, Keep, Lines, Loaded, Sampled, Source, submit_frame, vertex_field};
+use crate::source::{AttributeKey, FrameScene, Keep, Lines, Loaded, Sampled, Source, vertex_field};
 
 /// The sky of object-space AO: open, or lit from the world axis nearest to the camera's `up`.
 pub fn sky(args: &RenderArgs, up: Vec3) -> Sky {
@@ -77,7 +77,6 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky, lon
             radius_px: args.chain.bilateral_radius,
             depth_sigma_world: args.chain.bilateral_sigma,
         }),
-        raytraced: crate::truth::gpu_settings(args, longest_side),
         line_width_px: args.style.line_width,
         lighting: lineao::lighting::Lighting {
             line_shading: args.style.line_shading,
@@ -121,6 +120,7 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky, lon
         settings.strength = strength;
     }
     args.methods.apply_with(&mut settings, method, args.shown.samples, args.shown.radius);
+    crate::truth::budget(&mut settings.raytraced, args, longest_side);
     match &args.shown.settings {
         // Checked against the same types when parsed: it applies to any settings.
         Some(patch) => patch.apply(&settings).expect("--settings was checked when parsed"),
@@ -577,25 +577,27 @@ impl Session {
     pub fn frame(&self, chain: &mut AoChain, target: &wgpu::TextureView, options: FrameOptions) -> Result<()> {
         let gpu = &self.gpu;
         let meshes: Vec<&MeshGeometry> = self.meshes.iter().collect();
-        let scene = (&self.lines.geometry, &meshes[..]);
-        let view = (&self.camera, &self.bounds);
+        let frame = FrameScene {
+            geometry: &self.lines.geometry,
+            meshes: &meshes,
+            camera: &self.camera,
+            bounds: &self.bounds,
+            rays: if options.gpu_rays { Some(self.ray_scene()?) } else { None },
+            anatomy: self.anatomy.clone(),
+        };
         let again = options.settled && chain.settings().cull;
-        if options.gpu_rays {
-            chain.set_ray_scene(&gpu.device, Some(self.ray_scene()?));
-        }
-        chain.set_slice_volume(&gpu.device, self.anatomy.clone());
         if options.timings && !again {
             chain.set_timing(&gpu.device, &gpu.queue, true);
         }
-        submit_frame(gpu, chain, scene, view, target)?;
+        frame.submit(gpu, chain, target)?;
         if again {
             if options.timings {
                 chain.set_timing(&gpu.device, &gpu.queue, true);
             }
-            submit_frame(gpu, chain, scene, view, target)?;
+            frame.submit(gpu, chain, target)?;
         }
         if options.gpu_rays {
-            crate::truth::accumulate(gpu, chain, |chain| submit_frame(gpu, chain, scene, view, target))?;
+            crate::truth::accumulate(gpu, chain, |chain| frame.submit(gpu, chain, target))?;
         }
         Ok(())
     }

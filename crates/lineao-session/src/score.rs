@@ -261,6 +261,7 @@ pub fn run(args: &ScoreArgs) -> Result<()> {
     let session = Session::open_with_points(render)?;
     let report = score(&session, render, &methods, args.bundle_distance)?;
     let truth = &report.truth;
+    let local = crate::truth::settings(render, session.longest_side);
     if args.json {
         println!("{}", serde_json::to_string_pretty(&to_json(&session, render, &report))?);
     } else {
@@ -272,9 +273,9 @@ pub fn run(args: &ScoreArgs) -> Result<()> {
             render.image.width,
             render.image.height,
             truth.geometry_pixels,
-            render.truth.rays,
-            render.truth.ao_distance,
-            truth_settings_falloff(render),
+            local.rays,
+            crate::truth::reach_text(render),
+            local.falloff.name(),
             mean_over(&report.ao, &report.mask),
             100.0 * truth.buried_share(),
             bundle.distance,
@@ -387,10 +388,6 @@ fn legibility_json(l: &Result<Legibility, Absent>) -> serde_json::Value {
         }),
         Err(why) => json!({"absent": why.to_string()}),
     }
-}
-
-fn truth_settings_falloff(args: &crate::args::RenderArgs) -> &'static str {
-    args.truth.ao_falloff.name()
 }
 
 /// CONTRACT.md's `lineao score --json` object.

@@ -5,6 +5,7 @@
 //! submitted and read back.
 
 use std::path::PathBuf;
+use std::sync::Arc;
 
 use std::ops::ControlFlow;
 
@@ -332,22 +333,41 @@ pub fn upload(name: &str, tracts: &Tractogram, on: &lineao::Gpu) -> Result<LineG
     Ok(geometry)
 }
 
-/// Records one frame of `chain` (already sized) over `geometry` and `meshes`, seen by
-/// `camera`, into `target` (the chain's size and format), and submits it; a target the chain
-/// cannot draw into is its error, with nothing submitted.
-pub fn submit_frame(
-    gpu: &lineao::Gpu,
-    chain: &mut AoChain,
-    (geometry, meshes): (&LineGeometry, &[&MeshGeometry]),
-    (camera, bounds): (&Camera, &lineao::Bounds),
-    target: &wgpu::TextureView,
-) -> std::result::Result<(), lineao::Error> {
-    let (d, q) = (&gpu.device, &gpu.queue);
-    chain.prepare(d, q, camera, bounds);
-    let mut encoder = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::frame") });
-    chain.encode_with_meshes(&mut encoder, geometry, meshes, target)?;
-    q.submit([encoder.finish()]);
-    Ok(())
+/// What a frame draws beside its chain's settings: the lines and context surfaces seen by a
+/// camera (with the bounds that set its depth range), the ray tracer's scene where a panel
+/// traces it, the anatomy whose slices it shows. `render`, `score`, Python
+/// ([`crate::render::Session::frame`]) and the viewer's worker submit their frames through it.
+pub struct FrameScene<'a> {
+    pub geometry: &'a LineGeometry,
+    pub meshes: &'a [&'a MeshGeometry],
+    pub camera: &'a Camera,
+    pub bounds: &'a lineao::Bounds,
+    /// The ray tracer's scene (none given: the chain keeps the one it has).
+    pub rays: Option<Arc<lineao::RayScene>>,
+    pub anatomy: Option<Arc<lineao::SliceVolume>>,
+}
+
+impl FrameScene<'_> {
+    /// Records one frame of `chain` (already sized) into `target` (the chain's size and
+    /// format) and submits it; a target the chain cannot draw into is its error, with nothing
+    /// submitted. The same scene and anatomy again keep the chain's progressive picture.
+    pub fn submit(
+        &self,
+        gpu: &lineao::Gpu,
+        chain: &mut AoChain,
+        target: &wgpu::TextureView,
+    ) -> std::result::Result<(), lineao::Error> {
+        let (d, q) = (&gpu.device, &gpu.queue);
+        if let Some(rays) = &self.rays {
+            chain.set_ray_scene(d, Some(rays.clone()));
+        }
+        chain.set_slice_volume(d, self.anatomy.clone());
+        chain.prepare(d, q, self.camera, self.bounds);
+        let mut encoder = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::frame") });
+        chain.encode_with_meshes(&mut encoder, self.geometry, self.meshes, target)?;
+        q.submit([encoder.finish()]);
+        Ok(())
+    }
 }
 
 /// A progress bar on stderr for loading `path` when stderr is a terminal and the file is

@@ -23,31 +23,37 @@ pub struct Scene<'a> {
     pub radii: Option<&'a [f32]>,
 }
 
-/// The truth's settings from the command line, in a scene whose bounds' longest side is
+/// The CPU truth's settings from the command line (the ray-traced method's: `--rays`,
+/// `--ao-distance`, `--ao-falloff`, `--ray-seed`), in a scene whose bounds' longest side is
 /// `longest_side` world units (what `--ao-distance 20%` is a share of).
 pub fn settings(args: &RenderArgs, longest_side: f32) -> TruthSettings {
-    TruthSettings {
-        rays: args.truth.rays,
-        distance_world: args.truth.ao_distance.world(longest_side),
-        falloff: args.truth.ao_falloff,
-        seed: args.truth.ray_seed,
-        vo: None,
-        second: None,
-        threads: 0,
-    }
+    let rays = gpu_settings(args, longest_side);
+    rays.truth(rays.max_rays)
 }
 
-/// The GPU ray tracer's settings from the command line: `--rays` rays per pixel in all, at most
-/// [`RAYS_PER_FRAME`] per submitted frame, in a scene whose bounds' longest side is
-/// `longest_side`.
+/// The GPU ray tracer's settings from the command line, [`budget`]ed.
 pub fn gpu_settings(args: &RenderArgs, longest_side: f32) -> lineao::RayTracedSettings {
-    lineao::RayTracedSettings {
-        rays_per_frame: args.truth.rays.min(RAYS_PER_FRAME),
-        max_rays: args.truth.rays,
-        distance_world: args.truth.ao_distance.world(longest_side),
-        falloff: args.truth.ao_falloff,
-        seed: args.truth.ray_seed,
-        denoise: args.truth.denoise.then(lineao::RayDenoiseSettings::default),
+    let mut chain = lineao::ChainSettings::papers();
+    args.methods.apply(&mut chain);
+    budget(&mut chain.raytraced, args, longest_side);
+    chain.raytraced
+}
+
+/// `--ao-distance` as given (`2`, `20%`).
+pub fn reach_text(args: &RenderArgs) -> String {
+    let mut chain = lineao::ChainSettings::papers();
+    args.methods.apply(&mut chain);
+    let (_, reach) = crate::method_args::described().find(|(_, s)| s.flag == "ao-distance").expect("described");
+    (reach.get)(&chain).to_string()
+}
+
+/// What the session decides of the ray tracer's settings: the reach in world units (a share
+/// of `longest_side`, the scene's bounds', where `--ao-distance` gives one), and unless
+/// `--rays-per-frame` is given, all the rays at most [`RAYS_PER_FRAME`] per submitted frame.
+pub fn budget(rays: &mut lineao::RayTracedSettings, args: &RenderArgs, longest_side: f32) {
+    rays.resolve(longest_side);
+    if !args.methods.gives("rays-per-frame") {
+        rays.rays_per_frame = rays.max_rays.min(RAYS_PER_FRAME);
     }
 }
 

@@ -168,7 +168,7 @@ pub enum Error {
     /// A method's setting outside its range ([`method::setting::Setting`]): its flag (without
     /// the dashes), the value and what it takes, in its unit (`[0.25, 4] zoom units`, `> 0
     /// world units`, `5, 7 or 9`) — what a host matches on to say which setting to change.
-    #[error("invalid settings: --{setting} must be {}{expected}, got {value}", if expected.contains("..=") || expected.ends_with(']') || expected.contains("] ") { "in " } else { "" })]
+    #[error("invalid settings: --{setting} must be {}{expected}, got {value}", if expected.starts_with(['[', '(']) || expected.contains("..=") { "in " } else { "" })]
     OutOfRange { setting: &'static str, value: String, expected: String },
     #[error("invalid line geometry: {0}")]
     InvalidGeometry(String),

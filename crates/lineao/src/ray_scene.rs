@@ -96,6 +96,7 @@ pub struct RayScene {
     /// Changes with every upload: what tells the progressive tracer to start again.
     pub(crate) generation: u64,
     vertex_count: usize,
+    longest_side: f32,
 }
 
 static GENERATION: AtomicU64 = AtomicU64::new(1);
@@ -126,6 +127,8 @@ impl RayScene {
         if vertex_count >= TRIANGLE_BIT as usize || 2 * vertex_count as u64 > capacity {
             return Err(too_large("vertices", vertex_count as u64, 2 * vertex_count as u64, &limits));
         }
+        let points = geometry.positions.iter().chain(geometry.meshes.iter().flat_map(|m| m.0.iter()));
+        let longest_side = crate::camera::Bounds::corners_of(points).map_or(0.0, |(lo, hi)| (hi - lo).max_element());
         let flat = flatten(geometry);
         Ok(RayScene {
             nodes: upload(device, queue, "nodes", flat.nodes, 4, &limits)?,
@@ -136,7 +139,15 @@ impl RayScene {
             max_vertex_radius: flat.max_vertex_radius,
             generation: GENERATION.fetch_add(1, Ordering::Relaxed),
             vertex_count,
+            longest_side,
         })
+    }
+
+    /// The longest side of the axis-aligned box around its finite vertices (lines' and
+    /// meshes'), world units: what a reach given as a share of the scene is a share of
+    /// ([`crate::RayTracedSettings::distance_share`]).
+    pub fn longest_side(&self) -> f32 {
+        self.longest_side
     }
 
     /// Its textures in binding order: nodes, vertices, words, triangles.

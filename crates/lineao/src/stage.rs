@@ -68,6 +68,9 @@ impl Stages {
 
     /// Gives `scene` to the active stage (binding `targets` again) and to each one activated later.
     pub fn set_scene(&mut self, device: &wgpu::Device, scene: Option<Arc<RayScene>>, targets: Option<&FrameTargets>) {
+        if same(&self.scene, &scene) {
+            return;
+        }
         self.scene = scene.clone();
         if let Some(tracer) = self.ray_tracer_mut() {
             tracer.set_scene(scene);
@@ -99,5 +102,13 @@ impl Stages {
         if let Some(stage) = &mut self.active {
             stage.resize(device, targets);
         }
+    }
+}
+
+/// Whether `a` and `b` are the same shared value (or both none): setting it again changes nothing.
+pub(crate) fn same<T>(a: &Option<Arc<T>>, b: &Option<Arc<T>>) -> bool {
+    match (a, b) {
+        (Some(a), Some(b)) => Arc::ptr_eq(a, b),
+        (a, b) => a.is_none() && b.is_none(),
     }
 }

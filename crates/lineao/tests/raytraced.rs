@@ -215,6 +215,30 @@ fn an_orthographic_view_with_a_mesh_matches_and_the_cap_stops_tracing() {
 }
 
 #[test]
+fn a_reach_given_as_a_share_of_the_scene_traces_as_its_length() {
+    // 10 % of the scene's longest side (its lines' and the square's box) is the same picture as
+    // that length given in world units.
+    let scene = Scene::lines(40).with_mesh();
+    let mut s = settings(4);
+    s.surfaces = Some(SurfaceSettings::default());
+    s.raytraced.distance_share = Some(0.1);
+    let mut shared = Tracer::new(&scene, s.clone(), None);
+    let square = scene.mesh.unwrap().0;
+    let points = scene.positions.iter().chain(&square);
+    let (lo, hi) = Bounds::corners_of(points).unwrap();
+    let longest = (hi - lo).max_element();
+    assert!(longest > 80.0, "the square's 90 world units: {longest}");
+    let (nd, by_share) = shared.frame(&camera());
+    (s.raytraced.distance_share, s.raytraced.distance_world) = (None, 0.1 * longest);
+    let mut world = Tracer::new(&scene, s, None);
+    let (_, by_length) = world.frame(&camera());
+    assert_eq!(by_share.data, by_length.data);
+    let geometry = nd.data.iter().filter(|t| common::is_geometry(**t)).count();
+    let mean = by_share.data.iter().sum::<f32>() / geometry as f32;
+    assert!(mean > 0.05, "occlusion to compare: {mean}");
+}
+
+#[test]
 fn linear_falloff_matches_the_cpu_truth() {
     let scene = Scene::lines(60);
     let mut s = settings(8);

@@ -205,7 +205,7 @@ impl AoChain {
 
     /// The geometry the ray-traced method ([`AoMethod::RayTraced`]) traces: what the frame draws,
     /// uploaded once per geometry ([`RayScene::new`]). Without a scene that method shows no
-    /// occlusion. A new scene starts the progressive picture again.
+    /// occlusion. A new scene starts the progressive picture again; the same one again keeps it.
     pub fn set_ray_scene(&mut self, device: &wgpu::Device, scene: Option<Arc<RayScene>>) {
         self.stages.set_scene(device, scene, self.targets.as_ref());
     }
@@ -214,6 +214,9 @@ impl AoChain {
     /// while the settings change; none: no slices are drawn). The frame's `bounds` given to
     /// `prepare` should hold the slices ([`SliceVolume::slice_bounds`]).
     pub fn set_slice_volume(&mut self, device: &wgpu::Device, volume: Option<Arc<SliceVolume>>) {
+        if crate::stage::same(&self.slice_volume, &volume) {
+            return;
+        }
         if let Some(renderer) = &mut self.slices {
             renderer.set_volume(device, volume.clone());
         }

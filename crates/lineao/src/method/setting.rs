@@ -86,6 +86,10 @@ pub enum Kind {
     /// On or off. The flag sets it to `given` (`--no-normal-clamp` gives `false`), so its
     /// default is the other.
     Switch { given: bool },
+    /// A length > 0 ([`Value::Number`], in its unit), or a share in (0 %, 100 %] of the longest
+    /// side of the scene's axis-aligned bounds written with `%` ([`Value::Share`]: the ray
+    /// tracer's reach, LineVis's 20 %); a panel's slider spans `slider` by factors.
+    Reach { slider: [f32; 2] },
 }
 
 /// The shorthands of the command line that give a setting of the method shown.
@@ -104,6 +108,8 @@ pub enum Value {
     Count(u32),
     Choice(&'static str),
     Switch(bool),
+    /// A share of the scene's longest side ([`Kind::Reach`]), as a fraction (`20%`: 0.2).
+    Share(f32),
 }
 
 impl std::fmt::Display for Value {
@@ -113,15 +119,16 @@ impl std::fmt::Display for Value {
             Value::Count(n) => write!(f, "{n}"),
             Value::Choice(name) => f.write_str(name),
             Value::Switch(on) => f.write_str(if *on { "on" } else { "off" }),
+            Value::Share(share) => write!(f, "{}%", share * 100.0),
         }
     }
 }
 
 impl Value {
-    /// The number; a switch is 0 or 1, a choice NaN.
+    /// The number (a share's fraction); a switch is 0 or 1, a choice NaN.
     pub fn as_f32(self) -> f32 {
         match self {
-            Value::Number(x) => x,
+            Value::Number(x) | Value::Share(x) => x,
             Value::Count(n) => n as f32,
             Value::Choice(_) => f32::NAN,
             Value::Switch(on) => f32::from(u8::from(on)),
@@ -200,14 +207,23 @@ impl Setting {
             Kind::Counts(counts) => Some(listed(counts.iter().map(u32::to_string).collect()) + &unit),
             Kind::Choice(names) => Some(listed(names.iter().map(|n| n.to_string()).collect())),
             Kind::Switch { .. } => None,
+            Kind::Reach { .. } => Some(format!("> 0{unit}, or a share in (0 %, 100 %] of the scene's longest side")),
         }
     }
 
-    /// `text` as the command line writes it (`2.5`, `16`; a switch `on`/`off`, `true`/`false`),
-    /// within the range: the error says what was expected.
+    /// `text` as the command line writes it (`2.5`, `16`, `20%`; a switch `on`/`off`,
+    /// `true`/`false`), within the range: the error says what was expected.
     pub fn parse(&self, text: &str) -> Result<Value, String> {
         let text = text.trim();
+        let number = |text: &str| text.trim().parse::<f32>().map_err(|_| format!("expected a number, got '{text}'"));
         let value = match self.kind {
+            Kind::Reach { .. } => match text.strip_suffix('%') {
+                Some(percent) => Value::Share(
+                    percent.trim().parse::<f32>().map_err(|_| format!("expected a share such as 20%, got '{text}'"))?
+                        / 100.0,
+                ),
+                None => Value::Number(number(text)?),
+            },
             Kind::Number { .. } | Kind::Above { .. } => {
                 Value::Number(text.parse().map_err(|_| format!("expected a number, got '{text}'"))?)
             }
@@ -237,6 +253,8 @@ impl Setting {
             (Kind::Counts(counts), Value::Count(n)) => counts.contains(&n),
             (Kind::Choice(names), Value::Choice(name)) => names.contains(&name),
             (Kind::Switch { .. }, Value::Switch(_)) => true,
+            (Kind::Reach { .. }, Value::Number(x)) => x.is_finite() && x > 0.0,
+            (Kind::Reach { .. }, Value::Share(share)) => share > 0.0 && share <= 1.0,
             _ => false,
         };
         if fits {
@@ -290,6 +308,7 @@ mod tests {
                     Kind::Counts(counts) => Value::Count(counts[counts.len() - 1]),
                     Kind::Choice(names) => Value::Choice(names[names.len() - 1]),
                     Kind::Switch { given } => Value::Switch(given),
+                    Kind::Reach { slider } => Value::Number(slider[1]),
                 };
                 let mut chain = ChainSettings { method, ..ChainSettings::default() };
                 (s.set)(&mut chain, other);
@@ -298,7 +317,8 @@ mod tests {
                 let outside = match s.kind {
                     Kind::Number { max, .. } => Some(Value::Number(2.0 * max + 1.0)),
                     Kind::Above { min, .. } => Some(Value::Number(min - 1.0)),
-                    Kind::Count { max, .. } => Some(Value::Count(max + 1)),
+                    Kind::Count { max, .. } => max.checked_add(1).map(Value::Count),
+                    Kind::Reach { .. } => Some(Value::Share(1.5)),
                     _ => None,
                 };
                 if let Some(outside) = outside {

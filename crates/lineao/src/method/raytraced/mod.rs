@@ -59,7 +59,7 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     preset: |_, settings| settings.strength = 1.0,
     validate: |s| s.raytraced.validate(),
     levels: super::one_level,
-    settings: &[],
+    settings: settings::SETTINGS,
     conform: super::conform_always,
     bench: &[
         // One ray per pixel each frame, continuing one picture (started by the first warm-up
@@ -185,7 +185,8 @@ impl Key {
         bits.extend([view.width, view.height, view.guard, view.near.to_bits(), view.far.to_bits()]);
         bits.extend([targets.size.0, targets.size.1]);
         // Not the rays per frame: ray i of a picture is ray i whatever the frames it came in.
-        bits.extend([r.distance_world.to_bits(), (r.falloff == Falloff::Linear) as u32, r.seed]);
+        let reach = r.reach(scene.map_or(0.0, RayScene::longest_side));
+        bits.extend([reach.to_bits(), (r.falloff == Falloff::Linear) as u32, r.seed]);
         // With the denoiser tube pixels find their own segment on the first frame.
         bits.push(r.denoise.is_some() as u32);
         bits.push(settings.line_width_px.to_bits());
@@ -361,8 +362,8 @@ impl RayTracedAo {
             frame_rays: progress.frame_rays,
             first_ray: progress.traced,
             seed: r.seed,
-            distance: r.distance_world,
-            epsilon: (EPSILON_PER_DISTANCE * r.distance_world as f64) as f32,
+            distance: r.reach(scene.longest_side()),
+            epsilon: (EPSILON_PER_DISTANCE * r.reach(scene.longest_side()) as f64) as f32,
             line_half: 0.5 * settings.line_width_px / view.f_px,
             tube_radius,
             max_radius: tube_radius.max(scene.max_vertex_radius),

@@ -1,5 +1,76 @@
 //! The GPU ray tracer's settings: rays per frame, the cap, the reach, and the denoiser.
 
+use crate::method::setting::{Kind, Setting, Unit, Value};
+
+/// The ray tracer's settings as the front ends show them (CONTRACT.md's flags, which the CPU
+/// truth of `lineao score` and `render --cpu` reads too).
+pub(crate) const SETTINGS: &[Setting] = &[
+    Setting {
+        flag: "rays",
+        label: "rays per pixel",
+        help: "Ray-traced AO: rays per geometry pixel, after which the picture is complete. 256 is LineVis's reference count: a standard error of at most 0.03 per pixel",
+        kind: Kind::Count { min: 1, max: 1 << 20 },
+        default: Some("256; the viewer's 1024"),
+        get: |s| Value::Count(s.raytraced.max_rays),
+        set: |s, v| {
+            let r = &mut s.raytraced;
+            r.max_rays = v.as_u32();
+            r.rays_per_frame = r.rays_per_frame.min(r.max_rays);
+        },
+        ..Setting::BASE
+    },
+    Setting {
+        flag: "rays-per-frame",
+        label: "rays per frame",
+        help: "Ray-traced AO: rays per pixel each frame adds; fewer keep a slow GPU responsive",
+        kind: Kind::Count { min: 1, max: 1024 },
+        default: Some("render: the rays, at most 64; the viewer's 4"),
+        get: |s| Value::Count(s.raytraced.rays_per_frame),
+        set: |s, v| s.raytraced.rays_per_frame = v.as_u32(),
+        ..Setting::BASE
+    },
+    Setting {
+        flag: "ao-distance",
+        label: "reach",
+        help: "Ray-traced AO: how far a ray looks for an occluder (the truth's R). 2 is the reach VO and SSAO sample by default and that of LineAO's widest hemisphere (r0 + 2 z(P) px); 20% is LineVis's default reach and score's bundle-scale truth",
+        unit: Unit::WorldUnits,
+        kind: Kind::Reach { slider: [0.1, 20.0] },
+        get: |s| s.raytraced.distance_share.map_or(Value::Number(s.raytraced.distance_world), Value::Share),
+        set: |s, v| match v {
+            Value::Share(share) => s.raytraced.distance_share = Some(share),
+            v => (s.raytraced.distance_world, s.raytraced.distance_share) = (v.as_f32(), None),
+        },
+        ..Setting::BASE
+    },
+    Setting {
+        flag: "ao-falloff",
+        label: "falloff",
+        help: "Ray-traced AO: binary (none) or obscurance with a linear falloff (linear)",
+        kind: Kind::Choice(&["none", "linear"]),
+        get: |s| Value::Choice(s.raytraced.falloff.name()),
+        set: |s, v| s.raytraced.falloff = v.named(),
+        ..Setting::BASE
+    },
+    Setting {
+        flag: "ray-seed",
+        label: "seed",
+        help: "Ray-traced AO: seed of the per-pixel scrambled ray sequence",
+        kind: Kind::Count { min: 0, max: u32::MAX },
+        get: |s| Value::Count(s.raytraced.seed),
+        set: |s, v| s.raytraced.seed = v.as_u32(),
+        ..Setting::BASE
+    },
+    Setting {
+        flag: "denoise",
+        label: "denoise (edge-aware)",
+        help: "Ray-traced AO on the GPU: the edge-aware denoiser after the rays (same line or surface, a window narrowing as 1/√rays), for few rays",
+        kind: Kind::Switch { given: true },
+        get: |s| Value::Switch(s.raytraced.denoise.is_some()),
+        set: |s, v| s.raytraced.denoise = v.is_on().then(|| s.raytraced.denoise.clone().unwrap_or_default()),
+        ..Setting::BASE
+    },
+];
+
 /// The ray-traced method on the GPU ([`crate::method::raytraced`]): rays per frame while the
 /// view rests, accumulated up to a cap, as the CPU truth traces them.
 #[derive(Clone, Debug, PartialEq)]
@@ -10,10 +81,14 @@ pub struct RayTracedSettings {
     /// Rays per geometry pixel each frame, ≥ 1. Default 4 (LineVis's).
     pub rays_per_frame: u32,
     /// Rays per pixel after which the frame is converged and nothing more is traced, ≥ 1.
-    /// Default 1024.
+    /// Default 256 (LineVis's reference count).
     pub max_rays: u32,
     /// The rays' reach R in world units, > 0. Default 2 (the truth's).
     pub distance_world: f32,
+    /// Where set, the reach is this share in (0, 1] of the longest side of the ray scene's
+    /// axis-aligned bounds instead ([`RayTracedSettings::resolve`]; LineVis's 0.2).
+    #[cfg_attr(feature = "serde", serde(skip_serializing_if = "Option::is_none"))]
+    pub distance_share: Option<f32>,
     pub falloff: crate::truth::Falloff,
     /// Seed of the per-pixel scramble (the CPU truth's `seed`).
     pub seed: u32,
@@ -83,8 +158,9 @@ impl Default for RayTracedSettings {
         let truth = crate::truth::TruthSettings::default();
         RayTracedSettings {
             rays_per_frame: 4,
-            max_rays: 1024,
+            max_rays: 256,
             distance_world: truth.distance_world,
+            distance_share: None,
             falloff: truth.falloff,
             seed: truth.seed,
             denoise: None,
@@ -93,6 +169,18 @@ impl Default for RayTracedSettings {
 }
 
 impl RayTracedSettings {
+    /// The reach in world units in a scene whose bounds' longest side is `longest_side`.
+    pub fn reach(&self, longest_side: f32) -> f32 {
+        self.distance_share.map_or(self.distance_world, |share| share * longest_side)
+    }
+
+    /// The reach as world units (the share of `longest_side` where one is set, which is then
+    /// cleared): what a front end that knows its scene's bounds does once.
+    pub fn resolve(&mut self, longest_side: f32) {
+        self.distance_world = self.reach(longest_side);
+        self.distance_share = None;
+    }
+
     /// The CPU truth's settings tracing the same rays as `rays` rays per pixel of these.
     pub fn truth(&self, rays: u32) -> crate::truth::TruthSettings {
         crate::truth::TruthSettings {
@@ -115,6 +203,11 @@ impl RayTracedSettings {
         }
         if let Some(denoise) = &self.denoise {
             denoise.validate()?;
+        }
+        if let Some(share) = self.distance_share.filter(|s| !(*s > 0.0 && *s <= 1.0)) {
+            return Err(crate::Error::InvalidSettings(format!(
+                "the rays' reach as a share of the scene must be in (0, 1], got {share}"
+            )));
         }
         self.truth(1).validate()
     }
