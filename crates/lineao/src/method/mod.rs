@@ -290,6 +290,27 @@ pub(crate) fn fits_always(_: (u32, u32), _: &wgpu::Limits) -> Result<(), crate::
     Ok(())
 }
 
+/// [`MethodInfo::fits`] of a method's storage buffer of `bytes` for a guard-banded `size`:
+/// more than the device's storage buffers take is [`crate::Error::TooLarge`], saying what
+/// (`what`) needs it.
+pub(crate) fn fits_storage(
+    what: &str,
+    size: (u32, u32),
+    bytes: u64,
+    limits: &wgpu::Limits,
+) -> Result<(), crate::Error> {
+    let max_storage = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+    if bytes <= max_storage {
+        return Ok(());
+    }
+    let message = format!(
+        "{what} for {} x {} px (with the guard band) needs {bytes} bytes, more than the adapter's {max_storage} \
+         byte storage buffers",
+        size.0, size.1
+    );
+    Err(crate::Error::TooLarge { limit: crate::Limit::StorageBuffer, value: bytes, max: max_storage, message })
+}
+
 /// [`MethodInfo::conform`] of a method whose values are valid apart.
 pub(crate) fn conform_always(_: &mut ChainSettings) {}
 

@@ -237,22 +237,8 @@ pub const ACCUMULATION_BYTES: u64 = 16;
 /// Whether the accumulation for a guard-banded `size` fits the device's storage buffers (the
 /// method's entry in the registry's size check).
 fn fits(size: (u32, u32), limits: &wgpu::Limits) -> Result<(), crate::Error> {
-    let max_storage = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
     let bytes = size.0 as u64 * size.1 as u64 * ACCUMULATION_BYTES;
-    if bytes > max_storage {
-        let message = format!(
-            "the ray tracer's accumulation for {} x {} px (with the guard band) needs {bytes} bytes, more than \
-             the adapter's {max_storage} byte storage buffers",
-            size.0, size.1
-        );
-        return Err(crate::Error::TooLarge {
-            limit: crate::Limit::StorageBuffer,
-            value: bytes,
-            max: max_storage,
-            message,
-        });
-    }
-    Ok(())
+    super::fits_storage("the ray tracer's accumulation", size, bytes, limits)
 }
 
 impl RayTracedAo {

@@ -102,22 +102,7 @@ impl Moments {
 /// Whether VO area's moments pyramid for a guard-banded `size` fits the device's storage
 /// buffers (the method's entry in the registry's size check).
 pub(crate) fn fits(size: (u32, u32), limits: &wgpu::Limits) -> Result<(), crate::Error> {
-    let max_storage = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
-    let bytes = Moments::bytes(size);
-    if bytes > max_storage {
-        let message = format!(
-            "VO area's moments pyramid for {} x {} px (with the guard band) needs {bytes} bytes, more than the \
-             adapter's {max_storage} byte storage buffers",
-            size.0, size.1
-        );
-        return Err(crate::Error::TooLarge {
-            limit: crate::Limit::StorageBuffer,
-            value: bytes,
-            max: max_storage,
-            message,
-        });
-    }
-    Ok(())
+    crate::method::fits_storage("VO area's moments pyramid", size, Moments::bytes(size), limits)
 }
 
 /// The pass that writes [`Moments`] from `nd[0]`; it owns the pyramid, sized by `resize`.
