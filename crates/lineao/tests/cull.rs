@@ -243,6 +243,45 @@ fn culled_tubes_draw_the_g_buffer_of_all_tubes() {
     }
 }
 
+/// Checks the levels of detail the GPU chose for the visible pieces of the last frame against
+/// the CPU reference's (`lineao::reference::cull::levels`): the same wherever no level's test
+/// lies within 1e-3 px of the bound; those are counted.
+fn same_levels_as_the_cpu_reference(
+    gpu: &lineao::Gpu,
+    renderer: &LineRenderer,
+    geometry: &LineGeometry,
+    view: &FrameView,
+    case: &str,
+) {
+    use lineao::reference::cull::{CullView, levels};
+    let frame = CullView { view: view.view, proj: view.proj, size: view.banded_size(), line_width_px: LINE_WIDTH };
+    let pages = geometry.page_contents(&gpu.device, &gpu.queue).unwrap();
+    let expected = levels(&pages, &frame, 1e-3);
+    let got = renderer.cull().unwrap().cull().marks(&gpu.queue, geometry).unwrap();
+    let (mut visible, mut unsure, mut coarse) = (0, 0, 0);
+    for (page, (expected, got)) in expected.iter().zip(&got).enumerate() {
+        for (i, (levels, &bits)) in expected.iter().zip(got).enumerate() {
+            for (p, level) in levels.iter().enumerate() {
+                if bits & (1 << p) == 0 {
+                    continue;
+                }
+                visible += 1;
+                let chosen = (bits >> (3 + 2 * p)) & 3;
+                coarse += (chosen > 0) as usize;
+                match level {
+                    Some(level) => assert_eq!(chosen, *level, "{case}: page {page} cluster {i} piece {p}"),
+                    None => unsure += 1,
+                }
+            }
+        }
+    }
+    println!(
+        "{case}: the CPU reference's level for every sure piece of {visible} visible ({coarse} coarser); {unsure} unsure"
+    );
+    assert!(unsure * 100 <= visible.max(100), "{case}: {unsure} levels unsure");
+    assert!(visible > 0, "{case}: nothing visible to check");
+}
+
 /// The culled lines at levels of detail (`passes::cull`'s `LOD_PIXELS`): against every line's
 /// full strip, the same pixels covered but a few at the silhouette, and the front line's depth
 /// within half a pixel's width of the full strip's at nearly every pixel (elsewhere another
@@ -267,6 +306,7 @@ fn culled_lines_at_levels_of_detail_stay_within_half_a_pixel() {
         same_gbuffer(&expected, &first, case);
         let got = draw(&gpu, &lod, &geometry, &camera);
         let counts = lod.cull().unwrap().counts(q, &geometry).unwrap();
+        same_levels_as_the_cpu_reference(&gpu, &lod, &geometry, &view, case);
         let (mut covered, mut coverage, mut far, mut identical) = (0usize, 0usize, 0usize, 0usize);
         for i in 0..expected[0].data.len() {
             let (a, b) = (is_geometry(expected[1].data[i]), is_geometry(got[1].data[i]));

@@ -9,6 +9,12 @@
 //! made twice — with the rectangle `slack` pixels narrower and the depth margin smaller, and
 //! with both larger — and a piece is *visible* where even the narrow test passes, *hidden*
 //! where even the wide one fails, else *unsure*: the GPU must agree on every sure one.
+//!
+//! The level of detail each visible piece is drawn at next ([`levels`], `piece_level` in
+//! `cull.wgsl`): the coarsest stride (2^level points, level < 4) at which every dropped point
+//! lies within [`LOD_PIXELS`](crate::passes::cull::LOD_PIXELS) of the segment between the kept
+//! points around it, its distance measured at the scale of the piece's nearest point, plus the
+//! turn of the sideways push at it; a piece with a point behind the eye is drawn whole.
 
 use glam::{Mat4, Vec3, Vec4Swizzles};
 
@@ -107,6 +113,77 @@ pub fn marks(pages: &[PageContents], view: &CullView, depth: &Image<f32>, slack:
                             (Verdict::Visible, Verdict::Visible) => Verdict::Visible,
                             _ => Verdict::Unsure,
                         }
+                    })
+                })
+                .collect()
+        })
+        .collect()
+}
+
+/// `LEVELS` of `cull.wgsl`: strides 1, 2, 4 and 8.
+const LEVELS: u32 = 4;
+
+/// Every piece's level of detail (per page, per cluster, pieces 0–2): the one the GPU picks for
+/// a visible piece of a frame of `view`, or `None` where a level's test lies within `slack`
+/// pixels of [`LOD_PIXELS`](crate::passes::cull::LOD_PIXELS) (the GPU's f32 may go either way)
+/// or the piece does not exist.
+pub fn levels(pages: &[PageContents], view: &CullView, slack: f32) -> Vec<Vec<[Option<u32>; 3]>> {
+    let viewport = glam::Vec2::new(view.size.0 as f32, view.size.1 as f32);
+    let scale = 0.5 * (view.proj.x_axis.x * viewport.x).max(view.proj.y_axis.y * viewport.y);
+    let half_width = 0.5 * view.line_width_px;
+    let level = |points: &[Vec3]| -> Option<u32> {
+        let mut nearest = f32::INFINITY;
+        let mut p = Vec::with_capacity(points.len());
+        for &point in points {
+            let view_pos = view.view.transform_point3(point);
+            let w = (view.proj * view_pos.extend(1.0)).w;
+            if w <= 0.0 {
+                return Some(0);
+            }
+            nearest = nearest.min(w);
+            p.push(view_pos);
+        }
+        let px = scale / nearest;
+        let n = p.len();
+        for level in (1..LEVELS).rev() {
+            let stride = 1 << level;
+            // The test's largest value over the dropped points: within `slack` of the bound,
+            // the GPU may decide either way.
+            let worst = (1..n.saturating_sub(1))
+                .filter(|k| k % stride != 0)
+                .map(|k| {
+                    let (a, b) = (p[k - k % stride], p[(k - k % stride + stride).min(n - 1)]);
+                    let ab = b - a;
+                    let t = ((p[k] - a).dot(ab) / ab.dot(ab).max(1e-30)).clamp(0.0, 1.0);
+                    let off_line = (p[k] - (a + t * ab)).length() * px;
+                    let turn = ((p[k + 1] - p[k - 1]).normalize() - ab.normalize()).length() * half_width;
+                    off_line + turn
+                })
+                .fold(0.0f32, f32::max);
+            if (worst - crate::passes::cull::LOD_PIXELS).abs() <= slack {
+                return None;
+            }
+            if worst <= crate::passes::cull::LOD_PIXELS {
+                return Some(level);
+            }
+        }
+        Some(0)
+    };
+    pages
+        .iter()
+        .map(|page| {
+            page.records
+                .iter()
+                .map(|c| {
+                    std::array::from_fn(|p| {
+                        let (drawn, first) = (c.drawn() as usize, p * PIECE_SEGMENTS as usize);
+                        if first + 1 >= drawn {
+                            return None;
+                        }
+                        let last = (first + PIECE_SEGMENTS as usize).min(drawn - 1);
+                        let points: Vec<Vec3> =
+                            (first..=last).map(|k| Vec3::from_array(page.points[c.first as usize + k])).collect();
+                        level(&points)
                     })
                 })
                 .collect()
