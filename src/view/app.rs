@@ -27,7 +27,8 @@ use lineao_tracts::SceneKind;
 
 use super::camera::OrbitCamera;
 use super::controls::{ColorMode, Controls, RegionRule, method_label};
-use super::worker::{self, Dataset, Frame, FromWorker, Output, PREVIEW_VERTICES, Source, ToWorker, View, Worker};
+use super::loading::PREVIEW_VERTICES;
+use super::worker::{self, Dataset, Frame, FromWorker, Output, Source, ToWorker, View, Worker};
 
 /// How long after the last camera motion frames stay previews.
 const MOTION_REST: Duration = Duration::from_millis(300);

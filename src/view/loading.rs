@@ -19,12 +19,35 @@ use lineao::{Gpu, LineGeometry};
 use lineao_tracts::{ChunkDecoder, SceneKind, Tractogram};
 use web_time::Instant;
 
-use super::worker::{PREVIEW_VERTICES, Selected, Source};
-use crate::source::{CHUNK_VERTICES, Keep, Lines, Sampled, SourceError};
+use crate::source::{CHUNK_VERTICES, Keep, Lines, Sampled, Source, SourceError};
 
 /// How long a step reads and uploads before it lets the worker draw and listen, at least; a
 /// step reads as long as the time between steps (what the frames and the window took), up to
 /// [`STEP_MOST_MS`], so that the reading has half the time however slow the frames are.
+/// Vertices of a preview frame at most.
+pub const PREVIEW_VERTICES: usize = 250_000;
+
+/// A selection on the GPU: its rules, the streamlines there were, and how many it kept (`None`:
+/// every one).
+#[derive(Clone, Debug)]
+pub struct Selected {
+    pub selection: lineao_tracts::Selection,
+    pub streamlines: usize,
+    pub kept: Option<usize>,
+}
+
+/// The parts of a scene a frame reads: the loaded one's, or those of one being opened.
+pub struct SceneRef<'a> {
+    pub lines: &'a mut Lines,
+    pub preview: &'a mut Preview,
+    pub rays: &'a mut Option<Arc<lineao::RayScene>>,
+    pub source: &'a Source,
+    /// Still arriving: what needs every point on the CPU waits until it is all there.
+    pub opening: bool,
+    /// The selection last written to the GPU, and the streamlines there were then.
+    pub selected: &'a mut Option<Selected>,
+}
+
 const STEP_BUDGET_MS: f64 = 60.0;
 const STEP_MOST_MS: f64 = 500.0;
 /// How much reading passes between two draws of what has arrived (a flush of the geometry's
@@ -99,7 +122,7 @@ pub struct Opening {
     pub held: bool,
     /// Never built while the data arrives (the ray tracer waits for all of it).
     rays: Option<Arc<lineao::RayScene>>,
-    /// The selection on the GPU so far (`worker::SceneRef::selected`).
+    /// The selection on the GPU so far ([`SceneRef::selected`]).
     selected: Option<Selected>,
     /// The file's groups, once it is read.
     groups: Vec<lineao_tracts::Group>,
@@ -271,8 +294,8 @@ impl Opening {
     }
 
     /// The parts of the scene a frame reads while it arrives.
-    pub fn scene(&mut self) -> super::worker::SceneRef<'_> {
-        super::worker::SceneRef {
+    pub fn scene(&mut self) -> SceneRef<'_> {
+        SceneRef {
             lines: &mut self.lines,
             preview: &mut self.preview,
             rays: &mut self.rays,

@@ -14,7 +14,8 @@ use lineao_tracts::SceneKind;
 
 use super::app::{App, Options};
 use super::controls::{Controls, RAY_TRACED, methods};
-use super::worker::{PREVIEW_VERTICES, Source};
+use super::loading::PREVIEW_VERTICES;
+use super::worker::Source;
 use lineao::Preset;
 
 const SIZE: [f32; 2] = [1000.0, 640.0];

@@ -34,12 +34,9 @@ use lineao::volume::VolumeAoOptions;
 use lineao::{AoChain, AoMethod, ChainSettings, Gpu, LineColor, RayScene, SliceVolume};
 use lineao_tracts::ViewHint;
 
-use super::loading::{Opening, Preview, Step};
+use super::loading::{Opening, PREVIEW_VERTICES, Preview, SceneRef, Selected, Step};
 pub use crate::source::Source;
 use crate::source::{AttributeKey, FrameScene, Lines, Sampled};
-
-/// Vertices of a preview frame at most.
-pub const PREVIEW_VERTICES: usize = 250_000;
 
 /// One image of a frame: the chain's settings, and the object-space AO it needs.
 #[derive(Clone, Debug, PartialEq)]
@@ -126,15 +123,6 @@ pub struct Frame {
     pub render_ms: f64,
     /// The streamlines selected and all of them, where a rule leaves some out.
     pub selected: Option<(usize, usize)>,
-}
-
-/// A selection on the GPU: its rules, the streamlines there were, and how many it kept (`None`:
-/// every one).
-#[derive(Clone, Debug)]
-pub struct Selected {
-    pub selection: lineao_tracts::Selection,
-    pub streamlines: usize,
-    pub kept: Option<usize>,
 }
 
 impl Frame {
@@ -524,18 +512,6 @@ fn dataset(lines: &Lines, opening: &Opening, complete: bool) -> Dataset {
         first_ms: opening.first_ms().unwrap_or(elapsed),
         load_ms: elapsed,
     }
-}
-
-/// The parts of a scene a frame reads: the loaded one's, or those of one being opened.
-pub(super) struct SceneRef<'a> {
-    pub lines: &'a mut Lines,
-    pub preview: &'a mut Preview,
-    pub rays: &'a mut Option<Arc<RayScene>>,
-    pub source: &'a Source,
-    /// Still arriving: what needs every point on the CPU waits until it is all there.
-    pub opening: bool,
-    /// The selection last written to the GPU, and the streamlines there were then.
-    pub selected: &'a mut Option<Selected>,
 }
 
 /// Whether both are the same allocation, or both none.
