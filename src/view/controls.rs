@@ -317,11 +317,18 @@ impl Controls {
         for (method, setting) in lineao_session::method_args::described() {
             let chain = &self.params.chain;
             let value = (setting.get)(chain);
-            if shown.iter().any(|m| m.screen == method) && (setting.applies)(chain) && value != (setting.get)(&opened) {
-                let text = if matches!(setting.kind, Kind::Switch { .. }) { String::new() } else { value.to_string() };
-                flags.push((setting.flag.to_string(), text));
-                (setting.set)(&mut opened, value);
+            if !shown.iter().any(|m| m.screen == method) || !(setting.applies)(chain) || value == (setting.get)(&opened)
+            {
+                continue;
             }
+            let text = match setting.kind {
+                // A switch's flag only gives its `given` value; the other is the preset's.
+                Kind::Switch { given } if value == Value::Switch(given) => String::new(),
+                Kind::Switch { .. } => continue,
+                _ => value.to_string(),
+            };
+            flags.push((setting.flag.to_string(), text));
+            (setting.set)(&mut opened, value);
         }
         let selection = self.selection();
         let pair = |[a, b]: [f32; 2]| format!("{a},{b}");

@@ -214,16 +214,18 @@ mod tests {
     #[test]
     fn a_link_keeps_the_methods_settings_and_the_selection() {
         use lineao::method::setting::Value;
-        use lineao_cli::view::controls::{Controls, RegionRule, methods};
+        use lineao_cli::view::controls::{Controls, RAY_TRACED, RegionRule, methods};
         use lineao_tracts::Region;
         let ssao = methods().into_iter().find(|m| m.screen == AoMethod::Ssao && m.volume.is_none()).unwrap();
-        let mut controls = Controls::new([ssao, ssao], false, lineao::Preset::Legible);
+        let mut controls = Controls::new([ssao, RAY_TRACED], true, lineao::Preset::Legible);
         // As the panel moves them: the radius sets the range check too, which then moves back.
         let described = AoMethod::Ssao.info().settings;
         for (flag, value) in [("ssao-samples", Value::Count(8)), ("ssao-radius", Value::Number(3.3))] {
             (described.iter().find(|s| s.flag == flag).unwrap().set)(&mut controls.params.chain, value);
         }
         controls.params.chain.ssao.range_world = 8.0;
+        // A switch its flag cannot give (the denoiser off where the viewer turns it on) is left out.
+        controls.params.chain.raytraced.denoise = None;
         (controls.subset, controls.length) = (0.3, Some([20.0, 80.5]));
         controls.regions = vec![
             RegionRule { include: true, region: Region::Sphere { center: [1.5, -2.0, 0.1], radius: 7.25 } },
@@ -234,7 +236,7 @@ mod tests {
         assert_eq!(keys, ["ssao-samples", "ssao-radius", "ssao-range", "subset", "length", "include", "exclude"]);
         let query = link(
             (&LinkSource::Scene("bundles".into()), None),
-            &["ssao"],
+            &["ssao", "raytraced"],
             lineao::Preset::Legible,
             (None, false),
             &flags,
