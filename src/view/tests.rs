@@ -636,3 +636,21 @@ fn include_and_exclude_regions_select_streamlines_as_groups_do() {
     assert!(few > 0.0 && few < 0.3 * all, "{few} of the pixels through the sphere, {all} with all");
     assert!(harness.query_all_by_label_contains("+ sphere").count() > 0, "the button that adds a region");
 }
+
+#[test]
+fn a_frozen_cull_shows_from_behind_what_it_drew_for_the_view_before() {
+    let mut harness = harness(options(scene(SceneKind::Bundles, 200_000), [methods()[0], methods()[4]], false));
+    settle(&mut harness);
+    assert!(harness.state().controls.params.chain.cull, "the viewer culls by default");
+    let drawn = |harness: &Harness<'_, App>| non_background(&harness.state().shown.as_ref().unwrap().images[0]);
+    harness.state_mut().controls.debug_view = lineao::DebugView::Frozen;
+    settle(&mut harness);
+    // Half way round: the pieces found for the front, seen from behind.
+    harness.state_mut().camera.as_mut().unwrap().yaw += std::f32::consts::PI;
+    settle(&mut harness);
+    let frozen = drawn(&harness);
+    harness.state_mut().controls.debug_view = lineao::DebugView::Pieces;
+    settle(&mut harness);
+    let whole = drawn(&harness);
+    assert!(frozen > 0.0 && frozen < 0.95 * whole, "{frozen} of the pixels frozen, {whole} culled afresh");
+}

@@ -855,9 +855,14 @@ pub fn parse_debug_view(s: &str) -> Result<lineao::DebugView, String> {
         "depth" => D::Depth,
         "zoom" => D::Zoom,
         "pieces" => D::Pieces,
+        "frozen" => D::Frozen,
         _ => match s.strip_prefix("level:").map(str::parse::<u32>) {
             Some(Ok(k)) => D::Level(k),
-            _ => return Err(format!("unknown debug view '{s}' (final, ao, normals, depth, zoom, level:K, pieces)")),
+            _ => {
+                return Err(format!(
+                    "unknown debug view '{s}' (final, ao, normals, depth, zoom, level:K, pieces, frozen)"
+                ));
+            }
         },
     })
 }

@@ -91,6 +91,10 @@ pub enum DebugView {
     /// drawn at ([`crate::passes::cull`]): blue every point, green every 2nd, orange every 4th,
     /// red every 8th; lines drawn whole (not culled) and tubes gray.
     Pieces,
+    /// [`DebugView::Pieces`] with the cull frozen: the pieces found visible in the frame before
+    /// it was chosen, and no others, whatever the camera does — orbit away to see what the
+    /// cull drew for that view and what it left out (behind them, outside the frustum).
+    Frozen,
 }
 
 impl DebugView {
@@ -103,7 +107,7 @@ impl DebugView {
             DebugView::Zoom => (4, 0),
             DebugView::Level(k) => (5, k),
             // The geometry's colors say it.
-            DebugView::Pieces => (0, 0),
+            DebugView::Pieces | DebugView::Frozen => (0, 0),
         }
     }
 }

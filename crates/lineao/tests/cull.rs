@@ -424,3 +424,38 @@ fn a_selection_changed_between_culled_frames_draws_at_once() {
         assert_eq!(left, 0, "lod {lod}: {left} pixels of streamlines selected out");
     }
 }
+
+/// `DebugView::Frozen`'s cull: frozen after the frames of one view, a frame from another draws
+/// exactly the pieces found visible for the first — the early phase alone, no late pieces, the
+/// marks untouched — and so leaves the pixels the culled pieces would have covered empty; thawed,
+/// the next frame is again every line's G-buffer.
+#[test]
+fn a_frozen_cull_draws_the_pieces_it_found_for_the_view_before() {
+    let gpu = gpu();
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let (positions, offsets) = ball(4000);
+    let geometry = LineGeometry::new(d, q, &positions, &offsets).unwrap();
+    let all = LineRenderer::with_style(d, LineStyle::FullStrip);
+    let culled = LineRenderer::new(d).culled(d, false);
+    let cull = culled.cull().unwrap().cull();
+    let (from, to) = (outside(), cameras()[4].1);
+    draw(&gpu, &culled, &geometry, &from);
+    draw(&gpu, &culled, &geometry, &from);
+    let marks = cull.marks(q, &geometry).unwrap();
+    let visible: u64 =
+        marks.iter().flatten().map(|m| (m & lineao::passes::cull::MARK_VISIBLE).count_ones() as u64).sum();
+    cull.set_frozen(true);
+    let frozen = draw(&gpu, &culled, &geometry, &to);
+    let counts = cull.counts(q, &geometry).unwrap();
+    assert_eq!((counts.early, counts.late), (visible, 0), "{counts}");
+    assert_eq!(cull.marks(q, &geometry).unwrap(), marks, "a frozen frame marks nothing");
+    let expected = draw(&gpu, &all, &geometry, &to);
+    let covered = |g: &[NdImage; 4]| g[1].data.iter().filter(|t| is_geometry(**t)).count();
+    let (shown, whole) = (covered(&frozen), covered(&expected));
+    println!("frozen: {visible} pieces of {} drawn from the other side, {shown} of {whole} pixels", counts.pieces);
+    assert!(shown > 0 && shown * 10 < whole * 9, "{shown} of {whole} pixels: the other side's front is missing");
+    cull.set_frozen(false);
+    draw(&gpu, &culled, &geometry, &to);
+    let thawed = draw(&gpu, &culled, &geometry, &to);
+    same_gbuffer(&expected, &thawed, "thawed");
+}

@@ -400,7 +400,12 @@ impl AoChain {
             self.targets = Some(targets);
         }
         let targets = self.targets.as_ref()?;
-        let color = if s.debug_view == DebugView::Pieces { LineColor::Pieces } else { s.line_color };
+        let pieces = matches!(s.debug_view, DebugView::Pieces | DebugView::Frozen);
+        let color = if pieces { LineColor::Pieces } else { s.line_color };
+        let culls = [self.lines.cull(), self.tubes.as_ref().and_then(TubeRenderer::cull)];
+        for culled in culls.into_iter().flatten() {
+            culled.cull().set_frozen(s.debug_view == DebugView::Frozen);
+        }
         match (&self.tubes, &s.tubes) {
             (Some(tubes), Some(t)) => tubes.prepare(queue, &view, t.radius_world, color, &s.lighting, s.slab.as_ref()),
             _ => self.lines.prepare(queue, &view, s.line_width_px, color, &s.lighting, s.slab.as_ref()),

@@ -240,6 +240,9 @@ pub struct LineCull {
     early_whole: wgpu::ComputePipeline,
     /// The view of the frame being recorded ([`LineCull::set_view`]).
     view: std::sync::Mutex<Option<LevelsView>>,
+    /// Whether its frames draw what it last found visible and find nothing new
+    /// ([`LineCull::set_frozen`]).
+    frozen: std::sync::atomic::AtomicBool,
     pad: wgpu::ComputePipeline,
     test_groups: wgpu::ComputePipeline,
     size_dispatch: wgpu::ComputePipeline,
@@ -301,6 +304,7 @@ impl LineCull {
             early: pipeline("early", &[None, Some(&page), None, Some(&state_layout)]),
             early_whole: pipeline_of("early", &[None, Some(&page), None, Some(&state_layout)], false),
             view: Default::default(),
+            frozen: Default::default(),
             pad: pipeline("pad", &[None, None, None, Some(&state_layout)]),
             lod,
             test_groups: pipeline("test_groups", &listing),
@@ -422,8 +426,12 @@ impl LineCull {
         span: Option<Span<'s>>,
         mut draw: impl FnMut(&mut wgpu::CommandEncoder, Phase, Option<Span<'s>>),
     ) {
-        let (first, last) = Span::split(span);
         let pages = geometry.pages();
+        // Frozen, once every page has been culled: the pieces it last found visible, nothing
+        // tested, nothing marked (the early phase alone).
+        let frozen = self.frozen.load(std::sync::atomic::Ordering::Relaxed)
+            && pages.iter().all(|page| page.cull[self.slot()].get().is_some());
+        let (first, last) = if frozen { (span, None) } else { Span::split(span) };
         for page in pages {
             encoder.clear_buffer(&self.state(page).state, 0, Some(4 * STATE_HEADER_WORDS));
         }
@@ -434,13 +442,18 @@ impl LineCull {
                 let hold = matches!((*levels_of, view), (Some(then), Some(now)) if then.holds(&now));
                 pass.set_pipeline(if hold { &self.early } else { &self.early_whole });
                 // This frame's settling finds them for this view.
-                *levels_of = view;
+                if !frozen {
+                    *levels_of = view;
+                }
             }
             pass.set_bind_group(3, &state.compute_group, &[]);
             dispatch_over(pass, page.records);
         });
         self.pad(encoder, pages);
         draw(encoder, Phase::Early, None);
+        if frozen {
+            return;
+        }
         let built = self.pyramid.encode(encoder, &targets.depth, None);
         self.test(encoder, pages, frame, &built, &self.size_dispatch, &self.late, None);
         self.pad(encoder, pages);
@@ -455,6 +468,13 @@ impl LineCull {
             pass.set_bind_group(3, &state.compute_group, &[]);
             pass.dispatch_workgroups(1, 1, 1);
         });
+    }
+
+    /// Freezes the cull (`true`): its frames draw the pieces it found visible in the last frame
+    /// before, and test and mark nothing, so a camera moved away shows what it drew for that
+    /// view ([`crate::DebugView::Frozen`]). A geometry not culled yet is culled once first.
+    pub fn set_frozen(&self, frozen: bool) {
+        self.frozen.store(frozen, std::sync::atomic::Ordering::Relaxed);
     }
 
     /// Whether it picks a level of detail for each piece.
