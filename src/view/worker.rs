@@ -546,19 +546,17 @@ fn select(
         scene.preview.geometry.set_selection(d, q, None).map_err(error)?;
     } else if count == lines.geometry.streamlines {
         let rule = |e: lineao_tracts::selection::SelectionError| format!("{name}: {e}");
+        let mut keep: Vec<bool> =
+            lines.lengths.iter().enumerate().map(|(i, &l)| selection.keeps(i as u64, l)).collect();
+        selection.apply_field(&mut keep, &lines.tracts).map_err(rule)?;
         let regions = !(selection.include.is_empty() && selection.exclude.is_empty());
-        let mut keep: Vec<bool> = if regions && !scene.opening {
+        if regions && !scene.opening {
             if !lines.points_kept() {
                 send(FromWorker::Busy(format!("reading {name} again for its points (regions) …")));
                 lines.load_points(scene.source).map_err(|e| format!("{e:#}"))?;
             }
-            selection.chunk(&lines.tracts, 0).map_err(rule)?
-        } else {
-            let mut keep: Vec<bool> =
-                lines.lengths.iter().enumerate().map(|(i, &l)| selection.keeps(i as u64, l)).collect();
-            selection.apply_field(&mut keep, &lines.tracts).map_err(rule)?;
-            keep
-        };
+            selection.apply_regions(&mut keep, &lines.tracts);
+        }
         selection.apply_groups(&mut keep, &lines.tracts.groups).map_err(rule)?;
         lines.geometry.set_selection(d, q, Some(&keep)).map_err(error)?;
         kept = Some(keep.iter().filter(|&&k| k).count());

@@ -33,18 +33,22 @@ pub fn settings(args: &RenderArgs, longest_side: f32) -> TruthSettings {
 
 /// The GPU ray tracer's settings from the command line, [`budget`]ed.
 pub fn gpu_settings(args: &RenderArgs, longest_side: f32) -> lineao::RayTracedSettings {
-    let mut chain = lineao::ChainSettings::papers();
-    args.methods.apply(&mut chain);
-    budget(&mut chain.raytraced, args, longest_side);
-    chain.raytraced
+    let mut rays = given(args).raytraced;
+    budget(&mut rays, args, longest_side);
+    rays
 }
 
 /// `--ao-distance` as given (`2`, `20%`).
 pub fn reach_text(args: &RenderArgs) -> String {
+    let (_, reach) = crate::method_args::described().find(|(_, s)| s.flag == "ao-distance").expect("described");
+    (reach.get)(&given(args)).to_string()
+}
+
+/// The papers' settings with the described settings the command line gave.
+fn given(args: &RenderArgs) -> lineao::ChainSettings {
     let mut chain = lineao::ChainSettings::papers();
     args.methods.apply(&mut chain);
-    let (_, reach) = crate::method_args::described().find(|(_, s)| s.flag == "ao-distance").expect("described");
-    (reach.get)(&chain).to_string()
+    chain
 }
 
 /// What the session decides of the ray tracer's settings: the reach in world units (a share

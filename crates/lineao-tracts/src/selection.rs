@@ -176,6 +176,21 @@ impl Selection {
         Ok(())
     }
 
+    /// Leaves out of `mask` (one entry per streamline of `t`) the streamlines that miss an
+    /// include region or meet an exclude region: what a viewer that keeps each streamline's
+    /// length, and reads the points again for regions, adds ([`Selection::chunk`] judges them
+    /// with the others).
+    pub fn apply_regions(&self, mask: &mut [bool], t: &Tractogram) {
+        if self.include.is_empty() && self.exclude.is_empty() {
+            return;
+        }
+        for (i, kept) in mask.iter_mut().enumerate().filter(|(_, kept)| **kept) {
+            let points = &t.positions[t.offsets[i] as usize..t.offsets[i + 1] as usize];
+            *kept = self.include.iter().all(|r| r.meets_polyline(points))
+                && !self.exclude.iter().any(|r| r.meets_polyline(points));
+        }
+    }
+
     /// Every rule on a whole tractogram: one entry per streamline.
     pub fn mask(&self, t: &Tractogram) -> Result<Vec<bool>, SelectionError> {
         let mut mask = self.chunk(t, 0)?;
@@ -251,6 +266,14 @@ mod tests {
         assert_eq!(mask(Selection { exclude: vec![sphere, cube], ..Default::default() }), [true, false, false]);
         // Both include regions must be met.
         assert_eq!(mask(Selection { include: vec![sphere, cube], ..Default::default() }), [false; 3]);
+        // The regions alone (a viewer that keeps the lengths): what `mask` says, and what an
+        // earlier rule left out stays out.
+        let mut regions = [true; 3];
+        Selection { exclude: vec![sphere, cube], ..Default::default() }.apply_regions(&mut regions, &t);
+        assert_eq!(regions, [true, false, false]);
+        let mut after = [false, true, true];
+        Selection { include: vec![cube], ..Default::default() }.apply_regions(&mut after, &t);
+        assert_eq!(after, [false, false, true]);
     }
 
     #[test]
