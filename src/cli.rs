@@ -89,7 +89,8 @@ pub struct ViewArgs {
     /// The colormap of `--color field:NAME`.
     #[arg(long, value_parser = named::<Colormap>(), default_value = "viridis")]
     pub colormap: Colormap,
-    /// What to show: final, ao, normals, depth, zoom, or level:K.
+    /// What to show: final, ao, normals, depth, zoom, level:K, pieces, frozen or culled (as
+    /// `render --debug-view`; the viewer's debug view menu).
     #[arg(long, default_value = "final", value_parser = parse_debug_view)]
     pub debug_view: lineao::DebugView,
     /// Start with an orthographic camera.

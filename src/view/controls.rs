@@ -517,6 +517,7 @@ impl Controls {
         views.extend((0..levels).map(|k| (DebugView::Level(k), format!("pyramid level {k}"))));
         views.push((DebugView::Pieces, "pieces: level of detail".into()));
         views.push((DebugView::Frozen, "pieces: cull frozen (orbit away)".into()));
+        views.push((DebugView::Culled, "pieces: frozen, what it left out".into()));
         let current =
             views.iter().find(|(v, _)| *v == self.debug_view).map_or("final image".into(), |(_, l)| l.clone());
         egui::ComboBox::from_id_salt("debug-view").selected_text(current).show_ui(ui, |ui| {

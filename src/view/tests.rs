@@ -649,8 +649,19 @@ fn a_frozen_cull_shows_from_behind_what_it_drew_for_the_view_before() {
     harness.state_mut().camera.as_mut().unwrap().yaw += std::f32::consts::PI;
     settle(&mut harness);
     let frozen = drawn(&harness);
+    // Still frozen for the front, every piece: those it left out behind the front are purple.
+    harness.state_mut().controls.debug_view = lineao::DebugView::Culled;
+    settle(&mut harness);
+    let image = harness.state().shown.as_ref().unwrap().images[0].clone();
+    let purple =
+        image.chunks_exact(4).filter(|p| p[0] as u32 > p[1] as u32 + 40 && p[2] as u32 > p[1] as u32 + 40).count()
+            as f64
+            / (image.len() / 4) as f64;
+    let every = non_background(&image);
     harness.state_mut().controls.debug_view = lineao::DebugView::Pieces;
     settle(&mut harness);
     let whole = drawn(&harness);
     assert!(frozen > 0.0 && frozen < 0.95 * whole, "{frozen} of the pixels frozen, {whole} culled afresh");
+    assert!((every - whole).abs() < 0.01 * whole, "{every} of the pixels with every piece, {whole} culled afresh");
+    assert!(purple > 0.25 * every, "{purple} of the pixels purple (left out behind the front) of {every}");
 }

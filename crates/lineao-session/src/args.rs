@@ -373,9 +373,11 @@ pub struct ImageArgs {
     pub width: u32,
     #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=8192))]
     pub height: u32,
-    /// What to show: final, ao, normals, depth, zoom, level:K (pyramid level K), or pieces (the
+    /// What to show: final, ao, normals, depth, zoom, level:K (pyramid level K), pieces (the
     /// final image, each culled piece of line colored by its level of detail: blue every point,
-    /// green every 2nd, orange every 4th, red every 8th; with `--cull on`).
+    /// green every 2nd, orange every 4th, red every 8th; with `--cull on`), frozen (pieces, the
+    /// cull frozen after its first frame) or culled (frozen, every piece drawn: those it left out
+    /// light gray outside the view, purple behind what it drew).
     #[arg(long, default_value = "final", value_parser = parse_debug_view)]
     #[serde(deserialize_with = "crate::kwargs::debug_view")]
     pub debug_view: lineao::DebugView,
@@ -856,11 +858,12 @@ pub fn parse_debug_view(s: &str) -> Result<lineao::DebugView, String> {
         "zoom" => D::Zoom,
         "pieces" => D::Pieces,
         "frozen" => D::Frozen,
+        "culled" => D::Culled,
         _ => match s.strip_prefix("level:").map(str::parse::<u32>) {
             Some(Ok(k)) => D::Level(k),
             _ => {
                 return Err(format!(
-                    "unknown debug view '{s}' (final, ao, normals, depth, zoom, level:K, pieces, frozen)"
+                    "unknown debug view '{s}' (final, ao, normals, depth, zoom, level:K, pieces, frozen, culled)"
                 ));
             }
         },

@@ -55,7 +55,9 @@ struct Pyramid {
 // their coarse pieces), 16 the groups listed for `late`, 17 + d the pieces listed for draw d
 // (these HEADER words zeroed before each frame); then per cluster a word (from `VISIBLE`):
 // bit p set where piece p passed the last test, bits LEVEL_SHIFT + 2p .. + 1 the level it was
-// drawn at (points kept: every 2^level-th); then the listed groups.
+// drawn at (points kept: every 2^level-th), bit OUTSIDE_SHIFT + p set where the test that hid it
+// found it outside the view (its group's box, or each of its segments: not the pyramid); then
+// the listed groups.
 @group(3) @binding(0) var<storage, read_write> state: array<atomic<u32>>;
 // The pieces to draw (`piece_entry`): the early phase's list in the first half, the late one's
 // in the second (each draw binds its half); in each, the full pieces from the front and the
@@ -72,6 +74,13 @@ const VISIBLE: u32 = HEADER;
 const LISTED_GROUPS: u32 = 16u;
 const LISTED_PIECES: u32 = 17u;
 const LEVEL_SHIFT: u32 = 3u;
+const OUTSIDE_SHIFT: u32 = 9u;
+// Why a piece was left out, as a listed piece says it (`list_all`; `shared/pieces.wgsl`).
+const LEFT_OUTSIDE: u32 = 1u;
+const LEFT_BEHIND: u32 = 2u;
+// A test's verdict where what it tested may be visible (else LEFT_OUTSIDE or LEFT_BEHIND).
+const VISIBLE_HERE: u32 = 0u;
+const OUTSIDE_ALL: u32 = 7u << OUTSIDE_SHIFT;
 // How far a piece drawn at a coarser level may lie from its full strip on screen (pixels).
 const LOD_PIXELS: f32 = 0.5;
 // The coarsest level: every 8th point kept (a piece's ends).
@@ -111,9 +120,9 @@ fn draw_of(phase: u32, level: u32) -> u32 {
     return phase + select(0u, 2u, level > 0u);
 }
 
-// A listed piece: its cluster, its level, which piece.
-fn piece_entry(cluster: u32, level: u32, p: u32) -> u32 {
-    return (cluster << 4u) | (level << 2u) | p;
+// A listed piece: its cluster, why it was left out (0: it was not), its level, which piece.
+fn piece_entry(cluster: u32, left: u32, level: u32, p: u32) -> u32 {
+    return (cluster << 6u) | (left << 4u) | (level << 2u) | p;
 }
 
 // Where slot `slot` of draw `d`'s list lies in `pieces`.
@@ -136,9 +145,14 @@ fn invocation(group: vec3<u32>, local: u32) -> u32 {
 // Lists piece `p` of cluster `cluster` at `level` for phase `phase` (0 early, 1 late): its
 // slot from its draw's piece count, an instance more for every PIECES_PER_INSTANCE of them.
 fn append(phase: u32, cluster: u32, level: u32, p: u32) {
+    append_left(phase, cluster, 0u, level, p);
+}
+
+// `append` of a piece the cull left out for reason `left` (`list_all`).
+fn append_left(phase: u32, cluster: u32, left: u32, level: u32, p: u32) {
     let d = draw_of(phase, level);
     let slot = atomicAdd(&state[LISTED_PIECES + d], 1u);
-    pieces[list_index(d, slot)] = piece_entry(cluster, level, p);
+    pieces[list_index(d, slot)] = piece_entry(cluster, left, level, p);
     if slot % PIECES_PER_INSTANCE == 0u {
         atomicAdd(&state[4u * d + 1u], 1u);
     }
@@ -149,20 +163,53 @@ fn marked_level(bits: u32, p: u32) -> u32 {
     return (bits >> (LEVEL_SHIFT + 2u * p)) & 3u;
 }
 
-@compute @workgroup_size(64)
-fn early(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) local: u32) {
-    let i = invocation(group, local);
+// The level piece `p` of a cluster whose mark is `bits` is drawn at (marks a cull at levels of
+// detail left say nothing to one without).
+fn drawn_level(bits: u32, p: u32) -> u32 {
+    return select(0u, marked_level(bits, p), LOD);
+}
+
+// The vertices an instance of each draw has, once a frame (invocation `i` < 4).
+fn start_draw(i: u32) {
     if i < 4u {
         atomicStore(&state[4u * i], instance_vertices(i));
     }
+}
+
+@compute @workgroup_size(64)
+fn early(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let i = invocation(group, local);
+    start_draw(i);
     if i >= cluster_count() {
         return;
     }
     let bits = atomicLoad(&state[VISIBLE + i]);
     for (var p = 0u; p < 3u; p++) {
         if (bits & (1u << p)) != 0u {
-            // Marks a cull at levels of detail left say nothing to one without.
-            append(0u, i, select(0u, marked_level(bits, p), LOD), p);
+            append(0u, i, drawn_level(bits, p), p);
+        }
+    }
+}
+
+// The frozen cull's picture of what it left out (`lineao::passes::cull::Frozen::All`): every
+// piece of the selected clusters listed for the early draw, whole (the camera has moved), the
+// ones not marked with why the last test left them out (outside the view, or behind the
+// pyramid).
+@compute @workgroup_size(64)
+fn list_all(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let i = invocation(group, local);
+    start_draw(i);
+    if i >= cluster_count() || !is_selected(clusters[i]) {
+        return;
+    }
+    let bits = atomicLoad(&state[VISIBLE + i]);
+    let segments = drawn_points(clusters[i]) - 1u;
+    for (var p = 0u; p * PIECE_SEGMENTS < segments; p++) {
+        if (bits & (1u << p)) != 0u {
+            append(0u, i, 0u, p);
+        } else {
+            let outside = (bits & (1u << (OUTSIDE_SHIFT + p))) != 0u;
+            append_left(0u, i, select(LEFT_BEHIND, LEFT_OUTSIDE, outside), 0u, p);
         }
     }
 }
@@ -190,12 +237,14 @@ fn test_groups(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocatio
     let box = cluster_groups[g];
     // Tubes reach their radius beyond their points.
     let grow = vec3<f32>(select(0.0, radius_bound(), TUBES));
-    if box_in_view_visible(box.lo.xyz - grow, box.hi.xyz + grow) {
+    let verdict = world_box_verdict(box.lo.xyz - grow, box.hi.xyz + grow);
+    if verdict == VISIBLE_HERE {
         atomicStore(&state[seen_at(atomicAdd(&listing[3], 1u))], g);
         return;
     }
+    let mark = select(0u, OUTSIDE_ALL, verdict == LEFT_OUTSIDE);
     for (var i = g * GROUP_CLUSTERS; i < min((g + 1u) * GROUP_CLUSTERS, clusters_of_page); i++) {
-        atomicStore(&state[VISIBLE + i], 0u);
+        atomicStore(&state[VISIBLE + i], mark);
     }
 }
 
@@ -232,8 +281,9 @@ fn marked(i: u32, bit: u32) -> bool {
     return (atomicLoad(&state[VISIBLE + i]) & bit) != 0u;
 }
 
-// An invocation per piece of a listed group: marks it visible or not, and lists the visible
-// ones the early draw did not draw (in full: their level is found by `settle`).
+// An invocation per piece of a listed group: marks it visible or not (and why not), and lists
+// the visible ones the early draw did not draw (in full: their level is found by `settle`).
+// Only a mark that changes is written.
 @compute @workgroup_size(48)
 fn late(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) local: u32) {
     let piece = listed_piece(group, local);
@@ -241,14 +291,24 @@ fn late(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
         return;
     }
     let bit = 1u << piece.y;
-    let before = marked(piece.x, bit);
-    if piece_visible(clusters[piece.x], piece.z, piece.w) {
-        atomicOr(&state[VISIBLE + piece.x], bit);
+    let outside_bit = 1u << (OUTSIDE_SHIFT + piece.y);
+    let bits = atomicLoad(&state[VISIBLE + piece.x]);
+    let before = (bits & bit) != 0u;
+    let verdict = piece_verdict(clusters[piece.x], piece.z, piece.w);
+    if verdict == VISIBLE_HERE {
+        if (bits & outside_bit) != 0u {
+            atomicAnd(&state[VISIBLE + piece.x], ~outside_bit);
+        }
         if !before {
+            atomicOr(&state[VISIBLE + piece.x], bit);
             append(1u, piece.x, 0u, piece.y);
         }
-    } else if before {
-        atomicAnd(&state[VISIBLE + piece.x], ~(bit | level_bits(piece.y)));
+        return;
+    }
+    let outside = select(0u, outside_bit, verdict == LEFT_OUTSIDE);
+    if before || (bits & outside_bit) != outside {
+        atomicAnd(&state[VISIBLE + piece.x], ~(bit | level_bits(piece.y) | outside_bit));
+        atomicOr(&state[VISIBLE + piece.x], outside);
     }
 }
 
@@ -293,7 +353,7 @@ fn settle(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_ind
         return;
     }
     let entry = pieces[list_index(d, i)];
-    let cluster = entry >> 4u;
+    let cluster = entry >> 6u;
     let p = entry & 3u;
     let bit = 1u << p;
     if !marked(cluster, bit) {
@@ -302,7 +362,8 @@ fn settle(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_ind
     let c = clusters[cluster];
     let first = p * PIECE_SEGMENTS;
     let last = min(first + PIECE_SEGMENTS, drawn_points(c) - 1u);
-    if !piece_visible(c, first, last) {
+    // Drawn, so in the view: hidden now behind the final depth.
+    if piece_verdict(c, first, last) != VISIBLE_HERE {
         atomicAnd(&state[VISIBLE + cluster], ~(bit | level_bits(p)));
     } else if LOD {
         // The level the next frame draws it at (here, where only the pieces drawn are tested:
@@ -364,13 +425,15 @@ fn piece_level(c: Cluster, first: u32, last: u32) -> u32 {
 }
 
 // Whether strip points `first ..= last` of cluster `c` may leave a fragment in front of the
-// pyramid: whether one of their segments may (never for a cluster selected out).
-fn piece_visible(c: Cluster, first: u32, last: u32) -> bool {
+// pyramid: whether one of their segments may (never for a cluster selected out). Hidden,
+// LEFT_OUTSIDE where each segment lies outside the view, else LEFT_BEHIND.
+fn piece_verdict(c: Cluster, first: u32, last: u32) -> u32 {
     if !is_selected(c) {
-        return false;
+        return LEFT_BEHIND;
     }
     let count = c.flags & CLUSTER_COUNT;
     var previous = vec3<f32>(0.0);
+    var verdict = LEFT_OUTSIDE;
     for (var k = first; k <= last; k++) {
         var owner = c;
         if k >= count {
@@ -378,25 +441,31 @@ fn piece_visible(c: Cluster, first: u32, last: u32) -> bool {
         }
         // As the vertex shader computes it.
         let view_pos = frame.view * vec4<f32>(decode_point(c.first + k, owner), 1.0);
+        var segment = LEFT_OUTSIDE;
         if TUBES {
-            if k > first && tube_visible(previous, view_pos.xyz) {
-                return true;
+            if k > first {
+                segment = tube_verdict(previous, view_pos.xyz);
             }
             previous = view_pos.xyz;
-            continue;
+        } else {
+            let clip = frame.proj * view_pos;
+            if clip.w <= 0.0 {
+                // Behind the eye: the rasterizer clips the piece, and its box says nothing.
+                return VISIBLE_HERE;
+            }
+            let ndc = clip.xyz / clip.w;
+            if k > first {
+                segment = segment_verdict(previous, ndc);
+            }
+            previous = ndc;
         }
-        let clip = frame.proj * view_pos;
-        if clip.w <= 0.0 {
-            // Behind the eye: the rasterizer clips the piece, and its box says nothing.
-            return true;
+        if segment == VISIBLE_HERE {
+            return VISIBLE_HERE;
         }
-        let ndc = clip.xyz / clip.w;
-        if k > first && segment_visible(previous, ndc) {
-            return true;
-        }
-        previous = ndc;
+        // Behind once one segment is in the view.
+        verdict = max(verdict, segment);
     }
-    return false;
+    return verdict;
 }
 
 // The largest tube radius of the page's points (world units): the frame's, or the largest a
@@ -405,23 +474,23 @@ fn radius_bound() -> f32 {
     return max(frame.tube_radius, cluster_page.max_radius);
 }
 
-// Whether the tube segment between view positions `a` and `b` may leave a fragment in front
-// of the pyramid: within its billboard (for the radius bound: no smaller on screen and no
-// farther), whose corners lie at most √2 × its larger reach from an end in x and in y, and
-// no nearer than the billboard's depth (the fragment shader's promise). An end behind the eye
-// leaves no billboard: drawn, for the bound says nothing.
-fn tube_visible(a: vec3<f32>, b: vec3<f32>) -> bool {
+// The verdict on the tube segment between view positions `a` and `b` (VISIBLE_HERE where it
+// may leave a fragment in front of the pyramid): within its billboard (for the radius bound: no
+// smaller on screen and no farther), whose corners lie at most √2 × its larger reach from an end
+// in x and in y, and no nearer than the billboard's depth (the fragment shader's promise). An end
+// behind the eye leaves no billboard: drawn, for the bound says nothing.
+fn tube_verdict(a: vec3<f32>, b: vec3<f32>) -> u32 {
     if behind_eye(a) || behind_eye(b) {
-        return true;
+        return VISIBLE_HERE;
     }
     let r = radius_bound();
     let bb = billboard(a, b, r, r);
     let reach = 1.4143 * max(bb.reach_a, bb.reach_b) + 1.0;
-    return pixels_visible(min(bb.pa, bb.pb) - reach, max(bb.pa, bb.pb) + reach, bb.depth, SEGMENT_SPAN);
+    return pixels_verdict(min(bb.pa, bb.pb) - reach, max(bb.pa, bb.pb) + reach, bb.depth, SEGMENT_SPAN);
 }
 
-// Whether what lies in the world box `lo`..`hi` may leave a fragment in front of the pyramid.
-fn box_in_view_visible(lo: vec3<f32>, hi: vec3<f32>) -> bool {
+// The verdict on what lies in the world box `lo`..`hi`.
+fn world_box_verdict(lo: vec3<f32>, hi: vec3<f32>) -> u32 {
     var ndc_lo = vec3<f32>(3.0e38);
     var ndc_hi = vec3<f32>(-3.0e38);
     for (var k = 0u; k < 8u; k++) {
@@ -429,44 +498,43 @@ fn box_in_view_visible(lo: vec3<f32>, hi: vec3<f32>) -> bool {
         let clip = frame.proj * (frame.view * vec4<f32>(corner, 1.0));
         if clip.w <= 0.0 {
             // Reaches behind the eye: no bound on screen.
-            return true;
+            return VISIBLE_HERE;
         }
         let ndc = clip.xyz / clip.w;
         ndc_lo = min(ndc_lo, ndc);
         ndc_hi = max(ndc_hi, ndc);
     }
-    return box_visible(ndc_lo, ndc_hi, GROUP_SPAN);
+    return box_verdict(ndc_lo, ndc_hi, GROUP_SPAN);
 }
 
-// Whether the segment between points at NDC `a` and `b` may leave a fragment in front of the
-// pyramid. Its two triangles' corners lie half a line width from `a` or `b` on screen, at
-// their depths.
-fn segment_visible(a: vec3<f32>, b: vec3<f32>) -> bool {
-    return box_visible(min(a, b), max(a, b), SEGMENT_SPAN);
+// The verdict on the segment between points at NDC `a` and `b`. Its two triangles' corners lie
+// half a line width from `a` or `b` on screen, at their depths.
+fn segment_verdict(a: vec3<f32>, b: vec3<f32>) -> u32 {
+    return box_verdict(min(a, b), max(a, b), SEGMENT_SPAN);
 }
 
-// Whether what lies in the NDC box `lo`..`hi` (drawn half a line width wider) may leave a
-// fragment in front of the pyramid.
-fn box_visible(lo: vec3<f32>, hi: vec3<f32>, span: u32) -> bool {
+// The verdict on what lies in the NDC box `lo`..`hi` (drawn half a line width wider).
+fn box_verdict(lo: vec3<f32>, hi: vec3<f32>, span: u32) -> u32 {
     // Wholly in front of the near plane or beyond the far one: clipped (lines; a tube's
     // depth is clamped into the range).
     if !TUBES && (hi.z < 0.0 || lo.z > 1.0) {
-        return false;
+        return LEFT_OUTSIDE;
     }
     // The pixels whose centres its quads can cover (a pixel more for rounding).
     let size = vec2<f32>(pyramid.size);
     let reach = 0.5 * frame.line_width_px + 1.0;
     let top_left = vec2<f32>(lo.x * 0.5 + 0.5, 0.5 - hi.y * 0.5) * size - reach;
     let bottom_right = vec2<f32>(hi.x * 0.5 + 0.5, 0.5 - lo.y * 0.5) * size + reach;
-    return pixels_visible(top_left, bottom_right, clamp(lo.z, 0.0, 1.0), span);
+    return pixels_verdict(top_left, bottom_right, clamp(lo.z, 0.0, 1.0), span);
 }
 
-// Whether a fragment no nearer than depth `nearest` on a pixel whose centre lies between
-// `top_left` and `bottom_right` may lie in front of the pyramid.
-fn pixels_visible(top_left: vec2<f32>, bottom_right: vec2<f32>, nearest: f32, span: u32) -> bool {
+// The verdict on a fragment no nearer than depth `nearest` on a pixel whose centre lies between
+// `top_left` and `bottom_right`: LEFT_OUTSIDE where no such pixel is in the targets,
+// LEFT_BEHIND where it lies behind the pyramid at each, else VISIBLE_HERE.
+fn pixels_verdict(top_left: vec2<f32>, bottom_right: vec2<f32>, nearest: f32, span: u32) -> u32 {
     let size = vec2<f32>(pyramid.size);
     if any(bottom_right < vec2<f32>(0.0)) || any(top_left >= size) {
-        return false;
+        return LEFT_OUTSIDE;
     }
     let a_px = vec2<u32>(clamp(floor(top_left), vec2<f32>(0.0), size - 1.0));
     let b_px = vec2<u32>(clamp(floor(bottom_right), vec2<f32>(0.0), size - 1.0));
@@ -484,5 +552,5 @@ fn pixels_visible(top_left: vec2<f32>, bottom_right: vec2<f32>, nearest: f32, sp
             farthest = max(farthest, pyramid_texels[level.x + y * level.y + x]);
         }
     }
-    return nearest <= farthest + DEPTH_MARGIN;
+    return select(LEFT_BEHIND, VISIBLE_HERE, nearest <= farthest + DEPTH_MARGIN);
 }

@@ -167,6 +167,7 @@ struct Piece {
     cluster: Cluster,
     at: StripPosition,
     stride: u32,
+    left: u32,
 }
 
 // Vertex `v` of instance `instance` of the full (or `coarse`) pieces: block v / `stride` is a
@@ -190,14 +191,14 @@ fn piece_vertex(v: u32, instance: u32, coarse: bool) -> Piece {
     // Its strip's last vertex (the repeat after it, or the end of the instance).
     let at = full_strip(min(k, stride - 3u), kept_points(piece));
     let point = select(-1, i32(kept_point(piece, u32(max(at.point, 0)))), at.point >= 0);
-    return Piece(piece.cluster, StripPosition(point, at.side), piece.stride);
+    return Piece(piece.cluster, StripPosition(point, at.side), piece.stride, piece.left);
 }
 
 // A piece's strip vertex, colored by its level in color mode 3.
 fn piece_strip_vertex(piece: Piece) -> VsOut {
     var out = strip_vertex(piece.cluster, piece.at);
     if frame.color_mode == 3u {
-        out.color = piece_color(piece.stride);
+        out.color = piece_color(piece.stride, piece.left);
     }
     return out;
 }

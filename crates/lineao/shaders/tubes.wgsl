@@ -104,7 +104,13 @@ fn vs_tube_piece(@builtin(vertex_index) v: u32, @builtin(instance_index) instanc
     let per_piece = 6u * PIECE_SEGMENTS;
     let piece = visible_piece(instance * PIECES_PER_INSTANCE + v / per_piece, false);
     let k = v % per_piece;
-    return segment_vertex(piece.cluster, piece.first + k / 6u, k % 6u, piece.first + piece.points);
+    var out = segment_vertex(piece.cluster, piece.first + k / 6u, k % 6u, piece.first + piece.points);
+    // Gray in color mode 3 (`base_color`), but where the frozen cull shows why it left one out.
+    if frame.color_mode == 3u && piece.left != 0u {
+        out.color_a = piece_color(1u, piece.left);
+        out.color_b = out.color_a;
+    }
+    return out;
 }
 
 // The first hit of the ray ro + t rd (|rd| = 1) with the rounded cone between spheres (pa, ra)

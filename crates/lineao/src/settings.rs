@@ -95,6 +95,10 @@ pub enum DebugView {
     /// it was chosen, and no others, whatever the camera does — orbit away to see what the
     /// cull drew for that view and what it left out (behind them, outside the frustum).
     Frozen,
+    /// [`DebugView::Frozen`] drawing every piece: those the cull drew blue, those it left out
+    /// light gray where it found them outside the view, purple where behind what it drew (a
+    /// piece of a group whose box was hidden counts as behind).
+    Culled,
 }
 
 impl DebugView {
@@ -107,7 +111,7 @@ impl DebugView {
             DebugView::Zoom => (4, 0),
             DebugView::Level(k) => (5, k),
             // The geometry's colors say it.
-            DebugView::Pieces | DebugView::Frozen => (0, 0),
+            DebugView::Pieces | DebugView::Frozen | DebugView::Culled => (0, 0),
         }
     }
 }

@@ -8,6 +8,7 @@ mod common;
 
 use common::{gpu, is_geometry};
 use glam::Vec3;
+use lineao::passes::cull::Frozen;
 use lineao::passes::lines::{LineRenderer, LineStyle, VertexAttributes};
 use lineao::passes::tubes::TubeRenderer;
 use lineao::reference::NdImage;
@@ -142,24 +143,44 @@ fn same_marks_as_the_cpu_reference(
     };
     let frame = CullView { view: view.view, proj: view.proj, size: view.banded_size(), line_width_px: LINE_WIDTH };
     let pages = geometry.page_contents(&gpu.device, &gpu.queue).unwrap();
-    let expected = marks(&pages, &frame, &depth, Slack { px: 0.01, depth: 1e-7 });
+    let slack = Slack { px: 0.01, depth: 1e-7 };
+    let expected = marks(&pages, &frame, &depth, slack);
+    // Against nothing drawn, only what lies outside the view is hidden.
+    let empty = lineao::reference::Image { data: vec![1.0; depth.data.len()], ..depth };
+    let in_view = marks(&pages, &frame, &empty, slack);
     let got = renderer.cull().unwrap().cull().marks(&gpu.queue, geometry).unwrap();
-    let (mut pieces, mut unsure) = (0, 0);
-    for (page, (expected, got)) in expected.iter().zip(&got).enumerate() {
-        for (i, (verdicts, &bits)) in expected.iter().zip(got).enumerate() {
+    let (mut pieces, mut unsure, mut outside, mut said_outside) = (0, 0, 0, 0);
+    for (page, ((expected, in_view), got)) in expected.iter().zip(&in_view).zip(&got).enumerate() {
+        for (i, ((verdicts, in_view), &bits)) in expected.iter().zip(in_view).zip(got).enumerate() {
             for (p, verdict) in verdicts.iter().enumerate() {
                 let marked = bits & (1 << p) != 0;
+                let marked_outside = bits & (1 << (9 + p)) != 0;
                 match verdict {
                     Verdict::Visible => assert!(marked, "{case}: page {page} cluster {i} piece {p} is visible"),
                     Verdict::Hidden => assert!(!marked, "{case}: page {page} cluster {i} piece {p} is hidden"),
                     Verdict::Unsure => unsure += 1,
                 }
                 pieces += (*verdict != Verdict::Hidden) as usize;
+                // Why a hidden piece was left out: never "outside" for one in the view, nor
+                // for one marked visible.
+                let record = &pages[page].records[i];
+                let exists = p * 8 + 1 < record.drawn() as usize && record.is_selected();
+                if in_view[p] == Verdict::Visible || marked {
+                    assert!(!marked_outside, "{case}: page {page} cluster {i} piece {p} is in the view");
+                }
+                if exists && in_view[p] == Verdict::Hidden {
+                    outside += 1;
+                    said_outside += marked_outside as usize;
+                }
             }
         }
     }
-    println!("{case}: the CPU reference agrees on every sure piece; {unsure} unsure of {pieces} not hidden");
+    println!(
+        "{case}: the CPU reference agrees on every sure piece; {unsure} unsure of {pieces} not hidden; \
+         {said_outside} of the {outside} pieces outside the view marked so (the others' group hidden behind)"
+    );
     assert!(unsure * 100 <= pieces.max(100), "{case}: {unsure} pieces unsure");
+    assert!(said_outside * 2 >= outside, "{case}: {said_outside} of {outside} pieces outside the view marked so");
 }
 
 #[test]
@@ -444,7 +465,7 @@ fn a_frozen_cull_draws_the_pieces_it_found_for_the_view_before() {
     let marks = cull.marks(q, &geometry).unwrap();
     let visible: u64 =
         marks.iter().flatten().map(|m| (m & lineao::passes::cull::MARK_VISIBLE).count_ones() as u64).sum();
-    cull.set_frozen(true);
+    cull.set_frozen(Frozen::Visible);
     let frozen = draw(&gpu, &culled, &geometry, &to);
     let counts = cull.counts(q, &geometry).unwrap();
     assert_eq!((counts.early, counts.late), (visible, 0), "{counts}");
@@ -454,8 +475,78 @@ fn a_frozen_cull_draws_the_pieces_it_found_for_the_view_before() {
     let (shown, whole) = (covered(&frozen), covered(&expected));
     println!("frozen: {visible} pieces of {} drawn from the other side, {shown} of {whole} pixels", counts.pieces);
     assert!(shown > 0 && shown * 10 < whole * 9, "{shown} of {whole} pixels: the other side's front is missing");
-    cull.set_frozen(false);
+    cull.set_frozen(Frozen::No);
     draw(&gpu, &culled, &geometry, &to);
     let thawed = draw(&gpu, &culled, &geometry, &to);
     same_gbuffer(&expected, &thawed, "thawed");
+}
+
+/// `DebugView::Culled`'s cull: frozen after the frames of one view, a frame from another draws
+/// every piece — every line's G-buffer depth bit for bit — in the colors of the pieces' debug
+/// view: blue where drawn, purple where left out behind what was drawn, light gray where
+/// outside the view; the marks untouched.
+#[test]
+fn a_frozen_cull_shows_why_it_left_each_piece_out() {
+    let gpu = gpu();
+    let q = &gpu.queue;
+    let (positions, offsets) = ball(4000);
+    let geometry = LineGeometry::new(&gpu.device, q, &positions, &offsets).unwrap();
+    let all = LineRenderer::with_style(&gpu.device, LineStyle::FullStrip);
+    let culled = LineRenderer::new(&gpu.device).culled(&gpu.device, false);
+    let cull = culled.cull().unwrap().cull();
+    let draw_pieces = |camera: &Camera| {
+        draw_with(&gpu, camera, |encoder, targets, view, s| {
+            culled.prepare(q, view, s.line_width_px, lineao::LineColor::Pieces, &s.lighting, None);
+            culled.encode(encoder, targets, &geometry, lineao::passes::Load::Clear(s.background), None);
+        })
+    };
+    // Close up, most of the ball lies outside the view; seen from the other side, its back.
+    let cameras = cameras();
+    for (from, to, hue) in [(&cameras[2].1, outside(), Hue::Gray), (&outside(), cameras[4].1, Hue::Purple)] {
+        cull.set_frozen(Frozen::No);
+        draw_pieces(from);
+        draw_pieces(from);
+        let marks = cull.marks(q, &geometry).unwrap();
+        cull.set_frozen(Frozen::All);
+        let shown = draw_pieces(&to);
+        let counts = cull.counts(q, &geometry).unwrap();
+        assert_eq!((counts.early, counts.late), (counts.pieces, 0), "{counts}");
+        assert_eq!(cull.marks(q, &geometry).unwrap(), marks, "a frozen frame marks nothing");
+        let expected = draw(&gpu, &all, &geometry, &to);
+        let mut hues = [0usize; 4];
+        for i in 0..expected[3].data.len() {
+            let depth = (expected[3].data[i][0], shown[3].data[i][0]);
+            assert_eq!(depth.0.to_bits(), depth.1.to_bits(), "depth differs at pixel {i}: {depth:?}");
+            if is_geometry(shown[1].data[i]) {
+                hues[hue_of(shown[0].data[i]) as usize] += 1;
+            }
+        }
+        println!("frozen, every piece: {hues:?} pixels blue, purple, gray, other");
+        assert_eq!(hues[Hue::Other as usize], 0);
+        assert!(hues[Hue::Blue as usize] > 0 && hues[hue as usize] > hues.iter().sum::<usize>() / 4, "{hues:?}");
+    }
+}
+
+#[derive(Clone, Copy)]
+enum Hue {
+    Blue,
+    Purple,
+    Gray,
+    Other,
+}
+
+/// Which of the pieces' debug colors a lit G-buffer color is (lighting scales its channels
+/// alike).
+fn hue_of(color: [f32; 4]) -> Hue {
+    let [r, g, b, _] = color;
+    let most = r.max(g).max(b);
+    if most - r.min(g).min(b) < 0.02 * most {
+        Hue::Gray
+    } else if b > g && g > r {
+        Hue::Blue
+    } else if b > r && r > 2.0 * g {
+        Hue::Purple
+    } else {
+        Hue::Other
+    }
 }

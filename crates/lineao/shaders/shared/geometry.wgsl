@@ -83,8 +83,15 @@ fn base_color(t_world: vec3<f32>, scalar: f32) -> vec3<f32> {
 }
 
 // Color mode 3: a culled piece drawn keeping every `stride`-th point (1 blue, 2 green, 4
-// orange, 8 red).
-fn piece_color(stride: u32) -> vec3<f32> {
+// orange, 8 red), or one the cull left out (`left`: 1 outside the view light gray, 2 behind
+// what it drew purple).
+fn piece_color(stride: u32, left: u32) -> vec3<f32> {
+    if left == 1u {
+        return vec3<f32>(0.8);
+    }
+    if left == 2u {
+        return vec3<f32>(0.65, 0.2, 0.85);
+    }
     let colors = array<vec3<f32>, 4>(
         vec3<f32>(0.15, 0.35, 1.0),
         vec3<f32>(0.1, 0.75, 0.25),

@@ -50,6 +50,7 @@ use crate::method::raytraced::RayProgress;
 use crate::method::{self, Reach};
 use crate::passes::bilateral::Bilateral;
 use crate::passes::composite::{Composite, Shown};
+use crate::passes::cull::Frozen;
 use crate::passes::lines::LineRenderer;
 use crate::passes::lines::LineStyle;
 use crate::passes::meshes::{MeshGeometry, MeshRenderer};
@@ -400,11 +401,16 @@ impl AoChain {
             self.targets = Some(targets);
         }
         let targets = self.targets.as_ref()?;
-        let pieces = matches!(s.debug_view, DebugView::Pieces | DebugView::Frozen);
+        let pieces = matches!(s.debug_view, DebugView::Pieces | DebugView::Frozen | DebugView::Culled);
         let color = if pieces { LineColor::Pieces } else { s.line_color };
         let culls = [self.lines.cull(), self.tubes.as_ref().and_then(TubeRenderer::cull)];
+        let frozen = match s.debug_view {
+            DebugView::Frozen => Frozen::Visible,
+            DebugView::Culled => Frozen::All,
+            _ => Frozen::No,
+        };
         for culled in culls.into_iter().flatten() {
-            culled.cull().set_frozen(s.debug_view == DebugView::Frozen);
+            culled.cull().set_frozen(frozen);
         }
         match (&self.tubes, &s.tubes) {
             (Some(tubes), Some(t)) => tubes.prepare(queue, &view, t.radius_world, color, &s.lighting, s.slab.as_ref()),

@@ -95,8 +95,12 @@ const LISTED_PIECES: usize = 17;
 /// How far from its full strip a piece drawn at a coarser level may lie on screen, in pixels
 /// (`LOD_PIXELS` in `shaders/cull.wgsl`).
 pub const LOD_PIXELS: f32 = 0.5;
-/// Bits of a cluster's mark that say which pieces are visible (the others: their levels).
+/// Bits of a cluster's mark that say which pieces are visible (bits 3–8: their levels).
 pub const MARK_VISIBLE: u32 = 0b111;
+/// Bits of a cluster's mark that say which pieces the test that hid them found outside the
+/// view (their group's box, or each of their segments), not behind the pyramid (`OUTSIDE_SHIFT`
+/// in `shaders/cull.wgsl`).
+pub const MARK_OUTSIDE: u32 = 0b111 << 9;
 /// Bytes of the listed groups' indirect dispatch and their count (`listing`).
 const LISTING_BYTES: u64 = 16;
 
@@ -139,6 +143,19 @@ impl Phase {
     pub fn offset(self, coarse: bool) -> u64 {
         16 * (self as u64 + 2 * coarse as u64)
     }
+}
+
+/// What a frozen cull draws ([`LineCull::set_frozen`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Frozen {
+    /// Nothing: it is not frozen, every frame culls.
+    #[default]
+    No,
+    /// The pieces it found visible in the last frame culled ([`crate::DebugView::Frozen`]).
+    Visible,
+    /// Every piece of the selected streamlines, those it left out with why: outside the view or
+    /// behind what it drew ([`crate::DebugView::Culled`], in the pieces' colors).
+    All,
 }
 
 /// The view a page's levels of detail were found for.
@@ -240,9 +257,11 @@ pub struct LineCull {
     early_whole: wgpu::ComputePipeline,
     /// The view of the frame being recorded ([`LineCull::set_view`]).
     view: std::sync::Mutex<Option<LevelsView>>,
-    /// Whether its frames draw what it last found visible and find nothing new
+    /// Whether its frames draw what it last found (and left out) and find nothing new
     /// ([`LineCull::set_frozen`]).
-    frozen: std::sync::atomic::AtomicBool,
+    frozen: std::sync::Mutex<Frozen>,
+    /// Lists every piece, why it was left out ([`Frozen::All`]).
+    list_all: wgpu::ComputePipeline,
     pad: wgpu::ComputePipeline,
     test_groups: wgpu::ComputePipeline,
     size_dispatch: wgpu::ComputePipeline,
@@ -297,14 +316,16 @@ impl LineCull {
         let pipeline = |entry: &str, groups: &[Option<&wgpu::BindGroupLayout>]| pipeline_of(entry, groups, lod);
         let all = [Some(frame), Some(&page), Some(&pyramid_layout), Some(&state_layout)];
         let listing = [Some(frame), Some(&page), Some(&pyramid_layout), Some(&listing_layout)];
+        let marks = [None, Some(&page), None, Some(&state_layout)];
         LineCull {
             device: device.clone(),
             shape,
             pyramid: DepthPyramid::new(device),
-            early: pipeline("early", &[None, Some(&page), None, Some(&state_layout)]),
-            early_whole: pipeline_of("early", &[None, Some(&page), None, Some(&state_layout)], false),
+            early: pipeline("early", &marks),
+            early_whole: pipeline_of("early", &marks, false),
             view: Default::default(),
             frozen: Default::default(),
+            list_all: pipeline_of("list_all", &marks, false),
             pad: pipeline("pad", &[None, None, None, Some(&state_layout)]),
             lod,
             test_groups: pipeline("test_groups", &listing),
@@ -427,22 +448,26 @@ impl LineCull {
         mut draw: impl FnMut(&mut wgpu::CommandEncoder, Phase, Option<Span<'s>>),
     ) {
         let pages = geometry.pages();
-        // Frozen, once every page has been culled: the pieces it last found visible, nothing
-        // tested, nothing marked (the early phase alone).
-        let frozen = self.frozen.load(std::sync::atomic::Ordering::Relaxed)
-            && pages.iter().all(|page| page.cull[self.slot()].get().is_some());
-        let (first, last) = if frozen { (span, None) } else { Span::split(span) };
+        // Frozen, once every page has been culled: the pieces it last found visible (or every
+        // piece, with why it left them out), nothing tested, nothing marked (the early phase
+        // alone).
+        let frozen = match *self.frozen.lock().unwrap_or_else(|poisoned| poisoned.into_inner()) {
+            _ if pages.iter().any(|page| page.cull[self.slot()].get().is_none()) => Frozen::No,
+            frozen => frozen,
+        };
+        let (first, last) = if frozen == Frozen::No { Span::split(span) } else { (span, None) };
         for page in pages {
             encoder.clear_buffer(&self.state(page).state, 0, Some(4 * STATE_HEADER_WORDS));
         }
         let view = *self.view.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
-        self.over_pages(encoder, pages, None, &self.early, first, |pass, page, state| {
-            if self.lod {
+        let list = if frozen == Frozen::All { &self.list_all } else { &self.early };
+        self.over_pages(encoder, pages, None, list, first, |pass, page, state| {
+            if self.lod && frozen != Frozen::All {
                 let mut levels_of = state.levels_of.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
                 let hold = matches!((*levels_of, view), (Some(then), Some(now)) if then.holds(&now));
                 pass.set_pipeline(if hold { &self.early } else { &self.early_whole });
                 // This frame's settling finds them for this view.
-                if !frozen {
+                if frozen == Frozen::No {
                     *levels_of = view;
                 }
             }
@@ -451,7 +476,7 @@ impl LineCull {
         });
         self.pad(encoder, pages);
         draw(encoder, Phase::Early, None);
-        if frozen {
+        if frozen != Frozen::No {
             return;
         }
         let built = self.pyramid.encode(encoder, &targets.depth, None);
@@ -470,11 +495,13 @@ impl LineCull {
         });
     }
 
-    /// Freezes the cull (`true`): its frames draw the pieces it found visible in the last frame
-    /// before, and test and mark nothing, so a camera moved away shows what it drew for that
-    /// view ([`crate::DebugView::Frozen`]). A geometry not culled yet is culled once first.
-    pub fn set_frozen(&self, frozen: bool) {
-        self.frozen.store(frozen, std::sync::atomic::Ordering::Relaxed);
+    /// Freezes the cull (or thaws it: [`Frozen::No`]): its frames draw the pieces it found
+    /// visible in the last frame before (and with [`Frozen::All`] the others, in the colors of
+    /// why it left them out), and test and mark nothing, so a camera moved away shows what it
+    /// drew for that view ([`crate::DebugView::Frozen`], [`crate::DebugView::Culled`]). A
+    /// geometry not culled yet is culled once first.
+    pub fn set_frozen(&self, frozen: Frozen) {
+        *self.frozen.lock().unwrap_or_else(|poisoned| poisoned.into_inner()) = frozen;
     }
 
     /// Whether it picks a level of detail for each piece.
@@ -600,7 +627,9 @@ impl LineCull {
     }
 
     /// Each page's marks after the last frame recorded, a word per cluster (bit p: piece p
-    /// passed; bits 3 + 2p and 4 + 2p: the level it was drawn at), read back (waits for the device): what the CPU reference checks.
+    /// passed; bits 3 + 2p and 4 + 2p: the level it was drawn at; bit 9 + p: the test that hid
+    /// it found it outside the view, [`MARK_OUTSIDE`]), read back (waits for the device): what
+    /// the CPU reference checks.
     pub fn marks(&self, queue: &wgpu::Queue, geometry: &LineGeometry) -> Result<Vec<Vec<u32>>, crate::Error> {
         let states = self.read_states(queue, geometry)?;
         let marks = states.into_iter().zip(geometry.pages()).map(|(words, page)| match words {
