@@ -198,6 +198,9 @@ pub enum Load {
     /// The frame's first writer: color to this background (linear RGB), ND to background, zoom,
     /// specular and octants to 0, depth to 1.
     Clear([f32; 3]),
+    /// The frame's first writer over a depth already written (a host's:
+    /// [`crate::passes::seed_depth`]): the colors cleared as [`Load::Clear`] does, the depth kept.
+    ClearOverDepth([f32; 3]),
     /// Draw over what earlier passes wrote.
     Keep,
 }
@@ -213,7 +216,9 @@ pub(crate) fn begin<'e>(
 ) -> wgpu::RenderPass<'e> {
     let ops = |clear: [f64; 4]| wgpu::Operations {
         load: match load {
-            Load::Clear(_) => wgpu::LoadOp::Clear(wgpu::Color { r: clear[0], g: clear[1], b: clear[2], a: clear[3] }),
+            Load::Clear(_) | Load::ClearOverDepth(_) => {
+                wgpu::LoadOp::Clear(wgpu::Color { r: clear[0], g: clear[1], b: clear[2], a: clear[3] })
+            }
             Load::Keep => wgpu::LoadOp::Load,
         },
         store: wgpu::StoreOp::Store,
@@ -222,7 +227,7 @@ pub(crate) fn begin<'e>(
         Some(wgpu::RenderPassColorAttachment { view, depth_slice: None, resolve_target: None, ops: ops(clear) })
     };
     let [r, g, b] = match load {
-        Load::Clear(background) => background.map(f64::from),
+        Load::Clear(background) | Load::ClearOverDepth(background) => background.map(f64::from),
         Load::Keep => [0.0; 3],
     };
     let mut color_attachments = vec![
@@ -242,7 +247,7 @@ pub(crate) fn begin<'e>(
             depth_ops: Some(wgpu::Operations {
                 load: match load {
                     Load::Clear(_) => wgpu::LoadOp::Clear(1.0),
-                    Load::Keep => wgpu::LoadOp::Load,
+                    Load::ClearOverDepth(_) | Load::Keep => wgpu::LoadOp::Load,
                 },
                 store: wgpu::StoreOp::Store,
             }),

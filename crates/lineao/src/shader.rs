@@ -31,6 +31,7 @@ const SHARED: &[(&str, &str)] = &[
     ("meshes.wgsl", include_str!("../shaders/meshes.wgsl")),
     ("nd_from_depth.wgsl", include_str!("../shaders/nd_from_depth.wgsl")),
     ("nd_pyramid.wgsl", include_str!("../shaders/nd_pyramid.wgsl")),
+    ("seed_depth.wgsl", include_str!("../shaders/seed_depth.wgsl")),
     ("slices.wgsl", include_str!("../shaders/slices.wgsl")),
     ("strip.wgsl", include_str!("../shaders/strip.wgsl")),
     ("tubes.wgsl", include_str!("../shaders/tubes.wgsl")),

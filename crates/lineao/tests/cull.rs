@@ -8,7 +8,7 @@ mod common;
 
 use common::{gpu, is_geometry};
 use glam::Vec3;
-use lineao::passes::cull::Frozen;
+use lineao::passes::cull::{Frozen, LineCull};
 use lineao::passes::lines::{LineRenderer, LineStyle, VertexAttributes};
 use lineao::passes::tubes::TubeRenderer;
 use lineao::reference::NdImage;
@@ -217,6 +217,88 @@ fn culled_lines_draw_the_g_buffer_of_all_lines() {
     let counts = culled.cull().unwrap().counts(q, &geometry).unwrap();
     let (early, late) = (counts.early, counts.late);
     assert!((early + late) * 2 < pieces, "drew {early} + {late} of {pieces}");
+}
+
+/// Over a host's depth seeded into the G-buffer (`passes::seed_depth`, what `OverlayAo` does
+/// with a depth it can read: here a wall through the ball's centre), the culled lines draw the
+/// G-buffer every line's full strip draws over it, bit for bit, first frame and second, leave
+/// out the pieces behind the wall, and their marks are the CPU reference's on the final depth.
+#[test]
+fn culled_lines_over_a_seeded_depth_draw_the_g_buffer_of_all_lines() {
+    use lineao::passes::seed_depth::SeedDepth;
+    let gpu = gpu();
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let (positions, offsets) = ball(4000);
+    let geometry = LineGeometry::new(d, q, &positions, &offsets).unwrap();
+    let all = LineRenderer::with_style(d, LineStyle::FullStrip);
+    let culled = LineRenderer::new(d).culled(d, false);
+    let seed = SeedDepth::new(d);
+    let camera = outside();
+    // The host: the same view, its depth a wall through the ball's centre.
+    let view = FrameView::new(&camera, &bounds(), SIZE.0, SIZE.1, GUARD, 1.0);
+    let host = lineao::OverlayDepth { format: wgpu::TextureFormat::Depth32Float, proj: view.proj };
+    let wall = view.proj.project_point3(view.view.transform_point3(Vec3::ZERO)).z;
+    let host_depth = d.create_texture(&wgpu::TextureDescriptor {
+        label: Some("test::host_depth"),
+        size: wgpu::Extent3d { width: SIZE.0, height: SIZE.1, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: host.format,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        view_formats: &[],
+    });
+    let host_view = host_depth.create_view(&Default::default());
+    let mut encoder = d.create_command_encoder(&Default::default());
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("test::host_frame"),
+        color_attachments: &[],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: &host_view,
+            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(wall), store: wgpu::StoreOp::Store }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    q.submit([encoder.finish()]);
+    let draw_seeded = |renderer: &LineRenderer| {
+        draw_with(&gpu, &camera, |encoder, targets, view, s| {
+            seed.prepare(q, targets, view, &host);
+            seed.encode(encoder, targets, &host_view);
+            renderer.prepare(q, view, s.line_width_px, s.line_color, &s.lighting, None);
+            renderer.encode(encoder, targets, &geometry, lineao::passes::Load::ClearOverDepth(s.background), None);
+        })
+    };
+    let expected = draw_seeded(&all);
+    let unseeded = draw(&gpu, &all, &geometry, &camera);
+    // Where every line lies behind the wall the seeded G-buffer holds none; elsewhere the
+    // front line is the one drawn without the seed.
+    let mut behind = 0;
+    for (i, (seeded, nd)) in expected[1].data.iter().zip(&unseeded[1].data).enumerate() {
+        let depth = unseeded[3].data[i][0];
+        if is_geometry(*nd) && depth > wall * (1.0 + 1e-5) {
+            behind += 1;
+            assert!(!is_geometry(*seeded), "a line behind the wall at pixel {i}");
+        } else if depth < wall * (1.0 - 1e-5) {
+            assert_eq!(seeded, nd, "the line in front of the wall at pixel {i}");
+        }
+    }
+    let all_pixels = unseeded[1].data.iter().filter(|t| is_geometry(**t)).count();
+    assert!(behind > 0, "no pixel with every line behind the wall");
+    let mut drawn = Vec::new();
+    for frame in ["first", "second"] {
+        let got = draw_seeded(&culled);
+        let counts = culled.cull().unwrap().counts(q, &geometry).unwrap();
+        let (covered, ties) = same_gbuffer(&expected, &got, "seeded");
+        println!("seeded, {frame} frame: {counts}; {covered} geometry pixels of {all_pixels} unseeded, {ties} ties");
+        assert!(ties * 2000 <= covered, "{ties} of {covered} pixels differ at equal depth");
+        same_marks_as_the_cpu_reference(&gpu, &culled, &geometry, &camera, &got[3], "seeded");
+        drawn.push(counts.early + counts.late);
+    }
+    // The half behind the wall is left out even on the first frame (nothing drawn before).
+    assert!(drawn[0] * 10 < LineCull::pieces(&geometry) * 7, "{drawn:?}");
 }
 
 /// The culled tubes draw the G-buffer of every tube, with radii of their own (the cull bounds

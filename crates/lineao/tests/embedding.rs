@@ -551,6 +551,114 @@ fn the_overlay_keeps_the_hosts_frame_and_writes_its_depth() {
     chain.encode(&mut encoder, &geometry, &small.view).unwrap();
 }
 
+/// A host depth the chain can read (`TEXTURE_BINDING`) seeds the G-buffer's
+/// (`passes::seed_depth`): behind the host's wall no line leaves a pixel in the G-buffer, in
+/// front of it every pixel is the one drawing every line leaves; culled, fewer pieces are
+/// drawn than without the seed (`tests/cull.rs` checks the culled G-buffer over a seeded depth
+/// bit for bit). Reversed-Z with an infinite far plane, and standard depth.
+#[test]
+fn a_host_depth_the_chain_can_read_seeds_the_g_buffer_and_culls_what_it_hides() {
+    let gpu = gpu();
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let (positions, offsets) = polylines(150, 0.3);
+    let (camera, _) = cameras_for_polylines();
+    let geometry = LineGeometry::new(d, q, &positions, &offsets).unwrap();
+    let bounds = geometry.bounds.unwrap();
+    let size = (160u32, 120u32);
+    let Projection::Perspective { fov_y_deg } = camera.projection else { unreachable!() };
+    let (fov, aspect) = (fov_y_deg.to_radians(), size.0 as f32 / size.1 as f32);
+    use glam::camera::rh::proj::directx;
+    let reversed_infinite = directx::perspective_infinite_reverse(fov, aspect, 0.1);
+    let standard = directx::perspective(fov, aspect, 0.1, 1000.0);
+    let format = wgpu::TextureFormat::Depth32Float;
+    for (name, proj) in [("reversed-Z, infinite far", reversed_infinite), ("standard", standard)] {
+        // Two frames into a host's frame whose depth is a wall at `wall_z` (view space), the
+        // chain culling or not, the host's depth readable or not: the G-buffer, the chain's view
+        // and what the cull drew.
+        let run = |wall_z: f32, cull: bool, readable: bool| {
+            let settings = ChainSettings { lod: false, cull, ..ChainSettings::default() };
+            let mut chain = AoChain::new(d, common::OUTPUT_FORMAT, settings).unwrap();
+            chain.resize(size.0, size.1).unwrap();
+            let depth_of = lineao::OverlayDepth { format, proj };
+            let mut overlay = OverlayAo::new(d, chain, Some(depth_of)).unwrap();
+            let usage = wgpu::TextureUsages::RENDER_ATTACHMENT
+                | if readable { wgpu::TextureUsages::TEXTURE_BINDING } else { wgpu::TextureUsages::empty() };
+            let depth = texture(&gpu, size, format, usage, 1);
+            let color = lineao::targets::Target::output(d, "test::host_color", size, common::OUTPUT_FORMAT);
+            let wall = proj.project_point3(Vec3::new(0.0, 0.0, wall_z)).z.clamp(0.0, 1.0);
+            let mut view = None;
+            for _ in 0..2 {
+                let mut encoder = d.create_command_encoder(&Default::default());
+                encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("test::host_frame"),
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view: &color.view,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    })],
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                        view: &depth,
+                        depth_ops: Some(wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(wall),
+                            store: wgpu::StoreOp::Store,
+                        }),
+                        stencil_ops: None,
+                    }),
+                    timestamp_writes: None,
+                    occlusion_query_set: None,
+                    multiview_mask: None,
+                });
+                view = Some(overlay.chain_mut().prepare(d, q, &camera, &bounds).unwrap());
+                overlay.encode(&mut encoder, &geometry, &[], &color.view, Some(&depth)).unwrap();
+                q.submit([encoder.finish()]);
+            }
+            let gbuffer = common::read_gbuffer(&gpu, overlay.chain().targets().unwrap());
+            (gbuffer, view.unwrap(), overlay.chain().cull_counts(q, &geometry).unwrap())
+        };
+        // Every line, no seed: where the wall goes (the middle of the lines' depths).
+        let (plain, view, _) = run(-1e6, false, false);
+        let z_of = |nd: [f32; 4]| -(view.near + nd[3] * (view.far - view.near));
+        let wall_z = -0.5 * (view.near + view.far);
+        let (all, _, _) = run(wall_z, false, true);
+        let (_, _, counts) = run(wall_z, true, true);
+        let (unseeded, _, unseeded_counts) = run(wall_z, true, false);
+        let (counts, unseeded_counts) = (counts.unwrap(), unseeded_counts.unwrap());
+        let (mut front, mut hidden) = (0, 0);
+        for i in 0..plain[1].data.len() {
+            let nd = plain[1].data[i];
+            if is_geometry(all[1].data[i]) {
+                let z = z_of(all[1].data[i]);
+                assert!(z > wall_z * (1.0 + 2e-5), "{name}: a line at z {z} behind the wall at {wall_z} (pixel {i})");
+            }
+            if is_geometry(nd) && z_of(nd) > wall_z * (1.0 - 1e-4) {
+                front += 1;
+                assert_eq!(all[1].data[i], nd, "{name}: the line in front of the wall at pixel {i}");
+            } else if is_geometry(nd) && z_of(nd) < wall_z * (1.0 + 1e-4) {
+                hidden += 1;
+                assert!(!is_geometry(all[1].data[i]), "{name}: a pixel behind the wall drawn at {i}");
+            }
+        }
+        let drawn = |c: &lineao::passes::cull::CullCounts| c.early + c.late;
+        println!(
+            "{name}: {front} line pixels in front of the wall, {hidden} behind it; culled against the seed {} of {} \
+             pieces drawn, without it {}",
+            drawn(&counts),
+            counts.pieces,
+            drawn(&unseeded_counts)
+        );
+        assert!(front > 200 && hidden > 200, "{name}: the wall should split the lines ({front}, {hidden})");
+        assert!(drawn(&counts) * 10 < drawn(&unseeded_counts) * 9, "{name}: {counts} against {unseeded_counts}");
+        // Without the seed the lines behind the wall stay in the G-buffer (and darken their
+        // neighbours in front).
+        let behind = unseeded[1].data.iter().filter(|&&nd| is_geometry(nd) && z_of(nd) < wall_z).count();
+        assert!(behind > 200, "{name}: {behind} pixels behind the wall without the seed");
+    }
+}
+
 fn read_texture_vec4(gpu: &lineao::Gpu, texture: &wgpu::Texture) -> Vec<[f32; 4]> {
     bytemuck::pod_collect_to_vec(&lineao::readback::read_texture(&gpu.device, &gpu.queue, texture).unwrap().bytes)
 }

@@ -54,6 +54,7 @@ use crate::passes::cull::Frozen;
 use crate::passes::lines::LineRenderer;
 use crate::passes::lines::LineStyle;
 use crate::passes::meshes::{MeshGeometry, MeshRenderer};
+use crate::passes::seed_depth::SeedDepth;
 use crate::passes::slices::{SliceRenderer, SliceVolume};
 use crate::passes::tubes::TubeRenderer;
 use crate::passes::volume_ao::VolumeAo;
@@ -84,6 +85,8 @@ pub struct AoChain {
     /// Made when the settings ask for object-space AO.
     volume_ao: Option<VolumeAo>,
     composite: Composite,
+    /// An overlay's seeding of the G-buffer's depth from the host's ([`OverlayAo::set_depth`]).
+    seed: Option<SeedDepth>,
     /// The composite's target format.
     format: wgpu::TextureFormat,
     size: (u32, u32),
@@ -131,6 +134,7 @@ impl AoChain {
             bilateral: Bilateral::new(device),
             volume_ao: settings.volume.as_ref().map(|_| VolumeAo::new(device)),
             composite: Composite::new(device, format),
+            seed: None,
             format,
             settings,
             size: (0, 0),
@@ -438,6 +442,9 @@ impl AoChain {
         };
         let strength = if s.method == AoMethod::None && s.volume.is_none() { 0.0 } else { s.strength };
         self.composite.prepare(queue, targets, &view, strength, s.debug_view, shown);
+        if let (Some(seed), Some(Some(host))) = (&self.seed, self.composite.overlay_depth()) {
+            seed.prepare(queue, targets, &view, &host);
+        }
         self.view = Some(view);
         Some(view)
     }
@@ -517,7 +524,9 @@ impl AoChain {
         self.check_target(target)?;
         self.record(
             encoder,
-            |encoder, targets, span| self.draw_geometry(encoder, targets, geometry, meshes, span),
+            |encoder, targets, span| {
+                self.draw_geometry(encoder, targets, geometry, meshes, Load::Clear(self.settings.background), span)
+            },
             |composite, encoder, span| composite.encode(encoder, target, span),
         );
         Ok(())
@@ -553,9 +562,9 @@ impl AoChain {
         targets: &FrameTargets,
         geometry: &LineGeometry,
         meshes: &[&MeshGeometry],
+        load: Load,
         span: Option<Span<'_>>,
     ) {
-        let load = Load::Clear(self.settings.background);
         let meshes = self.meshes.as_ref().filter(|_| !meshes.is_empty()).map(|renderer| (renderer, meshes));
         let slices = self.slices.as_ref().filter(|renderer| renderer.has_volume());
         // The lines' span covers the surfaces and slices when there are any: its end is the

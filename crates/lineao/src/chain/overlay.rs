@@ -6,13 +6,16 @@
 //! ([`crate::passes::composite`]): it loads the host's colour instead of clearing it, discards
 //! the background, and with the host's depth ([`OverlayDepth`]) writes each line pixel's depth
 //! as the host's projection puts it, tested against what the host drew before and kept for what
-//! it draws after.
+//! it draws after. A host depth the chain can read (`TEXTURE_BINDING`) also seeds the
+//! G-buffer's depth ([`crate::passes::seed_depth`]): the lines behind the host's picture are
+//! culled like any hidden line and occlude nothing.
 
 use super::AoChain;
 use crate::Error;
 use crate::LineGeometry;
 use crate::passes::composite::OverlayDepth;
 use crate::passes::meshes::MeshGeometry;
+use crate::passes::seed_depth::{SeedDepth, can_read};
 
 /// An [`AoChain`] that draws its geometry into a host's frame.
 pub struct OverlayAo {
@@ -39,6 +42,11 @@ impl OverlayAo {
             return Err(Error::Usage(format!("the overlay's depth format {:?} is not a depth format", d.format)));
         }
         self.chain.composite.set_overlay(device, depth);
+        match (depth, &self.chain.seed) {
+            (None, _) => self.chain.seed = None,
+            (Some(_), None) => self.chain.seed = Some(SeedDepth::new(device)),
+            (Some(_), Some(_)) => {}
+        }
         Ok(())
     }
 
@@ -59,7 +67,9 @@ impl OverlayAo {
     /// chain's visible size, one sample; `target` of the chain's format with
     /// `RENDER_ATTACHMENT`, `depth` of the overlay's format with `RENDER_ATTACHMENT` and its
     /// stored contents (`StoreOp::Store` where the host drew it). A mismatch is an
-    /// [`Error::Usage`] with nothing recorded.
+    /// [`Error::Usage`] with nothing recorded. A `depth` with `TEXTURE_BINDING` too seeds the
+    /// G-buffer's depth ([`crate::passes::seed_depth`]): what the host's picture hides is not
+    /// drawn (culled, where the chain culls) and darkens nothing.
     pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -92,9 +102,21 @@ impl OverlayAo {
             )?,
             (None, None) => {}
         }
+        // The host's depth, where the chain can read it, seeds the G-buffer's.
+        let seed = chain.seed.as_ref().zip(depth.filter(|view| can_read(view)));
         chain.record(
             encoder,
-            |encoder, targets, span| chain.draw_geometry(encoder, targets, geometry, meshes, span),
+            |encoder, targets, span| {
+                let background = chain.settings.background;
+                let load = match seed {
+                    Some((seed, depth)) => {
+                        seed.encode(encoder, targets, depth);
+                        crate::passes::Load::ClearOverDepth(background)
+                    }
+                    None => crate::passes::Load::Clear(background),
+                };
+                chain.draw_geometry(encoder, targets, geometry, meshes, load, span)
+            },
             |composite, encoder, span| composite.encode_overlay(encoder, target, depth, span),
         );
         Ok(())

@@ -65,12 +65,11 @@ pub struct OverlayDepth {
 impl OverlayDepth {
     /// The z and w rows of the projection: depth = (x z + y) / (z z + w) of a view-space z.
     fn rows(&self) -> [f32; 4] {
-        let (z, w) = (self.proj.row(2), self.proj.row(3));
-        [z.z, z.w, w.z, w.w]
+        super::seed_depth::depth_rows(&self.proj)
     }
 
     /// Whether depth grows toward the eye (reversed-Z), so the test keeps the greater.
-    fn reversed(&self) -> bool {
+    pub(crate) fn reversed(&self) -> bool {
         let [a, b, c, d] = self.rows();
         let depth = |z: f32| (a * z + b) / (c * z + d);
         depth(-1.0) > depth(-2.0)
