@@ -71,8 +71,8 @@ struct Pyramid {
 @group(3) @binding(2) var<storage, read_write> listing: array<atomic<u32>>;
 // The pieces `late_bounds` lists for `late` (cluster << 2 | piece: 3 words a cluster), then each
 // piece's bounding radius (`piece_radii`: 2 words a cluster, 16 bits a piece). Bound where
-// `listing` is not (`late` is dispatched from `listing`), in its place.
-@group(3) @binding(2) var<storage, read_write> bounds: array<u32>;
+// `listing` is not (`late` is dispatched from `listing`).
+@group(3) @binding(3) var<storage, read_write> bounds: array<u32>;
 
 const HEADER: u32 = 32u;
 const VISIBLE: u32 = HEADER;

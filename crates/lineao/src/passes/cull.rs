@@ -242,18 +242,40 @@ impl PageCull {
 /// boxes, at their bindings in `shaders/shared/clusters.wgsl`.
 fn geometry_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let storage = wgpu::BufferBindingType::Storage { read_only: true };
-    let entries = [(0, storage), (1, storage), (2, storage), (6, wgpu::BufferBindingType::Uniform), (7, storage)].map(
-        |(binding, ty)| wgpu::BindGroupLayoutEntry {
+    let entries = [(0, storage), (1, storage), (2, storage), (6, wgpu::BufferBindingType::Uniform), (7, storage)];
+    buffers_layout(device, "lineao::LineCull::geometry", &entries)
+}
+
+/// A bind group of whole buffers at their bindings.
+fn buffers_group(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    buffers: &[(u32, &wgpu::Buffer)],
+) -> wgpu::BindGroup {
+    let entries: Vec<_> = buffers
+        .iter()
+        .map(|&(binding, buffer)| wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries })
+}
+
+/// A compute layout of buffers at their bindings.
+fn buffers_layout(
+    device: &wgpu::Device,
+    label: &str,
+    entries: &[(u32, wgpu::BufferBindingType)],
+) -> wgpu::BindGroupLayout {
+    let entries: Vec<_> = entries
+        .iter()
+        .map(|&(binding, ty)| wgpu::BindGroupLayoutEntry {
             binding,
             visibility: wgpu::ShaderStages::COMPUTE,
             ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
             count: None,
-        },
-    );
-    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("lineao::LineCull::geometry"),
-        entries: &entries,
-    })
+        })
+        .collect();
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &entries })
 }
 
 /// The layout of the visible pieces as the vertex shader reads them (group 2 of the culled
@@ -293,6 +315,8 @@ pub struct LineCull {
     pyramid_layout: wgpu::BindGroupLayout,
     state_layout: wgpu::BindGroupLayout,
     listing_layout: wgpu::BindGroupLayout,
+    /// The state, the pieces and their bounds (`bounds` in `shaders/cull.wgsl`, binding 3).
+    bounds_layout: wgpu::BindGroupLayout,
     /// The pyramid's bind group, made once for each pyramid (the targets' size).
     pyramid_group: std::sync::Mutex<Option<(Arc<Built>, wgpu::BindGroup)>>,
     pieces_layout: wgpu::BindGroupLayout,
@@ -311,6 +335,8 @@ impl LineCull {
         let state = [Slot::StorageReadWrite; 3];
         let state_layout = binding::layout(device, label, compute, &state[..2]);
         let listing_layout = binding::layout(device, label, compute, &state);
+        let read_write = wgpu::BufferBindingType::Storage { read_only: false };
+        let bounds_layout = buffers_layout(device, label, &[(0, read_write), (1, read_write), (3, read_write)]);
         let page = geometry_layout(device);
         let module = crate::shader::module(device, "cull.wgsl");
         let lod = lod && shape == Shape::Lines;
@@ -336,6 +362,7 @@ impl LineCull {
         let pipeline = |entry: &str, groups: &[Option<&wgpu::BindGroupLayout>]| pipeline_of(entry, groups, lod);
         let all = [Some(frame), Some(&page), Some(&pyramid_layout), Some(&state_layout)];
         let listing = [Some(frame), Some(&page), Some(&pyramid_layout), Some(&listing_layout)];
+        let with_bounds = [Some(frame), Some(&page), Some(&pyramid_layout), Some(&bounds_layout)];
         let marks = [None, Some(&page), None, Some(&state_layout)];
         LineCull {
             device: device.clone(),
@@ -350,10 +377,10 @@ impl LineCull {
             lod,
             test_groups: pipeline("test_groups", &listing),
             size_dispatch: pipeline("size_dispatch", &[None, None, None, Some(&listing_layout)]),
-            late_bounds: pipeline("late_bounds", &listing),
+            late_bounds: pipeline("late_bounds", &with_bounds),
             size_late: pipeline("size_late", &[None, None, None, Some(&listing_layout)]),
-            late: pipeline("late", &listing),
-            piece_radii: pipeline("piece_radii", &[None, Some(&page), None, Some(&listing_layout)]),
+            late: pipeline("late", &with_bounds),
+            piece_radii: pipeline("piece_radii", &[None, Some(&page), None, Some(&bounds_layout)]),
             size_settle: pipeline("size_settle", &[None, None, None, Some(&listing_layout)]),
             settle: pipeline("settle", &all),
             pieces_layout: pieces_layout(device),
@@ -361,6 +388,7 @@ impl LineCull {
             pyramid_layout,
             state_layout,
             listing_layout,
+            bounds_layout,
             pyramid_group: std::sync::Mutex::new(None),
         }
     }
@@ -439,23 +467,19 @@ impl LineCull {
                 |layout, count: usize| binding::group(device, "lineao::LineCull::state", layout, &bound[..count]);
             let compute_group = group(&self.state_layout, 2);
             let listing_group = group(&self.listing_layout, 3);
-            let bounds_group = binding::group(
+            let bounds_group = buffers_group(
                 device,
                 "lineao::LineCull::bounds",
-                &self.listing_layout,
-                &[state.as_entire_binding(), pieces.as_entire_binding(), bounds.as_entire_binding()],
+                &self.bounds_layout,
+                &[(0, &state), (1, &pieces), (3, &bounds)],
             );
             let draw_groups = [0, list].map(|offset| {
                 let list = wgpu::BufferBinding { buffer: &pieces, offset, size: wgpu::BufferSize::new(list) };
                 let list = wgpu::BindingResource::Buffer(list);
                 binding::group(device, "lineao::LineCull::pieces", &self.pieces_layout, &[list])
             });
-            let geometry = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("lineao::LineCull::geometry"),
-                layout: &self.geometry_layout,
-                entries: &[(0, &page.xy), (1, &page.z), (2, &page.clusters), (6, &page.uniform), (7, &page.groups)]
-                    .map(|(binding, buffer)| wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() }),
-            });
+            let buffers = [(0, &page.xy), (1, &page.z), (2, &page.clusters), (6, &page.uniform), (7, &page.groups)];
+            let geometry = buffers_group(device, "lineao::LineCull::geometry", &self.geometry_layout, &buffers);
             PageCull {
                 state,
                 draw_groups,
