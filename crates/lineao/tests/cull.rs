@@ -48,6 +48,14 @@ fn ball(count: usize) -> (Vec<[f32; 3]>, Vec<u64>) {
     (positions, offsets)
 }
 
+/// `ball(count)` on the GPU, every line's full strip, and the culled lines (no levels of detail).
+fn ball_lines(gpu: &lineao::Gpu, count: usize) -> (LineGeometry, LineRenderer, LineRenderer) {
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let (positions, offsets) = ball(count);
+    let geometry = LineGeometry::new(d, q, &positions, &offsets).unwrap();
+    (geometry, LineRenderer::with_style(d, LineStyle::FullStrip), LineRenderer::new(d).culled(d, false))
+}
+
 /// Outside, inside, close up, orthographic, and a cut to the other side.
 fn cameras() -> [(&'static str, Camera); 5] {
     let inside = Camera { eye: Vec3::new(2.0, 1.0, 3.0), target: Vec3::new(30.0, 5.0, -10.0), ..outside() };
@@ -186,11 +194,8 @@ fn same_marks_as_the_cpu_reference(
 #[test]
 fn culled_lines_draw_the_g_buffer_of_all_lines() {
     let gpu = gpu();
-    let (d, q) = (&gpu.device, &gpu.queue);
-    let (positions, offsets) = ball(8000);
-    let geometry = LineGeometry::new(d, q, &positions, &offsets).unwrap();
-    let all = LineRenderer::with_style(d, LineStyle::FullStrip);
-    let culled = LineRenderer::new(d).culled(d, false);
+    let q = &gpu.queue;
+    let (geometry, all, culled) = ball_lines(&gpu, 8000);
     let pieces = lineao::passes::cull::LineCull::pieces(&geometry);
     for (case, camera) in cameras() {
         let expected = draw(&gpu, &all, &geometry, &camera);
@@ -228,40 +233,17 @@ fn culled_lines_over_a_seeded_depth_draw_the_g_buffer_of_all_lines() {
     use lineao::passes::seed_depth::SeedDepth;
     let gpu = gpu();
     let (d, q) = (&gpu.device, &gpu.queue);
-    let (positions, offsets) = ball(4000);
-    let geometry = LineGeometry::new(d, q, &positions, &offsets).unwrap();
-    let all = LineRenderer::with_style(d, LineStyle::FullStrip);
-    let culled = LineRenderer::new(d).culled(d, false);
+    let (geometry, all, culled) = ball_lines(&gpu, 4000);
     let seed = SeedDepth::new(d);
     let camera = outside();
     // The host: the same view, its depth a wall through the ball's centre.
     let view = FrameView::new(&camera, &bounds(), SIZE.0, SIZE.1, GUARD, 1.0);
     let host = lineao::OverlayDepth { format: wgpu::TextureFormat::Depth32Float, proj: view.proj };
     let wall = view.proj.project_point3(view.view.transform_point3(Vec3::ZERO)).z;
-    let host_depth = d.create_texture(&wgpu::TextureDescriptor {
-        label: Some("test::host_depth"),
-        size: wgpu::Extent3d { width: SIZE.0, height: SIZE.1, depth_or_array_layers: 1 },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: host.format,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-        view_formats: &[],
-    });
-    let host_view = host_depth.create_view(&Default::default());
+    let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+    let host_view = common::texture(&gpu, SIZE, host.format, usage, 1);
     let mut encoder = d.create_command_encoder(&Default::default());
-    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-        label: Some("test::host_frame"),
-        color_attachments: &[],
-        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-            view: &host_view,
-            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(wall), store: wgpu::StoreOp::Store }),
-            stencil_ops: None,
-        }),
-        timestamp_writes: None,
-        occlusion_query_set: None,
-        multiview_mask: None,
-    });
+    common::host_frame(&mut encoder, None, &host_view, wall);
     q.submit([encoder.finish()]);
     let draw_seeded = |renderer: &LineRenderer| {
         draw_with(&gpu, &camera, |encoder, targets, view, s| {
@@ -535,11 +517,8 @@ fn a_selection_changed_between_culled_frames_draws_at_once() {
 #[test]
 fn a_frozen_cull_draws_the_pieces_it_found_for_the_view_before() {
     let gpu = gpu();
-    let (d, q) = (&gpu.device, &gpu.queue);
-    let (positions, offsets) = ball(4000);
-    let geometry = LineGeometry::new(d, q, &positions, &offsets).unwrap();
-    let all = LineRenderer::with_style(d, LineStyle::FullStrip);
-    let culled = LineRenderer::new(d).culled(d, false);
+    let q = &gpu.queue;
+    let (geometry, all, culled) = ball_lines(&gpu, 4000);
     let cull = culled.cull().unwrap().cull();
     let (from, to) = (outside(), cameras()[4].1);
     draw(&gpu, &culled, &geometry, &from);
@@ -571,10 +550,7 @@ fn a_frozen_cull_draws_the_pieces_it_found_for_the_view_before() {
 fn a_frozen_cull_shows_why_it_left_each_piece_out() {
     let gpu = gpu();
     let q = &gpu.queue;
-    let (positions, offsets) = ball(4000);
-    let geometry = LineGeometry::new(&gpu.device, q, &positions, &offsets).unwrap();
-    let all = LineRenderer::with_style(&gpu.device, LineStyle::FullStrip);
-    let culled = LineRenderer::new(&gpu.device).culled(&gpu.device, false);
+    let (geometry, all, culled) = ball_lines(&gpu, 4000);
     let cull = culled.cull().unwrap().cull();
     let draw_pieces = |camera: &Camera| {
         draw_with(&gpu, camera, |encoder, targets, view, s| {

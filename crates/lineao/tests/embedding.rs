@@ -5,7 +5,7 @@
 
 mod common;
 
-use common::{cameras_for_polylines, gpu, host_depth, is_geometry, polylines, sphere_triangles};
+use common::{cameras_for_polylines, gpu, host_depth, is_geometry, polylines, sphere_triangles, texture};
 use glam::{Mat4, Vec3, Vec4Swizzles};
 use lineao::LineGeometry;
 use lineao::passes::nd_from_depth::{HostConfig, HostInputs, HostNormals};
@@ -304,28 +304,6 @@ fn the_composite_writes_any_host_color_format() {
     }
 }
 
-/// A plain texture of `size`, `format`, `usage` and `samples`, for the misuse tests.
-fn texture(
-    gpu: &lineao::Gpu,
-    size: (u32, u32),
-    format: wgpu::TextureFormat,
-    usage: wgpu::TextureUsages,
-    samples: u32,
-) -> wgpu::TextureView {
-    gpu.device
-        .create_texture(&wgpu::TextureDescriptor {
-            label: Some("test::misuse"),
-            size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
-            mip_level_count: 1,
-            sample_count: samples,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage,
-            view_formats: &[],
-        })
-        .create_view(&Default::default())
-}
-
 /// Every misuse of the host API is an `Error::Usage` naming what to change, with nothing
 /// recorded — never a silent no-op, never a wgpu panic inside lineao.
 #[test]
@@ -423,11 +401,7 @@ fn the_overlay_keeps_the_hosts_frame_and_writes_its_depth() {
     let bounds = geometry.bounds.unwrap();
     let size = (96u32, 72u32);
     let host_color = [0.25f32, 0.5, 0.75, 1.0];
-    let Projection::Perspective { fov_y_deg } = camera.projection else { unreachable!() };
-    let (fov, aspect) = (fov_y_deg.to_radians(), size.0 as f32 / size.1 as f32);
-    use glam::camera::rh::proj::directx;
-    let reversed_infinite = directx::perspective_infinite_reverse(fov, aspect, 0.1);
-    let standard = directx::perspective(fov, aspect, 0.1, 1000.0);
+    let [reversed_infinite, standard] = host_projections(&camera, size);
 
     // Without levels of detail, so that each frame is the first's.
     let exact = ChainSettings { lod: false, ..ChainSettings::default() };
@@ -464,26 +438,7 @@ fn the_overlay_keeps_the_hosts_frame_and_writes_its_depth() {
         let depth_view = depth.create_view(&Default::default());
         let mut encoder = d.create_command_encoder(&Default::default());
         let [r, g_, b, a] = host_color.map(f64::from);
-        encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-            label: Some("test::host_frame"),
-            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: &color.view,
-                depth_slice: None,
-                resolve_target: None,
-                ops: wgpu::Operations {
-                    load: wgpu::LoadOp::Clear(wgpu::Color { r, g: g_, b, a }),
-                    store: wgpu::StoreOp::Store,
-                },
-            })],
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &depth_view,
-                depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(wall), store: wgpu::StoreOp::Store }),
-                stencil_ops: None,
-            }),
-            timestamp_writes: None,
-            occlusion_query_set: None,
-            multiview_mask: None,
-        });
+        common::host_frame(&mut encoder, Some((&color.view, wgpu::Color { r, g: g_, b, a })), &depth_view, wall);
         overlay.set_depth(d, Some(lineao::OverlayDepth { format: wgpu::TextureFormat::Depth32Float, proj })).unwrap();
         overlay.chain_mut().prepare(d, q, &camera, &bounds).unwrap();
         overlay.encode(&mut encoder, &geometry, &[], &color.view, Some(&depth_view)).unwrap();
@@ -565,11 +520,7 @@ fn a_host_depth_the_chain_can_read_seeds_the_g_buffer_and_culls_what_it_hides() 
     let geometry = LineGeometry::new(d, q, &positions, &offsets).unwrap();
     let bounds = geometry.bounds.unwrap();
     let size = (160u32, 120u32);
-    let Projection::Perspective { fov_y_deg } = camera.projection else { unreachable!() };
-    let (fov, aspect) = (fov_y_deg.to_radians(), size.0 as f32 / size.1 as f32);
-    use glam::camera::rh::proj::directx;
-    let reversed_infinite = directx::perspective_infinite_reverse(fov, aspect, 0.1);
-    let standard = directx::perspective(fov, aspect, 0.1, 1000.0);
+    let [reversed_infinite, standard] = host_projections(&camera, size);
     let format = wgpu::TextureFormat::Depth32Float;
     for (name, proj) in [("reversed-Z, infinite far", reversed_infinite), ("standard", standard)] {
         // Two frames into a host's frame whose depth is a wall at `wall_z` (view space), the
@@ -589,29 +540,7 @@ fn a_host_depth_the_chain_can_read_seeds_the_g_buffer_and_culls_what_it_hides() 
             let mut view = None;
             for _ in 0..2 {
                 let mut encoder = d.create_command_encoder(&Default::default());
-                encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("test::host_frame"),
-                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                        view: &color.view,
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                            store: wgpu::StoreOp::Store,
-                        },
-                    })],
-                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                        view: &depth,
-                        depth_ops: Some(wgpu::Operations {
-                            load: wgpu::LoadOp::Clear(wall),
-                            store: wgpu::StoreOp::Store,
-                        }),
-                        stencil_ops: None,
-                    }),
-                    timestamp_writes: None,
-                    occlusion_query_set: None,
-                    multiview_mask: None,
-                });
+                common::host_frame(&mut encoder, Some((&color.view, wgpu::Color::BLACK)), &depth, wall);
                 view = Some(overlay.chain_mut().prepare(d, q, &camera, &bounds).unwrap());
                 overlay.encode(&mut encoder, &geometry, &[], &color.view, Some(&depth)).unwrap();
                 q.submit([encoder.finish()]);
@@ -657,6 +586,15 @@ fn a_host_depth_the_chain_can_read_seeds_the_g_buffer_and_culls_what_it_hides() 
         let behind = unseeded[1].data.iter().filter(|&&nd| is_geometry(nd) && z_of(nd) < wall_z).count();
         assert!(behind > 200, "{name}: {behind} pixels behind the wall without the seed");
     }
+}
+
+/// A host's projections of `camera` at `size`: reversed-Z with an infinite far plane, and
+/// standard depth.
+fn host_projections(camera: &Camera, size: (u32, u32)) -> [Mat4; 2] {
+    let Projection::Perspective { fov_y_deg } = camera.projection else { unreachable!() };
+    let (fov, aspect) = (fov_y_deg.to_radians(), size.0 as f32 / size.1 as f32);
+    use glam::camera::rh::proj::directx;
+    [directx::perspective_infinite_reverse(fov, aspect, 0.1), directx::perspective(fov, aspect, 0.1, 1000.0)]
 }
 
 fn read_texture_vec4(gpu: &lineao::Gpu, texture: &wgpu::Texture) -> Vec<[f32; 4]> {

@@ -325,6 +325,56 @@ pub fn unit_sphere_view() -> (Camera, Bounds) {
     (camera, Bounds { center: glam::Vec3::ZERO, radius: 1.0 })
 }
 
+/// A view of a new texture of `size`, `format`, `usage` and `samples`.
+pub fn texture(
+    gpu: &lineao::Gpu,
+    size: (u32, u32),
+    format: wgpu::TextureFormat,
+    usage: wgpu::TextureUsages,
+    samples: u32,
+) -> wgpu::TextureView {
+    gpu.device
+        .create_texture(&wgpu::TextureDescriptor {
+            label: Some("test::texture"),
+            size: wgpu::Extent3d { width: size.0, height: size.1, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: samples,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage,
+            view_formats: &[],
+        })
+        .create_view(&Default::default())
+}
+
+/// A host's frame as a host leaves it: `color` (where given) cleared to its colour and `depth`
+/// to `wall` (the host drew a wall at that depth), stored.
+pub fn host_frame(
+    encoder: &mut wgpu::CommandEncoder,
+    color: Option<(&wgpu::TextureView, wgpu::Color)>,
+    depth: &wgpu::TextureView,
+    wall: f32,
+) {
+    let color = color.map(|(view, clear)| wgpu::RenderPassColorAttachment {
+        view,
+        depth_slice: None,
+        resolve_target: None,
+        ops: wgpu::Operations { load: wgpu::LoadOp::Clear(clear), store: wgpu::StoreOp::Store },
+    });
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("test::host_frame"),
+        color_attachments: &[color],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: depth,
+            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(wall), store: wgpu::StoreOp::Store }),
+            stencil_ops: None,
+        }),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+}
+
 /// The G-buffer in `targets` (color, ND, zoom, hardware depth), read back; the scalar maps in
 /// the first channel.
 pub fn read_gbuffer(gpu: &Gpu, targets: &FrameTargets) -> [NdImage; 4] {
