@@ -368,7 +368,7 @@ fn radii_at() -> u32 {
 
 // Once a page (its cull state made): each piece's bounding radius around the segment between
 // its ends (a capsule), all its points as decoded, in units of two of its cluster's grid steps
-// rounded up (NO_RADIUS where that does not fit, or a piece the cluster lacks).
+// rounded up, at least one (NO_RADIUS where that does not fit, or a piece the cluster lacks).
 @compute @workgroup_size(64)
 fn piece_radii(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) local: u32) {
     let i = invocation(group, local);
@@ -389,8 +389,9 @@ fn piece_radii(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocatio
             let t = clamp(dot(q, ab) / max(dot(ab, ab), 1e-30), 0.0, 1.0);
             r = max(r, length(q - t * ab));
         }
-        // A step more for rounding; a grid of zero steps holds one point.
-        let units = select(0.0, ceil(r / (2.0 * c.scale)) + 1.0, r > 0.0);
+        // A step more for rounding (a grid of zero steps holds one point); at least one, for
+        // 0 says the radius is not found yet.
+        let units = select(1.0, ceil(r / (2.0 * c.scale)) + 1.0, c.scale > 0.0);
         if units < f32(NO_RADIUS) {
             radii[p] = u32(units);
         }
@@ -419,7 +420,8 @@ fn capsule_verdict(i: u32, p: u32, first: u32, last: u32) -> u32 {
         return LEFT_BEHIND;
     }
     let units = (bounds[radii_at() + 2u * i + (p >> 1u)] >> ((p & 1u) * 16u)) & 0xffffu;
-    if units == NO_RADIUS {
+    // No bound, or none found yet (the buffer starts zeroed).
+    if units == NO_RADIUS || units == 0u {
         return VISIBLE_HERE;
     }
     var r = 2.0 * f32(units) * c.scale;

@@ -628,8 +628,8 @@ impl LineCull {
 
     /// A test against the pyramid `built`: every page's groups (the pieces of hidden ones
     /// unmarked), then each of `stages`: `size` (`size_dispatch`, `size_late`, `size_settle`)
-    /// writes each page's indirect dispatch of `pieces` — the bounding spheres of the listed
-    /// groups' pieces and the late test of those that pass (`late_bounds`, `late`: `bounds` says
+    /// writes each page's indirect dispatch of `pieces` — the capsules of the listed groups'
+    /// pieces and the late test of those that pass (`late_bounds`, `late`: `bounds` says
     /// they read the pieces' bounds), or the settling of the pieces drawn.
     #[allow(clippy::too_many_arguments)]
     fn test(
