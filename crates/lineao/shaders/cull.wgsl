@@ -434,11 +434,11 @@ fn capsule_verdict(i: u32, p: u32, first: u32, last: u32) -> u32 {
     );
     // The view-space axes r long, in clip space.
     let axes = array<vec4<f32>, 3>(frame.proj[0] * r, frame.proj[1] * r, frame.proj[2] * r);
-    var bounds = NdcBounds(vec3<f32>(3.0e38), vec3<f32>(-3.0e38));
+    var rect = NdcBounds(vec3<f32>(3.0e38), vec3<f32>(-3.0e38));
     for (var k = 0u; k < 16u; k++) {
         let signs = vec3<f32>(f32(k & 1u), f32((k >> 1u) & 1u), f32((k >> 2u) & 1u)) * 2.0 - 1.0;
         let offset = signs.x * axes[0] + signs.y * axes[1] + signs.z * axes[2];
-        if !widen(&bounds, ends[k >> 3u] + offset) {
+        if !widen(&rect, ends[k >> 3u] + offset) {
             // Reaches behind the eye: no bound on screen.
             return VISIBLE_HERE;
         }
@@ -447,9 +447,8 @@ fn capsule_verdict(i: u32, p: u32, first: u32, last: u32) -> u32 {
     // a coarser one, never finer, and hides no piece their test would show (the marks stay
     // theirs; read finer, 4 × 4 texels, 34 % fewer pieces pass it at 10 M points, for 5 % of
     // the cull).
-    return box_verdict(bounds.lo, bounds.hi, SEGMENT_SPAN);
+    return box_verdict(rect.lo, rect.hi, SEGMENT_SPAN);
 }
-
 
 // The bits of a cluster's mark that hold piece `p`'s level.
 fn level_bits(p: u32) -> u32 {
@@ -627,15 +626,15 @@ fn tube_verdict(a: vec3<f32>, b: vec3<f32>) -> u32 {
 
 // The verdict on what lies in the world box `lo`..`hi`.
 fn world_box_verdict(lo: vec3<f32>, hi: vec3<f32>) -> u32 {
-    var bounds = NdcBounds(vec3<f32>(3.0e38), vec3<f32>(-3.0e38));
+    var rect = NdcBounds(vec3<f32>(3.0e38), vec3<f32>(-3.0e38));
     for (var k = 0u; k < 8u; k++) {
         let corner = select(lo, hi, vec3<bool>((k & 1u) != 0u, (k & 2u) != 0u, (k & 4u) != 0u));
-        if !widen(&bounds, frame.proj * (frame.view * vec4<f32>(corner, 1.0))) {
+        if !widen(&rect, frame.proj * (frame.view * vec4<f32>(corner, 1.0))) {
             // Reaches behind the eye: no bound on screen.
             return VISIBLE_HERE;
         }
     }
-    return box_verdict(bounds.lo, bounds.hi, GROUP_SPAN);
+    return box_verdict(rect.lo, rect.hi, GROUP_SPAN);
 }
 
 // A box in NDC.
