@@ -2,8 +2,9 @@
 // draw them: cluster << 6 | left << 4 | level << 2 | piece, where piece p of a cluster is its
 // strip's segments 8p .. 8p + 7 (points 8p ..= 8p + 8, or to its end), drawn keeping every
 // 2^level-th point of it and its last; `left` is 0 but in the frozen cull's picture of what it
-// left out (1 outside the view, 2 behind what it drew: `cull.wgsl`'s `list_all`). A draw of full pieces reads its list from the front,
-// one of coarse pieces (level > 0) from the back. Bind group 2 of their pipelines.
+// left out (1 outside the view, 2 behind what it drew: `cull.wgsl`'s `list_all`). A draw of
+// full pieces reads its list from the front, one of coarse pieces (level > 0) from the back.
+// Bind group 2 of their pipelines.
 #import shared/clusters.wgsl
 
 @group(2) @binding(0) var<storage, read> visible_pieces: array<u32>;
