@@ -307,15 +307,16 @@ fn whole_brain_in_chunks(seed: u64, vertices: u64, sink: &mut dyn FnMut(Tractogr
 }
 
 /// How a session uploads its lines onto `gpu`: waiting after each page (the CLI and the
-/// viewer's worker own their devices, so staging memory stays one page); pages of 256 k points
-/// on a CPU adapter (lavapipe: a page's points and records, 2.3 MB, stay in its caches while
-/// the page is drawn — at 50 M points the lines pass took 33 s in pages of 4 M points, 17 s in
-/// pages of 256 k), of 16 M on a GPU (fewer draws); and the alternating strip's tolerance a
-/// hundredth of a millimetre (files and the built-in scenes are in mm), whatever the chunks: a
-/// file streamed and the same streamlines uploaded whole from memory draw the same pixels.
+/// viewer's worker own their devices, so staging memory stays one page); pages of 4 M points on
+/// a CPU adapter and of 16 M on a GPU (fewer pages: the cull dispatches its passes per page,
+/// and lavapipe pays for each dispatch — at 50 M points in pages of 256 k a second of the
+/// culled frame; every cluster is drawn in batches of 256 k points there, whatever the page:
+/// `LineGeometry::draw_batches`); and the alternating strip's tolerance a hundredth of a
+/// millimetre (files and the built-in scenes are in mm), whatever the chunks: a file streamed
+/// and the same streamlines uploaded whole from memory draw the same pixels.
 pub fn geometry_options(gpu: &lineao::Gpu) -> GeometryOptions {
     let cpu = gpu.adapter.get_info().device_type == wgpu::DeviceType::Cpu;
-    let page_bytes = if cpu { 2 << 20 } else { 128 << 20 };
+    let page_bytes = if cpu { 32 << 20 } else { 128 << 20 };
     GeometryOptions { bounded_staging: true, page_bytes, tolerance: Some(0.01), ..Default::default() }
 }
 

@@ -12,6 +12,9 @@
 // which tests the piece's bounding capsule (two points decoded, not nine) and lists the pieces
 // that may be visible; `late` tests those segment by segment, an invocation each, so that
 // neighbouring invocations do the same work; `settle` runs an invocation per piece drawn.
+// Where the capsules cost more than the segment tests they save (a GPU: another pass, and a
+// list written and read, to spare arithmetic it has plenty of), `late_direct` tests each
+// piece of a listed group segment by segment at once; the marks are the same.
 //
 // A piece (segments 8p .. 8p + 7 of a cluster's strip) is visible where one of its segments
 // is, each bounded by its two points as the vertex shader computes them: its quads' corners are
@@ -359,6 +362,16 @@ fn late(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index
     let c = clusters[i];
     let first = p * PIECE_SEGMENTS;
     mark(i, p, piece_verdict(c, first, min(first + PIECE_SEGMENTS, drawn_points(c) - 1u)));
+}
+
+// An invocation per piece of a listed group, tested segment by segment without its capsule
+// first (`lineao::passes::cull::LineCull::set_capsules`) and marked.
+@compute @workgroup_size(48)
+fn late_direct(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) local: u32) {
+    let piece = listed_piece(group, local);
+    if piece.w > piece.z {
+        mark(piece.x, piece.y, piece_verdict(clusters[piece.x], piece.z, piece.w));
+    }
 }
 
 // Where piece radii start in `bounds`.

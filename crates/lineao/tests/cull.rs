@@ -197,23 +197,30 @@ fn culled_lines_draw_the_g_buffer_of_all_lines() {
     let q = &gpu.queue;
     let (geometry, all, culled) = ball_lines(&gpu, 8000);
     let pieces = lineao::passes::cull::LineCull::pieces(&geometry);
-    for (case, camera) in cameras() {
-        let expected = draw(&gpu, &all, &geometry, &camera);
-        // The first frame of a view (after the one before it), then the next.
-        for frame in ["first", "second"] {
-            let got = draw(&gpu, &culled, &geometry, &camera);
-            let counts = culled.cull().unwrap().counts(q, &geometry).unwrap();
-            let (early, late) = (counts.early, counts.late);
-            let (covered, ties) = same_gbuffer(&expected, &got, case);
-            println!(
-                "{case}, {frame} frame: drew {early} + {late} of {pieces} pieces ({:.1} %); {covered} geometry pixels, {ties} ties",
-                100.0 * (early + late) as f64 / pieces as f64
-            );
-            assert!(ties * 2000 <= covered, "{case}: {ties} of {covered} pixels differ at equal depth");
-            if frame == "second" {
-                assert!(late * 100 <= early, "{case}: a still camera draws what the last frame found visible");
+    // The late test with each piece's capsule first (a CPU adapter's default) and without (a
+    // GPU's): the same pictures and marks.
+    for capsules in [true, false] {
+        culled.cull().unwrap().cull().set_capsules(capsules);
+        for (case, camera) in cameras() {
+            let case = &format!("{case} (capsules {capsules})");
+            let expected = draw(&gpu, &all, &geometry, &camera);
+            // The first frame of a view (after the one before it), then the next.
+            for frame in ["first", "second"] {
+                let got = draw(&gpu, &culled, &geometry, &camera);
+                let counts = culled.cull().unwrap().counts(q, &geometry).unwrap();
+                assert_eq!(counts.segment_tested.is_some(), capsules, "{case}");
+                let (early, late) = (counts.early, counts.late);
+                let (covered, ties) = same_gbuffer(&expected, &got, case);
+                println!(
+                    "{case}, {frame} frame: drew {early} + {late} of {pieces} pieces ({:.1} %); {covered} geometry pixels, {ties} ties",
+                    100.0 * (early + late) as f64 / pieces as f64
+                );
+                assert!(ties * 2000 <= covered, "{case}: {ties} of {covered} pixels differ at equal depth");
+                if frame == "second" {
+                    assert!(late * 100 <= early, "{case}: a still camera draws what the last frame found visible");
+                }
+                same_marks_as_the_cpu_reference(&gpu, &culled, &geometry, &camera, &got[3], case);
             }
-            same_marks_as_the_cpu_reference(&gpu, &culled, &geometry, &camera, &got[3], case);
         }
     }
     // From outside most of the ball is hidden: a second frame draws well under half of it.

@@ -313,7 +313,9 @@ impl LineRenderer {
                 let Some(pipeline) = pipeline.filter(|_| !draws.is_empty()) else { continue };
                 pass.set_pipeline(pipeline);
                 for (vertices, instances) in draws {
-                    pass.draw(0..vertices, instances);
+                    for batch in geometry.draw_batches(instances) {
+                        pass.draw(0..vertices, batch);
+                    }
                 }
             }
         }

@@ -124,7 +124,9 @@ impl TubeRenderer {
         for page in geometry.pages() {
             pass.set_bind_group(1, &page.group, &[]);
             for (class, range) in page.classes.iter().enumerate().filter(|(_, r)| !r.is_empty()) {
-                pass.draw(0..6 * class_segments(class), range.clone());
+                for batch in geometry.draw_batches(range.clone()) {
+                    pass.draw(0..6 * class_segments(class), batch);
+                }
             }
         }
     }
