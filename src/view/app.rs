@@ -259,7 +259,8 @@ impl App {
         self.load_failed = false;
         (self.camera, self.framed, self.first_picture, self.first_frame_ms) = (None, None, None, None);
         self.opened_at = Some(Instant::now());
-        self.send(ToWorker::Load(source, self.sampled.clone()));
+        // The regions set now are judged as the streamlines arrive.
+        self.send(ToWorker::Load(source, self.sampled.clone(), self.controls.selection().regions()));
     }
 
     /// Shows `volume`'s slices with every dataset from now on, at `positions` (default: three

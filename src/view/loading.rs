@@ -141,11 +141,19 @@ pub enum Step {
 
 impl Opening {
     /// Starts opening `source` on `gpu`: nothing read yet; `sampled`, a volume sampled at
-    /// every vertex as a field.
-    pub fn start(source: Source, sampled: Option<Arc<Sampled>>, gpu: &Gpu) -> Result<Opening, String> {
+    /// every vertex as a field; `regions`, include and exclude regions (a selection of them
+    /// alone) each streamline is judged by as it arrives, so that they select while the file
+    /// arrives and need no second read of it ([`Lines::judged`]).
+    pub fn start(
+        source: Source,
+        sampled: Option<Arc<Sampled>>,
+        regions: lineao_tracts::Selection,
+        gpu: &Gpu,
+    ) -> Result<Opening, String> {
         let error = |e: SourceError| format!("{e:#}");
         // The lengths: the side panel selects by them.
-        let keep = Keep { fields: true, sampled, lengths: true, ..Keep::default() };
+        let selection = (!regions.is_everything()).then(|| Arc::new(regions));
+        let keep = Keep { fields: true, sampled, lengths: true, selection, ..Keep::default() };
         let lines = Lines::empty(source.name(), &keep, gpu).map_err(error)?;
         let chunks: Arc<Mutex<VecDeque<Tractogram>>> = Arc::default();
         let sink = {

@@ -638,6 +638,47 @@ fn include_and_exclude_regions_select_streamlines_as_groups_do() {
 }
 
 #[test]
+fn regions_select_streamlines_while_the_file_arrives() {
+    // A whole brain arriving in chunks, opened with an include sphere at its centre: the frames
+    // drawn while it arrives already leave out what misses the sphere (judged as each chunk
+    // came; before, regions waited for the whole file and read it again), and the last keeps
+    // what the selection keeps of the whole tractogram.
+    let vertices = 3_000_000;
+    let brain = lineao_tracts::scenes::wholebrain::WholeBrain::new(1, vertices as u64);
+    let whole = brain.tractogram(0..brain.streamlines());
+    let n = whole.positions.len() as f32;
+    let sum = whole.positions.iter().fold([0.0f32; 3], |s, p| [s[0] + p[0], s[1] + p[1], s[2] + p[2]]);
+    let sphere = lineao_tracts::Region::Sphere { center: sum.map(|c| c / n), radius: 15.0 };
+    let selection = lineao_tracts::Selection { include: vec![sphere], ..Default::default() };
+    let expected = selection.mask(&whole).unwrap().iter().filter(|&&k| k).count();
+    assert!(expected > 0 && expected < whole.streamlines() / 2, "{expected} of {}", whole.streamlines());
+    let mut options = options(scene(SceneKind::WholeBrain, vertices as usize), [methods()[1], methods()[4]], false);
+    options.controls.regions = vec![super::controls::RegionRule { include: true, region: sphere }];
+    let mut harness = harness(options);
+    let (deadline, mut arriving) = (Instant::now() + Duration::from_secs(300), Vec::new());
+    loop {
+        harness.step();
+        let app = harness.state();
+        let complete = app.dataset.as_ref().is_some_and(|d| d.complete);
+        if let (Some(frame), false) = (&app.shown, complete) {
+            arriving.extend(frame.selected);
+        }
+        if complete && app.settled() {
+            break;
+        }
+        assert!(Instant::now() < deadline, "the whole brain did not arrive in 300 s");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    settle(&mut harness);
+    assert!(harness.state().error.is_none(), "{:?}", harness.state().error);
+    let partial = arriving.iter().find(|&&(_, all)| all < whole.streamlines());
+    let &(kept, all) = partial.expect("a frame drawn while the file arrived, with the sphere's selection");
+    assert!(kept < all, "while arriving: {kept} of {all} kept");
+    let last = harness.state().shown.as_ref().unwrap().selected;
+    assert_eq!(last, Some((expected, whole.streamlines())));
+}
+
+#[test]
 fn a_frozen_cull_shows_from_behind_what_it_drew_for_the_view_before() {
     let mut harness = harness(options(scene(SceneKind::Bundles, 200_000), [methods()[0], methods()[4]], false));
     settle(&mut harness);

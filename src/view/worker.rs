@@ -63,8 +63,9 @@ pub struct View {
 }
 
 pub enum ToWorker {
-    /// Open a source, sampling a volume at its vertices where one is given.
-    Load(Source, Option<Arc<Sampled>>),
+    /// Open a source, sampling a volume at its vertices where one is given, judging each
+    /// streamline by include and exclude regions (a selection of them alone) as it arrives.
+    Load(Source, Option<Arc<Sampled>>, lineao_tracts::Selection),
     /// The anatomy whose slices are shown (`--volume`, a volume opened or dropped), or none:
     /// it stays on the GPU across datasets, and the newest view is drawn again with it.
     Anatomy(Option<Arc<lineao_tracts::Volume>>),
@@ -320,13 +321,13 @@ impl Worker {
         let render =
             pending.iter().rposition(|c| matches!(c, ToWorker::Render(_))).filter(|&r| last_load.is_none_or(|l| r > l));
         if let Some(l) = last_load {
-            let ToWorker::Load(source, sampled) = &pending[l] else { unreachable!() };
+            let ToWorker::Load(source, sampled, regions) = &pending[l] else { unreachable!() };
             (self.scene, self.continuing, self.opening, self.announced) = (None, None, None, false);
             for panel in &mut self.chains {
                 // The old dataset's BVH is freed now, not when the next one replaces it.
                 panel.chain.set_ray_scene(&gpu.device, None);
             }
-            match Opening::start(source.clone(), sampled.clone(), gpu) {
+            match Opening::start(source.clone(), sampled.clone(), regions.clone(), gpu) {
                 Ok(opening) => self.opening = Some(opening),
                 Err(e) => send(FromWorker::Error(e)),
             }
@@ -524,8 +525,9 @@ fn same<T>(a: Option<&Arc<T>>, b: Option<&Arc<T>>) -> bool {
 
 /// Selects on the GPU (full detail and preview) what `selection` keeps, where it or the
 /// streamlines changed since the scene was last selected: a bit per cluster, no geometry.
-/// Regions need every point: the file is read again for them (the first time, busy meanwhile)
-/// once all of it has arrived; while it arrives they wait.
+/// Regions need every point: the regions the file was opened with were judged as it arrived
+/// ([`Lines::judged`]); others are judged by reading the file again (the first time, busy
+/// meanwhile) once all of it has arrived, and while it arrives they wait.
 fn select(
     gpu: &Gpu,
     scene: &mut SceneRef<'_>,
@@ -549,8 +551,11 @@ fn select(
         let mut keep: Vec<bool> =
             lines.lengths.iter().enumerate().map(|(i, &l)| selection.keeps(i as u64, l)).collect();
         selection.apply_field(&mut keep, &lines.tracts).map_err(rule)?;
-        let regions = !(selection.include.is_empty() && selection.exclude.is_empty());
-        if regions && !scene.opening {
+        let regions = selection.regions();
+        let judged = lines.judged().filter(|(by, verdicts)| **by == regions && verdicts.len() == count);
+        if let Some((_, verdicts)) = judged {
+            keep.iter_mut().zip(verdicts).for_each(|(kept, passes)| *kept &= passes);
+        } else if !regions.is_everything() && !scene.opening {
             if !lines.points_kept() {
                 send(FromWorker::Busy(format!("reading {name} again for its points (regions) …")));
                 lines.load_points(scene.source).map_err(|e| format!("{e:#}"))?;

@@ -674,6 +674,12 @@ impl Lines {
         applied
     }
 
+    /// The selection the streamlines were judged by as they arrived ([`Keep::selection`]) and
+    /// the verdicts so far, one a streamline.
+    pub fn judged(&self) -> Option<(&lineao_tracts::Selection, &[bool])> {
+        self.keep.selection.as_deref().zip(self.selected.as_deref())
+    }
+
     /// How many streamlines are shown (all without a selection).
     pub fn selected_count(&self) -> usize {
         self.selected.as_ref().map_or(self.geometry.streamlines, |s| s.iter().filter(|&&k| k).count())

@@ -99,6 +99,12 @@ impl Selection {
         *self == Selection::default()
     }
 
+    /// Its include and exclude regions alone (every other rule passes everything): what a viewer
+    /// that keeps no points judges as a file arrives.
+    pub fn regions(&self) -> Selection {
+        Selection { include: self.include.clone(), exclude: self.exclude.clone(), ..Selection::default() }
+    }
+
     /// Whether the rules that a streamline's index in its file and its arc length decide (the
     /// subset, the length range) keep it: what a viewer that keeps only the lengths can change.
     pub fn keeps(&self, index: u64, length: f32) -> bool {
