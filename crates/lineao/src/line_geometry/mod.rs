@@ -378,7 +378,7 @@ impl LineGeometry {
 
     /// A draw of the clusters `instances` of a page split into the draws a renderer makes of
     /// them: one on a GPU, runs of 256 k points on a CPU adapter. At 50 M points in pages of 4 M
-    /// (lavapipe): drawing every line took 20.4 s a frame in one draw a page, 15.6 s in batches,
+    /// (lavapipe): drawing every line took 20.3 s a frame in one draw a page, 15.6 s in batches,
     /// as in pages of 256 k points — whose per-page dispatches cost the culled frame a second.
     pub(crate) fn draw_batches(&self, instances: Range<u32>) -> impl Iterator<Item = Range<u32>> {
         batches(instances, self.draw_batch)

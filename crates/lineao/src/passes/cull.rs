@@ -594,7 +594,7 @@ impl LineCull {
     /// points decoded instead of nine, in a pass of its own that lists the pieces that pass),
     /// or tests every piece of a visible group segment by segment at once. The marks, and so
     /// the pictures, are the same. By default on a CPU adapter, where the arithmetic saved is
-    /// the cost (lavapipe, 10 M points: the cull 17 % faster), and off on a GPU, where the
+    /// the cost (lavapipe, 10 M points: the cull 15 % faster), and off on a GPU, where the
     /// extra pass is (an H200, 50 M points: the cull 0.90 ms without, 1.22 with).
     pub fn set_capsules(&self, on: bool) {
         self.capsules.store(on, std::sync::atomic::Ordering::Relaxed);
