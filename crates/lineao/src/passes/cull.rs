@@ -79,8 +79,9 @@
 //!
 //! Each page keeps its state ([`PageCull`]), one for lines, lines at levels of detail and
 //! tubes each: a word a cluster (its visible pieces), the list of pieces to draw (a word each),
-//! the listed groups, the pieces listed for the segment test and the pieces' radii, and the
-//! indirect draws and dispatch: about 2.2 bytes a point, made on the page's first culled frame.
+//! the listed groups and the indirect draws and dispatch, about 1.3 bytes a point, made on the
+//! page's first culled frame; and where the capsules are tested, the pieces listed for the
+//! segment test and the pieces' radii, 0.9 bytes a point more, made when they first are.
 
 use std::sync::Arc;
 
@@ -205,6 +206,14 @@ impl LevelsView {
     }
 }
 
+/// A page's capsules: the pieces `late_bounds` lists for `late` and each piece's bounding
+/// radius (about 0.9 bytes a point), with the state and the pieces (`late_bounds`, `late`,
+/// `piece_radii`).
+struct PageCapsules {
+    bounds: wgpu::Buffer,
+    group: wgpu::BindGroup,
+}
+
 /// A page's culling state (see the module documentation).
 pub struct PageCull {
     /// The indirect draws (and, in the same buffer, the marks and the listed groups).
@@ -215,16 +224,12 @@ pub struct PageCull {
     compute_group: wgpu::BindGroup,
     /// With the listed groups' dispatch (`test_groups`, `size_dispatch`).
     listing_group: wgpu::BindGroup,
-    /// With the pieces' bounds (`late_bounds`, `late`, `piece_radii`).
-    bounds_group: wgpu::BindGroup,
     /// The page's arrays the tests read.
     geometry: wgpu::BindGroup,
     pieces: wgpu::Buffer,
     listing: wgpu::Buffer,
-    /// The pieces listed for `late` and each piece's bounding radius.
-    bounds: wgpu::Buffer,
-    /// Whether the radii are recorded (`piece_radii`, once).
-    bounded: std::sync::atomic::AtomicBool,
+    /// What the capsule test adds, made where it first runs ([`LineCull::set_capsules`]).
+    capsules: std::sync::OnceLock<PageCapsules>,
     /// The view its marks' levels of detail were found for.
     levels_of: std::sync::Mutex<Option<LevelsView>>,
 }
@@ -237,7 +242,8 @@ impl PageCull {
 
     /// Bytes of its buffers.
     pub fn bytes(&self) -> u64 {
-        self.state.size() + self.pieces.size() + self.listing.size() + self.bounds.size()
+        let capsules = self.capsules.get().map_or(0, |c| c.bounds.size());
+        self.state.size() + self.pieces.size() + self.listing.size() + capsules
     }
 }
 
@@ -387,7 +393,7 @@ impl LineCull {
             late_bounds: pipeline("late_bounds", &with_bounds),
             size_late: pipeline("size_late", &[None, None, None, Some(&listing_layout)]),
             late: pipeline("late", &with_bounds),
-            late_direct: pipeline("late_direct", &with_bounds),
+            late_direct: pipeline("late_direct", &all),
             capsules: (device.adapter_info().device_type == wgpu::DeviceType::Cpu).into(),
             piece_radii: pipeline("piece_radii", &[None, Some(&page), None, Some(&bounds_layout)]),
             size_settle: pipeline("size_settle", &[None, None, None, Some(&listing_layout)]),
@@ -465,23 +471,11 @@ impl LineCull {
                 LISTING_BYTES,
                 wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
             );
-            // Three words a piece listed for `late`, two a cluster for the radii.
-            let bounds = buffer(
-                "lineao::LineCull::bounds",
-                4 * (PIECES_PER_CLUSTER + 2) * clusters,
-                wgpu::BufferUsages::empty(),
-            );
             let bound = [&state, &pieces, &listing].map(|b| b.as_entire_binding());
             let group =
                 |layout, count: usize| binding::group(device, "lineao::LineCull::state", layout, &bound[..count]);
             let compute_group = group(&self.state_layout, 2);
             let listing_group = group(&self.listing_layout, 3);
-            let bounds_group = buffers_group(
-                device,
-                "lineao::LineCull::bounds",
-                &self.bounds_layout,
-                &[(0, &state), (1, &pieces), (3, &bounds)],
-            );
             let draw_groups = [0, list].map(|offset| {
                 let list = wgpu::BufferBinding { buffer: &pieces, offset, size: wgpu::BufferSize::new(list) };
                 let list = wgpu::BindingResource::Buffer(list);
@@ -494,14 +488,29 @@ impl LineCull {
                 draw_groups,
                 compute_group,
                 listing_group,
-                bounds_group,
                 geometry,
                 pieces,
                 listing,
-                bounds,
-                bounded: Default::default(),
+                capsules: Default::default(),
                 levels_of: Default::default(),
             }
+        })
+    }
+
+    /// `page`'s capsules (its `state`'s), made the first time.
+    fn capsules_of<'p>(&self, page: &Page, state: &'p PageCull) -> &'p PageCapsules {
+        state.capsules.get_or_init(|| {
+            let device = &self.device;
+            // Three words a piece listed for `late`, two a cluster for the radii.
+            let bounds = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("lineao::LineCull::bounds"),
+                size: 4 * (PIECES_PER_CLUSTER + 2) * page.records as u64,
+                usage: wgpu::BufferUsages::STORAGE,
+                mapped_at_creation: false,
+            });
+            let buffers = [(0, &state.state), (1, &state.pieces), (3, &bounds)];
+            let group = buffers_group(device, "lineao::LineCull::bounds", &self.bounds_layout, &buffers);
+            PageCapsules { bounds, group }
         })
     }
 
@@ -531,15 +540,13 @@ impl LineCull {
             encoder.clear_buffer(&self.state(page).state, 0, Some(4 * STATE_HEADER_WORDS));
         }
         // A page's pieces' bounding radii, once (its points do not change), where the capsules
-        // are tested.
+        // are tested: when its capsules are made.
         let capsules = self.capsules();
-        let unbounded: Vec<&Page> = pages
-            .iter()
-            .filter(|page| capsules && !self.state(page).bounded.swap(true, std::sync::atomic::Ordering::Relaxed))
-            .collect();
+        let unbounded: Vec<&Page> =
+            pages.iter().filter(|page| capsules && self.state(page).capsules.get().is_none()).collect();
         if !unbounded.is_empty() {
             self.over_pages(encoder, unbounded, None, &self.piece_radii, None, |pass, page, state| {
-                pass.set_bind_group(3, &state.bounds_group, &[]);
+                pass.set_bind_group(3, &self.capsules_of(page, state).group, &[]);
                 dispatch_over(pass, page.records);
             });
         }
@@ -566,7 +573,7 @@ impl LineCull {
         let built = self.pyramid.encode(encoder, &targets.depth, None);
         let late = [(&self.size_dispatch, &self.late_bounds), (&self.size_late, &self.late)];
         let late = if capsules { &late[..] } else { &[(&self.size_dispatch, &self.late_direct)] };
-        self.test(encoder, pages, frame, &built, late, true, None);
+        self.test(encoder, pages, frame, &built, late, capsules, None);
         self.pad(encoder, pages);
         draw(encoder, Phase::Late, None);
         let built = self.pyramid.encode(encoder, &targets.depth, None);
@@ -657,7 +664,7 @@ impl LineCull {
     /// unmarked), then each of `stages`: `size` (`size_dispatch`, `size_late`, `size_settle`)
     /// writes each page's indirect dispatch of `pieces` — the capsules of the listed groups'
     /// pieces and the late test of those that pass (`late_bounds`, `late`: `bounds` says
-    /// they read the pieces' bounds), or the settling of the pieces drawn.
+    /// they read the pieces' bounds, the page's capsules), or the settling of the pieces drawn.
     #[allow(clippy::too_many_arguments)]
     fn test(
         &self,
@@ -687,8 +694,9 @@ impl LineCull {
                 pass.dispatch_workgroups(1, 1, 1);
             });
             let span = if k + 1 == stages.len() { last.take() } else { None };
-            self.over_pages(encoder, pages, bound, pieces, span, |pass, _, state| {
-                pass.set_bind_group(3, if bounds { &state.bounds_group } else { &state.compute_group }, &[]);
+            self.over_pages(encoder, pages, bound, pieces, span, |pass, page, state| {
+                let group = if bounds { &self.capsules_of(page, state).group } else { &state.compute_group };
+                pass.set_bind_group(3, group, &[]);
                 pass.dispatch_workgroups_indirect(&state.listing, 0);
             });
         }
