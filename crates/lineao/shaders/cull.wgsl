@@ -530,16 +530,11 @@ fn settle(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_ind
 // segment's direction). A kept point keeps its own tangent, so the strip's corners there, and
 // the joins to the next pieces, are the full strip's.
 fn piece_level(c: Cluster, first: u32, last: u32) -> u32 {
-    let count = c.flags & CLUSTER_COUNT;
     var p: array<vec3<f32>, 9>;
     let n = last - first + 1u;
     var nearest = 3.0e38;
     for (var k = 0u; k < n; k++) {
-        var owner = c;
-        if first + k >= count {
-            owner = clusters[c.next];
-        }
-        let view_pos = frame.view * vec4<f32>(decode_point(c.first + first + k, owner), 1.0);
+        let view_pos = frame.view * vec4<f32>(strip_point(c, first + k), 1.0);
         let w = (frame.proj * view_pos).w;
         if w <= 0.0 {
             return 0u;
@@ -579,16 +574,11 @@ fn piece_verdict(c: Cluster, first: u32, last: u32) -> u32 {
     if !is_selected(c) {
         return LEFT_BEHIND;
     }
-    let count = c.flags & CLUSTER_COUNT;
     var previous = vec3<f32>(0.0);
     var verdict = LEFT_OUTSIDE;
     for (var k = first; k <= last; k++) {
-        var owner = c;
-        if k >= count {
-            owner = clusters[c.next];
-        }
         // As the vertex shader computes it.
-        let view_pos = frame.view * vec4<f32>(decode_point(c.first + k, owner), 1.0);
+        let view_pos = frame.view * vec4<f32>(strip_point(c, k), 1.0);
         var segment = LEFT_OUTSIDE;
         if TUBES {
             if k > first {
