@@ -348,10 +348,10 @@ impl App {
 
     /// Shows `message` as a failure (and ends a load in progress; what it drew stays on screen).
     pub fn fail(&mut self, message: String) {
+        // What arrived before a load failed stays, shown yet or not: the worker keeps it and
+        // sent it first (`FromWorker::Loaded`); a load that failed before anything arrived
+        // leaves nothing (`load` cleared the dataset before).
         let loading = self.loading.take().is_some();
-        if loading && self.shown.is_none() {
-            (self.dataset, self.shown) = (None, None);
-        }
         self.load_failed |= loading;
         self.busy = None;
         self.outcome.lock().expect("not poisoned").error = Some(message.clone());

@@ -282,6 +282,12 @@ impl Opening {
         Ok(())
     }
 
+    /// After an error: the chunks decoded before it appended too, and all of it on screen.
+    pub fn flush_arrived(&mut self, gpu: &Gpu) -> Result<(), String> {
+        self.append_chunks(gpu)?;
+        self.flush(gpu)
+    }
+
     /// Puts what is pending on screen.
     pub fn flush(&mut self, gpu: &Gpu) -> Result<(), String> {
         self.lines.geometry.flush(&gpu.device, &gpu.queue).map_err(|e| e.to_string())?;

@@ -280,7 +280,9 @@ fn a_real_file_opens_and_a_bad_one_says_why() {
     harness.get_by_label(&error);
 
     // A large file cut short in its data: drawn as it arrives, then the error naming the file
-    // and its byte beside what was drawn, which stays (and answers the camera).
+    // and its byte beside what arrived, which stays (and answers the camera) — drawn after the
+    // error where the reading failed before a first picture (a file shorter than a page read in
+    // a step).
     let brain = lineao_tracts::scenes::wholebrain::WholeBrain::new(1, 4_000_000);
     let whole = dir.join("whole.tck");
     lineao_tracts::save(&brain.tractogram(0..brain.streamlines()), &whole).unwrap();
@@ -289,6 +291,12 @@ fn a_real_file_opens_and_a_bad_one_says_why() {
     std::fs::write(&cut, &bytes[..bytes.len() * 9 / 10 + 5]).unwrap();
     harness.state_mut().load(Source::File(cut.clone()));
     settle(&mut harness);
+    let deadline = Instant::now() + Duration::from_secs(300);
+    while harness.state().dataset.is_some() && harness.state().shown.is_none() {
+        assert!(Instant::now() < deadline, "what arrived was not drawn in 300 s");
+        std::thread::sleep(Duration::from_millis(10));
+        harness.step();
+    }
     let app = harness.state();
     let error = app.error.clone().expect("an error");
     assert!(error.contains("cut.tck") && error.contains("at byte"), "{error}");

@@ -369,12 +369,15 @@ impl Worker {
                     more = true;
                 }
                 Err(e) => {
-                    // What was drawn before the error stays (the file's error is shown beside it).
+                    // All that arrived before the error goes on screen and stays (the file's
+                    // error is shown beside it), drawn already or not: a file shorter than a
+                    // page that fails within the first step's reading has drawn nothing yet, and
+                    // the chunks decoded in the read that failed wait to be appended. The counts
+                    // are its counts; a flush that fails, the GPU's memory full, leaves what was
+                    // drawn, if anything was.
                     let mut opening = self.opening.take().expect("opening");
+                    let _ = opening.flush_arrived(gpu);
                     if opening.drawn() {
-                        // All that arrived goes on screen, and the counts are its counts (a
-                        // flush that fails, the GPU's memory full, leaves what was drawn).
-                        let _ = opening.flush(gpu);
                         send(FromWorker::Loaded(dataset(&opening.lines, &opening, false)));
                         let (lines, preview, source) = opening.into_parts();
                         self.scene = Some(Scene { lines, preview, rays: None, source, selected: None });
