@@ -61,6 +61,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use lineao::LineGeometry;
+use lineao::lighting::LightingShape;
 use lineao::method::raytraced::RayTracedAo;
 use lineao::method::{BenchPass, Stage};
 use lineao::passes::Load;
@@ -139,22 +140,25 @@ impl Passes {
     ) -> Result<Passes> {
         let (device, queue) = (&gpu.device, &gpu.queue);
         let format = wgpu::TextureFormat::Rgba8UnormSrgb;
+        // Compiled for the bench's lighting, as the chain's are.
+        let shape = LightingShape::of(&settings.lighting);
+        let lines = |style| LineRenderer::with_slab(device, style, false, false, shape);
         let mut passes = Passes {
-            lines: LineRenderer::new(device),
-            lines_culled: LineRenderer::new(device).culled(device, true),
-            lines_culled_exact: LineRenderer::new(device).culled(device, false),
-            lines_native: LineRenderer::with_style(device, LineStyle::Native1px),
-            lines_full: LineRenderer::with_style(device, LineStyle::FullStrip),
+            lines: lines(LineStyle::Quads),
+            lines_culled: lines(LineStyle::Quads).culled(device, true),
+            lines_culled_exact: lines(LineStyle::Quads).culled(device, false),
+            lines_native: lines(LineStyle::Native1px),
+            lines_full: lines(LineStyle::FullStrip),
             strip: strip.map(|geometry| {
-                let mut renderer = lineao::passes::lines::StripRenderer::new(device, false);
+                let mut renderer = lineao::passes::lines::StripRenderer::new(device, false, shape);
                 renderer.prepare(queue, view, settings);
                 (geometry, renderer)
             }),
             pyramid: NdPyramid::new(device),
             composite: Composite::new(device, format),
             bilateral: Bilateral::new(device),
-            tubes: TubeRenderer::new(device, false),
-            tubes_culled: TubeRenderer::new(device, false).culled(device),
+            tubes: TubeRenderer::new(device, false, shape),
+            tubes_culled: TubeRenderer::new(device, false, shape).culled(device),
             nd_from_depth: NdFromDepth::new(device, HostConfig::default()),
             stages: Vec::new(),
             settings: settings.clone(),

@@ -272,13 +272,13 @@ fn line_gbuffer(view_pos: vec3<f32>, view_tangent: vec3<f32>, color: vec3<f32>) 
     // cylinder-averaged diffuse and specular (`lineao::lighting`).
     var diffuse = 0.0;
     var specular = 0.0;
-    for (var s = 0u; s < lighting.count; s++) {
+    for (var s = 0u; s < light_count(lighting); s++) {
         let light = lighting.lights[s];
-        let lit = illuminated_line(lighting.line_shading, light.xyz, c, t, lighting.shininess);
+        let lit = illuminated_line(line_shading(lighting), light.xyz, c, t, lighting.shininess);
         diffuse += light.w * lit.x;
         specular += light.w * lighting.ks * lit.y;
     }
-    let shaded = select(color, color * (1.0 - lighting.kd + lighting.kd * diffuse), lighting.line_shading == 1u);
+    let shaded = select(color, color * (1.0 - lighting.kd + lighting.kd * diffuse), line_shading(lighting) == 1u);
 
     var out: GBuffer;
     out.color = vec4<f32>(shaded, 1.0);

@@ -8,6 +8,7 @@
 //! [`crate::shader::GBUFFER_WGSL`] (`shaders/shared/gbuffer.wgsl`).
 
 use crate::camera::FrameView;
+use crate::lighting::LightingShape;
 use crate::settings::LineColor;
 use crate::targets::{self, FrameTargets};
 use crate::timing::{self, Span};
@@ -91,16 +92,18 @@ impl GeometryUniform {
 pub const GBUFFER_FORMATS: [wgpu::TextureFormat; 4] =
     [targets::COLOR_FORMAT, targets::ND_FORMAT, targets::ZOOM_FORMAT, targets::SPECULAR_FORMAT];
 
-/// The two uniform buffers of a geometry pass (frame, lighting) and their bind group.
+/// The two uniform buffers of a geometry pass (frame, lighting) and their bind group, and the
+/// lighting its pipelines are compiled for ([`pipeline`]).
 pub(crate) struct GeometryBindings {
     pub layout: wgpu::BindGroupLayout,
     pub frame: wgpu::Buffer,
     pub lighting: wgpu::Buffer,
     pub group: wgpu::BindGroup,
+    pub shape: LightingShape,
 }
 
 impl GeometryBindings {
-    pub fn new(device: &wgpu::Device, label: &str) -> GeometryBindings {
+    pub fn new(device: &wgpu::Device, label: &str, shape: LightingShape) -> GeometryBindings {
         use crate::binding::{self, Slot};
         let layout = binding::layout(
             device,
@@ -111,10 +114,13 @@ impl GeometryBindings {
         let frame = binding::uniform_buffer::<GeometryUniform>(device, label);
         let lighting = binding::uniform_buffer::<crate::lighting::LightingUniform>(device, label);
         let group = binding::group(device, label, &layout, &[frame.as_entire_binding(), lighting.as_entire_binding()]);
-        GeometryBindings { layout, frame, lighting, group }
+        GeometryBindings { layout, frame, lighting, group, shape }
     }
 
+    /// The frame's uniforms. `lighting` must fit the pipelines' shape, as the renderers'
+    /// constructors promise their callers.
     pub fn write(&self, queue: &wgpu::Queue, frame: &GeometryUniform, lighting: &crate::lighting::Lighting) {
+        debug_assert!(self.shape.fits(lighting), "{:?} drawn by pipelines made for {:?}", lighting, self.shape);
         queue.write_buffer(&self.frame, 0, bytemuck::bytes_of(frame));
         queue.write_buffer(&self.lighting, 0, bytemuck::bytes_of(&lighting.uniform()));
     }
@@ -136,12 +142,11 @@ pub(crate) struct PipelineSpec<'a> {
     pub constants: &'a [(&'a str, f64)],
 }
 
-/// A render pipeline writing the G-buffer (depth test `Less`, depth written).
-pub(crate) fn pipeline(
-    device: &wgpu::Device,
-    layout: &wgpu::BindGroupLayout,
-    spec: PipelineSpec,
-) -> wgpu::RenderPipeline {
+/// A render pipeline writing the G-buffer (depth test `Less`, depth written), compiled for the
+/// lighting shape of `bindings`.
+pub(crate) fn pipeline(device: &wgpu::Device, bindings: &GeometryBindings, spec: PipelineSpec) -> wgpu::RenderPipeline {
+    let layout = &bindings.layout;
+    let constants: Vec<_> = spec.constants.iter().copied().chain(bindings.shape.constants()).collect();
     let mut color_targets: Vec<_> = GBUFFER_FORMATS.iter().map(|&format| color_target(format)).collect();
     if spec.octants {
         color_targets.push(color_target(targets::OCTANTS_FORMAT));
@@ -159,7 +164,7 @@ pub(crate) fn pipeline(
         vertex: wgpu::VertexState {
             module: spec.module,
             entry_point: Some(spec.vertex),
-            compilation_options: wgpu::PipelineCompilationOptions { constants: spec.constants, ..Default::default() },
+            compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
             buffers: spec.buffers,
         },
         primitive: wgpu::PrimitiveState {
@@ -180,7 +185,7 @@ pub(crate) fn pipeline(
         fragment: Some(wgpu::FragmentState {
             module: spec.module,
             entry_point: Some(spec.fragment),
-            compilation_options: wgpu::PipelineCompilationOptions { constants: spec.constants, ..Default::default() },
+            compilation_options: wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() },
             targets: &color_targets,
         }),
         multiview_mask: None,

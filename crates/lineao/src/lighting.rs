@@ -184,6 +184,63 @@ impl Lighting {
     }
 }
 
+/// What of a [`Lighting`] a pipeline is compiled for (`LIGHTS`, `SHININESS_WHOLE` and
+/// `LINE_SHADING` in `shaders/shared/lighting.wgsl`): the number of lights, a whole shininess and
+/// how lines are lit, as constants, so that a CPU rasterizer runs straight code where a uniform
+/// would have it run a loop of a uniform count and both sides of a branch for every lane. On
+/// lavapipe (`lineao bench`, 1 M vertices) a frame's lines took 1.5× and tubes 1.3× as long
+/// with these read from the uniform; LineAO 3× with its light loop. A pipeline made for
+/// [`LightingShape::ANY`] takes every lighting from the uniform.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct LightingShape {
+    /// The number of lights; `None`: the uniform's.
+    pub lights: Option<u32>,
+    /// The shininess where it is a whole number in 1..512 ([`whole_exponent`]); 0: `pow` with
+    /// the uniform's.
+    pub shininess_whole: u32,
+    /// How lines are lit; `None`: the uniform's.
+    pub line_shading: Option<LineShading>,
+}
+
+impl LightingShape {
+    /// Every lighting, read from the uniform.
+    pub const ANY: LightingShape = LightingShape { lights: None, shininess_whole: 0, line_shading: None };
+
+    /// Exactly `lighting`'s shape.
+    pub fn of(lighting: &Lighting) -> LightingShape {
+        LightingShape {
+            lights: Some(lighting.lights.len().min(MAX_LIGHTS) as u32),
+            shininess_whole: whole_exponent(lighting.shininess),
+            line_shading: Some(lighting.line_shading),
+        }
+    }
+
+    /// Whether a pipeline of this shape draws `lighting` as it is.
+    pub fn fits(&self, lighting: &Lighting) -> bool {
+        let exact = LightingShape::of(lighting);
+        self.lights.is_none_or(|n| Some(n) == exact.lights)
+            && (self.shininess_whole == 0 || self.shininess_whole == exact.shininess_whole)
+            && self.line_shading.is_none_or(|s| Some(s) == exact.line_shading)
+    }
+
+    /// The shaders' `override` constants.
+    pub fn constants(&self) -> [(&'static str, f64); 3] {
+        const ANY: f64 = u32::MAX as f64;
+        [
+            ("LIGHTS", self.lights.map_or(ANY, f64::from)),
+            ("SHININESS_WHOLE", f64::from(self.shininess_whole)),
+            ("LINE_SHADING", self.line_shading.map_or(ANY, |s| f64::from(s as u32))),
+        ]
+    }
+}
+
+impl Default for LightingShape {
+    /// The shape of the default [`Lighting`].
+    fn default() -> Self {
+        LightingShape::of(&Lighting::default())
+    }
+}
+
 /// `alpha` when it is a whole number in 1..512, which the shader raises by squaring (a pipeline
 /// constant, `SHININESS_WHOLE`), else 0 (it calls `pow`).
 pub fn whole_exponent(alpha: f32) -> u32 {

@@ -8,6 +8,7 @@ mod common;
 
 use common::{gpu, is_geometry};
 use glam::Vec3;
+use lineao::lighting::LightingShape;
 use lineao::passes::cull::{Frozen, LineCull};
 use lineao::passes::lines::{LineRenderer, LineStyle, VertexAttributes};
 use lineao::passes::tubes::TubeRenderer;
@@ -299,8 +300,8 @@ fn culled_tubes_draw_the_g_buffer_of_all_tubes() {
     let (d, q) = (&gpu.device, &gpu.queue);
     let (positions, offsets) = ball(1500);
     let mut geometry = LineGeometry::new(d, q, &positions, &offsets).unwrap();
-    let all = TubeRenderer::new(d, false);
-    let culled = TubeRenderer::new(d, false).culled(d);
+    let all = TubeRenderer::new(d, false, LightingShape::ANY);
+    let culled = TubeRenderer::new(d, false, LightingShape::ANY).culled(d);
     let pieces = lineao::passes::cull::LineCull::pieces(&geometry);
     // Radii along each streamline from 0.1 to 1.0, a third of them the frame's (none stored).
     let radii: Vec<f32> =
@@ -471,7 +472,7 @@ fn a_selection_draws_what_the_selected_streamlines_alone_draw() {
             same_marks_as_the_cpu_reference(&gpu, &b, &masked, &camera, &got[3], "culled lines");
         }
     }
-    let (a, b) = (TubeRenderer::new(d, false), TubeRenderer::new(d, false));
+    let (a, b) = (TubeRenderer::new(d, false, LightingShape::ANY), TubeRenderer::new(d, false, LightingShape::ANY));
     let (expected, got) = (draw_tubes(&gpu, &a, &alone, &camera), draw_tubes(&gpu, &b, &masked, &camera));
     let (covered, ties) = same_gbuffer(&expected, &got, "tubes");
     assert!(covered > 5_000 && ties * 1000 <= covered, "{ties} ties of {covered}");

@@ -8,7 +8,7 @@ use common::{Frame, gpu, is_geometry, render};
 use glam::Vec3;
 use lineao::FrameView;
 use lineao::LineGeometry;
-use lineao::lighting::{LineShading, illuminated_line};
+use lineao::lighting::{LightingShape, LineShading, illuminated_line};
 use lineao::passes::lines::{GeometryOptions, LineRenderer, LineStyle};
 use lineao::targets::FrameTargets;
 use lineao::{AoMethod, ChainSettings, LineColor};
@@ -602,7 +602,7 @@ fn clusters_draw_the_g_buffer_of_the_earlier_strip() {
         renderer.prepare(q, &view, settings.line_width_px, settings.line_color, &settings.lighting, None);
         let background = lineao::passes::Load::Clear(settings.background);
         let new = gbuffer_of(&gpu, size, |e, t| renderer.encode(e, t, &geometry, background, None));
-        let mut old_renderer = StripRenderer::new(d, true);
+        let mut old_renderer = StripRenderer::new(d, true, LightingShape::ANY);
         old_renderer.prepare(q, &view, &settings);
         let old = gbuffer_of(&gpu, size, |e, t| old_renderer.encode(e, t, &strip, background, None));
         let (w, h) = (size.0 as usize, size.1 as usize);
@@ -715,4 +715,58 @@ fn drawn_points_lie_within_their_clusters_bound() {
         worst = worst.max(error / extent[input as usize]);
     }
     println!("worst error {worst:.2e} of the cluster's extent");
+}
+
+/// Pipelines compiled for a lighting's shape (the chain's: the number of lights, a whole
+/// shininess and the line shading as constants) draw the G-buffer of those that read the same
+/// lighting from the uniform ([`LightingShape::ANY`], which the reference tests above check
+/// through the chain too), lines and tubes, for lightings of every kind: none, one light at a
+/// whole and at a fractional shininess, three lights averaged over the cylinder. Within 1e-5 (a
+/// whole power is multiplied out, `pow` is exp2 ∘ log2).
+#[test]
+fn lighting_shapes_draw_what_the_uniform_draws() {
+    use lineao::lighting::{Light, Lighting};
+    use lineao::passes::tubes::TubeRenderer;
+    let gpu = gpu();
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let (positions, offsets) = waves(40, 200);
+    let geometry = LineGeometry::new(d, q, &positions, &offsets).unwrap();
+    let view = FrameView::new(&perspective(), &bounds().unwrap(), 200, 160, 0, 1.0);
+    let light = |x: f32, y: f32, intensity: f32| Light { dir: Vec3::new(x, y, 1.0), intensity };
+    let lightings = [
+        Lighting { lights: vec![], ..Lighting::default() },
+        Lighting::default(),
+        Lighting { shininess: 7.5, ..Lighting::default() },
+        Lighting {
+            lights: vec![light(-0.4, 0.6, 0.7), light(0.8, 0.1, 0.5), light(0.0, -0.9, 0.3)],
+            shininess: 8.0,
+            line_shading: LineShading::CylinderAveraged,
+            ..Lighting::default()
+        },
+    ];
+    let background = lineao::passes::Load::Clear([1.0; 3]);
+    for lighting in &lightings {
+        let shape = LightingShape::of(lighting);
+        assert!(shape.fits(lighting) && LightingShape::ANY.fits(lighting));
+        let draw = |shape| {
+            let lines = LineRenderer::with_slab(d, LineStyle::Quads, false, false, shape);
+            lines.prepare(q, &view, 3.0, LineColor::Tangent, lighting, None);
+            let tubes = TubeRenderer::new(d, false, shape);
+            tubes.prepare(q, &view, 0.6, LineColor::Tangent, lighting, None);
+            [
+                gbuffer_of(&gpu, (200, 160), |e, t| lines.encode(e, t, &geometry, background, None)),
+                gbuffer_of(&gpu, (200, 160), |e, t| tubes.encode(e, t, &geometry, background, None)),
+            ]
+        };
+        let (uniform, constant) = (draw(LightingShape::ANY), draw(shape));
+        for (name, a, b) in [("lines", &uniform[0], &constant[0]), ("tubes", &uniform[1], &constant[1])] {
+            let lit = a[1].data.iter().filter(|nd| is_geometry(**nd)).count();
+            assert!(lit > 2_000, "{name}: {lit} geometry pixels");
+            for (target, (a, b)) in a.iter().zip(b).enumerate() {
+                let worst = a.data.iter().zip(&b.data).flat_map(|(p, q)| (0..4).map(move |c| (p[c] - q[c]).abs()));
+                let worst = worst.fold(0.0f32, f32::max);
+                assert!(worst <= 1e-5, "{name}, {lighting:?}, target {target}: {worst}");
+            }
+        }
+    }
 }

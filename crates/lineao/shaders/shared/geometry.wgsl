@@ -51,10 +51,10 @@ fn outside_slab(view_pos: vec3<f32>) -> bool {
 fn phong(n: vec3<f32>, v: vec3<f32>) -> vec2<f32> {
     var diffuse = 0.0;
     var specular = 0.0;
-    for (var k = 0u; k < lighting.count; k++) {
+    for (var k = 0u; k < light_count(lighting); k++) {
         let light = lighting.lights[k];
         diffuse += light.w * max(dot(n, light.xyz), 0.0);
-        specular += light.w * lighting.ks * clamped_pow(dot(n, normalize(light.xyz + v)), lighting.shininess);
+        specular += light.w * lighting.ks * specular_pow(dot(n, normalize(light.xyz + v)), lighting.shininess);
     }
     return vec2<f32>(diffuse, specular);
 }

@@ -16,6 +16,37 @@ struct Lighting {
     _pad2: u32,
 }
 
+// The lighting's shape as pipeline constants (`lineao::lighting::LightingShape`), so that what
+// a uniform would decide per pixel is straight code: a CPU rasterizer runs a loop of a uniform
+// count, and both sides of a branch on a uniform, for every lane (LineAO 3x faster with its
+// light loop unrolled; lines 1.5x, tubes 1.3x with theirs, lavapipe, `lineao bench`).
+// ANY: decided by the uniform instead (a pipeline made for every lighting); the functions
+// below take the uniform's value.
+const ANY: u32 = 0xffffffffu;
+// The number of lights, <= MAX_LIGHTS.
+override LIGHTS: u32 = ANY;
+// The specular exponent α when it is a whole number in 1..512 (then raised by squaring,
+// `whole_pow`: LineAO 17 % faster on lavapipe at α = 32), 0 to use `lighting.shininess`.
+override SHININESS_WHOLE: u32 = 0u;
+// How lines are lit (`lighting.line_shading`'s values).
+override LINE_SHADING: u32 = ANY;
+
+fn light_count(uniform: Lighting) -> u32 {
+    return select(LIGHTS, uniform.count, LIGHTS == ANY);
+}
+
+fn line_shading(uniform: Lighting) -> u32 {
+    return select(LINE_SHADING, uniform.line_shading, LINE_SHADING == ANY);
+}
+
+// max(x, 0)^alpha for the shininess alpha of the uniform.
+fn specular_pow(x: f32, alpha: f32) -> f32 {
+    if SHININESS_WHOLE == 0u {
+        return clamped_pow(x, alpha);
+    }
+    return whole_pow(x, SHININESS_WHOLE);
+}
+
 // max(x, 0)^alpha, defined as 0 at x <= 0 (pow(0, a) is implementation-defined in WGSL).
 fn clamped_pow(x: f32, alpha: f32) -> f32 {
     return select(0.0, pow(x, alpha), x > 0.0);
@@ -45,7 +76,7 @@ fn illuminated_line(shading: u32, l: vec3<f32>, v: vec3<f32>, t: vec3<f32>, n: f
     let v_t = dot(v, t);
     let peak = sqrt(max(1.0 - l_t * l_t, 0.0)) * sqrt(max(1.0 - v_t * v_t, 0.0)) - l_t * v_t;
     if shading == 0u {
-        return vec2<f32>(0.0, clamped_pow(peak, n));
+        return vec2<f32>(0.0, specular_pow(peak, n));
     }
     let l_perp = l - l_t * t;
     let v_perp = v - v_t * t;
@@ -76,7 +107,7 @@ fn illuminated_line(shading: u32, l: vec3<f32>, v: vec3<f32>, t: vec3<f32>, n: f
     var integral = 0.0;
     for (var i = 0; i < 8; i++) {
         let u = h * nodes[i].x;
-        integral += nodes[i].y * clamped_pow(ab * cos(2.0 * u) - l_t * v_t, n) * cos(u);
+        integral += nodes[i].y * specular_pow(ab * cos(2.0 * u) - l_t * v_t, n) * cos(u);
     }
     let half = sqrt((1.0 + cos_alpha) * 0.5);
     return vec2<f32>(diffuse, half * h * integral);

@@ -46,6 +46,7 @@ use crate::Error;
 use crate::LineGeometry;
 use crate::camera::{self, Bounds, Camera, FrameView};
 use crate::gbuffer::Load;
+use crate::lighting::LightingShape;
 use crate::method::raytraced::RayProgress;
 use crate::method::{self, Reach};
 use crate::passes::bilateral::Bilateral;
@@ -128,7 +129,10 @@ impl AoChain {
             },
             lines: line_renderer(device, &settings),
             tubes: tube_renderer(device, &settings),
-            meshes: settings.surfaces.as_ref().map(|_| MeshRenderer::new(device, settings.volume.is_some())),
+            meshes: settings
+                .surfaces
+                .as_ref()
+                .map(|_| MeshRenderer::new(device, settings.volume.is_some(), lit(&settings))),
             slices: settings.slices.as_ref().map(|_| SliceRenderer::new(device, settings.volume.is_some())),
             slice_volume: None,
             bilateral: Bilateral::new(device),
@@ -168,19 +172,23 @@ impl AoChain {
         })
         .await?;
         let octants = settings.volume.is_some();
+        let shape = lit(&settings);
         if octants != self.lines.writes_octants()
+            || shape != self.lines.lighting_shape()
             || settings.slab.is_some() != self.lines.cuts()
             || settings.cull != self.lines.culls()
             || (settings.cull && settings.levels_of_detail() != self.lines.lods())
         {
-            // Writing octants or not, testing a slab or not, culling (at levels of detail) or not, is a
-            // matter of the geometry pipelines.
+            // Writing octants or not, testing a slab or not, culling (at levels of detail) or not,
+            // the lighting's shape, are matters of the geometry pipelines.
             self.lines = line_renderer(device, &settings);
             self.volume_ao = settings.volume.as_ref().map(|_| VolumeAo::new(device));
         }
         let tubes_match = match (&self.tubes, &settings.tubes) {
             (Some(renderer), Some(_)) => {
-                renderer.writes_octants() == octants && renderer.cull().is_some() == settings.cull
+                renderer.writes_octants() == octants
+                    && renderer.cull().is_some() == settings.cull
+                    && renderer.lighting_shape() == shape
             }
             (None, None) => true,
             _ => false,
@@ -189,8 +197,9 @@ impl AoChain {
             self.tubes = tube_renderer(device, &settings);
         }
         // Surfaces and slices: there when asked for, writing the octants where object-space AO is on.
-        if self.meshes.as_ref().map(MeshRenderer::writes_octants) != settings.surfaces.as_ref().map(|_| octants) {
-            self.meshes = settings.surfaces.as_ref().map(|_| MeshRenderer::new(device, octants));
+        let meshes = |m: &MeshRenderer| (m.writes_octants(), m.lighting_shape());
+        if self.meshes.as_ref().map(meshes) != settings.surfaces.as_ref().map(|_| (octants, shape)) {
+            self.meshes = settings.surfaces.as_ref().map(|_| MeshRenderer::new(device, octants, shape));
         }
         if self.slices.as_ref().map(SliceRenderer::writes_octants) != settings.slices.as_ref().map(|_| octants) {
             self.slices = settings.slices.as_ref().map(|_| SliceRenderer::new(device, octants));
@@ -630,15 +639,21 @@ impl AoChain {
 /// object-space AO, testing the slab where there is one, culled on the GPU with [`ChainSettings::cull`] (at levels of detail with
 /// [`ChainSettings::lod`]).
 fn line_renderer(device: &wgpu::Device, settings: &ChainSettings) -> LineRenderer {
-    let renderer =
-        LineRenderer::with_slab(device, LineStyle::Quads, settings.volume.is_some(), settings.slab.is_some());
+    let (octants, slab) = (settings.volume.is_some(), settings.slab.is_some());
+    let renderer = LineRenderer::with_slab(device, LineStyle::Quads, octants, slab, lit(settings));
     if settings.cull { renderer.culled(device, settings.levels_of_detail()) } else { renderer }
+}
+
+/// The lighting the chain's geometry pipelines are compiled for: exactly the settings' (a new
+/// one rebuilds them, [`AoChain::set_settings`]).
+fn lit(settings: &ChainSettings) -> LightingShape {
+    LightingShape::of(&settings.lighting)
 }
 
 /// The chain's tube renderer where `settings` asks for tubes: writing the octants with
 /// object-space AO, culled on the GPU with [`ChainSettings::cull`].
 fn tube_renderer(device: &wgpu::Device, settings: &ChainSettings) -> Option<TubeRenderer> {
     settings.tubes.as_ref()?;
-    let renderer = TubeRenderer::new(device, settings.volume.is_some());
+    let renderer = TubeRenderer::new(device, settings.volume.is_some(), lit(settings));
     Some(if settings.cull { renderer.culled(device) } else { renderer })
 }

@@ -14,6 +14,7 @@ use super::{MAX_ALTERNATING_WIDTH_PX, MAX_TOLERANCE_PX, validate_offsets};
 use crate::Error;
 use crate::camera::{Bounds, FrameView};
 use crate::gbuffer::{self, GeometryBindings, GeometryUniform, Load, PipelineSpec};
+use crate::lighting::LightingShape;
 use crate::settings::ChainSettings;
 use crate::targets::FrameTargets;
 use crate::timing::Span;
@@ -140,8 +141,9 @@ pub struct StripRenderer {
 impl StripRenderer {
     /// The renderer of earlier versions: the alternating strip where it stays within half a
     /// pixel of the full one, or with `full` always the full strip.
-    pub fn new(device: &wgpu::Device, full: bool) -> StripRenderer {
-        let bindings = GeometryBindings::new(device, "lineao::StripRenderer::bindings");
+    /// Compiled for lightings of `shape`, as [`crate::passes::lines::LineRenderer::with_slab`].
+    pub fn new(device: &wgpu::Device, full: bool, shape: LightingShape) -> StripRenderer {
+        let bindings = GeometryBindings::new(device, "lineao::StripRenderer::bindings", shape);
         let module = crate::shader::module(device, "strip.wgsl");
         let buffers = [Some(wgpu::VertexBufferLayout {
             array_stride: VERTEX_SIZE,
@@ -150,7 +152,7 @@ impl StripRenderer {
         })];
         let pipeline = gbuffer::pipeline(
             device,
-            &bindings.layout,
+            &bindings,
             PipelineSpec {
                 label: "lineao::StripRenderer::pipeline",
                 groups: &[],

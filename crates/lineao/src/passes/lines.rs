@@ -14,7 +14,7 @@ use std::sync::atomic::{AtomicU32, Ordering};
 
 use crate::camera::FrameView;
 use crate::gbuffer::{self, GeometryBindings, GeometryUniform, Load, PipelineSpec};
-use crate::lighting::Lighting;
+use crate::lighting::{Lighting, LightingShape};
 #[cfg(feature = "reference")]
 pub use crate::line_geometry::strip::{StripGeometry, StripRenderer};
 pub use crate::line_geometry::{
@@ -94,15 +94,23 @@ impl LineRenderer {
     /// With `octants`, targets that have an `octants` texture also get the geometry's
     /// per-vertex octant visibilities, interpolated ([`crate::passes::volume_ao`]); quads only.
     pub fn with_outputs(device: &wgpu::Device, style: LineStyle, octants: bool) -> LineRenderer {
-        Self::with_slab(device, style, octants, false)
+        Self::with_slab(device, style, octants, false, LightingShape::ANY)
     }
 
     /// [`LineRenderer::with_outputs`] whose fragments outside the frame's slab are discarded,
     /// with `slab` (the slab itself comes with each frame's [`LineRenderer::prepare`]; without
     /// `slab` it is ignored). Measured on lavapipe at 10 M points: the test alone, never
-    /// discarding, made drawing every line 1.5 × slower (8.6 s against 5.8 s).
-    pub fn with_slab(device: &wgpu::Device, style: LineStyle, octants: bool, slab: bool) -> LineRenderer {
-        let bindings = GeometryBindings::new(device, "lineao::LineRenderer::bindings");
+    /// discarding, made drawing every line 1.5 × slower (8.6 s against 5.8 s). Its pipelines
+    /// are compiled for lightings of `shape` ([`LightingShape::ANY`] for every one): each
+    /// [`LineRenderer::prepare`] must give one.
+    pub fn with_slab(
+        device: &wgpu::Device,
+        style: LineStyle,
+        octants: bool,
+        slab: bool,
+        shape: LightingShape,
+    ) -> LineRenderer {
+        let bindings = GeometryBindings::new(device, "lineao::LineRenderer::bindings", shape);
         let page = crate::line_geometry::page_layout(device);
         let module = crate::shader::module(device, "lines.wgsl");
         let topology = match style {
@@ -113,7 +121,7 @@ impl LineRenderer {
             let octants = fragment == "fs_octants";
             gbuffer::pipeline(
                 device,
-                &bindings.layout,
+                &bindings,
                 PipelineSpec {
                     label,
                     groups: &[&page],
@@ -173,7 +181,7 @@ impl LineRenderer {
             };
             gbuffer::pipeline(
                 device,
-                &self.bindings.layout,
+                &self.bindings,
                 PipelineSpec {
                     label: "lineao::LineRenderer::pieces",
                     groups: &[&page, &pieces],
@@ -235,6 +243,11 @@ impl LineRenderer {
     /// Whether this renderer writes the `octants` target.
     pub fn writes_octants(&self) -> bool {
         self.octants.is_some()
+    }
+
+    /// The lighting its pipelines are compiled for.
+    pub fn lighting_shape(&self) -> LightingShape {
+        self.bindings.shape
     }
 
     pub fn prepare(

@@ -6,7 +6,7 @@
 use crate::Error;
 use crate::camera::{Bounds, FrameView};
 use crate::gbuffer::{self, GeometryBindings, GeometryUniform, Load, PipelineSpec};
-use crate::lighting::Lighting;
+use crate::lighting::{Lighting, LightingShape};
 use crate::settings::LineColor;
 use crate::targets::FrameTargets;
 use crate::timing::Span;
@@ -91,9 +91,11 @@ pub struct MeshRenderer {
 
 impl MeshRenderer {
     /// With `octants`, targets that have an `octants` texture get full visibility where a
-    /// surface is ([`crate::passes::volume_ao`]: surfaces are not in the lines' volume).
-    pub fn new(device: &wgpu::Device, octants: bool) -> MeshRenderer {
-        let bindings = GeometryBindings::new(device, "lineao::MeshRenderer::bindings");
+    /// surface is ([`crate::passes::volume_ao`]: surfaces are not in the lines' volume). Its
+    /// pipeline is compiled for lightings of `shape` ([`LightingShape::ANY`] for every one):
+    /// each [`MeshRenderer::prepare`] must give one.
+    pub fn new(device: &wgpu::Device, octants: bool, shape: LightingShape) -> MeshRenderer {
+        let bindings = GeometryBindings::new(device, "lineao::MeshRenderer::bindings", shape);
         let module = crate::shader::module(device, "meshes.wgsl");
         let buffers = [Some(wgpu::VertexBufferLayout {
             array_stride: std::mem::size_of::<MeshVertex>() as u64,
@@ -102,7 +104,7 @@ impl MeshRenderer {
         })];
         let pipeline = gbuffer::pipeline(
             device,
-            &bindings.layout,
+            &bindings,
             PipelineSpec {
                 groups: &[],
                 label: "lineao::MeshRenderer::pipeline",
@@ -121,6 +123,11 @@ impl MeshRenderer {
     /// Whether this renderer writes the `octants` target.
     pub fn writes_octants(&self) -> bool {
         self.octants
+    }
+
+    /// The lighting its pipelines are compiled for.
+    pub fn lighting_shape(&self) -> LightingShape {
+        self.bindings.shape
     }
 
     /// `color`: the surfaces' linear RGB.

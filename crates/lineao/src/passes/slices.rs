@@ -25,7 +25,7 @@ use crate::Error;
 use crate::binding::{self, Slot};
 use crate::camera::{Bounds, FrameView};
 use crate::gbuffer::{self, GeometryBindings, GeometryUniform, Load, PipelineSpec};
-use crate::lighting::Lighting;
+use crate::lighting::{Lighting, LightingShape};
 use crate::settings::{LineColor, SliceSettings};
 use crate::targets::FrameTargets;
 use crate::timing::Span;
@@ -181,13 +181,14 @@ impl SliceRenderer {
     /// slice is (slices are not in the lines' volume, [`crate::passes::volume_ao`]).
     pub fn new(device: &wgpu::Device, octants: bool) -> SliceRenderer {
         let label = "lineao::SliceRenderer";
-        let bindings = GeometryBindings::new(device, label);
+        // Unlit: every lighting is the same to it.
+        let bindings = GeometryBindings::new(device, label, LightingShape::ANY);
         let layout =
             binding::layout(device, label, wgpu::ShaderStages::VERTEX_FRAGMENT, &[Slot::Texture3d, Slot::Uniform]);
         let module = crate::shader::module(device, "slices.wgsl");
         let pipeline = gbuffer::pipeline(
             device,
-            &bindings.layout,
+            &bindings,
             PipelineSpec {
                 groups: &[&layout],
                 label,

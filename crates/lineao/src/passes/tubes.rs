@@ -29,7 +29,7 @@
 
 use crate::camera::FrameView;
 use crate::gbuffer::{self, GeometryBindings, GeometryUniform, Load, PipelineSpec};
-use crate::lighting::Lighting;
+use crate::lighting::{Lighting, LightingShape};
 use crate::line_geometry::{LineGeometry, class_segments};
 use crate::passes::cull::{Culled, Shape};
 use crate::settings::{LineColor, Slab};
@@ -50,9 +50,11 @@ pub struct TubeRenderer {
 
 impl TubeRenderer {
     /// With `octants`, targets that have an `octants` texture also get the geometry's octant
-    /// visibilities along each segment ([`crate::passes::volume_ao`]).
-    pub fn new(device: &wgpu::Device, octants: bool) -> TubeRenderer {
-        let bindings = GeometryBindings::new(device, "lineao::TubeRenderer::bindings");
+    /// visibilities along each segment ([`crate::passes::volume_ao`]). Its pipelines are
+    /// compiled for lightings of `shape` ([`LightingShape::ANY`] for every one): each
+    /// [`TubeRenderer::prepare`] must give one.
+    pub fn new(device: &wgpu::Device, octants: bool, shape: LightingShape) -> TubeRenderer {
+        let bindings = GeometryBindings::new(device, "lineao::TubeRenderer::bindings", shape);
         let page = crate::line_geometry::page_layout(device);
         // The depth test before shading where the device takes the shader's promise that its
         // depth is never nearer than the billboard's (`tubes.wgsl`).
@@ -86,6 +88,11 @@ impl TubeRenderer {
     /// Whether this renderer writes the `octants` target.
     pub fn writes_octants(&self) -> bool {
         self.octants
+    }
+
+    /// The lighting its pipelines are compiled for.
+    pub fn lighting_shape(&self) -> LightingShape {
+        self.bindings.shape
     }
 
     /// `radius_world`: the tubes' radius where the geometry carries none.
@@ -144,7 +151,7 @@ fn tube_pipeline(
 ) -> wgpu::RenderPipeline {
     gbuffer::pipeline(
         device,
-        &bindings.layout,
+        bindings,
         PipelineSpec {
             label: "lineao::TubeRenderer::pipeline",
             groups,

@@ -27,15 +27,9 @@ override TAP_FLOOR: bool = false;
 override LIGHT_ATTENUATION: bool = true;
 // Variant `reference` instead of `paper`.
 override REFERENCE: bool = false;
-// Number of lights (<= MAX_LIGHTS): a constant, so the per-sample light loop unrolls (3x faster
-// LineAO than looping to lighting.count on lavapipe, measured with `lineao bench`).
-override LIGHTS: u32 = 1u;
 // `outer = level`: `line_ao` reads hemispheres j >= 1 from outer1..outer4, which
 // `line_ao_outer` wrote for hemisphere LEVEL.
 override OUTER_LEVEL: bool = false;
-// The specular exponent α when it is a whole number in 1..512 (then raised by squaring,
-// `whole_pow`: LineAO 17 % faster on lavapipe at α = 32), 0 to use `lighting.shininess` as it is.
-override SHININESS_WHOLE: u32 = 0u;
 override LEVEL: u32 = 1u;
 
 // OUTER_DEPTH_TOLERANCE: Rust's `lineao::method::line_ao::OUTER_DEPTH_TOLERANCE`.
@@ -85,24 +79,17 @@ struct LineAoUniform {
 // Illumination-based attenuation (Eq. 14-15): 1 - min(sum over lights of the Blinn-Phong BRDF
 // lit from L_s and seen from ω, 1). `n_omega` = n · ω. For unit L and ω, |L + ω|² = 2 + 2 L·ω,
 // so n · normalize(L + ω) needs no normalize (this loop runs once per sample).
-fn specular_pow(n_h: f32) -> f32 {
-    if (SHININESS_WHOLE == 0u) {
-        return clamped_pow(n_h, lighting.shininess);
-    }
-    return whole_pow(n_h, SHININESS_WHOLE);
-}
-
 fn light_weight(n: vec3<f32>, omega: vec3<f32>, n_omega: f32) -> f32 {
     if (!LIGHT_ATTENUATION) {
         return 1.0;
     }
     var reflected = 0.0;
-    for (var s = 0u; s < LIGHTS; s++) {
+    for (var s = 0u; s < light_count(lighting); s++) {
         let light = lighting.lights[s];
         let n_l = dot(n, light.xyz);
         let sum_sq = 2.0 + 2.0 * dot(light.xyz, omega);
         let n_h = select(0.0, min((n_l + n_omega) * inverseSqrt(sum_sq), 1.0), sum_sq > 1e-12);
-        reflected += light.w * (lighting.kd * max(n_l, 0.0) + lighting.ks * specular_pow(n_h));
+        reflected += light.w * (lighting.kd * max(n_l, 0.0) + lighting.ks * specular_pow(n_h, lighting.shininess));
     }
     return 1.0 - min(reflected, 1.0);
 }
@@ -169,7 +156,7 @@ fn upsample_outer(outer: texture_2d<f32>, j: u32, pixel: vec2<u32>) -> f32 {
 // diffuse plus specular with exponent 100 (unweighted by kd, ks).
 fn occluder_light(n_o: vec3<f32>, omega: vec3<f32>) -> f32 {
     var reflected = 0.0;
-    for (var s = 0u; s < LIGHTS; s++) {
+    for (var s = 0u; s < light_count(lighting); s++) {
         let light = lighting.lights[s];
         let half_sum = light.xyz + omega;
         let half_len = length(half_sum);

@@ -57,7 +57,7 @@
 
 use crate::binding::{self, Slot};
 use crate::camera::FrameView;
-use crate::lighting::{Lighting, LightingUniform};
+use crate::lighting::{Lighting, LightingShape, LightingUniform};
 use crate::method::BenchPass;
 use crate::noise;
 use crate::passes::dispatch_full_screen;
@@ -148,9 +148,7 @@ struct Shape {
     s_h: u32,
     noise_seed: u32,
     light_attenuation: bool,
-    lights: u32,
-    /// The shininess as a whole number in 1..512, else 0 (`SHININESS_WHOLE` in the shader).
-    shininess_whole: u32,
+    lighting: LightingShape,
 }
 
 impl Shape {
@@ -162,8 +160,7 @@ impl Shape {
             s_h: settings.s_h,
             noise_seed: settings.noise_seed,
             light_attenuation: settings.light_attenuation,
-            lights: lighting.lights.len().min(crate::lighting::MAX_LIGHTS) as u32,
-            shininess_whole: crate::lighting::whole_exponent(lighting.shininess),
+            lighting: LightingShape::of(lighting),
         }
     }
 }
@@ -229,16 +226,15 @@ impl LineAo {
         let outer_layout = binding::layout(device, "lineao::LineAo::outer_layout", wgpu::ShaderStages::COMPUTE, &slots);
         let shape = Shape::of(settings, lighting);
         let outer_level = shape.outer == LineAoOuter::Level;
-        let constants = [
+        let mut constants = vec![
             ("S_R", shape.s_r as f64),
             ("S_H", shape.s_h as f64),
             ("TAP_FLOOR", (evaluation == Evaluation::TapFloor) as u32 as f64),
             ("LIGHT_ATTENUATION", shape.light_attenuation as u32 as f64),
             ("REFERENCE", (shape.variant == LineAoVariant::Reference) as u32 as f64),
-            ("LIGHTS", shape.lights as f64),
             ("OUTER_LEVEL", outer_level as u32 as f64),
-            ("SHININESS_WHOLE", shape.shininess_whole as f64),
         ];
+        constants.extend(shape.lighting.constants());
         let pipeline = binding::compute_pipeline(
             device,
             "lineao::LineAo::pipeline",
