@@ -13,7 +13,7 @@ use lineao::reference;
 use lineao::reference::tubes::{intersect_rounded_cone, pixel_ray, rounded_cone_distance, rounded_cone_normal};
 use lineao::verify::{check_policy, line_ao_flip_bound};
 use lineao::{AoMethod, ChainSettings, TubeSettings};
-use lineao::{Camera, FrameView, Projection};
+use lineao::{Bounds, Camera, FrameView, Projection};
 
 fn random(k: u32, stream: u32) -> f32 {
     lineao::noise::uniform(21, stream, k)
@@ -169,6 +169,32 @@ fn a_straight_tube_is_the_analytic_cylinder_with_round_ends() {
                 .map(|(p, n)| Expected { point: p.as_vec3(), normals: vec![n.as_vec3()] })
         });
     }
+}
+
+/// A short, thick tube close to the eye in a corner of a wide view, where a sphere projects to
+/// its most stretched ellipse: the billboard (`shaders/shared/billboard.wgsl`, bounded with no
+/// margin) still holds every pixel whose ray meets it, against the analytic capsule.
+#[test]
+fn a_tube_in_the_corner_of_a_wide_view_is_whole() {
+    let gpu = gpu();
+    let (a, b, r) = (Vec3::new(20.0, 14.0, 15.0), Vec3::new(23.0, 15.0, 13.0), 4.0f32);
+    let geometry = LineGeometry::new(&gpu.device, &gpu.queue, &[a.to_array(), b.to_array()], &[0, 2]).unwrap();
+    let camera = Camera {
+        eye: Vec3::new(0.0, 0.0, 30.0),
+        target: Vec3::ZERO,
+        up: Vec3::Y,
+        projection: Projection::Perspective { fov_y_deg: 100.0 },
+    };
+    let frame =
+        render_geometry(&gpu, &geometry, &camera, Bounds { center: Vec3::ZERO, radius: 40.0 }, tubes(r), (320, 240));
+    let (va, vb) = ((frame.view.view * a.extend(1.0)).xyz(), (frame.view.view * b.extend(1.0)).xyz());
+    assert!(va.x / -va.z > 1.2 && va.y / -va.z > 0.8, "in the view's corner: {va}");
+    let inv_proj = frame.view.proj.inverse();
+    compare_gbuffer("corner", &frame, |pixel| {
+        let (o, d) = pixel_ray(&frame.view, inv_proj, pixel);
+        analytic_capsule(o.as_dvec3(), d.as_dvec3(), va.as_dvec3(), vb.as_dvec3(), r as f64)
+            .map(|(p, n)| Expected { point: p.as_vec3(), normals: vec![n.as_vec3()] })
+    });
 }
 
 /// Ray o + t d (unit d) against the capsule of [a, b] with radius r: first hit and normal.
