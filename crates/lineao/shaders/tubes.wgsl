@@ -46,8 +46,9 @@ struct TubeIn {
 }
 
 // Corner `corner` (0..3 of the billboard: (−, −), (−, +), (+, −), (+, +)) of the segment from
-// `a` to `b` (world points with unit tangents `ta`, `tb`) of radii `ra`, `rb` (world units).
-fn tube_vertex(corner: u32, a_world: PulledPoint, b_world: PulledPoint, ra: f32, rb: f32) -> TubeOut {
+// `a` to `b` (world points with unit tangents `ta`, `tb`) of radii `ra`, `rb` (world units);
+// `whole_a`: a starts its run, so no segment before holds its sphere.
+fn tube_vertex(corner: u32, a_world: PulledPoint, b_world: PulledPoint, ra: f32, rb: f32, whole_a: bool) -> TubeOut {
     var out: TubeOut;
     let a = (frame.view * vec4<f32>(a_world.position, 1.0)).xyz;
     let b = (frame.view * vec4<f32>(b_world.position, 1.0)).xyz;
@@ -67,15 +68,25 @@ fn tube_vertex(corner: u32, a_world: PulledPoint, b_world: PulledPoint, ra: f32,
         out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
         return out;
     }
-    // The billboard (`shared/billboard.wgsl`): the ends' disks on screen, hulled by a rectangle
-    // along the segment, at the solid's nearest depth (the fragment shader writes the true
-    // depth, never nearer).
+    // The billboard (`shared/billboard.wgsl`): a rectangle along the segment around what it
+    // must show — end b's sphere, the body, and end a's sphere where the run starts at a (else
+    // the segment before shows that sphere: a billboard reaching a sphere's radius behind each
+    // end made every segment's overlap its neighbours' twice, 1.2× the fragments of a tube
+    // frame, lavapipe, 1 M vertices) — at the solid's nearest depth (the fragment shader
+    // writes the true depth, never nearer).
     let bb = billboard(a, b, ra, rb);
     let along = select(vec2<f32>(1.0, 0.0), normalize(bb.pb - bb.pa), distance(bb.pa, bb.pb) > 1e-6);
+    let length_px = dot(bb.pb - bb.pa, along);
+    var reach_a = vec2<f32>(bb.reach_a);
+    if !whole_a {
+        reach_a = body_reach(a, b, ra, rb, along, bb.reach_a);
+    }
+    let back = min(-reach_a.x, length_px - bb.reach_b);
+    let front = max(reach_a.y, length_px + bb.reach_b);
     let across = vec2<f32>(-along.y, along.x) * max(bb.reach_a, bb.reach_b);
     let end = (corner & 2u) != 0u;
     let side = select(-1.0, 1.0, (corner & 1u) != 0u);
-    let pixel = select(bb.pa - along * bb.reach_a, bb.pb + along * bb.reach_b, end) + across * side;
+    let pixel = bb.pa + along * select(back, front, end) + across * side;
     let ndc = (pixel / frame.viewport - 0.5) * vec2<f32>(2.0, -2.0);
     out.clip = vec4<f32>(ndc, bb.depth, 1.0);
     let near = frame.inv_proj * vec4<f32>(ndc, 0.0, 1.0);
@@ -100,7 +111,8 @@ fn segment_vertex(c: Cluster, segment: u32, corner: u32, end: u32) -> TubeOut {
     let rb = point_radius(b.index);
     let radius_a = select(frame.tube_radius, ra, ra > 0.0);
     let radius_b = select(frame.tube_radius, rb, rb > 0.0);
-    return tube_vertex(corners[corner], a, b, radius_a, radius_b);
+    let whole_a = segment == 0u && (c.flags & JOINS_PREVIOUS) == 0u;
+    return tube_vertex(corners[corner], a, b, radius_a, radius_b, whole_a);
 }
 
 // Vertex v of a cluster's tubes: segment v / 6, two triangles of its billboard's corners.

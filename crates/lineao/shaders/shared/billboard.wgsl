@@ -55,6 +55,48 @@ fn billboard(a: vec3<f32>, b: vec3<f32>, ra: f32, rb: f32) -> Billboard {
     return out;
 }
 
+// How far (back, front) in pixels along the unit screen direction `s` the projection of the
+// circle where the body of the rounded cone from `a` to `b` (view positions, radii `ra`, `rb`)
+// meets end a's sphere reaches from the projection of `a`; the disk's reach where one sphere
+// holds the other. The body is the hull of that circle and its twin at b, so a billboard that
+// leaves end a's sphere to the segment before (which holds it whole) starts this far behind a.
+// The circle: centre a + u ra sin φ, radius ρ = ra cos φ, normal u (unit a → b; sin φ =
+// (ra − rb) / |b − a|). A point a + δ of it projects to offset f (d δ_xy + δ_z a_xy) / (d (d − δ_z))
+// from a's (d = −a_z), along s: f (δ · g) / (d (d − δ_z)) with g = (d s, s · a_xy); over the
+// circle δ · g = ra sin φ (u · g) + ρ (w · g) for unit w ⊥ u, within ±ρ |g⊥u|, and |δ| ≤ ra bounds
+// the denominator below by d (d − ra). Orthographic: f (δ · (s, 0)).
+fn body_reach(a: vec3<f32>, b: vec3<f32>, ra: f32, rb: f32, s: vec2<f32>, disk: f32) -> vec2<f32> {
+    let axis = b - a;
+    let l2 = dot(axis, axis);
+    let d2 = l2 - (ra - rb) * (ra - rb);
+    if d2 <= 0.0 || l2 <= 0.0 {
+        return vec2<f32>(disk);
+    }
+    let l = sqrt(l2);
+    let u = axis / l;
+    let sin_phi = (ra - rb) / l;
+    let rho = ra * sqrt(d2) / l;
+    // Screen y runs down, view y up.
+    let s_view = vec2<f32>(s.x, -s.y);
+    var g = vec3<f32>(s_view, 0.0);
+    var scale = frame.f_px;
+    if !is_orthographic() {
+        let d = -a.z;
+        if d <= ra * 1.0001 {
+            return vec2<f32>(disk);
+        }
+        g = vec3<f32>(d * s_view, dot(s_view, a.xy));
+        scale = frame.f_px / (d * (d - ra));
+    }
+    let gu = dot(g, u);
+    let g_perp = sqrt(max(dot(g, g) - gu * gu, 0.0));
+    let centre = ra * sin_phi * gu;
+    let spread = rho * g_perp;
+    let front = max(centre + spread, 0.0) * scale;
+    let back = max(spread - centre, 0.0) * scale;
+    return min(vec2<f32>(back, front), vec2<f32>(disk)) + ROUNDING_PX;
+}
+
 // Whether an end at view position `p` lies behind the eye: its segment draws no billboard.
 fn behind_eye(p: vec3<f32>) -> bool {
     return !is_orthographic() && -p.z <= 0.0;
