@@ -106,6 +106,49 @@ fn a_slice_shows_the_volume_where_its_affine_puts_it() {
     }
 }
 
+/// The slices are drawn first (three quads), so the lines behind them fail the depth test and
+/// the cull leaves their pieces out: over the template's three slices it draws under 3/4 of the
+/// pieces it draws without them. The culled picture differs from every line drawn no more than
+/// it does without the slices: the culled pieces are full strips where drawing everything takes
+/// the alternating strip (within half a pixel, `tests/lines.rs`); a line the slices' depth
+/// culled wrongly would add pixels.
+#[test]
+fn the_cull_leaves_out_the_lines_behind_the_slices() {
+    let frame = |slices: bool, cull: bool| {
+        let mut keywords =
+            serde_json::json!({"method": "none", "width": 320, "height": 256, "cull": cull, "lod": false});
+        if slices {
+            keywords["volume"] = images("MNI152_2009_template.nii.gz").into();
+            keywords["slices"] = "0,-18,10".into();
+        }
+        let (session, chain) = render(&images("stroke.trk.gz"), keywords);
+        let counts = chain.cull_counts(&session.gpu.queue, &session.lines.geometry).unwrap();
+        let drawn = counts.map(|c| (c.early + c.late) as f64 / c.pieces as f64);
+        let (d, q) = (&session.gpu.device, &session.gpu.queue);
+        let targets = chain.targets().unwrap();
+        let depth = read_texture(d, q, &targets.depth.texture).unwrap().to_f32();
+        let color = read_texture(d, q, &targets.color.texture).unwrap().to_vec4();
+        (drawn, depth, color)
+    };
+    let differing = |a: &(Option<f64>, Vec<f32>, Vec<[f32; 4]>), b: &(Option<f64>, Vec<f32>, Vec<[f32; 4]>)| {
+        (0..a.1.len()).filter(|&i| a.1[i] != b.1[i] || a.2[i] != b.2[i]).count()
+    };
+    let (bare, bare_whole) = (frame(false, true), frame(false, false));
+    let (sliced, sliced_whole) = (frame(true, true), frame(true, false));
+    let (bare_drawn, sliced_drawn) = (bare.0.expect("culled"), sliced.0.expect("culled"));
+    assert!(bare_whole.0.is_none() && sliced_whole.0.is_none(), "--cull off draws every line");
+    let (bare_differ, sliced_differ) = (differing(&bare, &bare_whole), differing(&sliced, &sliced_whole));
+    println!(
+        "pieces drawn: {:.1} % without the slices, {:.1} % with them; pixels unlike every line drawn: {bare_differ}, \
+         {sliced_differ}",
+        100.0 * bare_drawn,
+        100.0 * sliced_drawn
+    );
+    assert!(sliced_drawn < 0.75 * bare_drawn, "{sliced_drawn} against {bare_drawn}");
+    assert!(sliced_differ <= bare_differ, "{sliced_differ} pixels against {bare_differ}");
+    assert!(sliced.1.iter().filter(|&&d| d < 1.0).count() > 40_000);
+}
+
 #[test]
 fn a_slab_leaves_no_line_outside_it() {
     let (center, thickness) = (16.0, 12.0);

@@ -563,8 +563,9 @@ impl AoChain {
         encoder.pop_debug_group();
     }
 
-    /// The lines (or tubes), the context surfaces and the anatomy slices into the G-buffer,
-    /// under one `span`.
+    /// The anatomy slices, the lines (or tubes) and the context surfaces into the G-buffer, under
+    /// one `span`. The slices first: they are three quads, and the lines behind them then fail
+    /// the depth test before they are shaded, and the cull leaves their pieces out.
     fn draw_geometry(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -576,22 +577,27 @@ impl AoChain {
     ) {
         let meshes = self.meshes.as_ref().filter(|_| !meshes.is_empty()).map(|renderer| (renderer, meshes));
         let slices = self.slices.as_ref().filter(|renderer| renderer.has_volume());
-        // The lines' span covers the surfaces and slices when there are any: its end is the
-        // last pass's.
-        let (lines_span, last_span) = match (&meshes, slices) {
+        // The span starts with the first pass and ends with the last.
+        let (mut first_span, mut last_span) = match (&meshes, slices) {
             (None, None) => (span, None),
             _ => Span::split(span),
+        };
+        let mut load = load;
+        if let Some(renderer) = slices {
+            renderer.encode(encoder, targets, load, first_span.take());
+            load = Load::Keep;
+        }
+        let lines_span = match (first_span, meshes.is_some()) {
+            (Some(first), _) => Some(first),
+            (None, false) => last_span.take(),
+            (None, true) => None,
         };
         match &self.tubes {
             Some(tubes) => tubes.encode(encoder, targets, geometry, load, lines_span),
             None => self.lines.encode(encoder, targets, geometry, load, lines_span),
         }
         if let Some((renderer, meshes)) = meshes {
-            let span = if slices.is_some() { None } else { last_span };
-            renderer.encode(encoder, targets, meshes, Load::Keep, span);
-        }
-        if let Some(renderer) = slices {
-            renderer.encode(encoder, targets, Load::Keep, last_span);
+            renderer.encode(encoder, targets, meshes, Load::Keep, last_span);
         }
     }
 
