@@ -267,8 +267,9 @@ fn a_real_file_opens_and_a_bad_one_says_why() {
     harness.get_by_label_contains("stroke.trk.gz");
 
     // A truncated copy: an error naming the file, shown in the window; no panic.
-    let dir = std::env::temp_dir().join(format!("lineao-view-test-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    // Removed when the test ends, failed or not (its files are ~90 MB).
+    let scratch = tempfile::tempdir().unwrap();
+    let dir = scratch.path();
     let bad = dir.join("truncated.trk");
     let bytes = std::fs::read(data("dipy+dipy/dipy/data/files/tracks300.trk")).unwrap();
     std::fs::write(&bad, &bytes[..1200]).unwrap();
@@ -321,7 +322,6 @@ fn a_real_file_opens_and_a_bad_one_says_why() {
     let app = harness.state();
     assert!(app.error.is_none(), "{:?}", app.error);
     assert_eq!(app.dataset.as_ref().map(|d| (d.streamlines, d.vertices)), Some((300, 14576)));
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
