@@ -188,7 +188,7 @@ impl Lighting {
 /// `LINE_SHADING` in `shaders/shared/lighting.wgsl`): the number of lights, a whole shininess and
 /// how lines are lit, as constants, so that a CPU rasterizer runs straight code where a uniform
 /// would have it run a loop of a uniform count and both sides of a branch for every lane. On
-/// lavapipe (`lineao bench`, 1 M vertices) a frame's lines took 1.5× and tubes 1.3× as long
+/// lavapipe (`lineao bench`, 1 M vertices) a frame's lines took 1.65× and tubes 1.32× as long
 /// with these read from the uniform; LineAO 3× with its light loop. A pipeline made for
 /// [`LightingShape::ANY`] takes every lighting from the uniform.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -231,13 +231,6 @@ impl LightingShape {
             ("SHININESS_WHOLE", f64::from(self.shininess_whole)),
             ("LINE_SHADING", self.line_shading.map_or(ANY, |s| f64::from(s as u32))),
         ]
-    }
-}
-
-impl Default for LightingShape {
-    /// The shape of the default [`Lighting`].
-    fn default() -> Self {
-        LightingShape::of(&Lighting::default())
     }
 }
 

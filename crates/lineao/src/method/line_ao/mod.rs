@@ -160,7 +160,8 @@ impl Shape {
             s_h: settings.s_h,
             noise_seed: settings.noise_seed,
             light_attenuation: settings.light_attenuation,
-            lighting: LightingShape::of(lighting),
+            // Lines' shading is not LineAO's: a change of it keeps the pipeline.
+            lighting: LightingShape { line_shading: None, ..LightingShape::of(lighting) },
         }
     }
 }
