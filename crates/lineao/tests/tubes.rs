@@ -161,14 +161,19 @@ fn a_straight_tube_is_the_analytic_cylinder_with_round_ends() {
     let orthographic = Camera { projection: Projection::Orthographic { height: 70.0 }, ..perspective };
     for (name, camera) in [("perspective", perspective), ("orthographic", orthographic)] {
         let frame = render_tubes(&gpu, &geometry, &camera, tubes(r), (320, 240));
-        let (va, vb) = ((frame.view.view * a.extend(1.0)).xyz(), (frame.view.view * b.extend(1.0)).xyz());
-        let inv_proj = frame.view.proj.inverse();
-        compare_gbuffer(name, &frame, |pixel| {
-            let (o, d) = pixel_ray(&frame.view, inv_proj, pixel);
-            analytic_capsule(o.as_dvec3(), d.as_dvec3(), va.as_dvec3(), vb.as_dvec3(), r as f64)
-                .map(|(p, n)| Expected { point: p.as_vec3(), normals: vec![n.as_vec3()] })
-        });
+        compare_with_capsule(name, &frame, [a, b], r);
     }
+}
+
+/// The frame against the analytic capsule of world ends `ends` and radius `r`, in f64.
+fn compare_with_capsule(name: &str, frame: &Frame, ends: [Vec3; 2], r: f32) {
+    let [va, vb] = ends.map(|p| (frame.view.view * p.extend(1.0)).xyz().as_dvec3());
+    let inv_proj = frame.view.proj.inverse();
+    compare_gbuffer(name, frame, |pixel| {
+        let (o, d) = pixel_ray(&frame.view, inv_proj, pixel);
+        analytic_capsule(o.as_dvec3(), d.as_dvec3(), va, vb, r as f64)
+            .map(|(p, n)| Expected { point: p.as_vec3(), normals: vec![n.as_vec3()] })
+    });
 }
 
 /// A short, thick tube close to the eye in a corner of a wide view, where a sphere projects to
@@ -187,14 +192,9 @@ fn a_tube_in_the_corner_of_a_wide_view_is_whole() {
     };
     let frame =
         render_geometry(&gpu, &geometry, &camera, Bounds { center: Vec3::ZERO, radius: 40.0 }, tubes(r), (320, 240));
-    let (va, vb) = ((frame.view.view * a.extend(1.0)).xyz(), (frame.view.view * b.extend(1.0)).xyz());
+    let va = (frame.view.view * a.extend(1.0)).xyz();
     assert!(va.x / -va.z > 1.2 && va.y / -va.z > 0.8, "in the view's corner: {va}");
-    let inv_proj = frame.view.proj.inverse();
-    compare_gbuffer("corner", &frame, |pixel| {
-        let (o, d) = pixel_ray(&frame.view, inv_proj, pixel);
-        analytic_capsule(o.as_dvec3(), d.as_dvec3(), va.as_dvec3(), vb.as_dvec3(), r as f64)
-            .map(|(p, n)| Expected { point: p.as_vec3(), normals: vec![n.as_vec3()] })
-    });
+    compare_with_capsule("corner", &frame, [a, b], r);
 }
 
 /// Ray o + t d (unit d) against the capsule of [a, b] with radius r: first hit and normal.
