@@ -13,6 +13,11 @@
 #import shared/geometry.wgsl
 #import shared/pieces.wgsl
 
+// Whether the fragment shader writes the octant visibilities (`fs_tube_octants`): without, the
+// vertices neither read nor pass them (a uniform branch runs both sides on a CPU rasterizer:
+// the reads cost `tubes` 7 %, lavapipe, 1 M vertices).
+override OCTANTS: bool = true;
+
 struct TubeOut {
     @builtin(position) clip: vec4<f32>,
     // View-space ends and their radii, world units.
@@ -57,12 +62,14 @@ fn tube_vertex(corner: u32, a_world: PulledPoint, b_world: PulledPoint, ra: f32,
     out.radii = vec2<f32>(ra, rb);
     out.color_a = base_color(a_world.tangent, point_scalar(a_world.index));
     out.color_b = base_color(b_world.tangent, point_scalar(b_world.index));
-    let octants_a = point_octants(a_world.index);
-    let octants_b = point_octants(b_world.index);
-    out.octants_a_lo = octants_a[0];
-    out.octants_a_hi = octants_a[1];
-    out.octants_b_lo = octants_b[0];
-    out.octants_b_hi = octants_b[1];
+    if OCTANTS {
+        let octants_a = point_octants(a_world.index);
+        let octants_b = point_octants(b_world.index);
+        out.octants_a_lo = octants_a[0];
+        out.octants_a_hi = octants_a[1];
+        out.octants_b_lo = octants_b[0];
+        out.octants_b_hi = octants_b[1];
+    }
     // An end behind the eye: a degenerate billboard (outside the clip volume).
     if behind_eye(a) || behind_eye(b) {
         out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);

@@ -69,10 +69,15 @@ struct ClusterGroup {
 // Point `i` of the page on the grid of cluster `c` (its own, or for the next cluster's first
 // point, the next's).
 fn decode_point(i: u32, c: Cluster) -> vec3<f32> {
+    return decode_on_grid(i, c.origin, c.scale);
+}
+
+// Point `i` of the page on the grid of `origin` and `scale`.
+fn decode_on_grid(i: u32, origin: vec3<f32>, scale: f32) -> vec3<f32> {
     let xy = cluster_xy[i];
     let z = (cluster_z[i >> 1u] >> ((i & 1u) << 4u)) & 0xffffu;
     let q = vec3<f32>(f32(xy & 0xffffu), f32(xy >> 16u), f32(z));
-    return fma(q, vec3<f32>(c.scale), c.origin);
+    return fma(q, vec3<f32>(scale), origin);
 }
 
 // A point of a cluster's strip: where it is, its unit vertex tangent (the central difference
@@ -95,46 +100,36 @@ fn drawn_points(c: Cluster) -> u32 {
 }
 
 // Point `k` (< drawn_points) of cluster `c` with its vertex tangent. Its neighbours across a
-// cluster border are decoded on their clusters' grids (the next one's is read only for the
-// last two points).
+// cluster border are decoded on their clusters' grids (the next cluster's first point, k =
+// count, on the next one's). Each of the three points is decoded once, its grid chosen by
+// `select`: a CPU rasterizer runs both sides of every branch for every lane, and the branches
+// this had (a point inside the cluster or at its end) decoded six (`tubes` 1.1× as slow,
+// lavapipe, 1 M vertices).
 fn pulled_point(c: Cluster, k: u32) -> PulledPoint {
     let count = c.flags & CLUSTER_COUNT;
     let i = c.first + k;
-    if k + 1u < count {
-        // Inside the cluster (its first point's previous may be the previous cluster's last).
-        let p = decode_point(i, c);
-        let next = decode_point(i + 1u, c);
-        var previous = p;
-        if k > 0u {
-            previous = decode_point(i - 1u, c);
-        } else if (c.flags & JOINS_PREVIOUS) != 0u {
-            previous = decode_point(i - 1u, clusters[c.previous]);
-        }
-        return PulledPoint(p, vertex_tangent(previous, p, next), i);
-    }
-    // The cluster's last point, or the next cluster's first (on that cluster's grid), whose
-    // next is the next cluster's first or second (clusters hold at least two).
-    var after = c;
+    let joins_previous = (c.flags & JOINS_PREVIOUS) != 0u;
     let joins_next = (c.flags & JOINS_NEXT) != 0u;
-    if joins_next {
-        after = clusters[c.next];
-    }
-    var owner = c;
-    if k >= count {
-        owner = after;
-    }
-    let p = decode_point(i, owner);
-    var previous = p;
-    if k > 0u {
-        previous = decode_point(i - 1u, c);
-    } else if (c.flags & JOINS_PREVIOUS) != 0u {
-        previous = decode_point(i - 1u, clusters[c.previous]);
-    }
-    var next = p;
-    if joins_next {
-        next = decode_point(i + 1u, after);
-    }
-    return PulledPoint(p, vertex_tangent(previous, p, next), i);
+    let before = clusters[select(0u, c.previous, joins_previous)];
+    let after = clusters[select(0u, c.next, joins_next)];
+    let own = k < count;
+    let p = decode_on_grid(i, select(after.origin, c.origin, own), select(after.scale, c.scale, own));
+    // The previous point: the cluster's, else the previous cluster's last, else none.
+    let has_previous = k > 0u || joins_previous;
+    let previous = decode_on_grid(
+        select(i, i - 1u, has_previous),
+        select(before.origin, c.origin, k > 0u),
+        select(before.scale, c.scale, k > 0u),
+    );
+    // The next point: the cluster's, else the next cluster's first or second, else none.
+    let has_next = k + 1u < count || joins_next;
+    let next_own = k + 1u < count;
+    let next = decode_on_grid(
+        select(i, i + 1u, has_next),
+        select(after.origin, c.origin, next_own),
+        select(after.scale, c.scale, next_own),
+    );
+    return PulledPoint(p, vertex_tangent(select(p, previous, has_previous), p, select(p, next, has_next)), i);
 }
 
 // The unit vertex tangent at `p` between `previous` and `next` (which repeat `p` at a run's

@@ -161,7 +161,7 @@ fn tube_pipeline(
             buffers: &[],
             topology: wgpu::PrimitiveTopology::TriangleList,
             octants,
-            constants: &[],
+            constants: &[("OCTANTS", f64::from(u8::from(octants)))],
         },
     )
 }
