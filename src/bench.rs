@@ -19,7 +19,8 @@
 //!   culled without levels of detail (the full strip's G-buffer); `cull`: the cull's compute
 //!   alone;
 //! - `tubes`: the same streamlines as ray-cast tubes of radius 0.5 mm (against `lines`);
-//!   `tubes-culled`: the same tubes culled on the GPU, both phases (against `lines-culled`);
+//!   `tubes-culled`: the same tubes culled on the GPU at levels of detail, both phases (against
+//!   `lines-culled`); `tubes-culled-exact`: culled without levels of detail;
 //! - `nd-from-depth`: the ND and zoom maps derived from the G-buffer's depth, as from a host
 //!   renderer's (what embedding costs besides the method).
 //!
@@ -102,8 +103,10 @@ struct Passes {
     composite: Composite,
     bilateral: Bilateral,
     tubes: TubeRenderer,
-    /// The tubes culled on the GPU (`tubes-culled`, the chain's default for tubes).
+    /// The tubes culled on the GPU at levels of detail (`tubes-culled`, the chain's default for
+    /// tubes), and without them (`tubes-culled-exact`).
     tubes_culled: TubeRenderer,
+    tubes_culled_exact: TubeRenderer,
     /// The ND and zoom maps from the G-buffer's own depth, as from a host's (whose bind group
     /// is made per frame, on the device).
     nd_from_depth: NdFromDepth,
@@ -158,7 +161,8 @@ impl Passes {
             composite: Composite::new(device, format),
             bilateral: Bilateral::new(device),
             tubes: TubeRenderer::new(device, false, shape),
-            tubes_culled: TubeRenderer::new(device, false, shape).culled(device),
+            tubes_culled: TubeRenderer::new(device, false, shape).culled(device, true),
+            tubes_culled_exact: TubeRenderer::new(device, false, shape).culled(device, false),
             nd_from_depth: NdFromDepth::new(device, HostConfig::default()),
             stages: Vec::new(),
             settings: settings.clone(),
@@ -235,6 +239,9 @@ impl Passes {
             "bilateral" => self.bilateral.encode(encoder, targets, span),
             "tubes" => self.tubes.encode(encoder, targets, geometry, Load::Clear(background), span),
             "tubes-culled" => self.tubes_culled.encode(encoder, targets, geometry, Load::Clear(background), span),
+            "tubes-culled-exact" => {
+                self.tubes_culled_exact.encode(encoder, targets, geometry, Load::Clear(background), span)
+            }
             "nd-from-depth" => {
                 let inputs = HostInputs { depth: &targets.depth.view, normals: None, color: None };
                 self.nd_from_depth.encode(&self.device, encoder, targets, &inputs, span);
@@ -611,6 +618,7 @@ fn print_table(report: &serde_json::Value, passes: &[serde_json::Value]) {
         ("tubes", "lines"),
         ("tubes-culled", "lines-culled"),
         ("tubes-culled", "tubes"),
+        ("tubes-culled", "tubes-culled-exact"),
         ("lineao-chain", "ssao-16-chain"),
         ("lineao-level", "lineao"),
         ("lineao-chain-level", "ssao-16-chain"),

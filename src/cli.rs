@@ -219,7 +219,7 @@ pub struct BenchLoadArgs {
 // The passes `lineao bench --passes` names (its vocabulary, so the CLI needs nothing of the
 // bench itself).
 /// The bench's own GPU passes: the geometry and what every method shares.
-const OWN_GPU_PASSES: [&str; 14] = [
+const OWN_GPU_PASSES: [&str; 15] = [
     "lines",
     "lines-native-1px",
     "lines-full-strip",
@@ -233,6 +233,7 @@ const OWN_GPU_PASSES: [&str; 14] = [
     "bilateral",
     "tubes",
     "tubes-culled",
+    "tubes-culled-exact",
     "nd-from-depth",
 ];
 

@@ -320,6 +320,7 @@ fn bench_json_is_the_contract() {
         "bilateral",
         "tubes",
         "tubes-culled",
+        "tubes-culled-exact",
         "nd-from-depth",
         "raytraced-1spp",
         "raytraced-start-1spp",

@@ -24,10 +24,11 @@
 // tight, and the pyramid is read at a fine level. A box in front of the eye projects within
 // its corners' projections, no nearer than its nearest corner.
 //
-// With `LOD` (lines only) each visible piece is drawn at the coarsest level of detail that
-// leaves it within LOD_PIXELS of its full strip on screen (`piece_level`): every 2nd, 4th or 8th
-// point of it kept, and its ends. The coarse pieces are listed from the back of their phase's
-// list and drawn with fewer vertices a piece (`lines.wgsl`'s `vs_piece_coarse`).
+// With `LOD` each visible piece is drawn at the coarsest level of detail that leaves it within
+// LOD_PIXELS of its full strip (or tube) on screen (`piece_level`): every 2nd, 4th or 8th point
+// of it kept, and its ends. The coarse pieces are listed from the back of their phase's list
+// and drawn with fewer vertices a piece (`lines.wgsl`'s `vs_piece_coarse`, `tubes.wgsl`'s
+// `vs_tube_piece_coarse`).
 //
 // With `TUBES` the pieces are drawn as tubes (`tubes.wgsl`): a segment is bounded by its
 // billboard (`shared/billboard.wgsl`) for the largest radius of the page's points, and a group
@@ -119,10 +120,10 @@ fn seen_at(slot: u32) -> u32 {
 
 // Vertices of an instance of draw `d`'s culled lines (`lines.wgsl`'s `vs_piece`: each piece's
 // strip, `vs_piece_coarse` at most every second point's) or tubes (`tubes.wgsl`'s
-// `vs_tube_piece`: six vertices a segment).
+// `vs_tube_piece`: six vertices a segment, at most every second point's for `vs_tube_piece_coarse`).
 fn instance_vertices(d: u32) -> u32 {
     if TUBES {
-        return PIECES_PER_INSTANCE * 6u * PIECE_SEGMENTS;
+        return PIECES_PER_INSTANCE * 6u * select(PIECE_SEGMENTS, PIECE_SEGMENTS / 2u, d >= 2u);
     }
     return PIECES_PER_INSTANCE * select(PIECE_STRIDE, COARSE_PIECE_STRIDE, d >= 2u);
 }
@@ -528,7 +529,9 @@ fn settle(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_ind
 // (its distance in view space, at the scale of the piece's nearest point), and the sideways
 // push at it turns by no more (half a line width times its tangent's distance from the
 // segment's direction). A kept point keeps its own tangent, so the strip's corners there, and
-// the joins to the next pieces, are the full strip's.
+// the joins to the next pieces, are the full strip's. Tubes: the solid around the kept points
+// lies within the same distance of the full one (each is its axis grown by the radius), and
+// its rim turns by the radius (the page's largest) times that distance of directions, on screen.
 fn piece_level(c: Cluster, first: u32, last: u32) -> u32 {
     var p: array<vec3<f32>, 9>;
     let n = last - first + 1u;
@@ -544,7 +547,7 @@ fn piece_level(c: Cluster, first: u32, last: u32) -> u32 {
     }
     // Pixels a view-space unit spans at the nearest point.
     let px = 0.5 * max(frame.proj[0][0] * frame.viewport.x, frame.proj[1][1] * frame.viewport.y) / nearest;
-    let half_width = 0.5 * frame.line_width_px;
+    let half_width = select(0.5 * frame.line_width_px, radius_bound() * px, TUBES);
     for (var level = LEVELS - 1u; level > 0u; level--) {
         let stride = 1u << level;
         var fits = true;

@@ -103,22 +103,23 @@ fn tube_vertex(corner: u32, a_world: PulledPoint, b_world: PulledPoint, ra: f32,
     return out;
 }
 
-// Corner `corner` (0..5: two triangles) of segment `segment` of cluster `c`'s strip, whose
-// points before `end` are drawn; a segment past them lies outside the clip volume.
-fn segment_vertex(c: Cluster, segment: u32, corner: u32, end: u32) -> TubeOut {
-    if segment + 1u >= end || !is_selected(c) {
+// Corner `corner` (0..5: two triangles) of the tube between points `first` and `last` of
+// cluster `c`'s strip (consecutive, or kept at a level of detail: `last` keeps its own
+// tangent); `drawn`: whether there is such a segment, else it lies outside the clip volume.
+fn segment_vertex(c: Cluster, first: u32, last: u32, corner: u32, drawn: bool) -> TubeOut {
+    if !drawn || !is_selected(c) {
         var out: TubeOut;
         out.clip = vec4<f32>(2.0, 2.0, 2.0, 1.0);
         return out;
     }
     let corners = array<u32, 6>(0u, 1u, 2u, 2u, 1u, 3u);
-    let a = pulled_point(c, segment);
-    let b = pulled_point(c, segment + 1u);
+    let a = pulled_point(c, first);
+    let b = pulled_point(c, last);
     let ra = point_radius(a.index);
     let rb = point_radius(b.index);
     let radius_a = select(frame.tube_radius, ra, ra > 0.0);
     let radius_b = select(frame.tube_radius, rb, rb > 0.0);
-    let whole_a = segment == 0u && (c.flags & JOINS_PREVIOUS) == 0u;
+    let whole_a = first == 0u && (c.flags & JOINS_PREVIOUS) == 0u;
     return tube_vertex(corners[corner], a, b, radius_a, radius_b, whole_a);
 }
 
@@ -126,23 +127,36 @@ fn segment_vertex(c: Cluster, segment: u32, corner: u32, end: u32) -> TubeOut {
 @vertex
 fn vs_tube(@builtin(vertex_index) v: u32, @builtin(instance_index) cluster: u32) -> TubeOut {
     let c = clusters[cluster];
-    return segment_vertex(c, v / 6u, v % 6u, drawn_points(c));
+    let segment = v / 6u;
+    return segment_vertex(c, segment, segment + 1u, v % 6u, segment + 1u < drawn_points(c));
 }
 
 // Vertex v of an instance of the culled tubes (`lineao::passes::cull`): PIECES_PER_INSTANCE
-// listed pieces, six vertices for each of a piece's segments.
-@vertex
-fn vs_tube_piece(@builtin(vertex_index) v: u32, @builtin(instance_index) instance: u32) -> TubeOut {
-    let per_piece = 6u * PIECE_SEGMENTS;
-    let piece = visible_piece(instance * PIECES_PER_INSTANCE + v / per_piece, false);
+// listed pieces of list `coarse`, six vertices for each segment between a piece's kept points,
+// of which a full piece has PIECE_SEGMENTS and a coarse one (at most every second point kept)
+// half as many. In color mode 3 the piece's level, or why the frozen cull left it out.
+fn piece_tube_vertex(v: u32, instance: u32, coarse: bool) -> TubeOut {
+    let per_piece = 6u * select(PIECE_SEGMENTS, PIECE_SEGMENTS / 2u, coarse);
+    let piece = visible_piece(instance * PIECES_PER_INSTANCE + v / per_piece, coarse);
     let k = v % per_piece;
-    var out = segment_vertex(piece.cluster, piece.first + k / 6u, k % 6u, piece.first + piece.points);
-    // Gray in color mode 3 (`base_color`), but where the frozen cull shows why it left one out.
-    if frame.color_mode == 3u && piece.left != 0u {
-        out.color_a = piece_color(1u, piece.left);
+    let segment = k / 6u;
+    let drawn = segment + 1u < kept_points(piece);
+    var out = segment_vertex(piece.cluster, kept_point(piece, segment), kept_point(piece, segment + 1u), k % 6u, drawn);
+    if frame.color_mode == 3u {
+        out.color_a = piece_color(piece.stride, piece.left);
         out.color_b = out.color_a;
     }
     return out;
+}
+
+@vertex
+fn vs_tube_piece(@builtin(vertex_index) v: u32, @builtin(instance_index) instance: u32) -> TubeOut {
+    return piece_tube_vertex(v, instance, false);
+}
+
+@vertex
+fn vs_tube_piece_coarse(@builtin(vertex_index) v: u32, @builtin(instance_index) instance: u32) -> TubeOut {
+    return piece_tube_vertex(v, instance, true);
 }
 
 // The first hit of the ray ro + t rd (|rd| = 1) with the rounded cone between spheres (pa, ra)

@@ -9,7 +9,7 @@ mod common;
 use common::{gpu, is_geometry};
 use glam::Vec3;
 use lineao::lighting::LightingShape;
-use lineao::passes::cull::{Frozen, LineCull};
+use lineao::passes::cull::{Culled, Frozen, LineCull};
 use lineao::passes::lines::{LineRenderer, LineStyle, VertexAttributes};
 use lineao::passes::tubes::TubeRenderer;
 use lineao::reference::NdImage;
@@ -150,7 +150,13 @@ fn same_marks_as_the_cpu_reference(
         height: depth.height,
         data: depth.data.iter().map(|d| d[0]).collect(),
     };
-    let frame = CullView { view: view.view, proj: view.proj, size: view.banded_size(), line_width_px: LINE_WIDTH };
+    let frame = CullView {
+        view: view.view,
+        proj: view.proj,
+        size: view.banded_size(),
+        line_width_px: LINE_WIDTH,
+        tube_radius: None,
+    };
     let pages = geometry.page_contents(&gpu.device, &gpu.queue).unwrap();
     let slack = Slack { px: 0.01, depth: 1e-7 };
     let expected = marks(&pages, &frame, &depth, slack);
@@ -301,7 +307,7 @@ fn culled_tubes_draw_the_g_buffer_of_all_tubes() {
     let (positions, offsets) = ball(1500);
     let mut geometry = LineGeometry::new(d, q, &positions, &offsets).unwrap();
     let all = TubeRenderer::new(d, false, LightingShape::ANY);
-    let culled = TubeRenderer::new(d, false, LightingShape::ANY).culled(d);
+    let culled = TubeRenderer::new(d, false, LightingShape::ANY).culled(d, false);
     let pieces = lineao::passes::cull::LineCull::pieces(&geometry);
     // Radii along each streamline from 0.1 to 1.0, a third of them the frame's (none stored).
     let radii: Vec<f32> =
@@ -338,20 +344,22 @@ fn culled_tubes_draw_the_g_buffer_of_all_tubes() {
 }
 
 /// Checks the levels of detail the GPU chose for the visible pieces of the last frame against
-/// the CPU reference's (`lineao::reference::cull::levels`): the same wherever no level's test
-/// lies within 1e-3 px of the bound; those are counted.
+/// the CPU reference's (`lineao::reference::cull::levels`, for tubes of `tube_radius`): the same
+/// wherever no level's test lies within 1e-3 px of the bound; those are counted.
 fn same_levels_as_the_cpu_reference(
     gpu: &lineao::Gpu,
-    renderer: &LineRenderer,
+    culled: &Culled,
     geometry: &LineGeometry,
     view: &FrameView,
+    tube_radius: Option<f32>,
     case: &str,
 ) {
     use lineao::reference::cull::{CullView, levels};
-    let frame = CullView { view: view.view, proj: view.proj, size: view.banded_size(), line_width_px: LINE_WIDTH };
+    let frame =
+        CullView { view: view.view, proj: view.proj, size: view.banded_size(), line_width_px: LINE_WIDTH, tube_radius };
     let pages = geometry.page_contents(&gpu.device, &gpu.queue).unwrap();
     let expected = levels(&pages, &frame, 1e-3);
-    let got = renderer.cull().unwrap().cull().marks(&gpu.queue, geometry).unwrap();
+    let got = culled.cull().marks(&gpu.queue, geometry).unwrap();
     let (mut visible, mut unsure, mut coarse) = (0, 0, 0);
     for (page, (expected, got)) in expected.iter().zip(&got).enumerate() {
         for (i, (levels, &bits)) in expected.iter().zip(got).enumerate() {
@@ -376,31 +384,50 @@ fn same_levels_as_the_cpu_reference(
     assert!(visible > 0, "{case}: nothing visible to check");
 }
 
-/// The culled lines at levels of detail (`passes::cull`'s `LOD_PIXELS`): against every line's
-/// full strip, the same pixels covered but a few at the silhouette, and the front line's depth
-/// within half a pixel's width of the full strip's at nearly every pixel (elsewhere another
-/// line, shifted less than a pixel, is in front); and with fewer points drawn. The first frame
-/// after a cut is the full strip's.
-#[test]
-fn culled_lines_at_levels_of_detail_stay_within_half_a_pixel() {
-    let gpu = gpu();
-    let (d, q) = (&gpu.device, &gpu.queue);
-    let (positions, offsets) = ball(8000);
-    let geometry = LineGeometry::new(d, q, &positions, &offsets).unwrap();
-    let all = LineRenderer::with_style(d, LineStyle::FullStrip);
-    let lod = LineRenderer::new(d).culled(d, true);
+/// Culled lines or tubes (`draw` with `culled`'s cull, at levels of detail) against every line
+/// or tube drawn whole (`all`), for each camera: the same pixels covered but a few at the
+/// silhouette, and the front surface within half a pixel's width of the full one's at nearly
+/// every pixel (elsewhere another line, shifted less than a pixel, is in front) — for lines in
+/// depth, for tubes along the full surface's normal (a tube's solid lies within that distance
+/// of the full one, and a surface shifted by δ along its normal n moves δ / |n · d| along the
+/// ray d: without that factor 2 % of the pixels differ more, at the tubes' flanks); the levels
+/// the CPU reference's; the first frame after a cut the full G-buffer.
+fn levels_of_detail_stay_within_half_a_pixel(
+    gpu: &lineao::Gpu,
+    geometry: &LineGeometry,
+    culled: &Culled,
+    tube_radius: Option<f32>,
+    all: impl Fn(&Camera) -> [NdImage; 4],
+    draw: impl Fn(&Camera) -> [NdImage; 4],
+) {
+    let q = &gpu.queue;
+    let shape = if tube_radius.is_some() { "tubes" } else { "lines" };
+    let (width, height) = (SIZE.0 + 2 * GUARD, SIZE.1 + 2 * GUARD);
     for (case, camera) in cameras() {
+        let case = format!("{shape}, {case}");
         let view = FrameView::new(&camera, &bounds(), SIZE.0, SIZE.1, GUARD, 1.0);
-        let expected = draw(&gpu, &all, &geometry, &camera);
+        assert_eq!(view.banded_size(), (width, height));
+        let inverse = view.proj.inverse();
+        // A depth difference at pixel i as the distance the surface moved along its normal.
+        let along_normal = |i: usize, nd: [f32; 4]| {
+            if tube_radius.is_none() {
+                return 1.0;
+            }
+            let (x, y) = ((i as u32 % width) as f32 + 0.5, (i as u32 / width) as f32 + 0.5);
+            let ndc = |z| Vec3::new(2.0 * x / width as f32 - 1.0, 1.0 - 2.0 * y / height as f32, z);
+            let ray = (inverse.project_point3(ndc(1.0)) - inverse.project_point3(ndc(0.0))).normalize();
+            Vec3::new(nd[0], nd[1], nd[2]).dot(ray).abs() / ray.z.abs()
+        };
+        let expected = all(&camera);
         // The first frame after a cut draws every piece whole (the levels were found for
         // another view); the second draws them at the levels found against this one.
-        let first = draw(&gpu, &lod, &geometry, &camera);
-        let counts = lod.cull().unwrap().counts(q, &geometry).unwrap();
+        let first = draw(&camera);
+        let counts = culled.counts(q, geometry).unwrap();
         assert_eq!(counts.coarse, 0, "{case}: the first frame after a cut draws every piece whole");
-        same_gbuffer(&expected, &first, case);
-        let got = draw(&gpu, &lod, &geometry, &camera);
-        let counts = lod.cull().unwrap().counts(q, &geometry).unwrap();
-        same_levels_as_the_cpu_reference(&gpu, &lod, &geometry, &view, case);
+        same_gbuffer(&expected, &first, &case);
+        let got = draw(&camera);
+        let counts = culled.counts(q, geometry).unwrap();
+        same_levels_as_the_cpu_reference(gpu, culled, geometry, &view, tube_radius, &case);
         let (mut covered, mut coverage, mut far, mut identical) = (0usize, 0usize, 0usize, 0usize);
         for i in 0..expected[0].data.len() {
             let (a, b) = (is_geometry(expected[1].data[i]), is_geometry(got[1].data[i]));
@@ -414,12 +441,13 @@ fn culled_lines_at_levels_of_detail_stay_within_half_a_pixel() {
             let z = |nd: [f32; 4]| view.near + nd[3] * (view.far - view.near);
             let (za, zb) = (z(expected[1].data[i]), z(got[1].data[i]));
             let px = if view.orthographic { view.f_px } else { view.f_px / za };
-            far += ((za - zb).abs() > lineao::passes::cull::LOD_PIXELS / px) as usize;
+            let moved = (za - zb).abs() * along_normal(i, expected[1].data[i]);
+            far += (moved > lineao::passes::cull::LOD_PIXELS / px) as usize;
         }
         let share = |n: usize| 100.0 * n as f64 / covered as f64;
         println!(
             "{case}: {:.1} % of {} pieces drawn coarser; of {covered} geometry pixels {:.2} % covered or not \
-             otherwise, {:.2} % identical, {:.2} % with another depth beyond half a pixel",
+             otherwise, {:.2} % identical, {:.2} % moved beyond half a pixel",
             100.0 * counts.coarse as f64 / (counts.early + counts.late) as f64,
             counts.early + counts.late,
             share(coverage),
@@ -428,10 +456,39 @@ fn culled_lines_at_levels_of_detail_stay_within_half_a_pixel() {
         );
         assert!(coverage * 200 <= covered, "{case}: {coverage} of {covered} pixels covered otherwise");
         assert!(far * 50 <= covered, "{case}: {far} of {covered} pixels at another depth");
-        if case == "outside" {
+        if case.ends_with("outside") {
             assert!(counts.coarse * 2 >= counts.early + counts.late, "{case}: {counts}");
         }
     }
+}
+
+/// The culled lines at levels of detail (`passes::cull`'s `LOD_PIXELS`) against every line's
+/// full strip.
+#[test]
+fn culled_lines_at_levels_of_detail_stay_within_half_a_pixel() {
+    let gpu = gpu();
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let (positions, offsets) = ball(8000);
+    let geometry = LineGeometry::new(d, q, &positions, &offsets).unwrap();
+    let all = LineRenderer::with_style(d, LineStyle::FullStrip);
+    let lod = LineRenderer::new(d).culled(d, true);
+    let (all, draw) = (|c: &Camera| draw(&gpu, &all, &geometry, c), |c: &Camera| draw(&gpu, &lod, &geometry, c));
+    levels_of_detail_stay_within_half_a_pixel(&gpu, &geometry, lod.cull().unwrap(), None, all, draw);
+}
+
+/// The culled tubes at levels of detail against every tube (the rim's turn bounded by the
+/// radius on screen).
+#[test]
+fn culled_tubes_at_levels_of_detail_stay_within_half_a_pixel() {
+    let gpu = gpu();
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let (positions, offsets) = ball(1500);
+    let geometry = LineGeometry::new(d, q, &positions, &offsets).unwrap();
+    let all = TubeRenderer::new(d, false, LightingShape::ANY);
+    let lod = TubeRenderer::new(d, false, LightingShape::ANY).culled(d, true);
+    let (all, draw) =
+        (|c: &Camera| draw_tubes(&gpu, &all, &geometry, c), |c: &Camera| draw_tubes(&gpu, &lod, &geometry, c));
+    levels_of_detail_stay_within_half_a_pixel(&gpu, &geometry, lod.cull().unwrap(), Some(TUBE_RADIUS), all, draw);
 }
 
 /// The streamlines of (`positions`, `offsets`) that `keep` marks.

@@ -657,9 +657,10 @@ fn lit(settings: &ChainSettings) -> LightingShape {
 }
 
 /// The chain's tube renderer where `settings` asks for tubes: writing the octants with
-/// object-space AO, culled on the GPU with [`ChainSettings::cull`].
+/// object-space AO, culled on the GPU with [`ChainSettings::cull`] (at levels of detail with
+/// [`ChainSettings::lod`]).
 fn tube_renderer(device: &wgpu::Device, settings: &ChainSettings) -> Option<TubeRenderer> {
     settings.tubes.as_ref()?;
     let renderer = TubeRenderer::new(device, settings.volume.is_some(), lit(settings));
-    Some(if settings.cull { renderer.culled(device) } else { renderer })
+    Some(if settings.cull { renderer.culled(device, settings.levels_of_detail()) } else { renderer })
 }

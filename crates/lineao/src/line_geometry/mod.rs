@@ -248,9 +248,9 @@ pub(crate) struct Page {
     pub records: u32,
     /// Pieces of eight segments its clusters' strips have (the culled lines' unit).
     pub pieces: u64,
-    /// Its culling state for lines, lines at levels of detail and tubes (each marks what it
-    /// found visible, and at which level), made on its first culled frame.
-    pub cull: [std::sync::OnceLock<crate::passes::cull::PageCull>; 3],
+    /// Its culling state for lines and tubes, each at levels of detail or not (each marks what
+    /// it found visible, and at which level), made on its first culled frame.
+    pub cull: [std::sync::OnceLock<crate::passes::cull::PageCull>; 4],
     points: u32,
     runs: Vec<RunMap>,
     /// Per record, its polyline (for [`LineGeometry::set_selection`]).

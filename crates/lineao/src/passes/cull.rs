@@ -56,7 +56,7 @@
 //! and the order decides. A first frame, a camera cut or a resize costs one full draw (nothing
 //! was visible before, so the late phase draws all that passes against an empty pyramid).
 //!
-//! **Level of detail** (lines, where asked: [`LineCull::new`]'s `lod`, the chain's default):
+//! **Level of detail** (where asked: [`LineCull::new`]'s `lod`, the chain's default):
 //! the settling also picks for each piece drawn and still visible the coarsest level — every
 //! 2nd, 4th or 8th point kept, and its last — at which each dropped point lies within
 //! [`LOD_PIXELS`] of the segment between the kept points around it, on screen at the piece's
@@ -75,10 +75,15 @@
 //! piece: a segment's fragments lie within its billboard (`shaders/shared/billboard.wgsl`: the
 //! end spheres' disks on screen hulled by a rectangle, at the depth of the solid's front, which
 //! the written depth is never nearer than), bounded for the largest radius the page's points
-//! hold (its uniform) or the frame's; a group's box grows by that radius.
+//! hold (its uniform) or the frame's; a group's box grows by that radius. At a level of detail
+//! a tube's solid (its axis grown by the radius) lies within the dropped points' distance of
+//! the full one, and its rim turns by the radius times the tangents' turn: the radius (that
+//! bound) on screen takes the half line width's place. A segment between kept points leaves its
+//! start sphere to the one before, as at full detail (the two share that point); a coarse piece
+//! is drawn with 24 vertices a piece instead of 48.
 //!
-//! Each page keeps its state ([`PageCull`]), one for lines, lines at levels of detail and
-//! tubes each: a word a cluster (its visible pieces), the list of pieces to draw (a word each),
+//! Each page keeps its state ([`PageCull`]), one for lines and tubes, at levels of detail or not,
+//! each: a word a cluster (its visible pieces), the list of pieces to draw (a word each),
 //! the listed groups and the indirect draws and dispatch, about 1.3 bytes a point, made on the
 //! page's first culled frame; and where the capsules are tested, the pieces listed for the
 //! segment test and the pieces' radii, 0.9 bytes a point more, made when they first are.
@@ -337,7 +342,7 @@ pub struct LineCull {
 
 impl LineCull {
     /// The cull of geometry drawn as `shape` with `frame` (the renderer's group 0: its frame
-    /// uniform and lighting), picking a level of detail for each piece where `lod` (lines only).
+    /// uniform and lighting), picking a level of detail for each piece where `lod`.
     pub fn new(device: &wgpu::Device, frame: &wgpu::BindGroupLayout, shape: Shape, lod: bool) -> LineCull {
         let label = "lineao::LineCull";
         let compute = wgpu::ShaderStages::COMPUTE;
@@ -352,7 +357,6 @@ impl LineCull {
         let bounds_layout = buffers_layout(device, label, &[(0, read_write), (1, read_write), (3, read_write)]);
         let page = geometry_layout(device);
         let module = crate::shader::module(device, "cull.wgsl");
-        let lod = lod && shape == Shape::Lines;
         let constants = |lod: bool| [("TUBES", (shape == Shape::Tubes) as u32 as f64), ("LOD", lod as u32 as f64)];
         let pipeline_of = |entry: &str, groups: &[Option<&wgpu::BindGroupLayout>], lod: bool| {
             let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -623,13 +627,9 @@ impl LineCull {
         *self.view.lock().unwrap_or_else(|poisoned| poisoned.into_inner()) = Some(LevelsView::of(view));
     }
 
-    /// Which of a page's culling states is its own: lines, lines at levels of detail, tubes.
+    /// Which of a page's culling states is its own: lines or tubes, each at levels of detail or not.
     fn slot(&self) -> usize {
-        match (self.shape, self.lod) {
-            (Shape::Lines, false) => 0,
-            (Shape::Lines, true) => 1,
-            (Shape::Tubes, _) => 2,
-        }
+        2 * (self.shape == Shape::Tubes) as usize + self.lod as usize
     }
 
     /// One compute pass of `pipeline` timed into `span`, with the frame and the pyramid bound

@@ -66,17 +66,21 @@ impl TubeRenderer {
     }
 
     /// This renderer drawing only the pieces of tube that can be seen, found on the GPU each
-    /// frame ([`crate::passes::cull`]): the same G-buffer as drawing every segment.
-    pub fn culled(mut self, device: &wgpu::Device) -> TubeRenderer {
+    /// frame ([`crate::passes::cull`]): the same G-buffer as drawing every segment; with `lod`,
+    /// each piece through the fewest of its points that keep it within
+    /// [`LOD_PIXELS`](crate::passes::cull::LOD_PIXELS) of its full tube on screen.
+    pub fn culled(mut self, device: &wgpu::Device, lod: bool) -> TubeRenderer {
         if self.culled.is_some() {
             return self;
         }
         let page = crate::line_geometry::page_layout(device);
         let pieces = crate::passes::cull::pieces_layout(device);
         let groups = [&page, &pieces];
-        let create =
-            |octants, _coarse| tube_pipeline(device, &self.bindings, &self.module, &groups, "vs_tube_piece", octants);
-        self.culled = Some(Culled::new(device, &self.bindings.layout, Shape::Tubes, false, self.octants, create));
+        let create = |octants, coarse| {
+            let vertex = if coarse { "vs_tube_piece_coarse" } else { "vs_tube_piece" };
+            tube_pipeline(device, &self.bindings, &self.module, &groups, vertex, octants)
+        };
+        self.culled = Some(Culled::new(device, &self.bindings.layout, Shape::Tubes, lod, self.octants, create));
         self
     }
 
@@ -107,6 +111,9 @@ impl TubeRenderer {
     ) {
         let uniform = GeometryUniform::new(view, color, 0.0, radius_world).with_slab(view, slab);
         self.bindings.write(queue, &uniform, lighting);
+        if let Some(culled) = &self.culled {
+            culled.cull().set_view(view);
+        }
     }
 
     /// Draws `geometry` as tubes into the G-buffer, clearing it first or over earlier passes

@@ -37,6 +37,9 @@ pub struct CullView {
     /// The targets' guard-banded size.
     pub size: (u32, u32),
     pub line_width_px: f32,
+    /// Tubes of this radius (world units; the pages' largest or the frame's, as the GPU bounds
+    /// them) instead of lines, for the levels of detail.
+    pub tube_radius: Option<f32>,
 }
 
 /// What a test says once the GPU's rounding is allowed for.
@@ -144,6 +147,8 @@ pub fn levels(pages: &[PageContents], view: &CullView, slack: f32) -> Vec<Vec<[O
             p.push(view_pos);
         }
         let px = scale / nearest;
+        // How far the sideways push (lines) or the rim (tubes) turns with the direction.
+        let reach = view.tube_radius.map_or(half_width, |r| r * px);
         let n = p.len();
         for level in (1..LEVELS).rev() {
             let stride = 1 << level;
@@ -156,7 +161,7 @@ pub fn levels(pages: &[PageContents], view: &CullView, slack: f32) -> Vec<Vec<[O
                     let ab = b - a;
                     let t = ((p[k] - a).dot(ab) / ab.dot(ab).max(1e-30)).clamp(0.0, 1.0);
                     let off_line = (p[k] - (a + t * ab)).length() * px;
-                    let turn = ((p[k + 1] - p[k - 1]).normalize() - ab.normalize()).length() * half_width;
+                    let turn = ((p[k + 1] - p[k - 1]).normalize() - ab.normalize()).length() * reach;
                     off_line + turn
                 })
                 .fold(0.0f32, f32::max);
