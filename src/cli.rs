@@ -67,8 +67,8 @@ pub struct ViewArgs {
     /// or every line (`off`).
     #[arg(long, value_parser = parse_on_off, default_value = "on")]
     pub cull: bool,
-    /// Where lines are culled, draw each visible piece at the coarsest level of detail within
-    /// half a pixel of it (`on`), or every point (`off`: the full strip exactly).
+    /// Where lines or tubes are culled, draw each visible piece at the coarsest level of detail
+    /// within half a pixel of it (`on`), or every point (`off`: the full strip, every tube, exactly).
     #[arg(long, value_parser = parse_on_off, default_value = "on")]
     pub lod: bool,
     /// Cut the lines to a slab: AXIS (x, y, z or view), CENTRE and THICKNESS in world mm

@@ -445,8 +445,9 @@ pub struct StyleArgs {
     /// view is drawn twice and the picture is the second frame; the viewer culls].
     #[arg(long, value_parser = parse_on_off)]
     pub cull: Option<bool>,
-    /// Where lines are culled, draw each visible piece at the coarsest level of detail within
-    /// half a pixel of it (`on`), or every point (`off`: the full strip exactly) [default: on].
+    /// Where lines or tubes are culled, draw each visible piece at the coarsest level of detail
+    /// within half a pixel of it (`on`), or every point (`off`: the full strip, every tube,
+    /// exactly) [default: on].
     #[arg(long, value_parser = parse_on_off)]
     pub lod: Option<bool>,
 }

@@ -303,10 +303,11 @@ macro_rules! chain_settings {
             /// a chain draws frames one after another. A single picture has no frame before it, and
             /// culled it costs the full strip and the tests (`lineao render` turns it off).
             pub cull: bool,
-            /// Where it culls lines, draw each visible piece at the coarsest level of detail that lies
-            /// within half a pixel of it on screen ([`crate::passes::cull`]'s level of detail): fewer
-            /// vertices for lines seen from afar, a G-buffer that differs from the full strip's by
-            /// sub-pixel shifts. Off: the full strip exactly. Default on (but for the ray tracer:
+            /// Where it culls lines or tubes, draw each visible piece at the coarsest level of detail
+            /// that lies within half a pixel of it on screen ([`crate::passes::cull`]'s level of
+            /// detail): fewer vertices for lines and tubes seen from afar, a G-buffer that differs
+            /// from the full one by sub-pixel shifts (and a tube's normals by the turn that bounds).
+            /// Off: every segment exactly. Default on (but for the ray tracer:
             /// [`ChainSettings::levels_of_detail`]).
             pub lod: bool,
         }
@@ -352,7 +353,7 @@ impl Default for ChainSettings {
 }
 
 impl ChainSettings {
-    /// Whether the culled lines are drawn at levels of detail: [`ChainSettings::lod`], but never
+    /// Whether the culled lines and tubes are drawn at levels of detail: [`ChainSettings::lod`], but never
     /// for the GPU ray tracer, whose rays start on the G-buffer's lines and must find them
     /// where the scene it traces has them.
     pub fn levels_of_detail(&self) -> bool {
