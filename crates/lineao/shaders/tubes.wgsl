@@ -14,8 +14,7 @@
 #import shared/pieces.wgsl
 
 // Whether the fragment shader writes the octant visibilities (`fs_tube_octants`): without, the
-// vertices neither read nor pass them (a uniform branch runs both sides on a CPU rasterizer:
-// the reads cost `tubes` 7 %, lavapipe, 1 M vertices).
+// vertices neither read nor pass them (a uniform branch runs both sides on a CPU rasterizer).
 override OCTANTS: bool = true;
 
 struct TubeOut {
