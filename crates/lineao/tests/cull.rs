@@ -51,10 +51,18 @@ fn ball(count: usize) -> (Vec<[f32; 3]>, Vec<u64>) {
 
 /// `ball(count)` on the GPU, every line's full strip, and the culled lines (no levels of detail).
 fn ball_lines(gpu: &lineao::Gpu, count: usize) -> (LineGeometry, LineRenderer, LineRenderer) {
-    let (d, q) = (&gpu.device, &gpu.queue);
+    let d = &gpu.device;
+    (
+        ball_geometry(gpu, count),
+        LineRenderer::with_style(d, LineStyle::FullStrip),
+        LineRenderer::new(d).culled(d, false),
+    )
+}
+
+/// The `ball` of `count` streamlines on the GPU.
+fn ball_geometry(gpu: &lineao::Gpu, count: usize) -> LineGeometry {
     let (positions, offsets) = ball(count);
-    let geometry = LineGeometry::new(d, q, &positions, &offsets).unwrap();
-    (geometry, LineRenderer::with_style(d, LineStyle::FullStrip), LineRenderer::new(d).culled(d, false))
+    LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap()
 }
 
 /// Outside, inside, close up, orthographic, and a cut to the other side.
@@ -467,9 +475,8 @@ fn levels_of_detail_stay_within_half_a_pixel(
 #[test]
 fn culled_lines_at_levels_of_detail_stay_within_half_a_pixel() {
     let gpu = gpu();
-    let (d, q) = (&gpu.device, &gpu.queue);
-    let (positions, offsets) = ball(8000);
-    let geometry = LineGeometry::new(d, q, &positions, &offsets).unwrap();
+    let d = &gpu.device;
+    let geometry = ball_geometry(&gpu, 8000);
     let all = LineRenderer::with_style(d, LineStyle::FullStrip);
     let lod = LineRenderer::new(d).culled(d, true);
     let (all, draw) = (|c: &Camera| draw(&gpu, &all, &geometry, c), |c: &Camera| draw(&gpu, &lod, &geometry, c));
@@ -481,14 +488,46 @@ fn culled_lines_at_levels_of_detail_stay_within_half_a_pixel() {
 #[test]
 fn culled_tubes_at_levels_of_detail_stay_within_half_a_pixel() {
     let gpu = gpu();
-    let (d, q) = (&gpu.device, &gpu.queue);
-    let (positions, offsets) = ball(1500);
-    let geometry = LineGeometry::new(d, q, &positions, &offsets).unwrap();
+    let d = &gpu.device;
+    let geometry = ball_geometry(&gpu, 1500);
     let all = TubeRenderer::new(d, false, LightingShape::ANY);
     let lod = TubeRenderer::new(d, false, LightingShape::ANY).culled(d, true);
     let (all, draw) =
         (|c: &Camera| draw_tubes(&gpu, &all, &geometry, c), |c: &Camera| draw_tubes(&gpu, &lod, &geometry, c));
     levels_of_detail_stay_within_half_a_pixel(&gpu, &geometry, lod.cull().unwrap(), Some(TUBE_RADIUS), all, draw);
+}
+
+/// The chain's culled tubes follow its settings: levels of detail where asked, none with the
+/// ray tracer (whose rays must find the tubes where its scene has them), and a change of
+/// either rebuilds them.
+#[test]
+fn the_chain_draws_tubes_at_levels_of_detail_as_its_settings_say() {
+    use lineao::{AoChain, AoMethod, TubeSettings};
+    let gpu = gpu();
+    let (d, q) = (&gpu.device, &gpu.queue);
+    let geometry = ball_geometry(&gpu, 600);
+    let tubes = Some(TubeSettings { radius_world: TUBE_RADIUS });
+    let settings = |lod, method| ChainSettings { lod, method, tubes: tubes.clone(), ..ChainSettings::default() };
+    let mut chain = AoChain::new(d, common::OUTPUT_FORMAT, settings(true, AoMethod::None)).unwrap();
+    chain.resize(SIZE.0, SIZE.1).unwrap();
+    let output = lineao::targets::Target::output(d, "test::output", SIZE, common::OUTPUT_FORMAT);
+    // Coarser pieces drawn in the second of two frames of one view.
+    let coarse = |chain: &mut AoChain| {
+        for _ in 0..2 {
+            chain.prepare(d, q, &outside(), &bounds()).unwrap();
+            let mut encoder = d.create_command_encoder(&Default::default());
+            chain.encode(&mut encoder, &geometry, &output.view).unwrap();
+            q.submit([encoder.finish()]);
+        }
+        chain.cull_counts(q, &geometry).unwrap().expect("culled tubes").coarse
+    };
+    assert!(coarse(&mut chain) > 0, "levels of detail on: no piece drawn coarser");
+    chain.set_settings(d, settings(false, AoMethod::None)).unwrap();
+    assert_eq!(coarse(&mut chain), 0, "levels of detail off");
+    chain.set_settings(d, settings(true, AoMethod::None)).unwrap();
+    assert!(coarse(&mut chain) > 0, "levels of detail on again");
+    chain.set_settings(d, settings(true, AoMethod::RayTraced)).unwrap();
+    assert_eq!(coarse(&mut chain), 0, "the ray tracer");
 }
 
 /// The streamlines of (`positions`, `offsets`) that `keep` marks.

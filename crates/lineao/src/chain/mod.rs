@@ -188,6 +188,7 @@ impl AoChain {
             (Some(renderer), Some(_)) => {
                 renderer.writes_octants() == octants
                     && renderer.cull().is_some() == settings.cull
+                    && (!settings.cull || renderer.lods() == settings.levels_of_detail())
                     && renderer.lighting_shape() == shape
             }
             (None, None) => true,

@@ -89,6 +89,11 @@ impl TubeRenderer {
         self.culled.as_ref()
     }
 
+    /// Whether it culls at levels of detail ([`TubeRenderer::culled`]).
+    pub fn lods(&self) -> bool {
+        self.culled.as_ref().is_some_and(|c| c.cull().lod())
+    }
+
     /// Whether this renderer writes the `octants` target.
     pub fn writes_octants(&self) -> bool {
         self.octants
