@@ -151,7 +151,7 @@ fn a_straight_tube_is_the_analytic_cylinder_with_round_ends() {
     // between the end planes, else the end spheres.
     let gpu = gpu();
     let (a, b, r) = (Vec3::new(-20.0, 2.0, 1.0), Vec3::new(25.0, -3.0, -2.0), 4.0f32);
-    let geometry = LineGeometry::new(&gpu.device, &gpu.queue, &[a.to_array(), b.to_array()], &[0, 2]).unwrap();
+    let geometry = one_segment(&gpu, a, b);
     let perspective = Camera {
         eye: Vec3::new(10.0, 30.0, 80.0),
         target: Vec3::ZERO,
@@ -163,6 +163,11 @@ fn a_straight_tube_is_the_analytic_cylinder_with_round_ends() {
         let frame = render_tubes(&gpu, &geometry, &camera, tubes(r), (320, 240));
         compare_with_capsule(name, &frame, [a, b], r);
     }
+}
+
+/// The streamline of the one segment from `a` to `b`, on the GPU.
+fn one_segment(gpu: &lineao::Gpu, a: Vec3, b: Vec3) -> LineGeometry {
+    LineGeometry::new(&gpu.device, &gpu.queue, &[a.to_array(), b.to_array()], &[0, 2]).unwrap()
 }
 
 /// The frame against the analytic capsule of world ends `ends` and radius `r`, in f64.
@@ -183,7 +188,7 @@ fn compare_with_capsule(name: &str, frame: &Frame, ends: [Vec3; 2], r: f32) {
 fn a_tube_in_the_corner_of_a_wide_view_is_whole() {
     let gpu = gpu();
     let (a, b, r) = (Vec3::new(20.0, 14.0, 15.0), Vec3::new(23.0, 15.0, 13.0), 4.0f32);
-    let geometry = LineGeometry::new(&gpu.device, &gpu.queue, &[a.to_array(), b.to_array()], &[0, 2]).unwrap();
+    let geometry = one_segment(&gpu, a, b);
     let camera = Camera {
         eye: Vec3::new(0.0, 0.0, 30.0),
         target: Vec3::ZERO,
