@@ -66,7 +66,7 @@ use lineao::lighting::LightingShape;
 use lineao::method::raytraced::RayTracedAo;
 use lineao::method::{BenchPass, Stage};
 use lineao::passes::Load;
-use lineao::passes::bilateral::Bilateral;
+use lineao::passes::bilateral::{Bilateral, Region};
 use lineao::passes::composite::Composite;
 use lineao::passes::lines::{LineRenderer, LineStyle};
 use lineao::passes::nd_from_depth::{HostConfig, HostInputs, NdFromDepth};
@@ -195,7 +195,7 @@ impl Passes {
             passes.stages.push(StagePass { method, pass, stage });
         }
         passes.bilateral.resize(device, targets);
-        passes.bilateral.prepare(queue, view, &BilateralSettings::default());
+        passes.bilateral.prepare(queue, view, &BilateralSettings::default(), Region::All);
         passes.composite.resize(device, targets, &targets.ao);
         passes.composite.prepare(
             queue,

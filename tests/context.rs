@@ -58,7 +58,7 @@ fn geometry_points(session: &Session, chain: &lineao::AoChain) -> Vec<(usize, Ve
 #[test]
 fn a_slice_shows_the_volume_where_its_affine_puts_it() {
     // The T1 template (a plain affine) cut coronally, and the z-map whose affine flips x cut
-    // sagittally, each seen from its slice's side.
+    // sagittally, each seen from its slice's side; opaque, their zeros too.
     for (name, slices, axis, at, eye) in [
         ("MNI152_2009_template.nii.gz", "-,-18,-", 1, -18.0, "60,-260,40"),
         ("strokez.nii.gz", "20,-,-", 0, 20.0, "260,-40,40"),
@@ -66,7 +66,7 @@ fn a_slice_shows_the_volume_where_its_affine_puts_it() {
         let path = images(name);
         let keywords = serde_json::json!({
             "volume": path, "slices": slices, "method": "none", "width": 320, "height": 256,
-            "eye": eye, "target": "0,-18,10", "up": "0,0,1",
+            "eye": eye, "target": "0,-18,10", "up": "0,0,1", "opaque_slices": true,
         });
         let (session, chain) = render(&images("stroke.trk.gz"), keywords);
         let volume = lineao_tracts::Volume::load(&path).unwrap();
@@ -106,8 +106,85 @@ fn a_slice_shows_the_volume_where_its_affine_puts_it() {
     }
 }
 
+/// A slice is transparent where the voxels without data (0 or NaN) weigh half its sample: over
+/// the T1 template, whose values outside the brain are 0 and inside at least 1, every pixel of
+/// the slice samples above 0 (data weighing at least half), while `opaque_slices` also shows
+/// the zeros around the brain; both show the same values where both show the slice (within
+/// half-float rounding: their quads differ).
+#[test]
+fn a_slice_is_transparent_where_its_volume_holds_no_data() {
+    let path = images("MNI152_2009_template.nii.gz");
+    let volume = lineao_tracts::Volume::load(&path).unwrap();
+    let slice_samples = |opaque: bool| {
+        let keywords = serde_json::json!({
+            "volume": path, "slices": "-,-18,-", "method": "none", "width": 320, "height": 256,
+            "eye": "60,-260,40", "target": "0,-18,10", "up": "0,0,1", "opaque_slices": opaque,
+        });
+        let (session, chain) = render(&images("stroke.trk.gz"), keywords);
+        let gpu = &session.gpu;
+        let color = read_texture(&gpu.device, &gpu.queue, &chain.targets().unwrap().color.texture).unwrap().to_vec4();
+        let mut samples = std::collections::HashMap::new();
+        for (i, p) in geometry_points(&session, &chain) {
+            // The slices' pixels, marked by the colour's alpha (the lines write 1).
+            if color[i][3] == 0.0 {
+                assert!((p.y + 18.0).abs() < 0.05, "a slice pixel off the plane: {p}");
+                samples.insert(i, (volume.sample(p.to_array()), color[i][0]));
+            }
+        }
+        samples
+    };
+    let (clear, opaque) = (slice_samples(false), slice_samples(true));
+    let zeros = |s: &std::collections::HashMap<usize, (f32, f32)>| s.values().filter(|(v, _)| *v == 0.0).count();
+    println!(
+        "slice pixels: {} transparent where no data, {} opaque ({} of them zeros)",
+        clear.len(),
+        opaque.len(),
+        zeros(&opaque)
+    );
+    assert!(clear.len() > 3_000, "only {} slice pixels", clear.len());
+    assert!(clear.values().all(|(v, _)| *v > 0.0), "a transparent slice shows a sample of 0");
+    assert!(zeros(&opaque) > 5_000, "the opaque slice shows {} zeros", zeros(&opaque));
+    assert!(clear.iter().all(|(i, (_, c))| opaque.get(i).is_some_and(|(_, o)| (o - c).abs() < 2e-3)));
+}
+
+/// Over the slices the chain's bilateral blur smooths their pixels alone: the occlusion shown
+/// equals the CPU reference blurring the raw occlusion where the colour's alpha marks a slice,
+/// and every other pixel (the lines) keeps its raw occlusion exactly.
+#[test]
+fn the_blur_smooths_the_slices_and_leaves_the_lines_occlusion() {
+    let keywords = serde_json::json!({
+        "volume": images("MNI152_2009_template.nii.gz"), "slices": "0,-18,10", "width": 320, "height": 256,
+    });
+    let (session, chain) = render(&images("stroke.trk.gz"), keywords);
+    let (d, q) = (&session.gpu.device, &session.gpu.queue);
+    let targets = chain.targets().unwrap();
+    let (w, h) = (targets.size.0 as usize, targets.size.1 as usize);
+    let image = |data: Vec<f32>| lineao::reference::Image { width: w, height: h, data };
+    let ao = image(read_texture(d, q, &targets.ao.texture).unwrap().to_f32());
+    let shown =
+        image(read_texture(d, q, &targets.ao_blurred.as_ref().expect("the blur's targets").texture).unwrap().to_f32());
+    let nd0 = lineao::reference::Image {
+        width: w,
+        height: h,
+        data: read_texture(d, q, &targets.nd[0].texture).unwrap().to_vec4(),
+    };
+    let color = read_texture(d, q, &targets.color.texture).unwrap().to_vec4();
+    let slice = |x: usize, y: usize| color[y * w + x][3] == 0.0;
+    let (blur, slices_only) = chain.settings().bilateral().expect("a blur over the slices");
+    assert!(slices_only);
+    let view = lineao::reference::ViewParams::of(chain.frame_view().unwrap());
+    let cpu = lineao::reference::bilateral_where(&ao, &nd0, &view, &blur, &slice);
+    let stats = lineao::verify::check_policy(&shown, &cpu, &nd0, 1e-4).unwrap();
+    let slices = (0..w * h).filter(|&i| slice(i % w, i / w)).count();
+    let changed = (0..w * h).filter(|&i| (shown.data[i] - ao.data[i]).abs() > 1e-3).count();
+    let kept = (0..w * h).filter(|&i| !slice(i % w, i / w)).all(|i| shown.data[i] == ao.data[i]);
+    println!("{stats}; {slices} slice pixels, {changed} pixels changed");
+    assert!(kept, "a pixel that is no slice changed its occlusion");
+    assert!(slices > 3_000 && changed > 1_000, "{slices} slice pixels, {changed} changed");
+}
+
 /// The slices are drawn first (three quads), so the lines behind them fail the depth test and
-/// the cull leaves their pieces out: over the template's three slices it draws under 3/4 of the
+/// the cull leaves their pieces out: over the template's three opaque slices it draws under 3/4 of the
 /// pieces it draws without them. The culled picture differs from every line drawn no more than
 /// it does without the slices: the culled pieces are full strips where drawing everything takes
 /// the alternating strip (within half a pixel, `tests/lines.rs`); a line the slices' depth
@@ -120,6 +197,7 @@ fn the_cull_leaves_out_the_lines_behind_the_slices() {
         if slices {
             keywords["volume"] = images("MNI152_2009_template.nii.gz").into();
             keywords["slices"] = "0,-18,10".into();
+            keywords["opaque_slices"] = true.into();
         }
         let (session, chain) = render(&images("stroke.trk.gz"), keywords);
         let counts = chain.cull_counts(&session.gpu.queue, &session.lines.geometry).unwrap();

@@ -275,9 +275,9 @@ impl Controls {
         let (lo, hi) = world_box;
         let center = std::array::from_fn(|a| Some(0.5 * (lo[a] + hi[a])));
         let positions = positions.unwrap_or(center);
+        // The chain smooths the occlusion's sampling noise on the slices' pixels
+        // (`ChainSettings::bilateral`).
         self.params.chain.slices = Some(SliceSettings { positions, ..SliceSettings::default() });
-        // The occlusion's sampling noise is grain on a smooth slice: blurred (as `render` does).
-        self.params.chain.blur = Some(BilateralSettings::default());
         self.slice_box = Some(world_box);
     }
 
@@ -294,12 +294,8 @@ impl Controls {
     pub fn set_zoom_unit(&mut self, zoom_unit: f32) {
         let (rays, slab, slices) =
             (self.params.chain.raytraced.clone(), self.params.chain.slab, self.params.chain.slices.take());
-        let blur = slices.as_ref().and(self.params.chain.blur.clone());
         self.params = Params::preset(self.preset, zoom_unit);
         (self.params.chain.slab, self.params.chain.slices) = (slab, slices);
-        if blur.is_some() {
-            self.params.chain.blur = blur;
-        }
         let r = &mut self.params.chain.raytraced;
         (r.rays_per_frame, r.max_rays, r.denoise) = (rays.rays_per_frame, rays.max_rays, rays.denoise);
         self.given.apply(&mut self.params.chain);
@@ -663,6 +659,8 @@ impl Controls {
                 slices.positions[axis] = on.then_some(at);
             });
         }
+        ui.checkbox(&mut slices.opaque, "voxels without data (0, NaN) shown")
+            .on_hover_text("Off: a slice is transparent where the volume holds no data (its section only)");
     }
 
     fn color_ui(&mut self, ui: &mut Ui, fields: &[(String, [f32; 2])]) {

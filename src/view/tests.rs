@@ -478,7 +478,8 @@ fn a_slab_cuts_the_lines_and_the_brackets_move_it() {
 fn a_volume_opened_beside_the_tractogram_shows_its_slices_and_each_axis_turns_off() {
     // `view stroke.trk.gz`, then MNI152_2009_template.nii.gz dropped on the window (the page's
     // drop and `view --volume` come to the same [`App::set_anatomy`]): the axial slice at z = 10
-    // under the lines, black around the head (the template's zeros; no line is drawn black).
+    // under the lines, gray (no line is drawn gray), transparent around the brain (the
+    // template's zeros) unless opaque.
     let images = "niivue+niivue/packages/niivue/demos/images";
     // Without occlusion: the lines' own darkest pixels stay far from black.
     let options = options(Source::File(data(&format!("{images}/stroke.trk.gz"))), [methods()[0], methods()[4]], false);
@@ -486,25 +487,29 @@ fn a_volume_opened_beside_the_tractogram_shows_its_slices_and_each_axis_turns_of
     settle(&mut harness);
     let gray = |image: &[u8]| {
         let pixels = image.chunks_exact(4);
-        let count = pixels.clone().filter(|p| p[..3].iter().all(|&c| c < 8)).count();
+        let count = pixels.clone().filter(|p| p[0] == p[1] && p[1] == p[2] && p[0] < 250).count();
         count as f64 / pixels.len() as f64
     };
-    let black = |harness: &Harness<'_, App>| gray(&harness.state().shown.as_ref().unwrap().images[0]);
-    let lines = black(&harness);
-    assert!(lines < 0.001, "{lines} of the pixels black with the lines alone");
+    let shown_gray = |harness: &Harness<'_, App>| gray(&harness.state().shown.as_ref().unwrap().images[0]);
+    let lines = shown_gray(&harness);
+    assert!(lines < 0.001, "{lines} of the pixels gray with the lines alone");
     harness.state_mut().open_path(data(&format!("{images}/MNI152_2009_template.nii.gz")));
     harness.state_mut().controls.params.chain.slices.as_mut().unwrap().positions = [None, None, Some(10.0)];
     settle(&mut harness);
     let app = harness.state();
     assert!(app.error.is_none(), "{:?}", app.error);
     assert!(app.dataset.as_ref().unwrap().name.ends_with("stroke.trk.gz"), "the tractogram stays");
-    let shown = black(&harness);
-    assert!(shown > 0.05, "{shown} of the pixels black");
+    let shown = shown_gray(&harness);
+    assert!(shown > 0.01, "{shown} of the pixels gray");
+    harness.state_mut().controls.params.chain.slices.as_mut().unwrap().opaque = true;
+    settle(&mut harness);
+    let opaque = shown_gray(&harness);
+    assert!(opaque > shown + 0.03, "{opaque} of the pixels gray with the zeros shown, {shown} without");
     // Its checkbox off: no slice, no black.
     harness.state_mut().controls.params.chain.slices.as_mut().unwrap().positions[2] = None;
     settle(&mut harness);
-    let off = black(&harness);
-    assert!(off < 0.001, "{off} of the pixels black without the slice, {shown} with it");
+    let off = shown_gray(&harness);
+    assert!(off < 0.001, "{off} of the pixels gray without the slice, {shown} with it");
     assert!(harness.query_all_by_label_contains("z (axial)").count() > 0, "the axial slider");
     // A volume that cannot be read is said; the tractogram stays.
     harness.state_mut().open_path(PathBuf::from("/nonexistent/t1.nii.gz"));

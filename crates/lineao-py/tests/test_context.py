@@ -128,7 +128,10 @@ def test_slices_and_a_slab_are_keywords():
         rgb = image[..., :3].astype(int)
         return ((rgb[..., 0] == rgb[..., 1]) & (rgb[..., 1] == rgb[..., 2]) & (rgb[..., 0] < 250)).mean()
 
-    assert gray(with_slice) > 0.05 and gray(alone) < 0.01, (gray(with_slice), gray(alone))
+    # Transparent where the template holds no data (0) the slice shows the brain's section; opaque,
+    # the zeros around it too.
+    opaque = np.asarray(lineao.render(t, **rules, opaque_slices=True))
+    assert gray(alone) < 0.002 < 0.01 < gray(with_slice) < gray(opaque) - 0.05, (gray(alone), gray(with_slice), gray(opaque))
     background = lambda image: (image[..., :3] == 255).all(axis=-1).mean()
     slab = np.asarray(lineao.render(t, width=200, height=160, slab="z,10,6"))
     assert background(slab) > background(alone) + 0.1

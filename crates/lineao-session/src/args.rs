@@ -459,7 +459,8 @@ pub struct StyleArgs {
 pub struct ContextArgs {
     /// Anatomy: a NIfTI-1 volume (.nii, .nii.gz) placed by its sform (else qform, else voxel
     /// sizes: nibabel's rule), shown as slices that occlude the lines and that their AO darkens
-    /// (the bilateral blur is then on: the occlusion's sampling noise is grain on a slice).
+    /// (the bilateral blur then smooths the slices' pixels: the occlusion's sampling noise is
+    /// grain on a slice).
     #[arg(long, value_name = "NIFTI")]
     pub volume: Option<PathBuf>,
     /// Where the sagittal, coronal and axial slices cut x, y and z (world mm, RAS+), `-` for no
@@ -474,6 +475,10 @@ pub struct ContextArgs {
     /// The slices' colormap.
     #[arg(long, value_parser = named::<Colormap>(), default_value = "gray")]
     pub slice_colormap: Colormap,
+    /// Show the voxels that hold no data (0 or NaN) as the colormap's low end too [default: a
+    /// slice is transparent where they weigh half its sample: the data's cross-section only].
+    #[arg(long, requires = "volume")]
+    pub opaque_slices: bool,
     /// Cut the lines to a slab: AXIS (x, y, z, or view: facing the eye, the centre measured
     /// from the middle of the scene), its CENTRE and THICKNESS in world mm: `z,0,8`.
     #[arg(long, value_name = "AXIS,CENTRE,THICKNESS", value_parser = parse_slab, allow_hyphen_values = true)]

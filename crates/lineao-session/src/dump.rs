@@ -102,7 +102,7 @@ pub fn write(
         _ => &targets.ao,
     };
     write_npy(dir, "ao.npy", &[h, w], &read(&raw.texture)?.to_f32())?;
-    if let (Some(blurred), true) = (&targets.ao_blurred, s.blur.is_some() && s.method != AoMethod::None) {
+    if let (Some(blurred), true) = (&targets.ao_blurred, s.bilateral().is_some()) {
         // Our extension of CONTRACT.md: what the bilateral blur (the denoiser) made of `ao.npy`.
         write_npy(dir, "ao_blurred.npy", &[h, w], &read(&blurred.texture)?.to_f32())?;
     }
@@ -256,12 +256,11 @@ pub fn write(
         }
         merge(&mut params, extra);
     }
-    if let (Some(blur), true) = (&s.blur, s.method != AoMethod::None) {
-        // Our extension of CONTRACT.md: the blur after `ao.npy` (what the image shows).
-        merge(
-            &mut params,
-            json!({"bilateral": {"radius_px": blur.radius_px, "depth_sigma_world": blur.depth_sigma_world}}),
-        );
+    if let Some((blur, slices_only)) = s.bilateral() {
+        // Our extension of CONTRACT.md: the blur after `ao.npy` (what the image shows), over
+        // every pixel or the anatomy slices' alone.
+        let bilateral = json!({"radius_px": blur.radius_px, "depth_sigma_world": blur.depth_sigma_world, "slices_only": slices_only});
+        merge(&mut params, json!({ "bilateral": bilateral }));
     }
     // Our extension of CONTRACT.md: the method's described settings (`lineao::method::setting`)
     // by their keywords, as `render` takes them (a switch: whether its flag is in force).

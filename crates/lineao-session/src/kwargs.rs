@@ -144,12 +144,13 @@ impl RenderArgs {
 }
 
 /// The options that need another (clap's `requires`, which it does not expose).
-const REQUIRES: [(&str, &str); 5] = [
+const REQUIRES: [(&str, &str); 6] = [
     ("combine", "radius2"),
     ("bilateral_radius", "bilateral"),
     ("bilateral_sigma", "bilateral"),
     ("slices", "volume"),
     ("window", "volume"),
+    ("opaque_slices", "volume"),
 ];
 
 /// `deserialize_with` functions: the value's text through the command line's parser of the

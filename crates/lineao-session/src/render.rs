@@ -71,9 +71,9 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky, lon
     let mut settings = ChainSettings {
         method,
         volume,
-        // With anatomy slices the blur is on: a method's sampling noise, hidden in the lines,
-        // is grain on a smooth slice (docs/render.md).
-        blur: (args.chain.bilateral || args.context.volume.is_some()).then_some(BilateralSettings {
+        // Over anatomy slices without it the chain blurs the slices' pixels alone
+        // (`ChainSettings::bilateral`, docs/render.md).
+        blur: args.chain.bilateral.then_some(BilateralSettings {
             radius_px: args.chain.bilateral_radius,
             depth_sigma_world: args.chain.bilateral_sigma,
         }),
@@ -644,6 +644,7 @@ fn slice_settings(args: &RenderArgs) -> Option<SliceSettings> {
         positions: args.context.slices.unwrap_or([None; 3]),
         window: args.context.window,
         colormap: args.context.slice_colormap,
+        opaque: args.context.opaque_slices,
     })
 }
 

@@ -1,17 +1,20 @@
 // Anatomy slices (`lineao::passes::slices`): one quad an axis over the world box of the voxel
-// centres; each fragment samples the volume trilinearly between voxel centres through the
-// inverse affine and writes the G-buffer of CONTRACT.md with the value through the window and
-// colormap (`base_color`, color mode 2), unlit, the plane's normal turned toward the eye.
+// centres (of the voxels with data, where those without are transparent); each fragment
+// samples the volume trilinearly between voxel centres through the inverse affine and writes
+// the G-buffer of CONTRACT.md with the value through the window and colormap (`base_color`,
+// color mode 2), unlit, the plane's normal turned toward the eye. Transparent: no fragment
+// where the voxels without data (0 or NaN) weigh half the sample or more.
 #import shared/geometry.wgsl
 
 // Keep in sync with `lineao::passes::slices::SliceUniform`.
 struct SliceUniform {
     world_to_voxel: mat4x4<f32>,
+    // The box the quads span: around the voxel centres, or the data's box.
     box_min: vec4<f32>,
     box_max: vec4<f32>,
     // xyz: where each axis's slice lies (world units).
     positions: vec4<f32>,
-    // xyz: 1 where the axis has a slice.
+    // xyz: 1 where the axis has a slice; w: 1 where voxels without data are transparent.
     shown: vec4<u32>,
     // xyz: the last voxel index on each axis.
     last_voxel: vec4<f32>,
@@ -56,17 +59,22 @@ fn vs_slice(@builtin(vertex_index) v: u32, @builtin(instance_index) axis: u32) -
     return out;
 }
 
-// The volume at voxel coordinates `x` (within the box of the voxel centres), trilinear.
-fn trilinear(x: vec3<f32>) -> f32 {
+// The volume at voxel coordinates `x` (within the box of the voxel centres), trilinear, and
+// the weight of its voxels that hold data (finite, not 0) in that sum.
+fn trilinear(x: vec3<f32>) -> vec2<f32> {
     let last = vec3<i32>(slice.last_voxel.xyz);
     let i0 = clamp(vec3<i32>(floor(x)), vec3<i32>(0), last);
     let i1 = min(i0 + vec3<i32>(1), last);
     let f = clamp(x - vec3<f32>(i0), vec3<f32>(0.0), vec3<f32>(1.0));
-    var sum = 0.0;
+    var sum = vec2<f32>(0.0);
     for (var corner = 0u; corner < 8u; corner++) {
         let pick = vec3<bool>((corner & 1u) != 0u, (corner & 2u) != 0u, (corner & 4u) != 0u);
         let weight = select(1.0 - f, f, pick);
-        sum += weight.x * weight.y * weight.z * textureLoad(volume, select(i0, i1, pick), 0).r;
+        let v = textureLoad(volume, select(i0, i1, pick), 0).r;
+        // Finite and not 0: its bits' exponent is not all ones, and they are not ±0.
+        let bits = bitcast<u32>(v) & 0x7fffffffu;
+        let data = select(0.0, 1.0, bits != 0u && bits < 0x7f800000u);
+        sum += weight.x * weight.y * weight.z * vec2<f32>(v, data);
     }
     return sum;
 }
@@ -78,12 +86,18 @@ fn slice_gbuffer(in: SliceOut) -> GBuffer {
     if any(x < vec3<f32>(-slack)) || any(x > slice.last_voxel.xyz + vec3<f32>(slack)) {
         discard;
     }
+    let sample = trilinear(x);
+    if slice.shown.w != 0u && sample.y < 0.5 {
+        discard;
+    }
     var axis_world = vec3<f32>(0.0);
     axis_world[in.axis] = 1.0;
     let n = (frame.view * vec4<f32>(axis_world, 0.0)).xyz;
     var out: GBuffer;
     out.nd = gbuffer_nd(in.view_pos, n, frame.near, frame.far, is_orthographic());
-    out.color = vec4<f32>(base_color(vec3<f32>(0.0), trilinear(x)), 1.0);
+    // Alpha 0 marks a slice's pixel (every other writer of the G-buffer writes 1): the chain's
+    // bilateral blur smooths the occlusion there (`shaders/bilateral.wgsl`, SLICES_ONLY).
+    out.color = vec4<f32>(base_color(vec3<f32>(0.0), sample.x), 0.0);
     out.zoom = gbuffer_zoom(in.view_pos, frame.f_px, frame.zoom_unit, is_orthographic());
     out.specular = 0.0;
     return out;

@@ -176,11 +176,16 @@ pub struct SliceSettings {
     pub window: Option<[f32; 2]>,
     /// Default gray.
     pub colormap: Colormap,
+    /// Show the voxels that hold no data (0 or NaN: a skull-stripped T1's background, a masked
+    /// map's outside) as the colormap's low end too. Default false: a slice is transparent
+    /// where such voxels weigh half or more of its trilinear sample, so it shows the data's
+    /// cross-section and hides no line behind the empty rest of the volume's box.
+    pub opaque: bool,
 }
 
 impl Default for SliceSettings {
     fn default() -> Self {
-        SliceSettings { positions: [None, None, Some(0.0)], window: None, colormap: Colormap::Gray }
+        SliceSettings { positions: [None, None, Some(0.0)], window: None, colormap: Colormap::Gray, opaque: false }
     }
 }
 
@@ -465,6 +470,22 @@ impl ChainSettings {
     pub fn r0(&self) -> R0 {
         let per_zoom = self.tubes.as_ref().map_or(0.0, |t| 1.5 * 2.0 * t.radius_world / self.zoom_unit);
         R0 { px: self.r0_px(), per_zoom }
+    }
+
+    /// The bilateral blur the frame runs after its method, and whether it smooths only the
+    /// anatomy slices' pixels: [`ChainSettings::blur`] over every pixel; without it, with
+    /// [`ChainSettings::slices`], the default blur over the slices alone (a method's sampling
+    /// noise, hidden in the lines, is grain on a smooth slice; the lines keep their own
+    /// occlusion). None after no method.
+    pub fn bilateral(&self) -> Option<(BilateralSettings, bool)> {
+        if self.method == AoMethod::None {
+            return None;
+        }
+        match (&self.blur, &self.slices) {
+            (Some(blur), _) => Some((blur.clone(), false)),
+            (None, Some(_)) => Some((BilateralSettings::default(), true)),
+            (None, None) => None,
+        }
     }
 
     /// Pyramid levels the chain needs: what its method reads ([`crate::method::MethodInfo`]:

@@ -27,7 +27,7 @@ fn blur_on(
     write_target(q, &targets.ao, ao);
     let mut blur = Bilateral::new(d);
     blur.resize(d, &targets);
-    blur.prepare(q, &view, settings);
+    blur.prepare(q, &view, settings, lineao::passes::bilateral::Region::All);
     let mut encoder = d.create_command_encoder(&Default::default());
     blur.encode(&mut encoder, &targets, None);
     q.submit([encoder.finish()]);

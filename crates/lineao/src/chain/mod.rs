@@ -17,7 +17,9 @@
 //! and its 4 × 4 blur (→ `ao`); with [`AoMethod::VoLine`] to Volumetric Obscurance
 //! with line samples (`nd[0]`, `zoom` → `ao`); with [`AoMethod::VoArea`] to the moments pyramid
 //! (`nd[0]` → `moments`) and VO with area samples (→ `ao`). With `ChainSettings::blur` the
-//! bilateral blur follows any method (`ao` → `ao_blurred`, which the composite then shows).
+//! bilateral blur follows any method (`ao` → `ao_blurred`, which the composite then shows);
+//! with anatomy slices and no such blur it smooths the slices' pixels alone
+//! ([`ChainSettings::bilateral`]).
 //! With `ChainSettings::volume` the line renderer also writes the geometry's octant
 //! visibilities (`octants`), the [`VolumeAo`] pass makes object-space AO of them with each
 //! pixel's normal (`volume_ao`), and the composite shows it alone (method `None`) or combined
@@ -49,7 +51,7 @@ use crate::gbuffer::Load;
 use crate::lighting::LightingShape;
 use crate::method::raytraced::RayProgress;
 use crate::method::{self, Reach};
-use crate::passes::bilateral::Bilateral;
+use crate::passes::bilateral::{Bilateral, Region};
 use crate::passes::composite::{Composite, Shown};
 use crate::passes::cull::Frozen;
 use crate::passes::lines::LineRenderer;
@@ -210,7 +212,7 @@ impl AoChain {
         }
         // The pyramid's depth, the method's own targets, the blur's and object-space AO's, and
         // what the composite shows are bound at allocation.
-        let layout = |s: &ChainSettings| (s.levels(), s.blur.is_some(), s.volume.is_some());
+        let layout = |s: &ChainSettings| (s.levels(), s.bilateral().is_some(), s.volume.is_some());
         if layout(&settings) != layout(&self.settings) {
             self.targets = None;
         }
@@ -296,8 +298,7 @@ impl AoChain {
     /// The spans a frame with the current settings records.
     fn timed_spans(&self) -> Vec<&'static str> {
         let method = self.stages.active().map_or(&[][..], |stage| stage.spans(&self.settings));
-        let blur: &[&str] =
-            if self.settings.blur.is_some() && self.settings.method != AoMethod::None { &["blur"] } else { &[] };
+        let blur: &[&str] = if self.settings.bilateral().is_some() { &["blur"] } else { &[] };
         let volume: &[&str] = if self.settings.volume.is_some() { &["volume-ao"] } else { &[] };
         [&["lines"], method, blur, volume, &["composite"]].concat()
     }
@@ -340,7 +341,7 @@ impl AoChain {
             Reach::Unbounded => s.guard_max_px,
             // The bilateral blur reaches its radius further.
             Reach::Pixels { radius_px, levels } => {
-                let blur = s.blur.as_ref().map_or(0.0, |b| b.radius_px as f32);
+                let blur = s.bilateral().map_or(0.0, |(b, _)| b.radius_px as f32);
                 camera::guard_band(radius_px + blur, levels, s.guard_max_px)
             }
         }
@@ -399,7 +400,7 @@ impl AoChain {
         let stale = self.targets.as_ref().is_none_or(|t| t.guard != guard || t.nd.len() != levels as usize);
         if stale {
             let mut targets = FrameTargets::new(device, width, height, guard, levels);
-            if s.blur.is_some() {
+            if s.bilateral().is_some() {
                 targets = targets.with_blur(device);
             }
             if s.volume.is_some() {
@@ -439,8 +440,15 @@ impl AoChain {
         if let Some(stage) = self.stages.active() {
             stage.prepare(queue, targets, &view, s);
         }
-        if let Some(blur) = &s.blur {
-            self.bilateral.prepare(queue, &view, blur);
+        if let Some((blur, slices_only)) = s.bilateral() {
+            let region = match (slices_only, &self.slices, &s.slices) {
+                (false, ..) => Region::All,
+                (true, Some(renderer), Some(slices)) => {
+                    Region::Slices(renderer.screen_rect(&view, slices).unwrap_or_default())
+                }
+                (true, ..) => Region::Slices([0; 4]),
+            };
+            self.bilateral.prepare(queue, &view, &blur, region);
         }
         if let (Some(pass), Some(volume)) = (&self.volume_ao, &s.volume) {
             pass.prepare(queue, &view, volume.sky);
@@ -623,7 +631,7 @@ impl AoChain {
         if let Some(stage) = self.stages.active() {
             stage.encode(encoder, targets, span);
         }
-        if self.settings.blur.is_some() && self.settings.method != AoMethod::None {
+        if self.settings.bilateral().is_some() {
             self.bilateral.encode(encoder, targets, span("blur"));
         }
         if let Some(pass) = &self.volume_ao {

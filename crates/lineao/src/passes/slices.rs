@@ -19,7 +19,7 @@
 
 use std::sync::Arc;
 
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec2, Vec3};
 
 use crate::Error;
 use crate::binding::{self, Slot};
@@ -38,6 +38,9 @@ pub struct SliceVolume {
     /// The axis-aligned world box around the voxel centres.
     box_min: Vec3,
     box_max: Vec3,
+    /// The world box around the voxels with data (finite, not 0) and half a voxel beyond; none
+    /// without such voxels.
+    data_box: Option<(Vec3, Vec3)>,
     percentiles: [f32; 2],
 }
 
@@ -82,20 +85,31 @@ impl SliceVolume {
             texture.size(),
         );
         let last = Vec3::new(dims[0] as f32 - 1.0, dims[1] as f32 - 1.0, dims[2] as f32 - 1.0);
-        let corners = (0..8).map(|c| {
-            let pick = |bit: u32, v: f32| if c & (1 << bit) != 0 { v } else { 0.0 };
-            voxel_to_world.transform_point3(Vec3::new(pick(0, last.x), pick(1, last.y), pick(2, last.z)))
-        });
-        let (box_min, box_max) =
-            corners.fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)));
+        let (box_min, box_max) = world_box(voxel_to_world, Vec3::ZERO, last);
+        // A point half a voxel or more beyond the last voxel with data on an axis draws nothing
+        // (the voxels past it weigh at least half), so the data's voxels and half a voxel
+        // around them (within the box) hold every fragment that a transparent slice keeps.
+        let data_box = data_voxels(dims, values)
+            .map(|(lo, hi)| world_box(voxel_to_world, (lo - 0.5).max(Vec3::ZERO), (hi + 0.5).min(last)));
         Ok(SliceVolume {
             view: texture.create_view(&Default::default()),
             dims,
             world_to_voxel: voxel_to_world.inverse(),
             box_min,
             box_max,
+            data_box,
             percentiles: percentiles(values, [0.02, 0.98]),
         })
+    }
+
+    /// The world box the slices' quads span: around the voxel centres, or with `slices`
+    /// transparent where no data is, around the data (empty without any).
+    fn drawn_box(&self, slices: &SliceSettings) -> (Vec3, Vec3) {
+        match (slices.opaque, self.data_box) {
+            (true, _) => (self.box_min, self.box_max),
+            (false, Some(data)) => data,
+            (false, None) => (Vec3::INFINITY, Vec3::NEG_INFINITY),
+        }
     }
 
     /// The 2nd and 98th percentiles of the finite values other than 0 (the default window: an
@@ -134,6 +148,30 @@ impl SliceVolume {
     }
 }
 
+/// The axis-aligned world box around the voxel-space box `lo..=hi` (its eight corners through
+/// the affine).
+fn world_box(voxel_to_world: Mat4, lo: Vec3, hi: Vec3) -> (Vec3, Vec3) {
+    let corners = (0..8).map(|c| {
+        let corner = Vec3::select(glam::BVec3::new(c & 1 != 0, c & 2 != 0, c & 4 != 0), hi, lo);
+        voxel_to_world.transform_point3(corner)
+    });
+    corners.fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)))
+}
+
+/// The voxel-index box (lowest, highest) of the voxels that hold data: finite and not 0.
+fn data_voxels(dims: [u32; 3], values: &[f32]) -> Option<(Vec3, Vec3)> {
+    let has_data = |v: &f32| v.is_finite() && *v != 0.0;
+    let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+    for (row, voxels) in values.chunks_exact(dims[0] as usize).enumerate() {
+        let Some(first) = voxels.iter().position(has_data) else { continue };
+        let last = voxels.iter().rposition(has_data).unwrap_or(first);
+        let (j, k) = ((row % dims[1] as usize) as f32, (row / dims[1] as usize) as f32);
+        lo = lo.min(Vec3::new(first as f32, j, k));
+        hi = hi.max(Vec3::new(last as f32, j, k));
+    }
+    (lo.x <= hi.x).then_some((lo, hi))
+}
+
 /// The `quantiles` (in [0, 1]) of the finite `values` other than 0, from at most 2^20 of them
 /// evenly spaced; [v, v + 1] where they coincide, [0, 1] without such values.
 fn percentiles(values: &[f32], quantiles: [f32; 2]) -> [f32; 2] {
@@ -155,11 +193,12 @@ fn percentiles(values: &[f32], quantiles: [f32; 2]) -> [f32; 2] {
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 struct SliceUniform {
     world_to_voxel: [[f32; 4]; 4],
+    /// The box the quads span: around the voxel centres, or the data's box.
     box_min: [f32; 4],
     box_max: [f32; 4],
     /// xyz: where each axis's slice lies (world units).
     positions: [f32; 4],
-    /// xyz: 1 where the axis has a slice.
+    /// xyz: 1 where the axis has a slice; w: 1 where voxels without data are transparent.
     shown: [u32; 4],
     /// xyz: the last voxel index on each axis.
     last_voxel: [f32; 4],
@@ -234,15 +273,52 @@ impl SliceRenderer {
         let color = LineColor::Scalar { colormap: slices.colormap, range };
         self.bindings.write(queue, &GeometryUniform::new(view, color, 0.0, 0.0), lighting);
         let [x, y, z] = slices.positions;
+        let (lo, hi) = volume.drawn_box(slices);
         let uniform = SliceUniform {
             world_to_voxel: volume.world_to_voxel.to_cols_array_2d(),
-            box_min: volume.box_min.extend(0.0).to_array(),
-            box_max: volume.box_max.extend(0.0).to_array(),
+            box_min: lo.extend(0.0).to_array(),
+            box_max: hi.extend(0.0).to_array(),
             positions: [x.unwrap_or(0.0), y.unwrap_or(0.0), z.unwrap_or(0.0), 0.0],
-            shown: [x.is_some() as u32, y.is_some() as u32, z.is_some() as u32, 0],
+            shown: [x.is_some() as u32, y.is_some() as u32, z.is_some() as u32, !slices.opaque as u32],
             last_voxel: [volume.dims[0], volume.dims[1], volume.dims[2], 1].map(|d| d as f32 - 1.0),
         };
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
+    }
+
+    /// The guard-banded pixels `[x0, y0, x1, y1)` that hold every pixel of the slices in `view`
+    /// (the rectangle around their quads' corners; the whole target where a corner lies behind
+    /// the eye), or none when no slice is drawn.
+    pub fn screen_rect(&self, view: &FrameView, slices: &SliceSettings) -> Option<[u32; 4]> {
+        let (volume, _) = self.volume.as_ref()?;
+        let (lo, hi) = volume.drawn_box(slices);
+        let size = Vec2::new((view.width + 2 * view.guard) as f32, (view.height + 2 * view.guard) as f32);
+        let clip = view.proj * view.view;
+        let (mut min, mut max) = (Vec2::INFINITY, Vec2::NEG_INFINITY);
+        for (axis, p) in slices.positions.iter().enumerate() {
+            let Some(p) = *p else { continue };
+            if !(lo[axis]..=hi[axis]).contains(&p) {
+                continue;
+            }
+            let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
+            for c in 0..4 {
+                let mut corner = lo;
+                corner[u] = if c & 1 != 0 { hi[u] } else { lo[u] };
+                corner[w] = if c & 2 != 0 { hi[w] } else { lo[w] };
+                corner[axis] = p;
+                let q = clip * corner.extend(1.0);
+                if q.w <= 0.0 {
+                    return Some([0, 0, size.x as u32, size.y as u32]);
+                }
+                let pixel = (Vec2::new(q.x, -q.y) / q.w * 0.5 + 0.5) * size;
+                (min, max) = (min.min(pixel), max.max(pixel));
+            }
+        }
+        if min.x > max.x {
+            return None;
+        }
+        // A pixel's centre inside the quads lies within a pixel of their corners' rectangle.
+        let (min, max) = ((min - 1.0).floor().max(Vec2::ZERO), (max + 1.0).ceil().min(size));
+        (min.x < max.x && min.y < max.y).then_some([min.x as u32, min.y as u32, max.x as u32, max.y as u32])
     }
 
     /// Draws the slices over the G-buffer (or clearing it first: `load`), timed into `span`.

@@ -7,6 +7,18 @@ use crate::view_params::ViewParams;
 /// x then y, each neighbour k pixels away weighing exp(−k² · 1/(2σ_s²) − Δz² · 1/(2σ_z²)) over
 /// geometry pixels; background stays 0.
 pub fn bilateral(ao: &Image<f32>, nd: &NdImage, view: &ViewParams, settings: &BilateralSettings) -> Image<f32> {
+    bilateral_where(ao, nd, view, settings, &|_, _| true)
+}
+
+/// [`bilateral`] received only by the pixels where `receives` holds (the anatomy slices'); every
+/// other geometry pixel keeps its occlusion and still gives it to its neighbours.
+pub fn bilateral_where(
+    ao: &Image<f32>,
+    nd: &NdImage,
+    view: &ViewParams,
+    settings: &BilateralSettings,
+    receives: &dyn Fn(usize, usize) -> bool,
+) -> Image<f32> {
     let sigma_s = settings.radius_px as f32 * 0.5;
     let spatial = 1.0 / (2.0 * sigma_s * sigma_s);
     let depth = 1.0 / (2.0 * settings.depth_sigma_world * settings.depth_sigma_world);
@@ -16,6 +28,9 @@ pub fn bilateral(ao: &Image<f32>, nd: &NdImage, view: &ViewParams, settings: &Bi
         Image::from_fn(src.width, src.height, |x, y| {
             if !geometry(x, y) {
                 return 0.0;
+            }
+            if !receives(x, y) {
+                return src.get(x, y);
             }
             let z = view.linear_depth(nd.get(x, y)[3]);
             let (mut sum, mut weight) = (0.0f32, 0.0f32);

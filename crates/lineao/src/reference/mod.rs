@@ -25,7 +25,7 @@ pub use crate::method::vo_line::reference::{
     VoParams, vo_chord, vo_chord_half, vo_combine, vo_line, vo_line_pixel, vo_line_sample, vo_plane, vo_reflect,
     vo_sample, vo_visible,
 };
-pub use bilateral::bilateral;
+pub use bilateral::{bilateral, bilateral_where};
 pub use volume_ao::{unpack_octants, volume_ao};
 
 const BINOMIAL: [f32; 5] = [0.0625, 0.25, 0.375, 0.25, 0.0625];
