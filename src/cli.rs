@@ -84,7 +84,7 @@ pub struct ViewArgs {
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_slices, allow_hyphen_values = true, requires = "volume")]
     pub slices: Option<[Option<f32>; 3]>,
     /// Show the voxels without data (0 or NaN) too (see `render --opaque-slices`; the side
-    /// panel's checkbox).
+    /// panel's checkbox; the page's `opaque-slices`).
     #[arg(long, requires = "volume")]
     pub opaque_slices: bool,
     /// Line color: `tangent`, R,G,B in [0, 1], or `field:NAME` (see `render --color`).

@@ -149,6 +149,9 @@ pub struct Controls {
     pub slab_reach: f32,
     /// The world box of the anatomy's voxel centres (`--volume`), which its slices' sliders span.
     pub slice_box: Option<([f32; 3], [f32; 3])>,
+    /// Whether a volume's slices show its voxels without data (`--opaque-slices`, the page's
+    /// `opaque-slices`), until the side panel's checkbox says otherwise.
+    pub opaque_slices: bool,
     /// The share of the streamlines shown (1: all), drawn at random but the same ones for a share.
     pub subset: f32,
     /// The arc length range shown (world units), or all.
@@ -203,6 +206,7 @@ impl Controls {
             slab: Slab { axis: SlabAxis::Z, center: 0.0, thickness: 10.0 },
             slab_reach: 100.0,
             slice_box: None,
+            opaque_slices: false,
             subset: 1.0,
             length: None,
             max_length: 0.0,
@@ -277,7 +281,8 @@ impl Controls {
         let positions = positions.unwrap_or(center);
         // The chain smooths the occlusion's sampling noise on the slices' pixels
         // (`ChainSettings::bilateral`).
-        self.params.chain.slices = Some(SliceSettings { positions, ..SliceSettings::default() });
+        let opaque = self.params.chain.slices.as_ref().map_or(self.opaque_slices, |s| s.opaque);
+        self.params.chain.slices = Some(SliceSettings { positions, opaque, ..SliceSettings::default() });
         self.slice_box = Some(world_box);
     }
 

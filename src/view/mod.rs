@@ -82,11 +82,9 @@ pub fn options(args: &ViewArgs) -> app::Options {
     if let Some(slab) = args.slab {
         (controls.slab, controls.params.chain.slab) = (slab, Some(slab));
     }
+    controls.opaque_slices = args.opaque_slices;
     if let Some(volume) = &anatomy {
         controls.set_anatomy(volume.world_box(), args.slices);
-        if let Some(slices) = &mut controls.params.chain.slices {
-            slices.opaque = args.opaque_slices;
-        }
     }
     app::Options {
         source: Some(source),

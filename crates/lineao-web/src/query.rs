@@ -151,6 +151,8 @@ mod tests {
         let anatomy = parse("url=stroke.trk.gz&volume=t1.nii.gz&slices=0,-,10").unwrap();
         assert_eq!(anatomy.volume.as_deref(), Some("t1.nii.gz"));
         assert_eq!(anatomy.view.slices, Some([Some(0.0), None, Some(10.0)]));
+        assert!(!anatomy.view.opaque_slices);
+        assert!(parse("url=stroke.trk.gz&volume=t1.nii.gz&opaque-slices").unwrap().view.opaque_slices);
     }
 
     #[test]
