@@ -1,7 +1,7 @@
 // Separable bilateral blur (a depth-aware Gaussian, as the VO paper uses after its samples):
 // one axis per pipeline (AXIS 0 = x, 1 = y), applied x then y. Each geometry neighbour k
 // pixels away weighs exp(−k²/(2σ_s²) − Δz²/(2σ_z²)), Δz its linear depth minus the centre's in
-// world units; the background neither receives nor gives occlusion. With SLICES_ONLY only the
+// world units; the background neither receives nor gives occlusion. With `slices_only` only the
 // anatomy slices' pixels (the G-buffer colour's alpha 0, `shaders/slices.wgsl`) receive: every
 // other keeps its occlusion as it is.
 #import shared/nd.wgsl

@@ -96,7 +96,7 @@ fn slice_gbuffer(in: SliceOut) -> GBuffer {
     var out: GBuffer;
     out.nd = gbuffer_nd(in.view_pos, n, frame.near, frame.far, is_orthographic());
     // Alpha 0 marks a slice's pixel (every other writer of the G-buffer writes 1): the chain's
-    // bilateral blur smooths the occlusion there (`shaders/bilateral.wgsl`, SLICES_ONLY).
+    // bilateral blur smooths the occlusion there (`shaders/bilateral.wgsl`, `slices_only`).
     out.color = vec4<f32>(base_color(vec3<f32>(0.0), sample.x), 0.0);
     out.zoom = gbuffer_zoom(in.view_pos, frame.f_px, frame.zoom_unit, is_orthographic());
     out.specular = 0.0;

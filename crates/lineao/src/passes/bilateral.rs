@@ -153,6 +153,7 @@ impl Bilateral {
             .collect();
     }
 
+    /// Writes the uniform for `view`, `settings` and the pixels of `region`.
     pub fn prepare(&mut self, queue: &wgpu::Queue, view: &FrameView, settings: &BilateralSettings, region: Region) {
         let uniform = BilateralUniform::new(view, settings, region);
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
