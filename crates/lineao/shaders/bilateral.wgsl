@@ -1,9 +1,13 @@
 // Separable bilateral blur (a depth-aware Gaussian, as the VO paper uses after its samples):
 // one axis per pipeline (AXIS 0 = x, 1 = y), applied x then y. Each geometry neighbour k
 // pixels away weighs exp(−k²/(2σ_s²) − Δz²/(2σ_z²)), Δz its linear depth minus the centre's in
-// world units; the background neither receives nor gives occlusion. With `slices_only` only the
-// anatomy slices' pixels (the G-buffer colour's alpha 0, `shaders/slices.wgsl`) receive: every
-// other keeps its occlusion as it is.
+// world units; the background neither receives nor gives occlusion.
+//
+// Over anatomy slices (`slices_only`) only the slices' pixels (the G-buffer colour's alpha 0,
+// `shaders/slices.wgsl`) receive: every other keeps its occlusion. Then `list_tiles` lists the
+// 8 × 8 tiles that the slices' fragments marked (and, for the x half, those within the radius
+// above and below them), `dispatch_args` turns the counts into indirect dispatches, and
+// `bilateral_tiles` runs a workgroup per listed tile.
 #import shared/nd.wgsl
 #import shared/view.wgsl
 
@@ -18,8 +22,16 @@ struct BilateralUniform {
     depth: f32,
     // 1: only the slices' pixels are blurred.
     slices_only: u32,
-    // The first pixel of the x half (xy) and of the y half (zw): the slices' rectangle.
-    origin: vec4<i32>,
+    // Tiles across and down, the tiles above and below a slice's that the x half also covers,
+    // and the capacity of each list.
+    tiles: vec4<u32>,
+}
+
+// The tiles to blur: how many for the x and the y half, then each half's list of tile indices
+// (x at 0, y at `tiles.w`).
+struct TileLists {
+    counts: vec4<u32>,
+    tiles: array<u32>,
 }
 
 @group(0) @binding(0) var<uniform> params: BilateralUniform;
@@ -27,12 +39,23 @@ struct BilateralUniform {
 @group(0) @binding(2) var ao_in: texture_2d<f32>;
 @group(0) @binding(3) var ao_out: texture_storage_2d<r32float, write>;
 @group(0) @binding(4) var color: texture_2d<f32>;
+@group(0) @binding(5) var<storage, read> lists: TileLists;
 
-@compute @workgroup_size(8, 8)
-fn bilateral(@builtin(global_invocation_id) id: vec3<u32>) {
+// The listing's own group (`list_tiles`, `dispatch_args`; group 0 is empty for them): the
+// uniform again, the slices' marks, the lists written, and two indirect dispatches.
+struct TileListsWrite {
+    counts: array<atomic<u32>, 4>,
+    tiles: array<u32>,
+}
+@group(1) @binding(0) var<uniform> tiling: BilateralUniform;
+@group(1) @binding(1) var<storage, read> marked: array<u32>;
+@group(1) @binding(2) var<storage, read_write> listing: TileListsWrite;
+@group(1) @binding(3) var<storage, read_write> dispatches: array<u32, 6>;
+
+// Blurs `pixel` along AXIS.
+fn blur(pixel: vec2<i32>) {
     let size = vec2<i32>(textureDimensions(nd0));
-    let pixel = vec2<i32>(id.xy) + select(params.origin.zw, params.origin.xy, AXIS == 0u);
-    if pixel.x >= size.x || pixel.y >= size.y {
+    if any(pixel >= size) {
         return;
     }
     let here = textureLoad(nd0, pixel, 0);
@@ -63,4 +86,59 @@ fn bilateral(@builtin(global_invocation_id) id: vec3<u32>) {
         weight += w;
     }
     textureStore(ao_out, pixel, vec4<f32>(sum / weight, 0.0, 0.0, 0.0));
+}
+
+// Every pixel.
+@compute @workgroup_size(8, 8)
+fn bilateral(@builtin(global_invocation_id) id: vec3<u32>) {
+    blur(vec2<i32>(id.xy));
+}
+
+// The pixels of the listed tiles (a workgroup a tile; the dispatch 65 535 wide).
+@compute @workgroup_size(8, 8)
+fn bilateral_tiles(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_id) local: vec3<u32>) {
+    let index = group.x + group.y * 65535u;
+    if index >= lists.counts[AXIS] {
+        return;
+    }
+    let tile = lists.tiles[AXIS * params.tiles.w + index];
+    let corner = vec2<u32>(tile % params.tiles.x, tile / params.tiles.x) * 8u;
+    blur(vec2<i32>(corner + local.xy));
+}
+
+// Lists tile `id.x` for the y half where a slice marked it, for the x half where one marked it
+// or a tile up to `tiles.z` above or below (whose rows the y half reads).
+@compute @workgroup_size(64)
+fn list_tiles(@builtin(global_invocation_id) id: vec3<u32>) {
+    let tiles = tiling.tiles;
+    let t = id.x;
+    if t >= tiles.x * tiles.y {
+        return;
+    }
+    let row = i32(t / tiles.x);
+    let reach = i32(tiles.z);
+    var near = false;
+    for (var d = -reach; d <= reach; d++) {
+        let r = row + d;
+        if r >= 0 && r < i32(tiles.y) && marked[u32(i32(t) + d * i32(tiles.x))] != 0u {
+            near = true;
+        }
+    }
+    if near {
+        listing.tiles[atomicAdd(&listing.counts[0], 1u)] = t;
+    }
+    if marked[t] != 0u {
+        listing.tiles[tiles.w + atomicAdd(&listing.counts[1], 1u)] = t;
+    }
+}
+
+// The two halves' indirect dispatches: a workgroup a listed tile, 65 535 wide.
+@compute @workgroup_size(1)
+fn dispatch_args() {
+    for (var half = 0u; half < 2u; half++) {
+        let count = atomicLoad(&listing.counts[half]);
+        dispatches[3u * half] = min(count, 65535u);
+        dispatches[3u * half + 1u] = (count + 65534u) / 65535u;
+        dispatches[3u * half + 2u] = 1u;
+    }
 }

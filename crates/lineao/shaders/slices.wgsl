@@ -22,6 +22,9 @@ struct SliceUniform {
 
 @group(1) @binding(0) var volume: texture_3d<f32>;
 @group(1) @binding(1) var<uniform> slice: SliceUniform;
+// A u32 per 8 × 8 tile of the guard-banded target, row-major, set where a slice's fragment
+// falls (`lineao::targets::FrameTargets::slice_tiles`): the bilateral blur runs there alone.
+@group(2) @binding(0) var<storage, read_write> tiles: array<u32>;
 
 struct SliceOut {
     @builtin(position) clip: vec4<f32>,
@@ -89,6 +92,11 @@ fn slice_gbuffer(in: SliceOut) -> GBuffer {
     let sample = trilinear(x);
     if slice.shown.w != 0u && sample.y < 0.5 {
         discard;
+    }
+    let tile = vec2<u32>(in.clip.xy) / 8u;
+    let index = tile.y * ((u32(frame.viewport.x) + 7u) / 8u) + tile.x;
+    if index < arrayLength(&tiles) {
+        tiles[index] = 1u;
     }
     var axis_world = vec3<f32>(0.0);
     axis_world[in.axis] = 1.0;

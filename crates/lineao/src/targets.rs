@@ -99,6 +99,10 @@ const AO_USAGE: wgpu::TextureUsages = wgpu::TextureUsages::STORAGE_BINDING
     .union(wgpu::TextureUsages::COPY_SRC)
     .union(wgpu::TextureUsages::COPY_DST);
 
+/// The side in pixels of the tiles in which [`FrameTargets::slice_tiles`] marks the slices:
+/// the bilateral blur's workgroup.
+pub const SLICE_TILE: u32 = 8;
+
 /// Every size-dependent texture of the chain.
 pub struct FrameTargets {
     /// Guard-banded size.
@@ -116,6 +120,9 @@ pub struct FrameTargets {
     /// The bilateral blur's horizontal half, and its result.
     pub ao_blur_tmp: Option<Target>,
     pub ao_blurred: Option<Target>,
+    /// With the blur: a `u32` per 8 × 8 tile ([`SLICE_TILE`], row-major), not 0 where an anatomy
+    /// slice's fragment fell (`passes::slices` writes it, `passes::bilateral` reads it).
+    pub slice_tiles: Option<wgpu::Buffer>,
     /// Object-space AO: the geometry's octant visibilities per pixel, and the occlusion the
     /// `volume_ao` pass makes of them.
     pub octants: Option<Target>,
@@ -153,6 +160,7 @@ impl FrameTargets {
             ao: Target::ao(device, "lineao::FrameTargets::ao", size),
             ao_blur_tmp: None,
             ao_blurred: None,
+            slice_tiles: None,
             octants: None,
             volume_ao: None,
         }
@@ -169,11 +177,28 @@ impl FrameTargets {
         self
     }
 
-    /// These targets with the bilateral blur's two (`ao_blur_tmp`, `ao_blurred`).
+    /// These targets with the bilateral blur's two (`ao_blur_tmp`, `ao_blurred`) and the slices' tiles.
     pub fn with_blur(mut self, device: &wgpu::Device) -> FrameTargets {
         self.ao_blur_tmp = Some(Target::ao(device, "lineao::FrameTargets::ao_blur_tmp", self.size));
         self.ao_blurred = Some(Target::ao(device, "lineao::FrameTargets::ao_blurred", self.size));
+        self.slice_tiles = Some(device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("lineao::FrameTargets::slice_tiles"),
+            size: 4 * self.tile_count() as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        }));
         self
+    }
+
+    /// Tiles of [`SLICE_TILE`] pixels a side across and down the guard-banded size.
+    pub fn tiles(&self) -> (u32, u32) {
+        (self.size.0.div_ceil(SLICE_TILE), self.size.1.div_ceil(SLICE_TILE))
+    }
+
+    /// How many tiles [`FrameTargets::tiles`] makes.
+    pub fn tile_count(&self) -> u32 {
+        let (x, y) = self.tiles();
+        x * y
     }
 
     /// What the composite shows: `ao_blurred` when the blur's targets exist, else `ao`.

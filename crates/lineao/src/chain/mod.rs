@@ -208,6 +208,9 @@ impl AoChain {
             self.slices = settings.slices.as_ref().map(|_| SliceRenderer::new(device, octants));
             if let Some(renderer) = &mut self.slices {
                 renderer.set_volume(device, self.slice_volume.clone());
+                if let Some(targets) = &self.targets {
+                    renderer.resize(device, targets);
+                }
             }
         }
         // The pyramid's depth, the method's own targets, the blur's and object-space AO's, and
@@ -408,6 +411,9 @@ impl AoChain {
             }
             self.stages.resize(device, &targets);
             self.bilateral.resize(device, &targets);
+            if let Some(renderer) = &mut self.slices {
+                renderer.resize(device, &targets);
+            }
             if let Some(pass) = &mut self.volume_ao {
                 pass.resize(device, &targets);
             }
@@ -441,13 +447,7 @@ impl AoChain {
             stage.prepare(queue, targets, &view, s);
         }
         if let Some((blur, slices_only)) = s.bilateral() {
-            let region = match (slices_only, &self.slices, &s.slices) {
-                (false, ..) => Region::All,
-                (true, Some(renderer), Some(slices)) => {
-                    Region::Slices(renderer.screen_rect(&view, slices).unwrap_or_default())
-                }
-                (true, ..) => Region::Slices([0; 4]),
-            };
+            let region = if slices_only { Region::Slices } else { Region::All };
             self.bilateral.prepare(queue, &view, &blur, region);
         }
         if let (Some(pass), Some(volume)) = (&self.volume_ao, &s.volume) {

@@ -19,7 +19,7 @@
 
 use std::sync::Arc;
 
-use glam::{Mat4, Vec2, Vec3};
+use glam::{Mat4, Vec3};
 
 use crate::Error;
 use crate::binding::{self, Slot};
@@ -148,6 +148,25 @@ impl SliceVolume {
     }
 }
 
+/// The group of the tiles' buffer `tiles`, or of a buffer of one tile (marks that nothing reads).
+fn tiles_group(device: &wgpu::Device, layout: &wgpu::BindGroupLayout, tiles: Option<&wgpu::Buffer>) -> wgpu::BindGroup {
+    let label = "lineao::SliceRenderer::tiles";
+    let spare;
+    let buffer = match tiles {
+        Some(buffer) => buffer,
+        None => {
+            spare = device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: 4,
+                usage: wgpu::BufferUsages::STORAGE,
+                mapped_at_creation: false,
+            });
+            &spare
+        }
+    };
+    binding::group(device, label, layout, &[buffer.as_entire_binding()])
+}
+
 /// The axis-aligned world box around the voxel-space box `lo..=hi` (its eight corners through
 /// the affine).
 fn world_box(voxel_to_world: Mat4, lo: Vec3, hi: Vec3) -> (Vec3, Vec3) {
@@ -204,7 +223,8 @@ struct SliceUniform {
     last_voxel: [f32; 4],
 }
 
-/// Draws a [`SliceVolume`]'s slices into the G-buffer of [`FrameTargets`].
+/// Draws a [`SliceVolume`]'s slices into the G-buffer of [`FrameTargets`], marking the tiles
+/// they fall in ([`FrameTargets::slice_tiles`]).
 pub struct SliceRenderer {
     pipeline: wgpu::RenderPipeline,
     octants: bool,
@@ -213,6 +233,10 @@ pub struct SliceRenderer {
     uniform: wgpu::Buffer,
     /// The volume and its bind group, once set.
     volume: Option<(Arc<SliceVolume>, wgpu::BindGroup)>,
+    /// The tiles' buffer (the targets', or one of a single tile where they have none) and its
+    /// group, visible to the fragments alone.
+    tiles_layout: wgpu::BindGroupLayout,
+    tiles: wgpu::BindGroup,
 }
 
 impl SliceRenderer {
@@ -225,11 +249,12 @@ impl SliceRenderer {
         let layout =
             binding::layout(device, label, wgpu::ShaderStages::VERTEX_FRAGMENT, &[Slot::Texture3d, Slot::Uniform]);
         let module = crate::shader::module(device, "slices.wgsl");
+        let tiles_layout = binding::layout(device, label, wgpu::ShaderStages::FRAGMENT, &[Slot::StorageReadWrite]);
         let pipeline = gbuffer::pipeline(
             device,
             &bindings,
             PipelineSpec {
-                groups: &[&layout],
+                groups: &[&layout, &tiles_layout],
                 label,
                 module: &module,
                 vertex: "vs_slice",
@@ -241,7 +266,13 @@ impl SliceRenderer {
             },
         );
         let uniform = binding::uniform_buffer::<SliceUniform>(device, label);
-        SliceRenderer { pipeline, octants, bindings, layout, uniform, volume: None }
+        let tiles = tiles_group(device, &tiles_layout, None);
+        SliceRenderer { pipeline, octants, bindings, layout, uniform, volume: None, tiles_layout, tiles }
+    }
+
+    /// Marks the slices' tiles in `targets`' buffer (none without the blur's targets).
+    pub fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets) {
+        self.tiles = tiles_group(device, &self.tiles_layout, targets.slice_tiles.as_ref());
     }
 
     /// Whether this renderer writes the `octants` target.
@@ -285,50 +316,18 @@ impl SliceRenderer {
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
     }
 
-    /// The guard-banded pixels `[x0, y0, x1, y1)` that hold every pixel of the slices in `view`
-    /// (the rectangle around their quads' corners; the whole target where a corner lies behind
-    /// the eye), or none when no slice is drawn.
-    pub fn screen_rect(&self, view: &FrameView, slices: &SliceSettings) -> Option<[u32; 4]> {
-        let (volume, _) = self.volume.as_ref()?;
-        let (lo, hi) = volume.drawn_box(slices);
-        let size = Vec2::new((view.width + 2 * view.guard) as f32, (view.height + 2 * view.guard) as f32);
-        let clip = view.proj * view.view;
-        let (mut min, mut max) = (Vec2::INFINITY, Vec2::NEG_INFINITY);
-        for (axis, p) in slices.positions.iter().enumerate() {
-            let Some(p) = *p else { continue };
-            if !(lo[axis]..=hi[axis]).contains(&p) {
-                continue;
-            }
-            let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
-            for c in 0..4 {
-                let mut corner = lo;
-                corner[u] = if c & 1 != 0 { hi[u] } else { lo[u] };
-                corner[w] = if c & 2 != 0 { hi[w] } else { lo[w] };
-                corner[axis] = p;
-                let q = clip * corner.extend(1.0);
-                if q.w <= 0.0 {
-                    return Some([0, 0, size.x as u32, size.y as u32]);
-                }
-                let pixel = (Vec2::new(q.x, -q.y) / q.w * 0.5 + 0.5) * size;
-                (min, max) = (min.min(pixel), max.max(pixel));
-            }
-        }
-        if min.x > max.x {
-            return None;
-        }
-        // A pixel's centre inside the quads lies within a pixel of their corners' rectangle.
-        let (min, max) = ((min - 1.0).floor().max(Vec2::ZERO), (max + 1.0).ceil().min(size));
-        (min.x < max.x && min.y < max.y).then_some([min.x as u32, min.y as u32, max.x as u32, max.y as u32])
-    }
-
     /// Draws the slices over the G-buffer (or clearing it first: `load`), timed into `span`.
     pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, targets: &FrameTargets, load: Load, span: Option<Span>) {
         let Some((_, group)) = &self.volume else { return };
+        if let Some(tiles) = &targets.slice_tiles {
+            encoder.clear_buffer(tiles, 0, None);
+        }
         let octants = self.octants && targets.octants.is_some();
         let mut pass = gbuffer::begin(encoder, "lineao::SliceRenderer", targets, load, octants, span);
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &self.bindings.group, &[]);
         pass.set_bind_group(1, group, &[]);
+        pass.set_bind_group(2, &self.tiles, &[]);
         // One quad (two triangles) an axis.
         pass.draw(0..6, 0..3);
     }
