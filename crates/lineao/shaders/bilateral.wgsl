@@ -5,11 +5,13 @@
 //
 // Over anatomy slices (`slices_only`) only the slices' pixels (the G-buffer colour's alpha 0,
 // `shaders/slices.wgsl`) receive: every other keeps its occlusion. Then `list_tiles` lists the
-// 8 × 8 tiles that the slices' fragments marked (and, for the x half, those within the radius
+// SLICE_TILE² tiles that the slices' fragments marked (and, for the x half, those within the radius
 // above and below them), `dispatch_args` turns the counts into indirect dispatches, and
 // `bilateral_tiles` runs a workgroup per listed tile.
 #import shared/nd.wgsl
 #import shared/view.wgsl
+// SLICE_TILE: `lineao::targets::SLICE_TILE`, the tiles' side and the workgroup's.
+#import rust/constants.wgsl
 
 override AXIS: u32 = 0u;
 
@@ -95,14 +97,14 @@ fn bilateral(@builtin(global_invocation_id) id: vec3<u32>) {
 }
 
 // The pixels of the listed tiles (a workgroup a tile; the dispatch 65 535 wide).
-@compute @workgroup_size(8, 8)
+@compute @workgroup_size(SLICE_TILE, SLICE_TILE)
 fn bilateral_tiles(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_id) local: vec3<u32>) {
     let index = group.x + group.y * 65535u;
     if index >= lists.counts[AXIS] {
         return;
     }
     let tile = lists.tiles[AXIS * params.tiles.w + index];
-    let corner = vec2<u32>(tile % params.tiles.x, tile / params.tiles.x) * 8u;
+    let corner = vec2<u32>(tile % params.tiles.x, tile / params.tiles.x) * SLICE_TILE;
     blur(vec2<i32>(corner + local.xy));
 }
 

@@ -5,6 +5,8 @@
 // color mode 2), unlit, the plane's normal turned toward the eye. Transparent: no fragment
 // where the voxels without data (0 or NaN) weigh half the sample or more.
 #import shared/geometry.wgsl
+// SLICE_TILE: `lineao::targets::SLICE_TILE`.
+#import rust/constants.wgsl
 
 // Keep in sync with `lineao::passes::slices::SliceUniform`.
 struct SliceUniform {
@@ -22,7 +24,7 @@ struct SliceUniform {
 
 @group(1) @binding(0) var volume: texture_3d<f32>;
 @group(1) @binding(1) var<uniform> slice: SliceUniform;
-// A u32 per 8 × 8 tile of the guard-banded target, row-major, set where a slice's fragment
+// A u32 per SLICE_TILE² tile of the guard-banded target, row-major, set where a slice's fragment
 // falls (`lineao::targets::FrameTargets::slice_tiles`): the bilateral blur runs there alone.
 @group(2) @binding(0) var<storage, read_write> tiles: array<u32>;
 
@@ -93,8 +95,8 @@ fn slice_gbuffer(in: SliceOut) -> GBuffer {
     if slice.shown.w != 0u && sample.y < 0.5 {
         discard;
     }
-    let tile = vec2<u32>(in.clip.xy) / 8u;
-    let index = tile.y * ((u32(frame.viewport.x) + 7u) / 8u) + tile.x;
+    let tile = vec2<u32>(in.clip.xy) / SLICE_TILE;
+    let index = tile.y * ((u32(frame.viewport.x) + SLICE_TILE - 1u) / SLICE_TILE) + tile.x;
     if index < arrayLength(&tiles) {
         tiles[index] = 1u;
     }

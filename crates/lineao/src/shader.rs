@@ -53,13 +53,19 @@ pub enum Constant {
 
 /// The file, made by Rust, of the constants that the CPU reference and the shaders share: a
 /// shader that says `#import rust/constants.wgsl` gets every method's
-/// ([`crate::method::MethodInfo::constants`]) as WGSL `const`s, so no number is written twice.
+/// ([`crate::method::MethodInfo::constants`]) and the passes' ([`PASS_CONSTANTS`]) as WGSL
+/// `const`s, so no number is written twice.
 pub const CONSTANTS: &str = "rust/constants.wgsl";
+
+/// The passes' shared numbers: the side of the tiles in which the slices mark their pixels for
+/// the bilateral blur.
+pub const PASS_CONSTANTS: &[(&str, Constant)] = &[("SLICE_TILE", Constant::U32(crate::targets::SLICE_TILE))];
 
 /// [`CONSTANTS`]' text: `const NAME: f32 = …;` per constant, each f32 written with as many
 /// digits as give it back exactly.
 pub fn constants() -> String {
-    let all = crate::AoMethod::REGISTRY.iter().flat_map(|m| m.info().constants.iter());
+    let methods = crate::AoMethod::REGISTRY.iter().flat_map(|m| m.info().constants.iter());
+    let all = methods.chain(PASS_CONSTANTS);
     all.map(|(name, value)| match value {
         Constant::F32(v) => format!("const {name}: f32 = {v:?};\n"),
         Constant::U32(v) => format!("const {name}: u32 = {v}u;\n"),
