@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use glam::{Mat4, Vec3, Vec4};
-use lineao::readback::read_texture;
+use lineao::readback::{read_f32, read_rgba, read_texture};
 use lineao_session::args::RenderArgs;
 use lineao_session::render::Session;
 
@@ -159,17 +159,11 @@ fn the_blur_smooths_the_slices_and_leaves_the_lines_occlusion() {
     let (d, q) = (&session.gpu.device, &session.gpu.queue);
     let targets = chain.targets().unwrap();
     let (w, h) = (targets.size.0 as usize, targets.size.1 as usize);
-    let image = |data: Vec<f32>| lineao::reference::Image { width: w, height: h, data };
-    let ao = image(read_texture(d, q, &targets.ao.texture).unwrap().to_f32());
-    let shown =
-        image(read_texture(d, q, &targets.ao_blurred.as_ref().expect("the blur's targets").texture).unwrap().to_f32());
-    let nd0 = lineao::reference::Image {
-        width: w,
-        height: h,
-        data: read_texture(d, q, &targets.nd[0].texture).unwrap().to_vec4(),
-    };
-    let color = read_texture(d, q, &targets.color.texture).unwrap().to_vec4();
-    let slice = |x: usize, y: usize| color[y * w + x][3] == 0.0;
+    let ao = read_f32(d, q, &targets.ao).unwrap();
+    let shown = read_f32(d, q, targets.ao_blurred.as_ref().expect("the blur's targets")).unwrap();
+    let nd0 = read_rgba(d, q, &targets.nd[0]).unwrap();
+    let color = read_rgba(d, q, &targets.color).unwrap();
+    let slice = |x: usize, y: usize| color.get(x, y)[3] == 0.0;
     let (blur, slices_only) = chain.settings().bilateral().expect("a blur over the slices");
     assert!(slices_only);
     let view = lineao::reference::ViewParams::of(chain.frame_view().unwrap());

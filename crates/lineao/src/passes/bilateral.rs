@@ -123,8 +123,7 @@ impl Bilateral {
             bind_group_layouts: &[Some(&empty_layout), Some(&tiles_layout)],
             immediate_size: 0,
         });
-        let pipeline = |entry: &str, axis: f64| {
-            let layout = if entry.starts_with("bilateral") { &blurs } else { &listings };
+        let pipeline = |layout: &wgpu::PipelineLayout, entry: &str, axis: f64| {
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(label),
                 layout: Some(layout),
@@ -138,9 +137,9 @@ impl Bilateral {
             })
         };
         Bilateral {
-            pipelines: [pipeline("bilateral", 0.0), pipeline("bilateral", 1.0)],
-            tile_pipelines: [pipeline("bilateral_tiles", 0.0), pipeline("bilateral_tiles", 1.0)],
-            listing: [pipeline("list_tiles", 0.0), pipeline("dispatch_args", 0.0)],
+            pipelines: [pipeline(&blurs, "bilateral", 0.0), pipeline(&blurs, "bilateral", 1.0)],
+            tile_pipelines: [pipeline(&blurs, "bilateral_tiles", 0.0), pipeline(&blurs, "bilateral_tiles", 1.0)],
+            listing: [pipeline(&listings, "list_tiles", 0.0), pipeline(&listings, "dispatch_args", 0.0)],
             uniform: binding::uniform_buffer::<BilateralUniform>(device, label),
             empty: binding::group(device, label, &empty_layout, &[]),
             layout,
