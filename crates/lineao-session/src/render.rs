@@ -488,6 +488,29 @@ pub struct Rendered {
     pub chain: AoChain,
 }
 
+/// Each pass's median over `frames` (each a frame's pass times, the same passes), then the
+/// frames' sums: median, least and most. Returns the sums' median.
+fn print_medians(label: &str, frames: &[Vec<lineao::timing::PassTime>]) -> f64 {
+    let median = |mut values: Vec<f64>| {
+        values.sort_by(f64::total_cmp);
+        let n = values.len();
+        0.5 * (values[(n - 1) / 2] + values[n / 2])
+    };
+    let n = frames.len();
+    for (k, pass) in frames[0].iter().enumerate() {
+        let ms = median(frames.iter().map(|times| times[k].ms).collect());
+        eprintln!("lineao: {label}: {:<12} {ms:9.2} ms (GPU, median of {n} frames)", pass.name);
+    }
+    let sums: Vec<f64> = frames.iter().map(|times| times.iter().map(|t| t.ms).sum()).collect();
+    let (least, most) = sums.iter().fold((f64::MAX, f64::MIN), |(lo, hi), &s| (lo.min(s), hi.max(s)));
+    let frame = median(sums);
+    eprintln!(
+        "lineao: {label}: {:<12} {frame:9.2} ms (GPU, sum: median of {n} frames, {least:.2}..{most:.2})",
+        "frame"
+    );
+    frame
+}
+
 impl Session {
     /// Renders `panel` to sRGB bytes (with `--timings`, prints its passes; with `dump`, writes
     /// its inputs and output there, with `volume`'s settings when it has object-space AO). The
@@ -522,15 +545,52 @@ impl Session {
             gpu.wait()?;
             let wall_ms = start.elapsed().as_secs_f64() * 1e3;
             let label = &panel.label;
-            match chain.pass_times(&gpu.device)? {
-                Some(times) => {
-                    for t in &times {
+            // The picture's frames, each followed by one of the settings it is timed against.
+            let mut against = match &args.image.timings_against {
+                Some(patch) => {
+                    let settings = patch.apply(&panel.settings).map_err(anyhow::Error::msg)?;
+                    let mut chain = AoChain::new(&gpu.device, format, settings)?;
+                    chain.resize(args.image.width, args.image.height)?;
+                    Some((patch, chain, Vec::new()))
+                }
+                None => None,
+            };
+            let mut frames = Vec::new();
+            for k in 0..args.image.timed_frames {
+                if k > 0 {
+                    self.frame(&mut chain, &target.view, options)?;
+                    gpu.wait()?;
+                }
+                let Some(times) = chain.pass_times(&gpu.device)? else { break };
+                frames.push(times);
+                if let Some((_, other, times)) = &mut against {
+                    self.frame(other, &target.view, options)?;
+                    gpu.wait()?;
+                    times.extend(other.pass_times(&gpu.device)?);
+                }
+            }
+            match &frames[..] {
+                [] => eprintln!("lineao: {label}: frame {wall_ms:.2} ms (CPU wall time: no timestamp queries)"),
+                [times] if against.is_none() => {
+                    for t in times {
                         eprintln!("lineao: {label}: {:<12} {:9.2} ms (GPU)", t.name, t.ms);
                     }
                     let sum: f64 = times.iter().map(|t| t.ms).sum();
                     eprintln!("lineao: {label}: {:<12} {sum:9.2} ms (GPU, sum)", "frame");
                 }
-                None => eprintln!("lineao: {label}: frame {wall_ms:.2} ms (CPU wall time: no timestamp queries)"),
+                _ => {
+                    let frame = print_medians(label, &frames);
+                    if let Some((patch, _, times)) = &against {
+                        // The picture's own frame last, for the image read below.
+                        self.frame(&mut chain, &target.view, options)?;
+                        let label = format!("{label} against {patch}");
+                        let base = print_medians(&label, times);
+                        eprintln!(
+                            "lineao: {label}: the picture's frame {frame:.2} ms, {:+.1} % of {base:.2} ms",
+                            100.0 * (frame / base - 1.0)
+                        );
+                    }
+                }
             }
             if let Some(counts) = chain.cull_counts(&gpu.queue, &self.lines.geometry)? {
                 eprintln!("lineao: {label}: cull: {counts}");
