@@ -5,9 +5,10 @@
 //
 // Over anatomy slices (`slices_only`) only the slices' pixels (the G-buffer colour's alpha 0,
 // `shaders/slices.wgsl`) receive: every other keeps its occlusion. Then `list_tiles` lists the
-// SLICE_TILE² tiles that the slices' fragments marked (and, for the x half, those within the radius
-// above and below them), `dispatch_args` turns the counts into indirect dispatches, and
-// `bilateral_tiles` runs a workgroup per listed tile.
+// SLICE_TILE² tiles that the slices' fragments marked and that still show a slice's pixel,
+// `dispatch_args` turns the count into an indirect dispatch, and `bilateral_tiles` runs a
+// workgroup per listed tile, for each half (both outputs hold the raw occlusion elsewhere,
+// copied: no slice's pixel is there).
 #import shared/nd.wgsl
 #import shared/view.wgsl
 // SLICE_TILE: `lineao::targets::SLICE_TILE`, the tiles' side and the workgroup's.
@@ -24,13 +25,11 @@ struct BilateralUniform {
     depth: f32,
     // 1: only the slices' pixels are blurred.
     slices_only: u32,
-    // Tiles across and down, the tiles above and below a slice's that the x half also covers,
-    // and the capacity of each list.
+    // Tiles across and down (zw spare).
     tiles: vec4<u32>,
 }
 
-// The tiles to blur: how many for the x and the y half, then each half's list of tile indices
-// (x at 0, y at `tiles.w`).
+// The tiles to blur: how many (x; yzw spare), then their indices.
 struct TileLists {
     counts: vec4<u32>,
     tiles: array<u32>,
@@ -44,7 +43,8 @@ struct TileLists {
 @group(0) @binding(5) var<storage, read> lists: TileLists;
 
 // The listing's own group (`list_tiles`, `dispatch_args`; group 0 is empty for them): the
-// uniform again, the slices' marks, the lists written, and two indirect dispatches.
+// uniform again, the slices' marks, the list written, the halves' indirect dispatch, and the
+// G-buffer's colour again.
 struct TileListsWrite {
     counts: array<atomic<u32>, 4>,
     tiles: array<u32>,
@@ -52,7 +52,8 @@ struct TileListsWrite {
 @group(1) @binding(0) var<uniform> tiling: BilateralUniform;
 @group(1) @binding(1) var<storage, read> marked: array<u32>;
 @group(1) @binding(2) var<storage, read_write> listing: TileListsWrite;
-@group(1) @binding(3) var<storage, read_write> dispatches: array<u32, 6>;
+@group(1) @binding(3) var<storage, read_write> dispatches: array<u32, 3>;
+@group(1) @binding(4) var shown_color: texture_2d<f32>;
 
 // Blurs `pixel` along AXIS.
 fn blur(pixel: vec2<i32>) {
@@ -60,13 +61,16 @@ fn blur(pixel: vec2<i32>) {
     if any(pixel >= size) {
         return;
     }
-    let here = textureLoad(nd0, pixel, 0);
-    if nd_is_background(here) {
-        textureStore(ao_out, pixel, vec4<f32>(0.0));
+    // Over the slices every other pixel keeps its occlusion, copied before the halves.
+    let receives = params.slices_only == 0u || textureLoad(color, pixel, 0).a == 0.0;
+    if !receives {
         return;
     }
-    if params.slices_only != 0u && textureLoad(color, pixel, 0).a != 0.0 {
-        textureStore(ao_out, pixel, textureLoad(ao_in, pixel, 0));
+    let here = textureLoad(nd0, pixel, 0);
+    if nd_is_background(here) {
+        if params.slices_only == 0u {
+            textureStore(ao_out, pixel, vec4<f32>(0.0));
+        }
         return;
     }
     let z = linear_depth(params.view, here.w);
@@ -100,47 +104,39 @@ fn bilateral(@builtin(global_invocation_id) id: vec3<u32>) {
 @compute @workgroup_size(SLICE_TILE, SLICE_TILE)
 fn bilateral_tiles(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_id) local: vec3<u32>) {
     let index = group.x + group.y * 65535u;
-    if index >= lists.counts[AXIS] {
+    if index >= lists.counts.x {
         return;
     }
-    let tile = lists.tiles[AXIS * params.tiles.w + index];
+    let tile = lists.tiles[index];
     let corner = vec2<u32>(tile % params.tiles.x, tile / params.tiles.x) * SLICE_TILE;
     blur(vec2<i32>(corner + local.xy));
 }
 
-// Lists tile `id.x` for the y half where a slice marked it, for the x half where one marked it
-// or a tile up to `tiles.z` above or below (whose rows the y half reads).
+// Lists tile `id.x` where a slice marked it and one of its pixels shows a slice still (the
+// slices are drawn first: the lines in front hid every pixel of half the marked tiles).
 @compute @workgroup_size(64)
 fn list_tiles(@builtin(global_invocation_id) id: vec3<u32>) {
-    let tiles = tiling.tiles;
     let t = id.x;
-    if t >= tiles.x * tiles.y {
+    if t >= tiling.tiles.x * tiling.tiles.y || marked[t] == 0u {
         return;
     }
-    let row = i32(t / tiles.x);
-    let reach = i32(tiles.z);
-    var near = false;
-    for (var d = -reach; d <= reach; d++) {
-        let r = row + d;
-        if r >= 0 && r < i32(tiles.y) && marked[u32(i32(t) + d * i32(tiles.x))] != 0u {
-            near = true;
+    let corner = vec2<u32>(t % tiling.tiles.x, t / tiling.tiles.x) * SLICE_TILE;
+    let end = min(corner + SLICE_TILE, textureDimensions(shown_color));
+    for (var y = corner.y; y < end.y; y++) {
+        for (var x = corner.x; x < end.x; x++) {
+            if textureLoad(shown_color, vec2<u32>(x, y), 0).a == 0.0 {
+                listing.tiles[atomicAdd(&listing.counts[0], 1u)] = t;
+                return;
+            }
         }
-    }
-    if near {
-        listing.tiles[atomicAdd(&listing.counts[0], 1u)] = t;
-    }
-    if marked[t] != 0u {
-        listing.tiles[tiles.w + atomicAdd(&listing.counts[1], 1u)] = t;
     }
 }
 
-// The two halves' indirect dispatches: a workgroup a listed tile, 65 535 wide.
+// The halves' indirect dispatch: a workgroup a listed tile, 65 535 wide.
 @compute @workgroup_size(1)
 fn dispatch_args() {
-    for (var half = 0u; half < 2u; half++) {
-        let count = atomicLoad(&listing.counts[half]);
-        dispatches[3u * half] = min(count, 65535u);
-        dispatches[3u * half + 1u] = (count + 65534u) / 65535u;
-        dispatches[3u * half + 2u] = 1u;
-    }
+    let count = atomicLoad(&listing.counts[0]);
+    dispatches[0] = min(count, 65535u);
+    dispatches[1] = (count + 65534u) / 65535u;
+    dispatches[2] = 1u;
 }

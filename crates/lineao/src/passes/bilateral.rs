@@ -17,12 +17,14 @@
 //! Over anatomy slices the chain runs it on their pixels only
 //! ([`crate::ChainSettings::bilateral`]): the slices' pass writes the G-buffer colour's alpha
 //! as 0, every other writer 1, and a pixel whose alpha is not 0 keeps its occlusion (it still
-//! gives it to the slices' pixels around it). Then `ao` is copied to `ao_blurred`, and the two
-//! halves run only over the 8 × 8 tiles that the slices' fragments marked
-//! ([`FrameTargets::slice_tiles`]; the x half also over the tiles within the radius above and
-//! below, whose rows the y half reads), listed on the GPU and dispatched indirectly: on
-//! lavapipe each invocation costs about 13 ns whatever it does, so a pass over the slices'
-//! rectangle on screen cost 21 of its 39 ms with no pixel to blur.
+//! gives it to the slices' pixels around it). Then the two halves run only over the 8 × 8 tiles
+//! that the slices' fragments marked ([`FrameTargets::slice_tiles`]) and that still show a
+//! slice's pixel once everything is drawn (the slices are drawn first, and the lines in front
+//! hide every pixel of about half the marked tiles), listed on the GPU and dispatched
+//! indirectly: on lavapipe each invocation costs about 13 ns whatever it does, so a pass over
+//! the slices' rectangle on screen cost 21 of its 39 ms with no pixel to blur. `ao` is copied to
+//! both halves' outputs first: elsewhere no pixel is a slice's, so the copies hold what the
+//! halves would write there — which the y half reads above and below its tiles.
 
 use crate::binding::{self, Slot};
 use crate::camera::FrameView;
@@ -45,8 +47,7 @@ pub struct BilateralUniform {
     pub depth: f32,
     /// 1: only the anatomy slices' pixels receive.
     pub slices_only: u32,
-    /// Tiles across and down, the tiles above and below a slice's that the x half covers too,
-    /// and each list's capacity.
+    /// Tiles across and down (and two spare).
     pub tiles: [u32; 4],
 }
 
@@ -61,7 +62,7 @@ impl BilateralUniform {
             spatial: 1.0 / (2.0 * sigma_s * sigma_s),
             depth: 1.0 / (2.0 * settings.depth_sigma_world * settings.depth_sigma_world),
             slices_only: (region == Region::Slices) as u32,
-            tiles: [x, y, settings.radius_px.div_ceil(SLICE_TILE), x * y],
+            tiles: [x, y, 0, 0],
         }
     }
 }
@@ -113,7 +114,7 @@ impl Bilateral {
             device,
             label,
             wgpu::ShaderStages::COMPUTE,
-            &[Uniform, Storage, StorageReadWrite, StorageReadWrite],
+            &[Uniform, Storage, StorageReadWrite, StorageReadWrite, Texture],
         );
         let empty_layout = binding::layout(device, label, wgpu::ShaderStages::COMPUTE, &[]);
         let module = crate::shader::module(device, "bilateral.wgsl");
@@ -170,11 +171,13 @@ impl Bilateral {
                 mapped_at_creation: false,
             })
         };
-        // Two counts (and two spare), then a list of every tile for each half.
-        let lists = storage(16 + 8 * targets.tile_count() as u64, wgpu::BufferUsages::COPY_DST);
-        let dispatches = storage(24, wgpu::BufferUsages::INDIRECT);
-        let resources = [&self.uniform, marked, &lists, &dispatches].map(wgpu::Buffer::as_entire_binding);
-        let group = binding::group(device, label, &self.tiles_layout, &resources);
+        // A count (and three spare), then room for every tile.
+        let lists = storage(16 + 4 * targets.tile_count() as u64, wgpu::BufferUsages::COPY_DST);
+        let dispatches = storage(12, wgpu::BufferUsages::INDIRECT);
+        let [uniform, marked, listed, dispatched] =
+            [&self.uniform, marked, &lists, &dispatches].map(wgpu::Buffer::as_entire_binding);
+        let color = wgpu::BindingResource::TextureView(&targets.color.view);
+        let group = binding::group(device, label, &self.tiles_layout, &[uniform, marked, listed, dispatched, color]);
         let halves = [(&targets.ao, tmp), (tmp, blurred)];
         self.groups = halves
             .iter()
@@ -207,7 +210,9 @@ impl Bilateral {
     /// Records both halves (over the slices: after listing their tiles), timed into `span`
     /// when given.
     pub fn encode(&self, encoder: &mut wgpu::CommandEncoder, targets: &FrameTargets, span: Option<Span>) {
-        let (Some(blurred), Some(tiles), false) = (&targets.ao_blurred, &self.tiles, self.groups.is_empty()) else {
+        let (Some(tmp), Some(blurred), Some(tiles), false) =
+            (&targets.ao_blur_tmp, &targets.ao_blurred, &self.tiles, self.groups.is_empty())
+        else {
             return;
         };
         fn pass<'e>(encoder: &'e mut wgpu::CommandEncoder, span: Option<Span>) -> wgpu::ComputePass<'e> {
@@ -226,29 +231,29 @@ impl Bilateral {
             }
             return;
         }
-        // What is in no listed tile is no slice: it keeps its occlusion.
-        encoder.copy_texture_to_texture(
-            targets.ao.texture.as_image_copy(),
-            blurred.texture.as_image_copy(),
-            targets.ao.texture.size(),
-        );
         encoder.clear_buffer(&tiles.lists, 0, Some(16));
         // Separate passes: on lavapipe, dispatches within one pass did not see each other's
-        // writes (`passes::cull`).
+        // writes (`passes::cull`). The copies within the timed span.
         let (first, last) = Span::split(span);
-        let [list, args] = &self.listing;
-        for (k, (pipeline, size)) in [(list, targets.tile_count().div_ceil(64)), (args, 1)].into_iter().enumerate() {
-            let mut pass = pass(encoder, if k == 0 { first } else { None });
+        let listing = |encoder: &mut wgpu::CommandEncoder, pipeline, size, span| {
+            let mut pass = pass(encoder, span);
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &self.empty, &[]);
             pass.set_bind_group(1, &tiles.group, &[]);
             pass.dispatch_workgroups(size, 1, 1);
+        };
+        let [list, args] = &self.listing;
+        listing(encoder, list, targets.tile_count().div_ceil(64), first);
+        for copy in [tmp, blurred] {
+            let size = targets.ao.texture.size();
+            encoder.copy_texture_to_texture(targets.ao.texture.as_image_copy(), copy.texture.as_image_copy(), size);
         }
+        listing(encoder, args, 1, None);
         let mut pass = pass(encoder, last);
-        for (half, (pipeline, group)) in self.tile_pipelines.iter().zip(&self.groups).enumerate() {
+        for (pipeline, group) in self.tile_pipelines.iter().zip(&self.groups) {
             pass.set_pipeline(pipeline);
             pass.set_bind_group(0, group, &[]);
-            pass.dispatch_workgroups_indirect(&tiles.dispatches, 12 * half as u64);
+            pass.dispatch_workgroups_indirect(&tiles.dispatches, 0);
         }
     }
 }
