@@ -3,7 +3,9 @@
 // samples the volume trilinearly between voxel centres through the inverse affine and writes
 // the G-buffer of CONTRACT.md with the value through the window and colormap (`base_color`,
 // color mode 2), unlit, the plane's normal turned toward the eye. Transparent: no fragment
-// where the voxels without data (0 or NaN) weigh half the sample or more.
+// where the voxels without data (0 or NaN) weigh half the sample or more. The sample: one
+// filtered sample of the volume and of its data mask where the device filters f32 textures
+// (`fs_slice_filtered`), else eight `textureLoad`s (`fs_slice`).
 #import shared/geometry.wgsl
 // SLICE_TILE: `lineao::targets::SLICE_TILE`.
 #import rust/constants.wgsl
@@ -24,6 +26,9 @@ struct SliceUniform {
 
 @group(1) @binding(0) var volume: texture_3d<f32>;
 @group(1) @binding(1) var<uniform> slice: SliceUniform;
+// 1 where a voxel holds data (finite, not 0), and the trilinear sampler (clamped to the edge).
+@group(1) @binding(2) var data_mask: texture_3d<f32>;
+@group(1) @binding(3) var trilinear_sampler: sampler;
 // A u32 per SLICE_TILE² tile of the guard-banded target, row-major, set where a slice's fragment
 // falls (`lineao::targets::FrameTargets::slice_tiles`): the bilateral blur runs there alone.
 @group(2) @binding(0) var<storage, read_write> tiles: array<u32>;
@@ -84,14 +89,26 @@ fn trilinear(x: vec3<f32>) -> vec2<f32> {
     return sum;
 }
 
-fn slice_gbuffer(in: SliceOut) -> GBuffer {
+// `trilinear` by the texture units: the volume and the mask sampled once each.
+fn filtered(x: vec3<f32>) -> vec2<f32> {
+    let uvw = (x + 0.5) / (slice.last_voxel.xyz + 1.0);
+    let value = textureSampleLevel(volume, trilinear_sampler, uvw, 0.0).r;
+    return vec2<f32>(value, textureSampleLevel(data_mask, trilinear_sampler, uvw, 0.0).r);
+}
+
+// The fragment's voxel coordinates; none outside the box of the voxel centres (a little slack
+// for rounding on its faces).
+fn voxel(in: SliceOut) -> vec3<f32> {
     let x = (slice.world_to_voxel * vec4<f32>(in.world, 1.0)).xyz;
-    // Outside the box of the voxel centres (a little slack for rounding on its faces).
     let slack = 1e-3;
     if any(x < vec3<f32>(-slack)) || any(x > slice.last_voxel.xyz + vec3<f32>(slack)) {
         discard;
     }
-    let sample = trilinear(x);
+    return x;
+}
+
+// The G-buffer of the fragment whose volume `sample` is (value, weight of data).
+fn slice_gbuffer(in: SliceOut, sample: vec2<f32>) -> GBuffer {
     if slice.shown.w != 0u && sample.y < 0.5 {
         discard;
     }
@@ -115,11 +132,21 @@ fn slice_gbuffer(in: SliceOut) -> GBuffer {
 
 @fragment
 fn fs_slice(in: SliceOut) -> GBuffer {
-    return slice_gbuffer(in);
+    return slice_gbuffer(in, trilinear(voxel(in)));
+}
+
+@fragment
+fn fs_slice_filtered(in: SliceOut) -> GBuffer {
+    return slice_gbuffer(in, filtered(voxel(in)));
 }
 
 // Slices are not in the lines' density volume: fully visible to object-space AO.
 @fragment
 fn fs_slice_octants(in: SliceOut) -> GBufferOctants {
-    return with_octants(slice_gbuffer(in), vec4<f32>(1.0), vec4<f32>(1.0));
+    return with_octants(slice_gbuffer(in, trilinear(voxel(in))), vec4<f32>(1.0), vec4<f32>(1.0));
+}
+
+@fragment
+fn fs_slice_filtered_octants(in: SliceOut) -> GBufferOctants {
+    return with_octants(slice_gbuffer(in, filtered(voxel(in))), vec4<f32>(1.0), vec4<f32>(1.0));
 }

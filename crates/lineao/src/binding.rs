@@ -13,6 +13,11 @@ pub enum Slot {
     Texture,
     /// `texture_3d<f32>` read with `textureLoad` (unfilterable).
     Texture3d,
+    /// `texture_3d<f32>` sampled through a filtering sampler (f32 formats need the device's
+    /// `FLOAT32_FILTERABLE`).
+    FilterableTexture3d,
+    /// A filtering `sampler`.
+    Sampler,
     /// `texture_2d<u32>` read with `textureLoad`.
     UintTexture,
     /// `texture_2d_array<u32>` read with `textureLoad`.
@@ -54,11 +59,14 @@ pub fn layout(
                     view_dimension: wgpu::TextureViewDimension::D2,
                     multisampled: false,
                 },
-                Slot::Texture3d => wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                Slot::Texture3d | Slot::FilterableTexture3d => wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float {
+                        filterable: matches!(slot, Slot::FilterableTexture3d),
+                    },
                     view_dimension: wgpu::TextureViewDimension::D3,
                     multisampled: false,
                 },
+                Slot::Sampler => wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
                 Slot::DepthTexture { multisampled } => wgpu::BindingType::Texture {
                     sample_type: wgpu::TextureSampleType::Depth,
                     view_dimension: wgpu::TextureViewDimension::D2,

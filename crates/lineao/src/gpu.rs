@@ -129,12 +129,14 @@ impl Gpu {
         Gpu { instance, adapter, device, queue, lost }
     }
 
-    /// What lineao asks of an adapter: its own limits, plus timestamp queries and early depth
-    /// tests before a shader that writes its depth (the tubes') when offered.
+    /// What lineao asks of an adapter: its own limits, plus timestamp queries, early depth
+    /// tests before a shader that writes its depth (the tubes') and filtered f32 textures (the
+    /// anatomy slices' volume) when offered.
     pub fn device_descriptor(adapter: &wgpu::Adapter) -> wgpu::DeviceDescriptor<'static> {
         let wanted = wgpu::Features::TIMESTAMP_QUERY
             | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS
-            | wgpu::Features::SHADER_EARLY_DEPTH_TEST;
+            | wgpu::Features::SHADER_EARLY_DEPTH_TEST
+            | wgpu::Features::FLOAT32_FILTERABLE;
         wgpu::DeviceDescriptor {
             label: Some("lineao::Gpu::device"),
             required_features: adapter.features() & wanted,

@@ -14,8 +14,15 @@
 //! 2nd and 98th percentiles of the volume's finite values) and a colormap, unlit: a slice is a
 //! picture of the data, and the only darkening on it is the occlusion.
 //!
-//! The volume lives in an `R32Float` 3-D texture read with `textureLoad` (f32 textures are not
-//! filterable everywhere; eight loads are exact and cheap next to the lines).
+//! The volume lives in an `R32Float` 3-D texture beside an `R8Unorm` mask (1 where a voxel holds
+//! data). Where the device filters f32 textures (`FLOAT32_FILTERABLE`: lavapipe, most desktop
+//! GPUs and browsers) one trilinear sample of each gives the value and the data's weight, in the
+//! texture units; elsewhere eight `textureLoad`s do (exact, and what every device can do). On
+//! lavapipe the filtered path draws the default frame's slices 4–6 ms sooner (of ~30 ms;
+//! docs/measurements.md); on a GPU the texture units are what filtering is for. A GPU filters
+//! with weights of 8 fractional bits or more: the sample is off by at most 1/512 of the
+//! difference between neighbouring voxels, below a colormap's step. `tests/slices.rs` checks
+//! both paths against the CPU's trilinear sample.
 
 use std::sync::Arc;
 
@@ -33,6 +40,8 @@ use crate::timing::Span;
 /// A scalar volume on the GPU for [`SliceRenderer`].
 pub struct SliceVolume {
     view: wgpu::TextureView,
+    /// 1 where a voxel holds data (finite, not 0), else 0: `R8Unorm`, filterable everywhere.
+    mask: wgpu::TextureView,
     dims: [u32; 3],
     world_to_voxel: Mat4,
     /// The axis-aligned world box around the voxel centres.
@@ -68,22 +77,24 @@ impl SliceVolume {
         if !(det.is_finite() && det.abs() > 1e-12 && voxel_to_world.is_finite()) {
             return Err(Error::InvalidGeometry(format!("a singular voxel-to-world affine (determinant {det})")));
         }
-        let texture = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("lineao::SliceVolume"),
-            size: wgpu::Extent3d { width: dims[0], height: dims[1], depth_or_array_layers: dims[2] },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D3,
-            format: wgpu::TextureFormat::R32Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
-        queue.write_texture(
-            texture.as_image_copy(),
-            bytemuck::cast_slice(values),
-            wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(4 * dims[0]), rows_per_image: Some(dims[1]) },
-            texture.size(),
-        );
+        let texture = |format: wgpu::TextureFormat, texels: &[u8]| {
+            let texture = device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("lineao::SliceVolume"),
+                size: wgpu::Extent3d { width: dims[0], height: dims[1], depth_or_array_layers: dims[2] },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D3,
+                format,
+                usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+                view_formats: &[],
+            });
+            let row = format.block_copy_size(None).unwrap_or(1) * dims[0];
+            let layout =
+                wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row), rows_per_image: Some(dims[1]) };
+            queue.write_texture(texture.as_image_copy(), texels, layout, texture.size());
+            texture.create_view(&Default::default())
+        };
+        let mask: Vec<u8> = values.iter().map(|&v| if has_data(v) { 255 } else { 0 }).collect();
         let last = Vec3::new(dims[0] as f32 - 1.0, dims[1] as f32 - 1.0, dims[2] as f32 - 1.0);
         let (box_min, box_max) = world_box(voxel_to_world, Vec3::ZERO, last);
         // A point half a voxel or more beyond the last voxel with data on an axis draws nothing
@@ -92,7 +103,8 @@ impl SliceVolume {
         let data_box = data_voxels(dims, values)
             .map(|(lo, hi)| world_box(voxel_to_world, (lo - 0.5).max(Vec3::ZERO), (hi + 0.5).min(last)));
         Ok(SliceVolume {
-            view: texture.create_view(&Default::default()),
+            view: texture(wgpu::TextureFormat::R32Float, bytemuck::cast_slice(values)),
+            mask: texture(wgpu::TextureFormat::R8Unorm, &mask),
             dims,
             world_to_voxel: voxel_to_world.inverse(),
             box_min,
@@ -177,13 +189,17 @@ fn world_box(voxel_to_world: Mat4, lo: Vec3, hi: Vec3) -> (Vec3, Vec3) {
     corners.fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| (lo.min(p), hi.max(p)))
 }
 
-/// The voxel-index box (lowest, highest) of the voxels that hold data: finite and not 0.
+/// Whether a voxel's value is data: finite and not 0.
+fn has_data(v: f32) -> bool {
+    v.is_finite() && v != 0.0
+}
+
+/// The voxel-index box (lowest, highest) of the voxels that hold data.
 fn data_voxels(dims: [u32; 3], values: &[f32]) -> Option<(Vec3, Vec3)> {
-    let has_data = |v: &f32| v.is_finite() && *v != 0.0;
     let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
     for (row, voxels) in values.chunks_exact(dims[0] as usize).enumerate() {
-        let Some(first) = voxels.iter().position(has_data) else { continue };
-        let last = voxels.iter().rposition(has_data).unwrap_or(first);
+        let Some(first) = voxels.iter().position(|&v| has_data(v)) else { continue };
+        let last = voxels.iter().rposition(|&v| has_data(v)).unwrap_or(first);
         let (j, k) = ((row % dims[1] as usize) as f32, (row / dims[1] as usize) as f32);
         lo = lo.min(Vec3::new(first as f32, j, k));
         hi = hi.max(Vec3::new(last as f32, j, k));
@@ -237,6 +253,8 @@ pub struct SliceRenderer {
     /// group, visible to the fragments alone.
     tiles_layout: wgpu::BindGroupLayout,
     tiles: wgpu::BindGroup,
+    /// Trilinear, clamped to the edge: the volume's (where the device filters f32) and the mask's.
+    sampler: wgpu::Sampler,
 }
 
 impl SliceRenderer {
@@ -246,8 +264,14 @@ impl SliceRenderer {
         let label = "lineao::SliceRenderer";
         // Unlit: every lighting is the same to it.
         let bindings = GeometryBindings::new(device, label, LightingShape::ANY);
-        let layout =
-            binding::layout(device, label, wgpu::ShaderStages::VERTEX_FRAGMENT, &[Slot::Texture3d, Slot::Uniform]);
+        let filtered = device.features().contains(wgpu::Features::FLOAT32_FILTERABLE);
+        let volume = if filtered { Slot::FilterableTexture3d } else { Slot::Texture3d };
+        let layout = binding::layout(
+            device,
+            label,
+            wgpu::ShaderStages::VERTEX_FRAGMENT,
+            &[volume, Slot::Uniform, Slot::FilterableTexture3d, Slot::Sampler],
+        );
         let module = crate::shader::module(device, "slices.wgsl");
         let tiles_layout = binding::layout(device, label, wgpu::ShaderStages::FRAGMENT, &[Slot::StorageReadWrite]);
         let pipeline = gbuffer::pipeline(
@@ -258,7 +282,12 @@ impl SliceRenderer {
                 label,
                 module: &module,
                 vertex: "vs_slice",
-                fragment: if octants { "fs_slice_octants" } else { "fs_slice" },
+                fragment: match (filtered, octants) {
+                    (true, false) => "fs_slice_filtered",
+                    (true, true) => "fs_slice_filtered_octants",
+                    (false, false) => "fs_slice",
+                    (false, true) => "fs_slice_octants",
+                },
                 buffers: &[],
                 topology: wgpu::PrimitiveTopology::TriangleList,
                 octants,
@@ -267,7 +296,13 @@ impl SliceRenderer {
         );
         let uniform = binding::uniform_buffer::<SliceUniform>(device, label);
         let tiles = tiles_group(device, &tiles_layout, None);
-        SliceRenderer { pipeline, octants, bindings, layout, uniform, volume: None, tiles_layout, tiles }
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some(label),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        SliceRenderer { pipeline, octants, bindings, layout, uniform, volume: None, tiles_layout, tiles, sampler }
     }
 
     /// Marks the slices' tiles in `targets`' buffer (none without the blur's targets).
@@ -287,7 +322,12 @@ impl SliceRenderer {
                 device,
                 "lineao::SliceRenderer::volume",
                 &self.layout,
-                &[wgpu::BindingResource::TextureView(&volume.view), self.uniform.as_entire_binding()],
+                &[
+                    wgpu::BindingResource::TextureView(&volume.view),
+                    self.uniform.as_entire_binding(),
+                    wgpu::BindingResource::TextureView(&volume.mask),
+                    wgpu::BindingResource::Sampler(&self.sampler),
+                ],
             );
             (volume, group)
         });
