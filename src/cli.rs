@@ -79,7 +79,7 @@ pub struct ViewArgs {
     /// --volume`); the side panel moves them.
     #[arg(long, value_name = "NIFTI")]
     pub volume: Option<PathBuf>,
-    /// Where the slices cut x, y and z (mm; `-` for none) [default: all three through the
+    /// Where the slices cut x, y and z (mm; `none` or `-` for none) [default: all three through the
     /// volume's centre].
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_slices, allow_hyphen_values = true, requires = "volume")]
     pub slices: Option<[Option<f32>; 3]>,

@@ -473,8 +473,9 @@ pub struct ContextArgs {
     /// grain on a slice).
     #[arg(long, value_name = "NIFTI")]
     pub volume: Option<PathBuf>,
-    /// Where the sagittal, coronal and axial slices cut x, y and z (world mm, RAS+), `-` for no
-    /// slice on an axis: `0,-18,10`, `-,-,10` [default: all three through the volume's centre].
+    /// Where the sagittal, coronal and axial slices cut x, y and z (world mm, RAS+), `none` (or
+    /// `-`) for no slice on an axis: `0,-18,10`, `none,none,10` [default: all three through the
+    /// volume's centre].
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_slices, allow_hyphen_values = true, requires = "volume")]
     #[serde(deserialize_with = "crate::kwargs::opt_slices")]
     pub slices: Option<[Option<f32>; 3]>,
@@ -597,19 +598,20 @@ pub fn parse_region(s: &str) -> Result<lineao_tracts::Region, String> {
     }
 }
 
-/// `--slices`: three positions, each a number or `-`.
+/// `--slices`: three positions, each a number, or `none` (CONTRACT.md) or `-` for no slice.
 pub fn parse_slices(s: &str) -> Result<[Option<f32>; 3], String> {
     let parts: Vec<Option<f32>> = s
         .split(',')
         .map(|p| match p.trim() {
             "-" | "" => Ok(None),
+            p if p.eq_ignore_ascii_case("none") => Ok(None),
             p => match p.parse::<f32>() {
                 Ok(v) if v.is_finite() => Ok(Some(v)),
-                _ => Err(format!("'{p}' is neither a position in mm nor '-'")),
+                _ => Err(format!("'{p}' is neither a position in mm nor 'none' (or '-')")),
             },
         })
         .collect::<Result<_, _>>()?;
-    parts.try_into().map_err(|_| format!("expected X,Y,Z (a position or '-' each), got '{s}'"))
+    parts.try_into().map_err(|_| format!("expected X,Y,Z (a position or 'none' each), got '{s}'"))
 }
 
 /// `--window`: MIN,MAX with MIN < MAX.
@@ -1012,5 +1014,17 @@ mod tests {
         for bad in ["0%", "100.5%", "-1%", "x%", "0", "-2", "inf", ""] {
             assert!(parse_ao_distance(bad).is_err(), "{bad}");
         }
+    }
+
+    #[test]
+    fn a_slice_s_position_is_a_number_or_none() {
+        assert_eq!(parse_slices("0,-18.5,10"), Ok([Some(0.0), Some(-18.5), Some(10.0)]));
+        assert_eq!(parse_slices("none,-18,None"), Ok([None, Some(-18.0), None]));
+        assert_eq!(parse_slices("-,-, 10"), Ok([None, None, Some(10.0)]));
+        for bad in ["0,0", "0,0,0,0", "x,0,0", "0,inf,0", "0,NaN,0"] {
+            assert!(parse_slices(bad).is_err(), "{bad}");
+        }
+        let args = parse_render(["lineao", "render", "f.trk", "--volume", "t1.nii.gz", "--slices", "none,none,12"]);
+        assert_eq!(args.context.slices, Some([None, None, Some(12.0)]));
     }
 }
