@@ -85,6 +85,27 @@ fn exit_codes() {
     }
 }
 
+/// `--timed-frames` prints each pass's median, `--timings-against` the cost of a change of
+/// settings measured frame for frame, and the picture written is the picture's own.
+#[test]
+fn timings_over_frames_and_against_other_settings() {
+    let dir = scratch("timings");
+    let (timed, plain) = (dir.join("timed.png"), dir.join("plain.png"));
+    let size = ["--vertices", "3000", "--width", "96", "--height", "64"];
+    let against = r#"{"strength": 0.5, "slices": null}"#;
+    let timing = ["--timings", "--timed-frames", "3", "--timings-against", against, "-o", timed.to_str().unwrap()];
+    let out = lineao(&[&["render"][..], &size, &timing].concat());
+    let text = stderr(&out);
+    assert_eq!(out.status.code(), Some(0), "{text}");
+    assert!(text.contains("(GPU, median of 3 frames)"), "{text}");
+    assert!(text.contains(r#"against {"slices":null,"strength":0.5}: lines"#), "{text}");
+    assert!(text.contains("the picture's frame"), "{text}");
+    assert_eq!(lineao(&[&["render"][..], &size, &["-o", plain.to_str().unwrap()]].concat()).status.code(), Some(0));
+    assert!(std::fs::read(&timed).unwrap() == std::fs::read(&plain).unwrap(), "the timed picture differs");
+    // Without --timings the comparison is a bad command line.
+    assert_eq!(lineao(&["render", "--timings-against", against]).status.code(), Some(2));
+}
+
 fn read_npy(path: &Path) -> (Vec<u64>, Vec<f32>) {
     let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let npy = npyz::NpyFile::new(&bytes[..]).unwrap();
