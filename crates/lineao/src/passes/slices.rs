@@ -40,7 +40,8 @@ use crate::timing::Span;
 /// A scalar volume on the GPU for [`SliceRenderer`].
 pub struct SliceVolume {
     view: wgpu::TextureView,
-    /// 1 where a voxel holds data (finite, not 0), else 0: `R8Unorm`, filterable everywhere.
+    /// 1 where a voxel holds data (finite, not 0), else 0: `R8Unorm`, filterable everywhere
+    /// (one texel where the device cannot filter f32, so the slices load voxels instead).
     mask: wgpu::TextureView,
     dims: [u32; 3],
     world_to_voxel: Mat4,
@@ -77,7 +78,7 @@ impl SliceVolume {
         if !(det.is_finite() && det.abs() > 1e-12 && voxel_to_world.is_finite()) {
             return Err(Error::InvalidGeometry(format!("a singular voxel-to-world affine (determinant {det})")));
         }
-        let texture = |format: wgpu::TextureFormat, texels: &[u8]| {
+        let texture = |format: wgpu::TextureFormat, dims: [u32; 3], texels: &[u8]| {
             let texture = device.create_texture(&wgpu::TextureDescriptor {
                 label: Some("lineao::SliceVolume"),
                 size: wgpu::Extent3d { width: dims[0], height: dims[1], depth_or_array_layers: dims[2] },
@@ -94,7 +95,13 @@ impl SliceVolume {
             queue.write_texture(texture.as_image_copy(), texels, layout, texture.size());
             texture.create_view(&Default::default())
         };
-        let mask: Vec<u8> = values.iter().map(|&v| if has_data(v) { 255 } else { 0 }).collect();
+        // The mask where the slices sample it ([`SliceRenderer::new`]), else one texel to bind.
+        let mask = if device.features().contains(wgpu::Features::FLOAT32_FILTERABLE) {
+            let texels: Vec<u8> = values.iter().map(|&v| if has_data(v) { 255 } else { 0 }).collect();
+            texture(wgpu::TextureFormat::R8Unorm, dims, &texels)
+        } else {
+            texture(wgpu::TextureFormat::R8Unorm, [1; 3], &[0])
+        };
         let last = Vec3::new(dims[0] as f32 - 1.0, dims[1] as f32 - 1.0, dims[2] as f32 - 1.0);
         let (box_min, box_max) = world_box(voxel_to_world, Vec3::ZERO, last);
         // A point half a voxel or more beyond the last voxel with data on an axis draws nothing
@@ -103,8 +110,8 @@ impl SliceVolume {
         let data_box = data_voxels(dims, values)
             .map(|(lo, hi)| world_box(voxel_to_world, (lo - 0.5).max(Vec3::ZERO), (hi + 0.5).min(last)));
         Ok(SliceVolume {
-            view: texture(wgpu::TextureFormat::R32Float, bytemuck::cast_slice(values)),
-            mask: texture(wgpu::TextureFormat::R8Unorm, &mask),
+            view: texture(wgpu::TextureFormat::R32Float, dims, bytemuck::cast_slice(values)),
+            mask,
             dims,
             world_to_voxel: voxel_to_world.inverse(),
             box_min,
