@@ -584,11 +584,15 @@ impl Session {
                         // The picture's own frame last, for the image read below.
                         self.frame(&mut chain, &target.view, options)?;
                         let label = format!("{label} against {patch}");
-                        let base = print_medians(&label, times);
-                        eprintln!(
-                            "lineao: {label}: the picture's frame {frame:.2} ms, {:+.1} % of {base:.2} ms",
-                            100.0 * (frame / base - 1.0)
-                        );
+                        if times.is_empty() {
+                            eprintln!("lineao: {label}: no GPU times came back");
+                        } else {
+                            let base = print_medians(&label, times);
+                            eprintln!(
+                                "lineao: {label}: the picture's frame {frame:.2} ms, {:+.1} % of {base:.2} ms",
+                                100.0 * (frame / base - 1.0)
+                            );
+                        }
                     }
                 }
             }
