@@ -103,6 +103,11 @@ const AO_USAGE: wgpu::TextureUsages = wgpu::TextureUsages::STORAGE_BINDING
 /// the bilateral blur's workgroup.
 pub const SLICE_TILE: u32 = 8;
 
+/// Tiles of [`SLICE_TILE`] pixels a side across and down a target of `size`.
+pub fn tile_grid(size: (u32, u32)) -> (u32, u32) {
+    (size.0.div_ceil(SLICE_TILE), size.1.div_ceil(SLICE_TILE))
+}
+
 /// Every size-dependent texture of the chain.
 pub struct FrameTargets {
     /// Guard-banded size.
@@ -192,7 +197,7 @@ impl FrameTargets {
 
     /// Tiles of [`SLICE_TILE`] pixels a side across and down the guard-banded size.
     pub fn tiles(&self) -> (u32, u32) {
-        (self.size.0.div_ceil(SLICE_TILE), self.size.1.div_ceil(SLICE_TILE))
+        tile_grid(self.size)
     }
 
     /// How many tiles [`FrameTargets::tiles`] makes.

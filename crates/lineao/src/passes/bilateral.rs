@@ -30,7 +30,7 @@ use crate::binding::{self, Slot};
 use crate::camera::FrameView;
 use crate::passes::dispatch_size;
 use crate::settings::BilateralSettings;
-use crate::targets::{AO_FORMAT, FrameTargets, SLICE_TILE};
+use crate::targets::{AO_FORMAT, FrameTargets, tile_grid};
 use crate::timing::{self, Span};
 use crate::view_params::ViewParams;
 use crate::view_params::ViewUniform;
@@ -54,8 +54,7 @@ pub struct BilateralUniform {
 impl BilateralUniform {
     pub fn new(view: &FrameView, settings: &BilateralSettings, region: Region) -> BilateralUniform {
         let sigma_s = settings.radius_px as f32 * 0.5;
-        let (x, y) =
-            ((view.width + 2 * view.guard).div_ceil(SLICE_TILE), (view.height + 2 * view.guard).div_ceil(SLICE_TILE));
+        let (x, y) = tile_grid(view.banded_size());
         BilateralUniform {
             view: ViewParams::of(view).into(),
             radius: settings.radius_px as i32,
