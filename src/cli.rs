@@ -75,7 +75,7 @@ pub struct ViewArgs {
     /// (`z,0,8`); `[` and `]` move it (see `render --slab`).
     #[arg(long, value_name = "AXIS,CENTRE,THICKNESS", value_parser = lineao_session::args::parse_slab, allow_hyphen_values = true)]
     pub slab: Option<lineao::Slab>,
-    /// Anatomy: a NIfTI-1 volume shown as slices with each dataset opened (see `render
+    /// Anatomy: a NIfTI-1 or NIfTI-2 volume shown as slices with each dataset opened (see `render
     /// --volume`); the side panel moves them.
     #[arg(long, value_name = "NIFTI")]
     pub volume: Option<PathBuf>,

@@ -1,7 +1,8 @@
 """Colour by data: lineao.sample_volume and render(color="volume:FILE") — a NIfTI volume
 sampled at every vertex against an independent trilinear interpolation (nibabel's array and
 affine, scipy's map_coordinates), and the picture the command line draws with it — and a
-per-streamline field (TRX dps) spread over its streamlines' vertices."""
+per-streamline field (TRX dps) spread over its streamlines' vertices. NIfTI-2 files, which
+nibabel writes here, are read as their NIfTI-1 originals."""
 
 import nibabel as nib
 import numpy as np
@@ -40,6 +41,31 @@ def test_samples_along_the_streamlines_are_scipys(volume):
     # The same from nibabel's streamlines (any container render takes).
     nib_streamlines = nib.streamlines.load(str(STROKE)).streamlines
     assert np.array_equal(lineao.sample_volume(nib_streamlines, IMAGES / volume), got, equal_nan=True)
+
+
+@pytest.mark.parametrize("endianness", ["<", ">"])
+def test_a_nifti2_volume_is_its_nifti1_original(tmp_path, endianness):
+    """nibabel writes each shared volume as NIfTI-2 (its header widened to 64 bits, in either
+    byte order, the voxels as stored: int16 with a slope for the z-map): the samples along the
+    streamlines are the NIfTI-1 file's bit for bit, and the slices' picture is the same."""
+    t = lineao.load(STROKE)
+    for volume in ("strokez.nii.gz", "MNI152_2009_template.nii.gz"):
+        img = nib.load(str(IMAGES / volume))
+        header = nib.Nifti2Header.from_header(img.header).as_byteswapped(endianness)
+        path = tmp_path / f"{endianness == '>'}-{volume}"
+        # The stored integers and their scaling, not the scaled floats (which nibabel would
+        # quantize anew).
+        nifti2 = nib.Nifti2Image(img.dataobj.get_unscaled(), img.affine, header)
+        nifti2.header.set_slope_inter(img.dataobj.slope, img.dataobj.inter)
+        nib.save(nifti2, str(path))
+        again = nib.load(str(path))
+        assert isinstance(again, nib.Nifti2Image) and again.header.endianness == endianness
+        assert np.array_equal(np.asanyarray(again.dataobj), np.asanyarray(img.dataobj))
+        expected = lineao.sample_volume(t, IMAGES / volume)
+        assert np.array_equal(lineao.sample_volume(t, path), expected, equal_nan=True), volume
+        assert np.array_equal(np.isnan(expected), np.isnan(independent_samples(t.points, path)))
+    rules = {**SMALL, "slices": "0,-18,10"}
+    assert np.array_equal(lineao.render(t, volume=str(path), **rules), lineao.render(t, volume=str(IMAGES / volume), **rules))
 
 
 def test_points_outside_are_nan_and_bad_files_raise(tmp_path):

@@ -467,7 +467,7 @@ pub struct StyleArgs {
 #[command(next_help_heading = "Context")]
 #[serde(default)]
 pub struct ContextArgs {
-    /// Anatomy: a NIfTI-1 volume (.nii, .nii.gz) placed by its sform (else qform, else voxel
+    /// Anatomy: a NIfTI-1 or NIfTI-2 volume (.nii, .nii.gz) placed by its sform (else qform, else voxel
     /// sizes: nibabel's rule), shown as slices that occlude the lines and that their AO darkens
     /// (the bilateral blur then smooths the slices' pixels: the occlusion's sampling noise is
     /// grain on a slice).

@@ -56,3 +56,23 @@ g = {"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}], "nodes
                    {"bufferView": 1, "componentType": 5123, "count": 4, "type": "SCALAR"}]}
 put('gltf', 'lines.gltf', json.dumps(g).encode())
 put('obj', 'lines.obj', b"v 0 0 0\nv 1 0 0\nv 0 1 0\nl 1 2\nl 2 3\nl -1 -3\nf 1 2 3\n")
+# NIfTI volumes (the `nifti` target): 2 x 3 x 2 voxels, NIfTI-1 float32 with an sform and int16
+# scaled with a qform, NIfTI-2 little- and big-endian (+ gz)
+def nii1(dtype, code, values, qform):
+    h = bytearray(348); struct.pack_into('<i', h, 0, 348); struct.pack_into('<8h', h, 40, 3, 2, 3, 2, 1, 1, 1, 1)
+    struct.pack_into('<2h', h, 70, code, struct.calcsize(dtype) * 8); struct.pack_into('<8f', h, 76, -1, 2, 2, 2, 1, 1, 1, 1)
+    struct.pack_into('<3f', h, 108, 352, 0.5, 1)
+    if qform: struct.pack_into('<h', h, 252, 1); struct.pack_into('<6f', h, 256, 0, 0.7071068, 0, 10, -20, 30)
+    else: struct.pack_into('<h', h, 254, 2); struct.pack_into('<12f', h, 280, -2,0,0,4, 0,2,0,-6, 0,0,2,8)
+    h[344:348] = b"n+1\0"
+    return bytes(h) + bytes(4) + struct.pack('<%d%s' % (len(values), dtype), *values)
+put('nifti', 'sform_f32.nii', nii1('f', 16, [float(v) for v in range(12)], False))
+put('nifti', 'qform_i16.nii', nii1('h', 4, list(range(-6, 6)), True))
+def nii2(order):
+    h = bytearray(540); struct.pack_into(order + 'i', h, 0, 540); h[4:12] = b"n+2\0\r\n\x1a\n"
+    struct.pack_into(order + '2h', h, 12, 16, 32); struct.pack_into(order + '8q', h, 16, 3, 2, 3, 2, 1, 1, 1, 1)
+    struct.pack_into(order + '8d', h, 104, 1, 2, 2, 2, 1, 1, 1, 1); struct.pack_into(order + 'q3d', h, 168, 544, 1, 0, 0)
+    struct.pack_into(order + '2i', h, 344, 1, 2); struct.pack_into(order + '6d', h, 352, 0, 0, 0, 1, 2, 3)
+    struct.pack_into(order + '12d', h, 400, 2,0,0,4, 0,2,0,-6, 0,0,2,8)
+    return bytes(h) + bytes(4) + struct.pack(order + '12f', *range(12))
+put('nifti', 'le.nii', nii2('<')); put('nifti', 'be.nii', nii2('>')); put('nifti', 'le.nii.gz', gzip.compress(nii2('<')))

@@ -1,5 +1,11 @@
-//! **Volumes** in NIfTI-1 (`.nii`, `.nii.gz`), read by the `nifti` crate and placed in RAS+
-//! millimetres as nibabel places them, and sampled along streamlines.
+//! **Volumes** in NIfTI-1 or NIfTI-2 (`.nii`, `.nii.gz`), read by the `nifti` crate (NIfTI-2's
+//! header by our own code, which the crate lacks) and placed in RAS+ millimetres as nibabel
+//! places them, and sampled along streamlines.
+//!
+//! **Headers**: NIfTI-2 (2011, for HCP's CIFTI and large grids) is NIfTI-1's header with its
+//! sizes, offsets and geometry widened to 64 bits and reordered, 540 bytes against 348; which
+//! one a file holds, and its byte order, is read from `sizeof_hdr`, as nibabel does. Either
+//! becomes one `Header` of the fields the placement and the voxels need.
 //!
 //! **Placement** (nibabel's `get_best_affine`): the sform where `sform_code` is set, else the
 //! qform (the quaternion, its offsets and the voxel sizes, the third axis flipped where
@@ -22,6 +28,7 @@ use std::io::Read;
 use std::path::Path;
 
 use glam::{DMat4, DVec3, DVec4};
+use num_traits::FromPrimitive;
 
 use crate::error::{Error, ErrorKind, bad};
 
@@ -37,8 +44,136 @@ pub struct Volume {
     to_voxel: DMat4,
 }
 
-/// Bytes of a NIfTI-1 header.
-const HEADER_BYTES: usize = 348;
+/// Which NIfTI a header is.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Version {
+    Nifti1,
+    Nifti2,
+}
+
+impl Version {
+    /// The header's size (`sizeof_hdr`): the voxels start there at the earliest.
+    fn header_bytes(self) -> usize {
+        match self {
+            Version::Nifti1 => 348,
+            Version::Nifti2 => 540,
+        }
+    }
+
+    /// Where `dim` lies in the header.
+    fn dim_offset(self) -> u64 {
+        match self {
+            Version::Nifti1 => 40,
+            Version::Nifti2 => 16,
+        }
+    }
+}
+
+/// What placing a volume and reading its voxels take from its header, NIfTI-1's or NIfTI-2's
+/// (the same fields, NIfTI-2's widened to 64 bits and reordered).
+struct Header {
+    version: Version,
+    dim: [i64; 8],
+    datatype: i16,
+    pixdim: [f64; 8],
+    vox_offset: f64,
+    scl_slope: f64,
+    scl_inter: f64,
+    qform_code: i32,
+    sform_code: i32,
+    /// `quatern_b`, `quatern_c`, `quatern_d`, then `qoffset_x`, `qoffset_y`, `qoffset_z`.
+    quatern: [f64; 6],
+    /// `srow_x`, `srow_y`, `srow_z`.
+    srow: [[f64; 4]; 3],
+    endianness: nifti::Endianness,
+}
+
+/// NIfTI-2's magic for a single file (`n+2` and a line-ending check); `ni2` is a `.hdr` whose
+/// voxels are in an `.img` beside it.
+const NIFTI2_MAGIC: &[u8; 8] = b"n+2\0\r\n\x1a\n";
+const NIFTI2_PAIR_MAGIC: &[u8; 8] = b"ni2\0\r\n\x1a\n";
+
+impl Header {
+    /// The header at the start of `bytes`: NIfTI-2 where `sizeof_hdr` reads 540 in either byte
+    /// order, else NIfTI-1 (348), read by the `nifti` crate.
+    fn read(bytes: &[u8]) -> Result<Header, ErrorKind> {
+        let Some(&sizeof_hdr) = bytes.first_chunk::<4>() else {
+            return bad(bytes.len() as u64, "a NIfTI header");
+        };
+        let nifti2 = Version::Nifti2.header_bytes() as i32;
+        if i32::from_le_bytes(sizeof_hdr) == nifti2 {
+            return Header::nifti2(bytes, nifti::Endianness::Little);
+        }
+        if i32::from_be_bytes(sizeof_hdr) == nifti2 {
+            return Header::nifti2(bytes, nifti::Endianness::Big);
+        }
+        let size = Version::Nifti1.header_bytes();
+        if bytes.len() < size {
+            return bad(bytes.len() as u64, format!("a NIfTI-1 header of {size} bytes"));
+        }
+        let h = nifti::NiftiHeader::from_reader(&bytes[..size])
+            .map_err(|e| ErrorKind::Format { offset: 0, expected: format!("a NIfTI-1 header ({e})") })?;
+        let wide = |values: [f32; 4]| values.map(f64::from);
+        Ok(Header {
+            version: Version::Nifti1,
+            dim: h.dim.map(i64::from),
+            datatype: h.datatype,
+            pixdim: h.pixdim.map(f64::from),
+            vox_offset: h.vox_offset.into(),
+            scl_slope: h.scl_slope.into(),
+            scl_inter: h.scl_inter.into(),
+            qform_code: h.qform_code.into(),
+            sform_code: h.sform_code.into(),
+            quatern: [h.quatern_b, h.quatern_c, h.quatern_d, h.quatern_x, h.quatern_y, h.quatern_z].map(f64::from),
+            srow: [wide(h.srow_x), wide(h.srow_y), wide(h.srow_z)],
+            endianness: h.endianness,
+        })
+    }
+
+    /// A NIfTI-2 header (`nifti2.h`'s layout). Ours: the `nifti` crate reads NIfTI-1 alone
+    /// (nifti-rs#89; its pull request #96 is not merged), and NIfTI-2's header is NIfTI-1's
+    /// fields at fixed offsets, so the crate still decodes the voxels.
+    fn nifti2(bytes: &[u8], endianness: nifti::Endianness) -> Result<Header, ErrorKind> {
+        let size = Version::Nifti2.header_bytes();
+        if bytes.len() < size {
+            return bad(bytes.len() as u64, format!("a NIfTI-2 header of {size} bytes"));
+        }
+        match &bytes[4..12] {
+            magic if magic == NIFTI2_MAGIC => {}
+            magic if magic == NIFTI2_PAIR_MAGIC => {
+                return Err(ErrorKind::Unsupported(
+                    "a NIfTI-2 header whose voxels are in another file (`ni2`, an .hdr/.img pair): \
+                     a single .nii (`n+2`) is read"
+                        .into(),
+                ));
+            }
+            _ => return bad(4, "NIfTI-2's magic \"n+2\\0\\r\\n\\x1a\\n\""),
+        }
+        let big = endianness == nifti::Endianness::Big;
+        let word = |at: usize| -> [u8; 8] { bytes[at..at + 8].try_into().expect("within the header") };
+        let i64_at = |at: usize| if big { i64::from_be_bytes(word(at)) } else { i64::from_le_bytes(word(at)) };
+        let f64_at = |at: usize| if big { f64::from_be_bytes(word(at)) } else { f64::from_le_bytes(word(at)) };
+        let i32_at = |at: usize| {
+            let b: [u8; 4] = bytes[at..at + 4].try_into().expect("within the header");
+            if big { i32::from_be_bytes(b) } else { i32::from_le_bytes(b) }
+        };
+        let datatype = [bytes[12], bytes[13]];
+        Ok(Header {
+            version: Version::Nifti2,
+            dim: std::array::from_fn(|k| i64_at(16 + 8 * k)),
+            datatype: if big { i16::from_be_bytes(datatype) } else { i16::from_le_bytes(datatype) },
+            pixdim: std::array::from_fn(|k| f64_at(104 + 8 * k)),
+            vox_offset: i64_at(168) as f64,
+            scl_slope: f64_at(176),
+            scl_inter: f64_at(184),
+            qform_code: i32_at(344),
+            sform_code: i32_at(348),
+            quatern: std::array::from_fn(|k| f64_at(352 + 8 * k)),
+            srow: std::array::from_fn(|row| std::array::from_fn(|col| f64_at(400 + 32 * row + 8 * col))),
+            endianness,
+        })
+    }
+}
 
 impl Volume {
     /// A volume of `dims` voxels (`values` i fastest) placed by `affine`; an error where the
@@ -56,7 +191,7 @@ impl Volume {
         Ok(Volume { dims, values, affine, to_voxel: affine.inverse() })
     }
 
-    /// Reads a NIfTI-1 file (`.nii`, or `.nii.gz` by its content).
+    /// Reads a NIfTI-1 or NIfTI-2 file (`.nii`, or `.nii.gz` by its content).
     pub fn load(path: impl AsRef<Path>) -> Result<Volume, Error> {
         let path = path.as_ref();
         let bytes = std::fs::read(path).map_err(|e| ErrorKind::Io(e).at(path))?;
@@ -72,7 +207,7 @@ impl Volume {
         name.ends_with(".nii") || name.ends_with(".nii.gz")
     }
 
-    /// A NIfTI-1 file's bytes (gzip-wrapped or not), inflating at most `max_inflated` bytes.
+    /// A NIfTI-1 or NIfTI-2 file's bytes (gzip-wrapped or not), inflating at most `max_inflated` bytes.
     pub fn from_bytes(bytes: &[u8], max_inflated: u64) -> Result<Volume, ErrorKind> {
         let inflated;
         let bytes = if bytes.starts_with(&[0x1f, 0x8b]) {
@@ -89,20 +224,22 @@ impl Volume {
         } else {
             bytes
         };
-        if bytes.len() < HEADER_BYTES {
-            return bad(bytes.len() as u64, format!("a NIfTI-1 header of {HEADER_BYTES} bytes"));
-        }
-        let header = nifti::NiftiHeader::from_reader(&bytes[..HEADER_BYTES])
-            .map_err(|e| ErrorKind::Format { offset: 0, expected: format!("a NIfTI-1 header ({e})") })?;
+        let header = Header::read(bytes)?;
         let dim = header.dim;
-        let rank = dim[0] as usize;
+        let rank = dim[0];
         // 4-D and up only where every further axis is 1.
-        if !(1..=7).contains(&rank) || dim[4..=rank.max(3)].iter().any(|&d| d != 1) {
-            return bad(40, format!("a 3-D volume (dim {:?})", &dim[..=rank.min(7)]));
+        if !(1..=7).contains(&rank) || dim[4..=rank.max(3) as usize].iter().any(|&d| d != 1) {
+            let shown = &dim[..=rank.clamp(0, 7) as usize];
+            return bad(header.version.dim_offset(), format!("a 3-D volume (dim {shown:?})"));
         }
-        let dims = [0, 1, 2].map(|a| if a < rank { dim[a + 1] as usize } else { 1 });
-        let datatype =
-            header.data_type().map_err(|_| ErrorKind::Unsupported(format!("datatype {}", header.datatype)))?;
+        // The crate's volumes hold u16 sizes (NIfTI-1's); NIfTI-2's are 64 bits.
+        let dims = [1, 2, 3].map(|a| if a <= rank { u16::try_from(dim[a as usize]).ok() } else { Some(1) });
+        let [Some(i), Some(j), Some(k)] = dims else {
+            return bad(header.version.dim_offset(), format!("0 to 65 535 voxels an axis (dim {:?})", &dim[1..4]));
+        };
+        let dims = [i, j, k].map(usize::from);
+        let datatype = nifti::NiftiType::from_i16(header.datatype)
+            .ok_or_else(|| ErrorKind::Unsupported(format!("datatype {}", header.datatype)))?;
         if matches!(
             datatype,
             nifti::NiftiType::Rgb24
@@ -113,7 +250,7 @@ impl Volume {
         {
             return Err(ErrorKind::Unsupported(format!("a volume of {datatype:?} values (scalars only)")));
         }
-        let start = header.vox_offset.max(HEADER_BYTES as f32) as usize;
+        let start = header.vox_offset.max(header.version.header_bytes() as f64) as usize;
         let voxels = dims.iter().product::<usize>();
         let size = voxels.saturating_mul(datatype.size_of());
         if bytes.len() < start || bytes.len() - start < size {
@@ -131,9 +268,15 @@ impl Volume {
         raw_dim[0] = 3;
         raw_dim[1..4].copy_from_slice(&dims.map(|d| d as u16));
         let raw = bytes[start..start + size].to_vec();
-        let volume =
-            nifti::volume::InMemNiftiVolume::from_raw_fields(raw_dim, datatype, slope, inter, raw, header.endianness)
-                .map_err(|e| ErrorKind::Format { offset: start as u64, expected: format!("voxels ({e})") })?;
+        let volume = nifti::volume::InMemNiftiVolume::from_raw_fields(
+            raw_dim,
+            datatype,
+            slope as f32,
+            inter as f32,
+            raw,
+            header.endianness,
+        )
+        .map_err(|e| ErrorKind::Format { offset: start as u64, expected: format!("voxels ({e})") })?;
         use nifti::IntoNdArray;
         let array = volume
             .into_ndarray::<f32>()
@@ -205,18 +348,23 @@ impl Volume {
         sum as f32
     }
 
-    /// [`Volume::sample`] at every point, on every core.
+    /// [`Volume::sample`] at every point, on every core (on this thread for fewer than 2^14).
     pub fn sample_points(&self, points: &[[f32; 3]]) -> Vec<f32> {
         let mut out = vec![0.0f32; points.len()];
+        let sample_all = |points: &[[f32; 3]], out: &mut [f32]| {
+            for (p, o) in points.iter().zip(out) {
+                *o = self.sample(*p);
+            }
+        };
         let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(16);
         let chunk = points.len().div_ceil(threads).max(1 << 14);
+        if points.len() <= chunk {
+            sample_all(points, &mut out);
+            return out;
+        }
         std::thread::scope(|scope| {
             for (points, out) in points.chunks(chunk).zip(out.chunks_mut(chunk)) {
-                scope.spawn(move || {
-                    for (p, o) in points.iter().zip(out) {
-                        *o = self.sample(*p);
-                    }
-                });
+                scope.spawn(move || sample_all(points, out));
             }
         });
         out
@@ -224,14 +372,14 @@ impl Volume {
 }
 
 /// nibabel's `get_best_affine`: sform, else qform, else the voxel sizes about the centre.
-fn best_affine(h: &nifti::NiftiHeader, dims: [usize; 3]) -> DMat4 {
-    let zooms = [1, 2, 3].map(|a| if h.pixdim[a].is_finite() && h.pixdim[a] != 0.0 { h.pixdim[a] as f64 } else { 1.0 });
+fn best_affine(h: &Header, dims: [usize; 3]) -> DMat4 {
+    let zooms = [1, 2, 3].map(|a| if h.pixdim[a].is_finite() && h.pixdim[a] != 0.0 { h.pixdim[a] } else { 1.0 });
     if h.sform_code != 0 {
-        let row = |r: [f32; 4]| DVec4::from_array(r.map(f64::from));
-        return DMat4::from_cols(row(h.srow_x), row(h.srow_y), row(h.srow_z), DVec4::W).transpose();
+        let [x, y, z] = h.srow.map(DVec4::from_array);
+        return DMat4::from_cols(x, y, z, DVec4::W).transpose();
     }
     if h.qform_code != 0 {
-        let (b, c, d) = (h.quatern_b as f64, h.quatern_c as f64, h.quatern_d as f64);
+        let [b, c, d, qx, qy, qz] = h.quatern;
         let a = (1.0 - (b * b + c * c + d * d)).max(0.0).sqrt();
         let rotation = glam::DMat3::from_cols_array_2d(&[
             [a * a + b * b - c * c - d * d, 2.0 * (b * c + a * d), 2.0 * (b * d - a * c)],
@@ -240,7 +388,7 @@ fn best_affine(h: &nifti::NiftiHeader, dims: [usize; 3]) -> DMat4 {
         ]);
         let qfac = if h.pixdim[0] < 0.0 { -1.0 } else { 1.0 };
         let scale = glam::DMat3::from_diagonal(DVec3::new(zooms[0], zooms[1], zooms[2] * qfac));
-        let offset = DVec3::new(h.quatern_x as f64, h.quatern_y as f64, h.quatern_z as f64);
+        let offset = DVec3::new(qx, qy, qz);
         return DMat4::from_mat3(rotation * scale)
             + DMat4::from_cols(DVec4::ZERO, DVec4::ZERO, DVec4::ZERO, offset.extend(0.0));
     }

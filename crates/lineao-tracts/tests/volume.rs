@@ -1,6 +1,7 @@
 //! NIfTI volumes (`lineao_tracts::Volume`) against what nibabel reads of the shared ones
 //! (`../shared/data/FACTS.txt`): shape, affine (sform; the z-map's x axis flipped), value range
-//! and a voxel at a stated RAS+ position; and bad files as typed errors.
+//! and a voxel at a stated RAS+ position; the same files rewritten as NIfTI-2; and bad files as
+//! typed errors.
 
 use std::path::{Path, PathBuf};
 
@@ -96,4 +97,92 @@ fn bad_volumes_are_typed_errors_naming_the_file() {
     unknown[70..72].copy_from_slice(&1234i16.to_le_bytes());
     std::fs::write(&path, &unknown).unwrap();
     assert!(Volume::load(&path).unwrap_err().to_string().contains("datatype"));
+}
+
+/// `nifti1` (an uncompressed single-file NIfTI-1, little-endian) rewritten as NIfTI-2 by
+/// `nifti2.h`'s layout, every field copied by its offset in either header, in `big`-endian
+/// order if asked (the voxels swapped too); its voxels start at byte 544.
+fn as_nifti2(nifti1: &[u8], big: bool) -> Vec<u8> {
+    let i16_at = |at: usize| i16::from_le_bytes([nifti1[at], nifti1[at + 1]]);
+    let f32_at = |at: usize| f32::from_le_bytes(nifti1[at..at + 4].try_into().unwrap());
+    let mut out = vec![0u8; 544];
+    let mut put = |at: usize, le: &[u8]| {
+        let bytes: Vec<u8> = if big { le.iter().rev().copied().collect() } else { le.to_vec() };
+        out[at..at + bytes.len()].copy_from_slice(&bytes);
+    };
+    put(0, &540i32.to_le_bytes());
+    put(12, &i16_at(70).to_le_bytes()); // datatype
+    put(14, &i16_at(72).to_le_bytes()); // bitpix
+    for k in 0..8 {
+        put(16 + 8 * k, &i64::from(i16_at(40 + 2 * k)).to_le_bytes()); // dim
+        put(104 + 8 * k, &f64::from(f32_at(76 + 4 * k)).to_le_bytes()); // pixdim
+    }
+    put(168, &544i64.to_le_bytes()); // vox_offset
+    put(176, &f64::from(f32_at(112)).to_le_bytes()); // scl_slope
+    put(184, &f64::from(f32_at(116)).to_le_bytes()); // scl_inter
+    put(344, &i32::from(i16_at(252)).to_le_bytes()); // qform_code
+    put(348, &i32::from(i16_at(254)).to_le_bytes()); // sform_code
+    for k in 0..18 {
+        // quatern_b, c, d, qoffset_x, y, z, then srow_x, y, z: one run of floats in both.
+        put(352 + 8 * k, &f64::from(f32_at(256 + 4 * k)).to_le_bytes());
+    }
+    out[4..12].copy_from_slice(b"n+2\0\r\n\x1a\n");
+    let start = f32_at(108) as usize;
+    let size = (i16_at(72) / 8) as usize;
+    for voxel in nifti1[start..].chunks(size) {
+        if big {
+            out.extend(voxel.iter().rev());
+        } else {
+            out.extend_from_slice(voxel);
+        }
+    }
+    out
+}
+
+fn inflated(name: &str) -> Vec<u8> {
+    let bytes = std::fs::read(images(name)).unwrap();
+    let mut out = Vec::new();
+    std::io::Read::read_to_end(&mut flate2::read::GzDecoder::new(&bytes[..]), &mut out).unwrap();
+    out
+}
+
+#[test]
+fn a_nifti2_file_is_the_same_volume() {
+    for fact in FACTS {
+        let nifti1 = inflated(fact.file);
+        let expected = Volume::from_bytes(&nifti1, u64::MAX).unwrap();
+        for big in [false, true] {
+            let nifti2 = as_nifti2(&nifti1, big);
+            assert_eq!(&nifti2[4..8], b"n+2\0");
+            let got = Volume::from_bytes(&nifti2, u64::MAX).unwrap();
+            assert!(got == expected, "{}: NIfTI-2, big-endian {big}", fact.file);
+        }
+        // And through its qform alone (the template's sform and qform agree: nibabel's FACTS).
+        let mut qform_only = as_nifti2(&nifti1, false);
+        qform_only[348..352].fill(0);
+        let got = Volume::from_bytes(&qform_only, u64::MAX).unwrap();
+        let worst = (got.affine - expected.affine).to_cols_array().iter().fold(0.0f64, |m, d| m.max(d.abs()));
+        assert!(worst < 1e-6, "{}: qform against sform, {worst}", fact.file);
+    }
+}
+
+#[test]
+fn bad_nifti2_files_are_typed_errors() {
+    let nifti2 = as_nifti2(&inflated("strokez.nii.gz"), false);
+    let error = |bytes: &[u8]| Volume::from_bytes(bytes, u64::MAX).unwrap_err().to_string();
+    assert!(error(&nifti2[..300]).contains("a NIfTI-2 header of 540 bytes"), "{}", error(&nifti2[..300]));
+    assert!(error(&nifti2[..nifti2.len() - 1]).contains("bytes of voxels"));
+    let mut pair = nifti2.clone();
+    pair[4..8].copy_from_slice(b"ni2\0");
+    assert!(error(&pair).contains(".hdr/.img pair"), "{}", error(&pair));
+    let mut magic = nifti2.clone();
+    magic[6] = b'3';
+    assert!(error(&magic).contains("at byte 4: expected NIfTI-2's magic"), "{}", error(&magic));
+    // An axis of 2^32 voxels: more than the u16 sizes the voxels are read with, not allocated.
+    let mut huge = nifti2.clone();
+    huge[24..32].copy_from_slice(&(1i64 << 32).to_le_bytes());
+    assert!(error(&huge).contains("at byte 16: expected 0 to 65 535 voxels an axis"), "{}", error(&huge));
+    let mut negative = nifti2;
+    negative[32..40].copy_from_slice(&(-5i64).to_le_bytes());
+    assert!(error(&negative).contains("voxels an axis"), "{}", error(&negative));
 }
