@@ -36,7 +36,7 @@ pub fn options(args: &ViewArgs) -> app::Options {
             Source::Scene { kind, vertices: args.vertices.unwrap_or(kind.default_vertices()), seed: 1 }
         }
     };
-    // A volume to colour by that cannot be read is said, and the lines keep their tangent
+    // A volume or .tsf to colour by that cannot be read is said, and the lines keep their tangent
     // colours (the page cannot read files by name: it drops them).
     let sampled = crate::source::Sampled::of(&args.color).unwrap_or_else(|e| {
         eprintln!("lineao: {e:#}");
@@ -65,9 +65,11 @@ pub fn options(args: &ViewArgs) -> app::Options {
         ColorArg::Tangent => ColorMode::Tangent,
         ColorArg::Constant(rgb) => ColorMode::Constant(rgb.map(|c| (c.clamp(0.0, 1.0) * 255.0).round() as u8)),
         ColorArg::Field(name) => ColorMode::Field(name.clone()),
-        // Sampled at every vertex as the lines arrive: a field.
-        ColorArg::Volume(_) if sampled.is_some() => ColorMode::Field(args.color.field().expect("a volume's field")),
-        ColorArg::Volume(_) => ColorMode::Tangent,
+        // Sampled at (or read for) every vertex as the lines arrive: a field.
+        ColorArg::Volume(_) | ColorArg::Tsf(_) if sampled.is_some() => {
+            ColorMode::Field(args.color.field().expect("a file's field"))
+        }
+        ColorArg::Volume(_) | ColorArg::Tsf(_) => ColorMode::Tangent,
         // Direction until the file's groups are known (`Controls::set_groups`).
         ColorArg::Groups => ColorMode::Groups,
     };

@@ -254,6 +254,33 @@ fn a_volume_colours_the_lines_it_is_sampled_at() {
 }
 
 #[test]
+fn a_tsf_colours_the_tck_it_belongs_to() {
+    // `--color tsf:mni152.SLF1_R.tsf` on tract.SLF1_R.tck (mrview's scalar file): its values, a
+    // vertex each, the field the lines are coloured by as they arrive.
+    let images = "niivue+niivue/packages/niivue/demos/images";
+    let tsf = data(&format!("{images}/mni152.SLF1_R.tsf"));
+    let color = crate::args::ColorArg::Tsf(tsf.clone());
+    let mut options =
+        options(Source::File(data(&format!("{images}/tract.SLF1_R.tck"))), [methods()[1], methods()[4]], false);
+    options.sampled = crate::source::Sampled::of(&color).unwrap();
+    options.controls.color = super::controls::ColorMode::Field(color.field().unwrap());
+    let mut harness = harness(options);
+    settle(&mut harness);
+    let app = harness.state();
+    assert!(app.error.is_none(), "{:?}", app.error);
+    let frame = app.shown.as_ref().unwrap();
+    let lineao::LineColor::Scalar { range, .. } = frame.view.panels[0].settings.line_color else {
+        panic!("coloured by the .tsf's values: {:?}", frame.view.panels[0].settings.line_color)
+    };
+    let values = &lineao_tracts::load(&tsf).unwrap().tractogram.vertex_fields[0].values;
+    let (lo, hi) = values.iter().fold((f32::MAX, f32::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+    assert!(range[0] >= lo && range[1] <= hi && range[1] - range[0] > 0.5 * (hi - lo), "{range:?} in {lo}..{hi}");
+    for label in crate::label::legend_labels(range) {
+        harness.get_by_label(&label);
+    }
+}
+
+#[test]
 fn a_real_file_opens_and_a_bad_one_says_why() {
     let path = data("niivue+niivue/packages/niivue/demos/images/stroke.trk.gz");
     let mut harness = harness(options(Source::File(path.clone()), [methods()[1], methods()[4]], false));

@@ -89,6 +89,45 @@ def test_render_colored_by_a_volume_is_the_command_lines(lineao_bin, tmp_path):
     assert (image != plain).any(axis=2).mean() > 0.05
 
 
+def read_tsf(path):
+    """An MRtrix track scalar file by its specification: a text header up to `END`, whose
+    `file: . OFFSET` says where the float32 values start (`datatype`), a NaN after each
+    streamline, an Inf at the end (when written whole)."""
+    data = path.read_bytes()
+    header = data[: data.index(b"\nEND\n")].decode().splitlines()
+    fields = dict(line.split(": ", 1) for line in header[1:])
+    assert fields["datatype"] == "Float32LE"
+    values = np.frombuffer(data[int(fields["file"].split()[1]) :], "<f4")
+    values = values[: np.argmax(np.isinf(values))] if np.isinf(values).any() else values
+    ends = np.flatnonzero(np.isnan(values))
+    runs = np.split(values, ends + 1)[: len(ends)]
+    return [run[:-1] for run in runs]
+
+
+def test_a_tsf_colours_the_tck_it_belongs_to(lineao_bin, tmp_path):
+    """`--color tsf:FILE` (mrview's scalar file) is the same picture as the .tsf's values,
+    read here by its specification, given as a per-vertex field; a .tsf of another
+    tractogram is an error naming both."""
+    tck, tsf = IMAGES / "tract.SLF1_R.tck", IMAGES / "mni152.SLF1_R.tsf"
+    t = lineao.load(tck)
+    runs = read_tsf(tsf)
+    assert [len(r) for r in runs] == list(t.lengths)
+    values = np.concatenate(runs).astype(np.float32)
+    assert np.ptp(values) > 0
+    given = lineao.Tractogram(t.points, t.offsets, t.lengths, vertex_fields={"v": values})
+    image = lineao.render(tck, color=f"tsf:{tsf}", **SMALL)
+    assert (image != lineao.render(given, color="field:v", **SMALL)).sum() == 0
+    assert (image != lineao.render(tck, **SMALL)).any(axis=2).mean() > 0.005
+    expected = cli_render(lineao_bin, tmp_path, tck, "--color", f"tsf:{tsf}", "--width", 320, "--height", 256)
+    assert (image != expected).sum() == 0
+    with pytest.raises(Exception, match=r"SLF1_R\.tsf does not belong to .*stroke\.trk\.gz: it holds values for 13"):
+        lineao.render(STROKE, color=f"tsf:{tsf}", **SMALL)
+    # Streamlines whose lengths differ from the .tsf's: the first one that differs is named.
+    first_short = lineao.Tractogram(t.points[1:], np.r_[0, t.offsets[1:] - 1], np.r_[11, t.lengths[1:]])
+    with pytest.raises(Exception, match="streamline 0 holds 12 values and 11 points"):
+        lineao.render(first_short, color=f"tsf:{tsf}", **SMALL)
+
+
 def test_a_per_streamline_field_colours_whole_streamlines(lineao_bin, tmp_path):
     trx = IMAGES / "dpsv.trx"
     image = lineao.render(trx, color="field:DataSetID", **SMALL)

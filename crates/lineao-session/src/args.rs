@@ -439,7 +439,9 @@ pub struct StyleArgs {
     /// Line color: `tangent` (|T| as RGB), R,G,B in [0, 1], `field:NAME` (the file's
     /// per-vertex field NAME, or per-streamline one over its vertices, through --colormap, its 2nd to 98th percentile spanning the map), or
     /// `volume:FILE` (a NIfTI volume sampled at every vertex, trilinear between voxel centres;
-    /// gray outside it), or `groups` (TRX groups, a colour each; gray outside every group).
+    /// gray outside it), `tsf:FILE` (an MRtrix track scalar file written beside the .tck: a
+    /// value a vertex, its streamlines the tractogram's), or `groups` (TRX groups, a colour each;
+    /// gray outside every group).
     #[arg(long, default_value = "tangent", value_parser = parse_color)]
     #[serde(deserialize_with = "crate::kwargs::color")]
     pub color: ColorArg,
@@ -773,6 +775,8 @@ pub enum ColorArg {
     Field(String),
     /// A NIfTI volume sampled at every vertex (trilinear, NaN outside: gray) through --colormap.
     Volume(std::path::PathBuf),
+    /// An MRtrix track scalar file's values (.tsf, a value a vertex) through --colormap.
+    Tsf(std::path::PathBuf),
     /// Each streamline by its (first) group, a colour each; gray outside every group.
     Groups,
 }
@@ -782,12 +786,21 @@ pub enum ColorArg {
 pub const GROUP_FIELD: &str = "groups:";
 
 impl ColorArg {
+    /// The file beside the tractogram whose values colour it (`volume:FILE`, `tsf:FILE`).
+    pub fn values_file(&self) -> Option<&std::path::Path> {
+        match self {
+            ColorArg::Volume(path) | ColorArg::Tsf(path) => Some(path),
+            _ => None,
+        }
+    }
+
     /// The per-vertex field it colours by: the file's, or the volume's samples (named
-    /// `volume:PATH`).
+    /// `volume:PATH`), or the .tsf's values (`tsf:PATH`).
     pub fn field(&self) -> Option<String> {
         match self {
             ColorArg::Field(name) => Some(name.clone()),
             ColorArg::Volume(path) => Some(format!("volume:{}", path.display())),
+            ColorArg::Tsf(path) => Some(format!("tsf:{}", path.display())),
             ColorArg::Groups => Some(GROUP_FIELD.to_string()),
             _ => None,
         }
@@ -864,6 +877,9 @@ pub fn parse_vec3(s: &str) -> Result<[f32; 3], String> {
 pub fn parse_color(s: &str) -> Result<ColorArg, String> {
     if let Some(path) = s.strip_prefix("volume:").filter(|p| !p.is_empty()) {
         return Ok(ColorArg::Volume(path.into()));
+    }
+    if let Some(path) = s.strip_prefix("tsf:").filter(|p| !p.is_empty()) {
+        return Ok(ColorArg::Tsf(path.into()));
     }
     match s.strip_prefix("field:") {
         Some(name) if !name.is_empty() => Ok(ColorArg::Field(name.to_string())),

@@ -91,7 +91,7 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky, lon
             ColorArg::Tangent => LineColor::Tangent,
             ColorArg::Constant(rgb) => LineColor::Constant(*rgb),
             // The range comes from the data (`run` sets it).
-            ColorArg::Field(_) | ColorArg::Volume(_) => {
+            ColorArg::Field(_) | ColorArg::Volume(_) | ColorArg::Tsf(_) => {
                 LineColor::Scalar { colormap: args.style.colormap, range: [0.0, 1.0] }
             }
             // A colour each, whatever --colormap says.
@@ -267,7 +267,8 @@ impl Session {
         let surfaces = load_surfaces(args)?;
         let base = base_attributes(args);
         if let Some(sampled) = Sampled::of(&args.style.color)? {
-            sampled.add_to(&mut loaded.tracts);
+            sampled.add_to(&mut loaded.tracts, 0, &loaded.name)?;
+            sampled.check_whole(loaded.tracts.streamlines(), &loaded.name)?;
         }
         if args.style.color == ColorArg::Groups {
             crate::source::add_group_field(&mut loaded.tracts);
@@ -442,9 +443,9 @@ impl Session {
             }
         };
         if let (true, LineColor::Scalar { colormap, range }) = (args.image.legend, panels[0].settings.line_color) {
-            let title = match &args.style.color {
-                ColorArg::Field(name) => name.clone(),
-                ColorArg::Volume(path) => path.file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned()),
+            let title = match (&args.style.color, args.style.color.values_file()) {
+                (ColorArg::Field(name), _) => name.clone(),
+                (_, Some(path)) => path.file_name().map_or(String::new(), |n| n.to_string_lossy().into_owned()),
                 _ => String::new(),
             };
             match args.style.color {

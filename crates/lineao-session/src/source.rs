@@ -20,10 +20,15 @@ use lineao_tracts::{Field, Progress, SceneKind, Tractogram, ViewHint};
 pub enum SourceError {
     #[error(transparent)]
     Load(#[from] lineao_tracts::Error),
-    #[error("{path}: a .{format} holds values without points; render its .tck")]
+    #[error("{path}: a .{format} holds values without points; render its .tck with --color tsf:FILE")]
     ValuesWithoutPoints { path: String, format: &'static str },
     #[error("{0} has no finite points")]
     NoFinitePoints(String),
+    /// A .tsf whose streamlines are not the tractogram's (`--color tsf:FILE`).
+    #[error("{tsf} does not belong to {name}: {detail}")]
+    ValuesMismatch { tsf: String, name: String, detail: String },
+    #[error("{path}: a .{format} file, where --color tsf:FILE takes a track scalar file (.tsf)")]
+    NotTsf { path: String, format: &'static str },
     /// The GPU refused the geometry (too large for its buffers, a lost device).
     #[error("{name}: {source}")]
     Gpu { name: String, source: lineao::Error },
@@ -487,27 +492,87 @@ pub struct Keep {
     pub lengths: bool,
 }
 
-/// A volume sampled at every vertex of a tractogram: a per-vertex field named `field`
-/// (`--color volume:FILE`).
+/// Values from a file beside the tractogram, one a vertex, as the per-vertex field named
+/// `field`: a volume sampled at every vertex (`--color volume:FILE`), or an MRtrix track scalar
+/// file's values (`--color tsf:FILE`).
 #[derive(Debug)]
 pub struct Sampled {
     pub field: String,
-    pub volume: lineao_tracts::Volume,
+    from: SampledFrom,
+}
+
+#[derive(Debug)]
+enum SampledFrom {
+    /// Sampled trilinearly at every vertex.
+    Volume(lineao_tracts::Volume),
+    /// A .tsf read whole (4 bytes a vertex): streamline k's values are its run k, in the order
+    /// MRtrix writes a .tsf beside the .tck it belongs to.
+    Tsf { path: String, values: Tractogram },
 }
 
 impl Sampled {
-    /// The volume of `--color volume:FILE`, where the color asks for one.
+    /// The volume of `--color volume:FILE` or the .tsf of `--color tsf:FILE`, where the colour
+    /// asks for one.
     pub fn of(color: &crate::args::ColorArg) -> Result<Option<std::sync::Arc<Sampled>>> {
-        let crate::args::ColorArg::Volume(path) = color else { return Ok(None) };
-        let volume = lineao_tracts::Volume::load(path).map_err(SourceError::Load)?;
-        Ok(Some(std::sync::Arc::new(Sampled { field: color.field().expect("a volume's field"), volume })))
+        use crate::args::ColorArg;
+        let from = match color {
+            ColorArg::Volume(path) => {
+                SampledFrom::Volume(lineao_tracts::Volume::load(path).map_err(SourceError::Load)?)
+            }
+            ColorArg::Tsf(path) => {
+                let loaded = lineao_tracts::load(path)?;
+                let path = path.display().to_string();
+                if loaded.format != lineao_tracts::Format::Tsf {
+                    return Err(SourceError::NotTsf { path, format: loaded.format.name() });
+                }
+                SampledFrom::Tsf { path, values: loaded.tractogram }
+            }
+            _ => return Ok(None),
+        };
+        Ok(Some(std::sync::Arc::new(Sampled { field: color.field().expect("a file's field"), from })))
     }
 
-    /// Adds the samples at `tracts`' vertices as its field (replacing one of that name).
-    pub fn add_to(&self, tracts: &mut Tractogram) {
+    /// Adds the values at `tracts`' vertices as its field (replacing one of that name), where
+    /// `tracts` begins at streamline `first` of the tractogram `name` (a chunk of it).
+    pub fn add_to(&self, tracts: &mut Tractogram, first: usize, name: &str) -> Result<()> {
+        let values = match &self.from {
+            SampledFrom::Volume(volume) => volume.sample_points(&tracts.positions),
+            SampledFrom::Tsf { path, values: tsf } => {
+                let mismatch =
+                    |detail: String| SourceError::ValuesMismatch { tsf: path.clone(), name: name.into(), detail };
+                let (have, wanted) = (tsf.streamlines(), tracts.streamlines());
+                if first + wanted > have {
+                    return Err(mismatch(format!("it holds values for {have} streamlines, the tractogram more")));
+                }
+                let runs = tsf.offsets.get(first..first + wanted + 1).unwrap_or_default();
+                for (k, (run, line)) in runs.windows(2).zip(tracts.offsets.windows(2)).enumerate() {
+                    let (values, points) = (run[1] - run[0], line[1] - line[0]);
+                    if values != points {
+                        let detail = format!("streamline {} holds {values} values and {points} points", first + k);
+                        return Err(mismatch(detail));
+                    }
+                }
+                let span = runs.first().zip(runs.last()).map_or(0..0, |(&a, &b)| a as usize..b as usize);
+                let all = tsf.vertex_fields.first().map_or(&[][..], |f| &f.values[..]);
+                all.get(span).ok_or_else(|| mismatch("its values end early".into()))?.to_vec()
+            }
+        };
         tracts.vertex_fields.retain(|f| f.name != self.field);
-        let values = self.volume.sample_points(&tracts.positions);
         tracts.vertex_fields.push(Field { name: self.field.clone(), columns: 1, values });
+        Ok(())
+    }
+
+    /// Checks, once the tractogram `name` has arrived whole with `streamlines`, that the values
+    /// were for all of it (a .tsf with more streamlines belongs to another tractogram).
+    pub fn check_whole(&self, streamlines: usize, name: &str) -> Result<()> {
+        match &self.from {
+            SampledFrom::Tsf { path, values } if values.streamlines() != streamlines => {
+                let detail =
+                    format!("it holds values for {} streamlines, the tractogram {streamlines}", values.streamlines());
+                Err(SourceError::ValuesMismatch { tsf: path.clone(), name: name.into(), detail })
+            }
+            _ => Ok(()),
+        }
     }
 }
 
@@ -599,7 +664,7 @@ impl Lines {
             return Err(SourceError::ValuesWithoutPoints { path: self.name.clone(), format: "tsf" });
         }
         if let Some(sampled) = &self.keep.sampled {
-            sampled.add_to(&mut chunk);
+            sampled.add_to(&mut chunk, self.geometry.streamlines, &self.name)?;
         }
         // A per-streamline field named for the colour or the radii: at every vertex.
         for field in [&self.held.scalar, &self.held.radius].into_iter().flatten() {
@@ -643,6 +708,9 @@ impl Lines {
             .map_err(|source| SourceError::Gpu { name: name.clone(), source })?;
         if self.geometry.bounds.is_none() {
             return Err(SourceError::NoFinitePoints(name.clone()));
+        }
+        if let Some(sampled) = &self.keep.sampled {
+            sampled.check_whole(self.geometry.streamlines, name)?;
         }
         self.hint = hint.unwrap_or_else(|| framing(&self.geometry));
         Ok(())
@@ -701,7 +769,7 @@ impl Lines {
         self.tracts.streamline_fields = loaded.tracts.streamline_fields;
         self.tracts.vertex_fields = loaded.tracts.vertex_fields;
         if let Some(sampled) = &self.keep.sampled {
-            sampled.add_to(&mut self.tracts);
+            sampled.add_to(&mut self.tracts, 0, &self.name)?;
         }
         for field in [&self.held.scalar, &self.held.radius].into_iter().flatten() {
             self.tracts.spread_streamline_field(field);
