@@ -226,14 +226,12 @@ fn a_methods_described_settings_are_its_controls() {
     assert!(mean_luminance(&frame.images[0]) < mean_luminance(&quarter) - 0.005);
 }
 
-#[test]
-fn a_volume_colours_the_lines_it_is_sampled_at() {
-    // `--color volume:strokez.nii.gz` on stroke.trk.gz: the z-map sampled at every vertex as it
-    // arrives, a field the lines are coloured by through the colormap.
+/// Opens `file` of the shared images coloured by `color` (a file beside it: `volume:`, `tsf:`)
+/// and returns the colour range the lines are drawn with (the side panel's colour bar says it)
+/// and the share of the picture they cover.
+fn colour_range_by_file(file: &str, color: crate::args::ColorArg) -> ([f32; 2], f64) {
     let images = "niivue+niivue/packages/niivue/demos/images";
-    let color = crate::args::ColorArg::Volume(data(&format!("{images}/strokez.nii.gz")));
-    let mut options =
-        options(Source::File(data(&format!("{images}/stroke.trk.gz"))), [methods()[1], methods()[4]], false);
+    let mut options = options(Source::File(data(&format!("{images}/{file}"))), [methods()[1], methods()[4]], false);
     options.sampled = crate::source::Sampled::of(&color).unwrap();
     options.controls.color = super::controls::ColorMode::Field(color.field().unwrap());
     let mut harness = harness(options);
@@ -242,42 +240,36 @@ fn a_volume_colours_the_lines_it_is_sampled_at() {
     assert!(app.error.is_none(), "{:?}", app.error);
     let frame = app.shown.as_ref().unwrap();
     let lineao::LineColor::Scalar { range, .. } = frame.view.panels[0].settings.line_color else {
-        panic!("coloured by the volume's samples: {:?}", frame.view.panels[0].settings.line_color)
+        panic!("coloured by {color:?}: {:?}", frame.view.panels[0].settings.line_color)
     };
-    // The z-map along the streamlines spans 0 to about 1 (its 2nd to 98th percentile).
-    assert!(range[0] >= 0.0 && range[1] > 0.5 && range[1] < 1.3, "{range:?}");
-    assert!(non_background(&frame.images[0]) > 0.05);
-    // The side panel's colour bar says the range.
+    let drawn = non_background(&frame.images[0]);
     for label in crate::label::legend_labels(range) {
         harness.get_by_label(&label);
     }
+    (range, drawn)
+}
+
+#[test]
+fn a_volume_colours_the_lines_it_is_sampled_at() {
+    // `--color volume:strokez.nii.gz` on stroke.trk.gz: the z-map sampled at every vertex as it
+    // arrives, a field the lines are coloured by through the colormap.
+    let volume = data("niivue+niivue/packages/niivue/demos/images/strokez.nii.gz");
+    let (range, drawn) = colour_range_by_file("stroke.trk.gz", crate::args::ColorArg::Volume(volume));
+    // The z-map along the streamlines spans 0 to about 1 (its 2nd to 98th percentile).
+    assert!(range[0] >= 0.0 && range[1] > 0.5 && range[1] < 1.3, "{range:?}");
+    assert!(drawn > 0.05, "{drawn}");
 }
 
 #[test]
 fn a_tsf_colours_the_tck_it_belongs_to() {
     // `--color tsf:mni152.SLF1_R.tsf` on tract.SLF1_R.tck (mrview's scalar file): its values, a
     // vertex each, the field the lines are coloured by as they arrive.
-    let images = "niivue+niivue/packages/niivue/demos/images";
-    let tsf = data(&format!("{images}/mni152.SLF1_R.tsf"));
-    let color = crate::args::ColorArg::Tsf(tsf.clone());
-    let mut options =
-        options(Source::File(data(&format!("{images}/tract.SLF1_R.tck"))), [methods()[1], methods()[4]], false);
-    options.sampled = crate::source::Sampled::of(&color).unwrap();
-    options.controls.color = super::controls::ColorMode::Field(color.field().unwrap());
-    let mut harness = harness(options);
-    settle(&mut harness);
-    let app = harness.state();
-    assert!(app.error.is_none(), "{:?}", app.error);
-    let frame = app.shown.as_ref().unwrap();
-    let lineao::LineColor::Scalar { range, .. } = frame.view.panels[0].settings.line_color else {
-        panic!("coloured by the .tsf's values: {:?}", frame.view.panels[0].settings.line_color)
-    };
+    let tsf = data("niivue+niivue/packages/niivue/demos/images/mni152.SLF1_R.tsf");
+    let (range, drawn) = colour_range_by_file("tract.SLF1_R.tck", crate::args::ColorArg::Tsf(tsf.clone()));
+    assert!(drawn > 0.002, "13 streamlines drawn: {drawn}");
     let values = &lineao_tracts::load(&tsf).unwrap().tractogram.vertex_fields[0].values;
     let (lo, hi) = values.iter().fold((f32::MAX, f32::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
     assert!(range[0] >= lo && range[1] <= hi && range[1] - range[0] > 0.5 * (hi - lo), "{range:?} in {lo}..{hi}");
-    for label in crate::label::legend_labels(range) {
-        harness.get_by_label(&label);
-    }
 }
 
 #[test]
