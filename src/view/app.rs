@@ -259,8 +259,13 @@ impl App {
         self.load_failed = false;
         (self.camera, self.framed, self.first_picture, self.first_frame_ms) = (None, None, None, None);
         self.opened_at = Some(Instant::now());
-        // The regions set now are judged as the streamlines arrive.
-        self.send(ToWorker::Load(source, self.sampled.clone(), self.controls.selection().regions()));
+        // The regions set now are judged as the streamlines arrive. A .tsf's values belong to
+        // this one tractogram, a volume's to every one.
+        let sampled = match &self.sampled {
+            Some(values) if values.is_for_one_tractogram() => self.sampled.take(),
+            sampled => sampled.clone(),
+        };
+        self.send(ToWorker::Load(source, sampled, self.controls.selection().regions()));
     }
 
     /// Shows `volume`'s slices with every dataset from now on, at `positions` (default: three
@@ -276,14 +281,33 @@ impl App {
         self.anatomy.as_deref()
     }
 
-    /// Opens a file by its name: a NIfTI volume is the anatomy, anything else a dataset.
+    /// Opens a file by its name: a NIfTI volume is the anatomy, a track scalar file (.tsf) the
+    /// values the dataset is coloured by, anything else a dataset.
     pub fn open_path(&mut self, path: PathBuf) {
-        if !lineao_tracts::Volume::is_nifti_name(&path.to_string_lossy()) {
+        let name = path.to_string_lossy();
+        if is_tsf_name(&name) {
+            return match crate::source::Sampled::of(&crate::args::ColorArg::Tsf(path)) {
+                Ok(sampled) => self.colour_by(sampled.expect("a .tsf")),
+                Err(e) => self.error = Some(format!("{e:#}")),
+            };
+        }
+        if !lineao_tracts::Volume::is_nifti_name(&name) {
             return self.load(Source::File(path));
         }
         match lineao_tracts::Volume::load(&path) {
             Ok(volume) => self.set_anatomy(Arc::new(volume), None),
             Err(e) => self.error = Some(format!("{e}; the tractogram is shown without slices")),
+        }
+    }
+
+    /// Colours the lines by `values` (a .tsf opened or dropped beside the tractogram, which it
+    /// belongs to): the dataset shown or arriving takes them, else the next one opened.
+    pub fn colour_by(&mut self, values: Arc<crate::source::Sampled>) {
+        self.controls.color = ColorMode::Field(values.field.clone());
+        if self.dataset.is_some() || self.loading.is_some() {
+            self.send(ToWorker::Values(values));
+        } else {
+            self.sampled = Some(values);
         }
     }
 
@@ -410,6 +434,11 @@ impl App {
                         self.controls.color = ColorMode::Tangent;
                     }
                     self.dataset = Some(dataset);
+                }
+                FromWorker::Fields(fields) => {
+                    if let Some(dataset) = &mut self.dataset {
+                        dataset.fields = fields;
+                    }
                 }
                 FromWorker::Frame(frame) if self.dataset.is_some() => {
                     self.busy = None;
@@ -782,8 +811,11 @@ impl App {
         if let Some(path) = self.save_dialog.take_picked() {
             ctx.send_viewport_cmd(egui::ViewportCommand::Screenshot(egui::UserData::new(path)));
         }
-        // Several files at once: a volume and a tractogram dropped together are both opened.
-        let dropped: Vec<PathBuf> = ctx.input(|i| i.raw.dropped_files.iter().map(|f| f.path().to_path_buf()).collect());
+        // Several files at once: a volume and a tractogram dropped together are both opened, a
+        // .tsf after the tractogram it colours.
+        let mut dropped: Vec<PathBuf> =
+            ctx.input(|i| i.raw.dropped_files.iter().map(|f| f.path().to_path_buf()).collect());
+        dropped.sort_by_key(|path| is_tsf_name(&path.to_string_lossy()));
         for path in dropped {
             self.open_path(path);
         }
@@ -943,4 +975,10 @@ fn badge(painter: &egui::Painter, anchor: Pos2, align: Align2, text: &str) {
     let rect = align.anchor_size(anchor, galley.size() + Vec2::new(12.0, 8.0));
     painter.rect_filled(rect, 4.0, Color32::from_black_alpha(170));
     painter.galley(rect.min + Vec2::new(6.0, 4.0), galley, Color32::WHITE);
+}
+
+/// Whether a file's name is an MRtrix track scalar file's (`.tsf`, any case): values for the
+/// tractogram shown, not a dataset.
+pub fn is_tsf_name(name: &str) -> bool {
+    name.to_ascii_lowercase().ends_with(".tsf")
 }

@@ -13,7 +13,7 @@ use lineao::AoMethod;
 use lineao_tracts::SceneKind;
 
 use super::app::{App, Options};
-use super::controls::{Controls, RAY_TRACED, methods};
+use super::controls::{ColorMode, Controls, RAY_TRACED, methods};
 use super::loading::PREVIEW_VERTICES;
 use super::worker::Source;
 use lineao::Preset;
@@ -270,6 +270,51 @@ fn a_tsf_colours_the_tck_it_belongs_to() {
     let values = &lineao_tracts::load(&tsf).unwrap().tractogram.vertex_fields[0].values;
     let (lo, hi) = values.iter().fold((f32::MAX, f32::MIN), |(lo, hi), &v| (lo.min(v), hi.max(v)));
     assert!(range[0] >= lo && range[1] <= hi && range[1] - range[0] > 0.5 * (hi - lo), "{range:?} in {lo}..{hi}");
+}
+
+#[test]
+fn a_tsf_opened_beside_its_tck_colours_it_and_another_tractogram_is_left_alone() {
+    // `view tract.SLF1_R.tck`, then mni152.SLF1_R.tsf opened (or dropped) beside it: the values
+    // are added to the lines shown, without reading the .tck again, and coloured by; a .tsf
+    // opened first waits for the tractogram; another tractogram opened next is not coloured by
+    // it; a .tsf of another tractogram is an error naming both, the lines kept.
+    let images = "niivue+niivue/packages/niivue/demos/images";
+    let (tck, tsf) = (data(&format!("{images}/tract.SLF1_R.tck")), data(&format!("{images}/mni152.SLF1_R.tsf")));
+    let coloured_by = |harness: &Harness<'_, App>| match &harness.state().controls.color {
+        ColorMode::Field(name) => harness.state().dataset.as_ref().unwrap().fields.iter().any(|(f, _)| f == name),
+        _ => false,
+    };
+    let mut harness = harness(options(Source::File(tck.clone()), [methods()[1], methods()[4]], false));
+    settle(&mut harness);
+    let plain = harness.state().shown.as_ref().unwrap().images[0].clone();
+    harness.state_mut().open_path(tsf.clone());
+    settle(&mut harness);
+    let app = harness.state();
+    assert!(app.error.is_none(), "{:?}", app.error);
+    assert!(coloured_by(&harness), "{:?}", harness.state().controls.color);
+    let shown = &harness.state().shown.as_ref().unwrap().images[0];
+    let changed = shown.chunks_exact(4).zip(plain.chunks_exact(4)).filter(|(a, b)| a != b).count();
+    assert!(changed > 1000, "{changed} pixels recoloured");
+    // Another tractogram: its own colours.
+    harness.state_mut().open_path(data(&format!("{images}/tract.IFOF_R.trk")));
+    settle(&mut harness);
+    assert!(harness.state().error.is_none(), "{:?}", harness.state().error);
+    assert_eq!(harness.state().controls.color, ColorMode::Tangent);
+    // The .tsf beside it: not its streamlines.
+    harness.state_mut().open_path(tsf.clone());
+    settle(&mut harness);
+    let error = harness.state().error.clone().expect("an error");
+    assert!(error.contains("mni152.SLF1_R.tsf does not belong to") && error.contains("tract.IFOF_R.trk"), "{error}");
+    assert_eq!(harness.state().dataset.as_ref().unwrap().streamlines, 14, "the lines stay");
+
+    // The .tsf first, in a window with nothing open yet: the next tractogram takes it.
+    let empty = Options { source: None, ..options(Source::File(tck.clone()), [methods()[1], methods()[4]], false) };
+    let mut harness = self::harness(empty);
+    harness.state_mut().open_path(tsf);
+    harness.state_mut().open_path(tck);
+    settle(&mut harness);
+    assert!(harness.state().error.is_none(), "{:?}", harness.state().error);
+    assert!(coloured_by(&harness), "{:?}", harness.state().controls.color);
 }
 
 #[test]

@@ -69,6 +69,9 @@ pub enum ToWorker {
     /// The anatomy whose slices are shown (`--volume`, a volume opened or dropped), or none:
     /// it stays on the GPU across datasets, and the newest view is drawn again with it.
     Anatomy(Option<Arc<lineao_tracts::Volume>>),
+    /// Values for the dataset shown or arriving (a .tsf opened beside it), a field to colour
+    /// by: for what has arrived at once, for the rest as it arrives.
+    Values(Arc<Sampled>),
     Render(View),
 }
 
@@ -151,6 +154,9 @@ pub enum FromWorker {
         total: Option<u64>,
     },
     Loaded(Dataset),
+    /// The dataset's per-vertex fields changed ([`ToWorker::Values`]): all of them, as in
+    /// [`Dataset::fields`].
+    Fields(Vec<(String, [f32; 2])>),
     Frame(Box<Frame>),
     /// Something takes a while (computing object-space AO).
     Busy(String),
@@ -316,6 +322,13 @@ impl Worker {
             redraw = self.set_anatomy(anatomy.as_ref(), send);
         }
         pending.retain(|c| !matches!(c, ToWorker::Anatomy(_)));
+        // Values asked after the last load: for the dataset it opens, else the one there.
+        let last_load = pending.iter().rposition(|c| matches!(c, ToWorker::Load(..)));
+        let values: Vec<Arc<Sampled>> = (pending.iter().enumerate())
+            .filter(|&(k, _)| last_load.is_none_or(|l| k > l))
+            .filter_map(|(_, c)| if let ToWorker::Values(sampled) = c { Some(sampled.clone()) } else { None })
+            .collect();
+        pending.retain(|c| !matches!(c, ToWorker::Values(_)));
         let gpu = &self.gpu;
         let last_load = pending.iter().rposition(|c| matches!(c, ToWorker::Load(..)));
         let render =
@@ -331,6 +344,18 @@ impl Worker {
                 Ok(opening) => self.opening = Some(opening),
                 Err(e) => send(FromWorker::Error(e)),
             }
+        }
+        for sampled in values {
+            let (lines, complete) = match (&mut self.scene, &mut self.opening) {
+                (_, Some(opening)) => (&mut opening.lines, false),
+                (Some(scene), None) => (&mut scene.lines, true),
+                (None, None) => continue,
+            };
+            match lines.add_values(sampled, complete) {
+                Ok(()) => send(FromWorker::Fields(vertex_fields(lines))),
+                Err(e) => send(FromWorker::Error(format!("{e:#}"))),
+            }
+            redraw = true;
         }
         // A dataset arriving: a step of reading, and once part of it is on the GPU, the newest
         // view drawn again.
@@ -473,15 +498,17 @@ pub fn run(rx: Receiver<ToWorker>, tx: Sender<FromWorker>, repaint: impl Fn() + 
     }
 }
 
+/// `lines`' one-column per-vertex fields with their 2nd–98th percentile ranges: what the app
+/// colours by.
+fn vertex_fields(lines: &Lines) -> Vec<(String, [f32; 2])> {
+    let fields = lines.tracts.vertex_fields.iter();
+    let shown = fields.filter(|f| f.columns == 1 && f.name != crate::args::GROUP_FIELD);
+    shown.map(|f| (f.name.clone(), crate::render::percentile_range(&f.values))).collect()
+}
+
 /// What the app is told of `lines`, being opened (`complete`: all of it is on the GPU).
 fn dataset(lines: &Lines, opening: &Opening, complete: bool) -> Dataset {
-    let fields = lines
-        .tracts
-        .vertex_fields
-        .iter()
-        .filter(|f| f.columns == 1 && f.name != crate::args::GROUP_FIELD)
-        .map(|f| (f.name.clone(), crate::render::percentile_range(&f.values)))
-        .collect();
+    let fields = vertex_fields(lines);
     let (streamlines, vertices) = (lines.geometry.streamlines, lines.geometry.vertices);
     // While the data arrives, a camera that frames what has arrived.
     let hint = match complete {

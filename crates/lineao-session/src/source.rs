@@ -510,6 +510,16 @@ enum SampledFrom {
     Tsf { path: String, values: Tractogram },
 }
 
+impl SampledFrom {
+    /// A loaded file that must be a .tsf.
+    fn tsf(path: String, loaded: lineao_tracts::Loaded) -> Result<SampledFrom> {
+        if loaded.format != lineao_tracts::Format::Tsf {
+            return Err(SourceError::NotTsf { path, format: loaded.format.name() });
+        }
+        Ok(SampledFrom::Tsf { path, values: loaded.tractogram })
+    }
+}
+
 impl Sampled {
     /// The volume of `--color volume:FILE` or the .tsf of `--color tsf:FILE`, where the colour
     /// asks for one.
@@ -519,17 +529,22 @@ impl Sampled {
             ColorArg::Volume(path) => {
                 SampledFrom::Volume(lineao_tracts::Volume::load(path).map_err(SourceError::Load)?)
             }
-            ColorArg::Tsf(path) => {
-                let loaded = lineao_tracts::load(path)?;
-                let path = path.display().to_string();
-                if loaded.format != lineao_tracts::Format::Tsf {
-                    return Err(SourceError::NotTsf { path, format: loaded.format.name() });
-                }
-                SampledFrom::Tsf { path, values: loaded.tractogram }
-            }
+            ColorArg::Tsf(path) => SampledFrom::tsf(path.display().to_string(), lineao_tracts::load(path)?)?,
             _ => return Ok(None),
         };
         Ok(Some(std::sync::Arc::new(Sampled { field: color.field().expect("a file's field"), from })))
+    }
+
+    /// A .tsf's bytes named `name` (dropped on a web page or a window).
+    pub fn tsf_from_bytes(name: &str, bytes: &[u8]) -> Result<Sampled> {
+        let loaded = lineao_tracts::load_from_bytes(bytes, name, &Default::default())?;
+        let field = crate::args::ColorArg::Tsf(name.into()).field().expect("a file's field");
+        Ok(Sampled { field, from: SampledFrom::tsf(name.to_string(), loaded)? })
+    }
+
+    /// Whether the values belong to one tractogram (a .tsf), not to a space (a volume).
+    pub fn is_for_one_tractogram(&self) -> bool {
+        matches!(self.from, SampledFrom::Tsf { .. })
     }
 
     /// Adds the values at `tracts`' vertices as its field (replacing one of that name), where
@@ -740,6 +755,23 @@ impl Lines {
         let applied = self.apply_selection(&groups, on);
         self.tracts.groups = groups;
         applied
+    }
+
+    /// Colours by `sampled` (a .tsf opened beside the tractogram) from now on: its values for
+    /// the streamlines here already, whose offsets a stream keeps with the fields
+    /// ([`Keep::fields`]; a .tsf needs no points), and for each chunk to come; `complete`: all of
+    /// the tractogram is here, and the values must be for all of it.
+    pub fn add_values(&mut self, sampled: std::sync::Arc<Sampled>, complete: bool) -> Result<()> {
+        // A volume is sampled at the points.
+        if !sampled.is_for_one_tractogram() && !self.points_kept {
+            return Err(SourceError::PointsNotKept(self.name.clone()));
+        }
+        sampled.add_to(&mut self.tracts, 0, &self.name)?;
+        if complete {
+            sampled.check_whole(self.geometry.streamlines, &self.name)?;
+        }
+        self.keep.sampled = Some(sampled);
+        Ok(())
     }
 
     /// The selection the streamlines were judged by as they arrived ([`Keep::selection`]) and

@@ -178,6 +178,14 @@ await check('a file dropped on the page opens; a bad one is an error, and the pa
   assert.equal(status.state, 'ready', status.message);
   assert.equal(status.streamlines, expected.streamlines);
   assert.equal(status.vertices, expected.vertices);
+  assert.equal(status.colorRange, null, 'direction colours');
+  // Its track scalar file dropped beside it: the lines coloured by its values.
+  await drop('mni152.SLF1_R.tsf', fs.readFileSync(path.join(data, SMALL.replace('tract.SLF1_R.tck', 'mni152.SLF1_R.tsf'))));
+  await page.waitForFunction(() => window.lineaoStatus.colorRange != null, null, { timeout: 120_000 });
+  status = await settle();
+  assert.equal(status.state, 'ready', status.message);
+  assert.deepEqual(status.fields, ['tsf:mni152.SLF1_R.tsf']);
+  assert.ok(status.colorRange[0] < status.colorRange[1], JSON.stringify(status.colorRange));
   // The file picker (File ▸ Open… clicks this input).
   await page.setInputFiles('#lineao-file', path.join(data, STROKE));
   await page.waitForFunction(() => window.lineaoStatus.name === 'stroke.trk.gz', null, { timeout: 120_000 });

@@ -42,6 +42,9 @@ enum Inbound {
         volume: Result<lineao_tracts::Volume, String>,
         from_url: bool,
     },
+    /// A track scalar file (.tsf) read whole: the values the tractogram is coloured by (or why
+    /// they cannot be).
+    Values(Result<lineao_cli::source::Sampled, String>),
     Readback {
         panel: usize,
         resolve: js_sys::Function,
@@ -162,18 +165,26 @@ pub async fn start(canvas_id: String, adapter: String) -> Result<(), JsValue> {
 }
 
 /// Opens `file` (dropped on the page or picked in its file input): a NIfTI volume is the
-/// anatomy, shown as slices with the tractogram; anything else is a dataset.
+/// anatomy, shown as slices with the tractogram; a track scalar file (.tsf) the values the
+/// tractogram is coloured by (read whole, so it arrives after a tractogram dropped with it
+/// has begun to); anything else is a dataset.
 #[wasm_bindgen]
 pub fn open_file(file: web_sys::File) {
     let (name, size) = (file.name(), file.size() as u64);
     if let Some(message) = crate::too_large(&name, size) {
         return post(Inbound::Failed(message));
     }
-    if lineao_tracts::Volume::is_nifti_name(&name) {
+    let nifti = lineao_tracts::Volume::is_nifti_name(&name);
+    if nifti || lineao_cli::view::app::is_tsf_name(&name) {
         return wasm_bindgen_futures::spawn_local(async move {
             let bytes = JsFuture::from(file.array_buffer()).await;
             let bytes = bytes.map(|b| Uint8Array::new(&b).to_vec()).map_err(|e| format!("{name}: {}", js_message(&e)));
-            post(Inbound::Anatomy { volume: bytes.and_then(|b| crate::volume(&name, &b)), from_url: false });
+            post(match nifti {
+                true => Inbound::Anatomy { volume: bytes.and_then(|b| crate::volume(&name, &b)), from_url: false },
+                false => Inbound::Values(bytes.and_then(|b| {
+                    lineao_cli::source::Sampled::tsf_from_bytes(&name, &b).map_err(|e| format!("{e:#}"))
+                })),
+            });
         });
     }
     let feed = SharedFeed::new(Some(size), HOLD.with(|h| h.get()));
@@ -337,6 +348,8 @@ impl eframe::App for Page {
                 }
                 // The tractogram is still shown, without slices.
                 Inbound::Anatomy { volume: Err(message), .. } => self.app.error = Some(message),
+                Inbound::Values(Ok(values)) => self.app.colour_by(Arc::new(values)),
+                Inbound::Values(Err(message)) => self.app.error = Some(message),
                 Inbound::Readback { panel, resolve, reject } => self.requests.push((panel, resolve, reject)),
             }
         }
@@ -482,6 +495,12 @@ impl Page {
             "frames": app.frames_received,
             "anatomy": app.anatomy().map(|v| v.dims),
             "slices": frame.and_then(|f| f.view.panels[0].settings.slices.as_ref().map(|s| s.positions)),
+            // The per-vertex fields the lines can be coloured by, and the range of the one they are.
+            "fields": app.dataset.as_ref().map(|d| d.fields.iter().map(|(name, _)| name.clone()).collect::<Vec<_>>()),
+            "colorRange": frame.and_then(|f| match f.view.panels[0].settings.line_color {
+                lineao::LineColor::Scalar { range, .. } => Some(range),
+                _ => None,
+            }),
             "raysPerPixel": frame.map(|f| f.rays.iter().map(|r| r.map(|r| r.progress.rays_per_pixel)).collect::<Vec<_>>()),
         })
         .to_string();
