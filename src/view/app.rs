@@ -129,8 +129,11 @@ pub struct App {
     save_dialog: FileDialog,
     screenshot: Option<(PathBuf, u32)>,
     screenshot_requested: bool,
-    /// The volume each dataset opened is coloured by (`--color volume:FILE`).
+    /// The volume each dataset opened is coloured by (`--color volume:FILE`), or the values of
+    /// a .tsf opened before its tractogram, for the next one opened.
     sampled: Option<Arc<crate::source::Sampled>>,
+    /// Values sent to the worker for the dataset ([`ToWorker::Values`]) and not answered yet.
+    values_pending: usize,
     anatomy: Option<Arc<lineao_tracts::Volume>>,
     pub outcome: Arc<Mutex<Outcome>>,
     frames: u64,
@@ -200,6 +203,7 @@ impl App {
             save_dialog: FileDialog::new().title("Save a screenshot (PNG)").default_file_name("lineao-view.png"),
             screenshot: options.screenshot,
             sampled: options.sampled,
+            values_pending: 0,
             anatomy: options.anatomy,
             screenshot_requested: false,
             outcome: Arc::default(),
@@ -265,6 +269,8 @@ impl App {
             Some(values) if values.is_for_one_tractogram() => self.sampled.take(),
             sampled => sampled.clone(),
         };
+        // Values sent for the dataset before are answered, or dropped with it.
+        self.values_pending = 0;
         self.send(ToWorker::Load(source, sampled, self.controls.selection().regions()));
     }
 
@@ -305,6 +311,7 @@ impl App {
     pub fn colour_by(&mut self, values: Arc<crate::source::Sampled>) {
         self.controls.color = ColorMode::Field(values.field.clone());
         if self.dataset.is_some() || self.loading.is_some() {
+            self.values_pending += 1;
             self.send(ToWorker::Values(values));
         } else {
             self.sampled = Some(values);
@@ -366,6 +373,7 @@ impl App {
             return true;
         }
         self.loading.is_none()
+            && self.values_pending == 0
             && self.requested.is_some()
             && self.shown.as_ref().map(|f| &f.view) == self.requested.as_ref()
     }
@@ -380,6 +388,12 @@ impl App {
         self.busy = None;
         self.outcome.lock().expect("not poisoned").error = Some(message.clone());
         self.error = Some(message);
+        // Values that failed (a .tsf of another tractogram) colour nothing.
+        if let (ColorMode::Field(name), Some(dataset)) = (&self.controls.color, &self.dataset)
+            && !dataset.fields.iter().any(|(f, _)| f == name)
+        {
+            self.controls.color = ColorMode::Tangent;
+        }
     }
 
     fn receive(&mut self, ctx: &egui::Context) {
@@ -436,6 +450,7 @@ impl App {
                     self.dataset = Some(dataset);
                 }
                 FromWorker::Fields(fields) => {
+                    self.values_pending = self.values_pending.saturating_sub(1);
                     if let Some(dataset) = &mut self.dataset {
                         dataset.fields = fields;
                     }
@@ -479,7 +494,11 @@ impl App {
                         frame.times = times;
                     }
                 }
-                FromWorker::Error(message) => self.fail(message),
+                FromWorker::Error(message) => {
+                    // Values are answered by their error where they fail.
+                    self.values_pending = self.values_pending.saturating_sub(1);
+                    self.fail(message);
+                }
             }
         }
     }

@@ -306,6 +306,7 @@ fn a_tsf_opened_beside_its_tck_colours_it_and_another_tractogram_is_left_alone()
     let error = harness.state().error.clone().expect("an error");
     assert!(error.contains("mni152.SLF1_R.tsf does not belong to") && error.contains("tract.IFOF_R.trk"), "{error}");
     assert_eq!(harness.state().dataset.as_ref().unwrap().streamlines, 14, "the lines stay");
+    assert_eq!(harness.state().controls.color, ColorMode::Tangent, "in their own colours");
 
     // The .tsf first, in a window with nothing open yet: the next tractogram takes it.
     let empty = Options { source: None, ..options(Source::File(tck.clone()), [methods()[1], methods()[4]], false) };

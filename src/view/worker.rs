@@ -349,7 +349,10 @@ impl Worker {
             let (lines, complete) = match (&mut self.scene, &mut self.opening) {
                 (_, Some(opening)) => (&mut opening.lines, false),
                 (Some(scene), None) => (&mut scene.lines, true),
-                (None, None) => continue,
+                (None, None) => {
+                    send(FromWorker::Error(format!("{}: no tractogram is open to colour", sampled.field)));
+                    continue;
+                }
             };
             match lines.add_values(sampled, complete) {
                 Ok(()) => send(FromWorker::Fields(vertex_fields(lines))),
