@@ -4,8 +4,9 @@
 // the G-buffer of CONTRACT.md with the value through the window and colormap (`base_color`,
 // color mode 2), unlit, the plane's normal turned toward the eye. Transparent: no fragment
 // where the voxels without data (0 or NaN) weigh half the sample or more. The sample: one
-// filtered sample of the volume and of its data mask where the device filters f32 textures
-// (`fs_slice_filtered`), else eight `textureLoad`s (`fs_slice`).
+// filtered sample where the device filters f32 textures (`fs_slice_filtered`: an `Rg32Float`
+// texel, the value and 1 where the voxel holds data), else eight `textureLoad`s of an
+// `R32Float` one (`fs_slice`).
 #import shared/geometry.wgsl
 // SLICE_TILE: `lineao::targets::SLICE_TILE`.
 #import rust/constants.wgsl
@@ -24,11 +25,11 @@ struct SliceUniform {
     last_voxel: vec4<f32>,
 }
 
+// r: the value; g (where the device filters f32): 1 where the voxel holds data (finite, not 0).
 @group(1) @binding(0) var volume: texture_3d<f32>;
 @group(1) @binding(1) var<uniform> slice: SliceUniform;
-// 1 where a voxel holds data (finite, not 0), and the trilinear sampler (clamped to the edge).
-@group(1) @binding(2) var data_mask: texture_3d<f32>;
-@group(1) @binding(3) var trilinear_sampler: sampler;
+// Trilinear, clamped to the edge.
+@group(1) @binding(2) var trilinear_sampler: sampler;
 // A u32 per SLICE_TILE² tile of the guard-banded target, row-major, set where a slice's fragment
 // falls (`lineao::targets::FrameTargets::slice_tiles`): the bilateral blur runs there alone.
 @group(2) @binding(0) var<storage, read_write> tiles: array<u32>;
@@ -89,11 +90,10 @@ fn trilinear(x: vec3<f32>) -> vec2<f32> {
     return sum;
 }
 
-// `trilinear` by the texture units: the volume and the mask sampled once each.
+// `trilinear` by the texture units: the value and the data's mark, sampled once.
 fn filtered(x: vec3<f32>) -> vec2<f32> {
     let uvw = (x + 0.5) / (slice.last_voxel.xyz + 1.0);
-    let value = textureSampleLevel(volume, trilinear_sampler, uvw, 0.0).r;
-    return vec2<f32>(value, textureSampleLevel(data_mask, trilinear_sampler, uvw, 0.0).r);
+    return textureSampleLevel(volume, trilinear_sampler, uvw, 0.0).rg;
 }
 
 // The fragment's voxel coordinates; none outside the box of the voxel centres (a little slack

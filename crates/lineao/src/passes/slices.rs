@@ -14,15 +14,17 @@
 //! 2nd and 98th percentiles of the volume's finite values) and a colormap, unlit: a slice is a
 //! picture of the data, and the only darkening on it is the occlusion.
 //!
-//! The volume lives in an `R32Float` 3-D texture beside an `R8Unorm` mask (1 where a voxel holds
-//! data). Where the device filters f32 textures (`FLOAT32_FILTERABLE`: lavapipe, most desktop
-//! GPUs and browsers) one trilinear sample of each gives the value and the data's weight, in the
-//! texture units; elsewhere eight `textureLoad`s do (exact, and what every device can do). On
-//! lavapipe the filtered path draws the default frame's slices 4–6 ms sooner (of ~30 ms;
-//! docs/measurements.md); on a GPU the texture units are what filtering is for. A GPU filters
-//! with weights of 8 fractional bits or more: the sample is off by at most 1/512 of the
-//! difference between neighbouring voxels, below a colormap's step. `tests/slices.rs` checks
-//! both paths against the CPU's trilinear sample.
+//! Where the device filters f32 textures (`FLOAT32_FILTERABLE`: lavapipe, most desktop GPUs and
+//! browsers) the volume lives in an `Rg32Float` 3-D texture, each voxel's value beside a 1 where
+//! it holds data, so that one trilinear sample gives the value and the data's weight, in the
+//! texture units (8 bytes a voxel); elsewhere in an `R32Float` one, and eight `textureLoad`s
+//! give both (exact, and what every device can do; 4 bytes a voxel). On lavapipe the filtered
+//! path draws the default frame's slices in about two thirds of the loads' time, and the packed
+//! texel in three quarters of two samples' (an `R32Float` value and an `R8Unorm` mask, until
+//! session 38; docs/measurements.md); on a GPU the texture units are what filtering is for. A
+//! GPU filters with weights of 8 fractional bits or more: the sample is off by at most 1/512 of
+//! the difference between neighbouring voxels, below a colormap's step. `tests/slices.rs`
+//! checks both paths against the CPU's trilinear sample.
 
 use std::sync::Arc;
 
@@ -39,10 +41,9 @@ use crate::timing::Span;
 
 /// A scalar volume on the GPU for [`SliceRenderer`].
 pub struct SliceVolume {
+    /// `Rg32Float` (the value, and 1 where the voxel holds data: finite, not 0) where the
+    /// device filters f32 textures, else `R32Float` (the value).
     view: wgpu::TextureView,
-    /// 1 where a voxel holds data (finite, not 0), else 0: `R8Unorm`, filterable everywhere
-    /// (one texel where the device cannot filter f32, so the slices load voxels instead).
-    mask: wgpu::TextureView,
     dims: [u32; 3],
     world_to_voxel: Mat4,
     /// The axis-aligned world box around the voxel centres.
@@ -95,12 +96,12 @@ impl SliceVolume {
             queue.write_texture(texture.as_image_copy(), texels, layout, texture.size());
             texture.create_view(&Default::default())
         };
-        // The mask where the slices sample it ([`SliceRenderer::new`]), else one texel to bind.
-        let mask = if device.features().contains(wgpu::Features::FLOAT32_FILTERABLE) {
-            let texels: Vec<u8> = values.iter().map(|&v| if has_data(v) { 255 } else { 0 }).collect();
-            texture(wgpu::TextureFormat::R8Unorm, dims, &texels)
+        // Where the slices sample it ([`SliceRenderer::new`]), the data's mark beside each value.
+        let view = if device.features().contains(wgpu::Features::FLOAT32_FILTERABLE) {
+            let texels: Vec<[f32; 2]> = values.iter().map(|&v| [v, has_data(v) as u32 as f32]).collect();
+            texture(wgpu::TextureFormat::Rg32Float, dims, bytemuck::cast_slice(&texels))
         } else {
-            texture(wgpu::TextureFormat::R8Unorm, [1; 3], &[0])
+            texture(wgpu::TextureFormat::R32Float, dims, bytemuck::cast_slice(values))
         };
         let last = Vec3::new(dims[0] as f32 - 1.0, dims[1] as f32 - 1.0, dims[2] as f32 - 1.0);
         let (box_min, box_max) = world_box(voxel_to_world, Vec3::ZERO, last);
@@ -110,8 +111,7 @@ impl SliceVolume {
         let data_box = data_voxels(dims, values)
             .map(|(lo, hi)| world_box(voxel_to_world, (lo - 0.5).max(Vec3::ZERO), (hi + 0.5).min(last)));
         Ok(SliceVolume {
-            view: texture(wgpu::TextureFormat::R32Float, dims, bytemuck::cast_slice(values)),
-            mask,
+            view,
             dims,
             world_to_voxel: voxel_to_world.inverse(),
             box_min,
@@ -260,7 +260,7 @@ pub struct SliceRenderer {
     /// group, visible to the fragments alone.
     tiles_layout: wgpu::BindGroupLayout,
     tiles: wgpu::BindGroup,
-    /// Trilinear, clamped to the edge: the volume's (where the device filters f32) and the mask's.
+    /// Trilinear, clamped to the edge: the volume's, where the device filters f32.
     sampler: wgpu::Sampler,
 }
 
@@ -277,7 +277,7 @@ impl SliceRenderer {
             device,
             label,
             wgpu::ShaderStages::VERTEX_FRAGMENT,
-            &[volume, Slot::Uniform, Slot::FilterableTexture3d, Slot::Sampler],
+            &[volume, Slot::Uniform, Slot::Sampler],
         );
         let module = crate::shader::module(device, "slices.wgsl");
         let tiles_layout = binding::layout(device, label, wgpu::ShaderStages::FRAGMENT, &[Slot::StorageReadWrite]);
@@ -332,7 +332,6 @@ impl SliceRenderer {
                 &[
                     wgpu::BindingResource::TextureView(&volume.view),
                     self.uniform.as_entire_binding(),
-                    wgpu::BindingResource::TextureView(&volume.mask),
                     wgpu::BindingResource::Sampler(&self.sampler),
                 ],
             );
