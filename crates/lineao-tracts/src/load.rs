@@ -232,6 +232,10 @@ pub(crate) fn detect(head: &[u8], path: &Path) -> Parse<Format> {
     if let Some(format) = Format::from_path(path).filter(|f| *f != Format::Trx) {
         return Ok(format);
     }
+    if crate::volume::is_nifti(head) {
+        let what = "a NIfTI volume, an image and not streamlines: open it as the anatomy beside a tractogram";
+        return Err(ErrorKind::UnknownFormat(what.into()));
+    }
     let shown: String = head.iter().take(16).map(|&b| if b.is_ascii_graphic() { b as char } else { '.' }).collect();
     Err(ErrorKind::UnknownFormat(format!("the file starts with '{shown}'")))
 }

@@ -93,6 +93,17 @@ struct Header {
 const NIFTI2_MAGIC: &[u8; 8] = b"n+2\0\r\n\x1a\n";
 const NIFTI2_PAIR_MAGIC: &[u8; 8] = b"ni2\0\r\n\x1a\n";
 
+/// Whether `head` (a file's first bytes, inflated) begins a NIfTI-1 or NIfTI-2 header with its
+/// magic: a volume handed where streamlines were asked for is told as one.
+pub(crate) fn is_nifti(head: &[u8]) -> bool {
+    let Some(&sizeof_hdr) = head.first_chunk::<4>() else { return false };
+    let sizes = [i32::from_le_bytes(sizeof_hdr), i32::from_be_bytes(sizeof_hdr)];
+    let nifti1 = sizes.contains(&348) && matches!(head.get(344..348), Some(b"n+1\0" | b"ni1\0"));
+    let nifti2 =
+        sizes.contains(&540) && matches!(head.get(4..12), Some(m) if m == NIFTI2_MAGIC || m == NIFTI2_PAIR_MAGIC);
+    nifti1 || nifti2
+}
+
 impl Header {
     /// The header at the start of `bytes`: NIfTI-2 where `sizeof_hdr` reads 540 in either byte
     /// order, else NIfTI-1 (348), read by the `nifti` crate.

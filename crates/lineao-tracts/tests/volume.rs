@@ -186,3 +186,18 @@ fn bad_nifti2_files_are_typed_errors() {
     negative[32..40].copy_from_slice(&(-5i64).to_le_bytes());
     assert!(error(&negative).contains("voxels an axis"), "{}", error(&negative));
 }
+
+#[test]
+fn a_volume_opened_as_a_tractogram_is_told_as_one() {
+    // The tractogram's place given a NIfTI file, gzip or not, NIfTI-1 or NIfTI-2.
+    let nifti1 = inflated("strokez.nii.gz");
+    for (name, bytes) in [
+        ("strokez.nii.gz", std::fs::read(images("strokez.nii.gz")).unwrap()),
+        ("strokez.nii", nifti1.clone()),
+        ("strokez2.nii", as_nifti2(&nifti1, true)),
+    ] {
+        let e = lineao_tracts::load_from_bytes(&bytes, name, &Default::default()).unwrap_err();
+        assert!(matches!(e.kind, ErrorKind::UnknownFormat(_)), "{e}");
+        assert!(e.to_string().contains("a NIfTI volume, an image and not streamlines"), "{e}");
+    }
+}
