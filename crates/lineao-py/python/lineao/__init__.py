@@ -400,7 +400,9 @@ def render(
     1024, lines 2 px wide, tangent colours on white). ``compare=("lineao", "ssao")`` gives a
     split screen, ``grid=True`` every method, ``preset="paper"``, ``s_h=…`` a setting; the same
     settings give the same pixels as the command line. ``color`` is ``"tangent"``,
-    ``(r, g, b)`` in [0, 1] or ``"field:NAME"``. Bad settings raise ``ValueError`` with the
+    ``(r, g, b)`` in [0, 1], ``"field:NAME"``, ``"volume:FILE.nii.gz"`` (a NIfTI-1 or NIfTI-2
+    volume sampled at every vertex), ``"tsf:FILE.tsf"`` (an MRtrix track scalar file's values,
+    a vertex each) or ``"groups"``. Bad settings raise ``ValueError`` with the
     library's message; with no Vulkan driver, ``RuntimeError`` says what to install.
     """
     if color is not None and not isinstance(color, str):
