@@ -197,7 +197,7 @@ impl App {
             last_motion: None,
             image_rect: None,
             open_dialog: FileDialog::new()
-                .title("Open a tractogram, a mesh or an anatomy (NIfTI)")
+                .title("Open a tractogram, a mesh, an anatomy (NIfTI) or a .tck's values (.tsf)")
                 .add_file_filter_extensions("Tractograms, meshes and volumes", extensions)
                 .default_file_filter("Tractograms, meshes and volumes"),
             save_dialog: FileDialog::new().title("Save a screenshot (PNG)").default_file_name("lineao-view.png"),
