@@ -290,14 +290,13 @@ impl App {
     /// Opens a file by its name: a NIfTI volume is the anatomy, a track scalar file (.tsf) the
     /// values the dataset is coloured by, anything else a dataset.
     pub fn open_path(&mut self, path: PathBuf) {
-        let name = path.to_string_lossy();
-        if is_tsf_name(&name) {
+        if is_tsf(&path) {
             return match crate::source::Sampled::of(&crate::args::ColorArg::Tsf(path)) {
                 Ok(sampled) => self.colour_by(sampled.expect("a .tsf")),
                 Err(e) => self.error = Some(format!("{e:#}")),
             };
         }
-        if !lineao_tracts::Volume::is_nifti_name(&name) {
+        if !lineao_tracts::Volume::is_nifti_name(&path.to_string_lossy()) {
             return self.load(Source::File(path));
         }
         match lineao_tracts::Volume::load(&path) {
@@ -834,7 +833,7 @@ impl App {
         // .tsf after the tractogram it colours.
         let mut dropped: Vec<PathBuf> =
             ctx.input(|i| i.raw.dropped_files.iter().map(|f| f.path().to_path_buf()).collect());
-        dropped.sort_by_key(|path| is_tsf_name(&path.to_string_lossy()));
+        dropped.sort_by_key(|path| is_tsf(path));
         for path in dropped {
             self.open_path(path);
         }
@@ -996,8 +995,8 @@ fn badge(painter: &egui::Painter, anchor: Pos2, align: Align2, text: &str) {
     painter.galley(rect.min + Vec2::new(6.0, 4.0), galley, Color32::WHITE);
 }
 
-/// Whether a file's name is an MRtrix track scalar file's (`.tsf`, any case): values for the
-/// tractogram shown, not a dataset.
-pub fn is_tsf_name(name: &str) -> bool {
-    name.to_ascii_lowercase().ends_with(".tsf")
+/// Whether a file is named as an MRtrix track scalar file (the loaders' rule: `.tsf`, gzipped or
+/// not, any case): values for the tractogram shown, not a dataset.
+pub fn is_tsf(path: &std::path::Path) -> bool {
+    lineao_tracts::Format::from_path(path) == Some(lineao_tracts::Format::Tsf)
 }

@@ -175,7 +175,7 @@ pub fn open_file(file: web_sys::File) {
         return post(Inbound::Failed(message));
     }
     let nifti = lineao_tracts::Volume::is_nifti_name(&name);
-    if nifti || lineao_cli::view::app::is_tsf_name(&name) {
+    if nifti || lineao_cli::view::app::is_tsf(std::path::Path::new(&name)) {
         return wasm_bindgen_futures::spawn_local(async move {
             let bytes = JsFuture::from(file.array_buffer()).await;
             let bytes = bytes.map(|b| Uint8Array::new(&b).to_vec()).map_err(|e| format!("{name}: {}", js_message(&e)));
