@@ -16,6 +16,7 @@ use lineao::{
 };
 
 use super::worker::Panel;
+use crate::args::ColorArg;
 use crate::cli::Method;
 
 /// The methods the selector offers: `render --grid`'s ([`Method::all`], in its order), then
@@ -308,7 +309,8 @@ impl Controls {
 
     /// What a link keeps of the controls, as `lineao view`'s options (flag without dashes,
     /// value; empty for a switch): the shown methods' described settings that differ from the
-    /// preset's, and the selection's rules.
+    /// preset's, the colour (a file's values as `volume:FILE` or `tsf:FILE`, see
+    /// [`colours_by_a_file`]), the slab and the selection's rules.
     pub fn link_flags(&self) -> Vec<(String, String)> {
         let mut flags = Vec::new();
         // The preset's values with the flags so far written in, as the page will open them (a
@@ -330,6 +332,23 @@ impl Controls {
             };
             flags.push((setting.flag.to_string(), text));
             (setting.set)(&mut opened, value);
+        }
+        let color = match &self.color {
+            ColorMode::Tangent => None,
+            // A file's values are named as `--color` takes them.
+            ColorMode::Field(name) if colours_by_a_file(name) => Some(name.clone()),
+            ColorMode::Field(name) => Some(format!("field:{name}")),
+            ColorMode::Groups => Some("groups".into()),
+            ColorMode::Constant(rgb) => Some(rgb.map(|c| format!("{:.4}", f32::from(c) / 255.0)).join(",")),
+        };
+        if let Some(color) = color {
+            if matches!(self.color, ColorMode::Field(_)) && self.colormap != Colormap::Viridis {
+                flags.push(("colormap".into(), self.colormap.name().into()));
+            }
+            flags.push(("color".into(), color));
+        }
+        if let Some(Slab { axis, center, thickness }) = self.params.chain.slab {
+            flags.push(("slab".into(), format!("{},{center},{thickness}", axis.name())));
         }
         let selection = self.selection();
         let pair = |[a, b]: [f32; 2]| format!("{a},{b}");
@@ -730,6 +749,12 @@ impl Controls {
             });
         }
     }
+}
+
+/// Whether the field `name` (of [`ColorMode::Field`]) holds a file's values beside the
+/// tractogram, named as `--color` takes them (`volume:FILE`, `tsf:FILE`), not one of its own.
+pub fn colours_by_a_file(name: &str) -> bool {
+    matches!(crate::args::parse_color(name), Ok(ColorArg::Volume(_) | ColorArg::Tsf(_)))
 }
 
 /// The legend of a field's colours: the colormap over `range`, its ends' and middle's numbers

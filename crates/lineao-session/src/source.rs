@@ -535,6 +535,12 @@ impl Sampled {
         Ok(Some(std::sync::Arc::new(Sampled { field: color.field().expect("a file's field"), from })))
     }
 
+    /// `volume`, read from `name` (fetched by a web page), sampled at every vertex.
+    pub fn from_volume(name: &str, volume: lineao_tracts::Volume) -> Sampled {
+        let field = crate::args::ColorArg::Volume(name.into()).field().expect("a file's field");
+        Sampled { field, from: SampledFrom::Volume(volume) }
+    }
+
     /// A .tsf's bytes named `name` (dropped on a web page or a window).
     pub fn tsf_from_bytes(name: &str, bytes: &[u8]) -> Result<Sampled> {
         let loaded = lineao_tracts::load_from_bytes(bytes, name, &Default::default())?;

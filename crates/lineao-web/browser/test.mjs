@@ -15,6 +15,9 @@ const [base, out, lineao, data, WHOLE_BRAIN] = process.argv.slice(2);
 const STROKE = 'niivue+niivue/packages/niivue/demos/images/stroke.trk.gz';
 const SMALL = 'niivue+niivue/packages/niivue/demos/images/tract.SLF1_R.tck';
 const MNI = 'niivue+niivue/packages/niivue/demos/images/MNI152_2009_template.nii.gz';
+const STROKEZ = 'niivue+niivue/packages/niivue/demos/images/strokez.nii.gz';
+// Built beside `lineao` by the workspace's tests: the native numbers the page's are compared with.
+const WEB_CHECK = path.join(path.dirname(lineao), 'lineao-web-check');
 const results = {};
 fs.mkdirSync(out, { recursive: true });
 
@@ -213,6 +216,42 @@ await check('an anatomy by ?volume= with ?slices=; a bad volume dropped is said,
   assert.match(status.message, /without slices/, status.message);
   assert.equal(status.vertices, info(STROKE).vertices, 'the tractogram stays');
   results.anatomy = { link, badVolume: status.message };
+});
+
+await check('colour by a volume or a .tsf by ?color=volume: or tsf: (the range the command line uses); one that cannot be fetched is said', async () => {
+  // niivue's tracts.layer.voxel demo: stroke.trk.gz coloured by the z-map sampled at its points.
+  const z = `data/${STROKEZ}`;
+  const url = `?url=data/${encodeURIComponent(STROKE)}`;
+  let { status } = await open(`${url}&color=volume:${encodeURIComponent(z)}`);
+  assert.equal(status.state, 'ready', status.message);
+  assert.equal(status.vertices, info(STROKE).vertices);
+  assert.deepEqual(status.fields, [`volume:${z}`]);
+  // The same f32 numbers natively, exactly (the page's status widens them to f64).
+  const native = JSON.parse(execFileSync(WEB_CHECK,
+    ['--color-range', path.join(data, STROKE), `volume:${path.join(data, STROKEZ)}`], { encoding: 'utf8' }));
+  assert.deepEqual(status.colorRange.map(Math.fround), native.map(Math.fround),
+    `page ${JSON.stringify(status.colorRange)}, native ${JSON.stringify(native)}`);
+  await page.screenshot({ path: path.join(out, 'stroke-by-strokez.png') });
+  const link = await page.evaluate(() => location.search);
+  assert.match(link, /color=volume%3Adata%2F/, link);
+  const range = status.colorRange;
+  // A .tck's track scalar file, likewise.
+  const tsf = SMALL.replace('tract.SLF1_R.tck', 'mni152.SLF1_R.tsf');
+  ({ status } = await open(`?url=data/${encodeURIComponent(SMALL)}&color=tsf:data/${encodeURIComponent(tsf)}`));
+  assert.equal(status.state, 'ready', status.message);
+  assert.deepEqual(status.fields, [`tsf:data/${tsf}`]);
+  const nativeTsf = JSON.parse(execFileSync(WEB_CHECK,
+    ['--color-range', path.join(data, SMALL), `tsf:${path.join(data, tsf)}`], { encoding: 'utf8' }));
+  assert.deepEqual(status.colorRange.map(Math.fround), nativeTsf.map(Math.fround));
+  // An address that fails: said, and the tractogram arrives whole in its own colours.
+  ({ status } = await open(`${url}&color=volume:data/missing.nii.gz`, ['error']));
+  assert.match(status.message, /missing\.nii\.gz: HTTP 404/, status.message);
+  assert.match(status.message, /keep their colours/, status.message);
+  await page.waitForFunction(() => window.lineaoStatus.complete === true, null, { timeout: 120_000 });
+  status = await page.evaluate(() => window.lineaoStatus);
+  assert.equal(status.vertices, info(STROKE).vertices, 'the tractogram is shown');
+  assert.equal(status.colorRange, null, 'in its own colours');
+  results.colourByVolume = { range, native, link, missing: status.message };
 });
 
 await check('a file arrives in pieces: drawn while it loads, kept by the page only up to hold=', async () => {

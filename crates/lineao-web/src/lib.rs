@@ -48,12 +48,12 @@ pub fn too_large(name: &str, bytes: u64) -> Option<String> {
     })
 }
 
-/// The NIfTI volume in `bytes` (gzip or not), read from `name`: what the page shows as slices.
-/// Inflated to at most 256 MiB or 64 × the file, whichever is larger (the loaders' limit).
+/// The NIfTI volume in `bytes` (gzip or not), read from `name`: what the page shows as slices,
+/// or samples to colour the lines by. Inflated to at most 256 MiB or 64 × the file, whichever
+/// is larger (the loaders' limit).
 pub fn volume(name: &str, bytes: &[u8]) -> Result<lineao_tracts::Volume, String> {
     let limit = (256u64 << 20).max((bytes.len() as u64).saturating_mul(64));
-    lineao_tracts::Volume::from_bytes(bytes, limit)
-        .map_err(|kind| format!("{}; the tractogram is shown without slices", kind.at(std::path::Path::new(name))))
+    lineao_tracts::Volume::from_bytes(bytes, limit).map_err(|kind| kind.at(std::path::Path::new(name)).to_string())
 }
 
 #[cfg(test)]
@@ -72,6 +72,6 @@ mod tests {
     #[test]
     fn a_volume_that_cannot_be_read_names_its_file() {
         let message = super::volume("data/t1.nii.gz", &[0x1f, 0x8b, 0, 0]).unwrap_err();
-        assert!(message.starts_with("data/t1.nii.gz") && message.contains("without slices"), "{message}");
+        assert!(message.starts_with("data/t1.nii.gz") && message.contains("gzip"), "{message}");
     }
 }

@@ -13,8 +13,10 @@ use eframe::egui_wgpu::{WgpuSetup, WgpuSetupCreateNew};
 use js_sys::{Array, Float32Array, Object, Promise, Reflect, Uint8Array};
 use lineao::method::ssao::SsaoStage;
 use lineao::readback::TextureData;
-use lineao_cli::source::{SharedFeed, Source};
+use lineao_cli::args::ColorArg;
+use lineao_cli::source::{Sampled, SharedFeed, Source};
 use lineao_cli::view::App;
+use lineao_cli::view::controls::colours_by_a_file;
 use wasm_bindgen::JsCast;
 use wasm_bindgen::prelude::*;
 use wasm_bindgen_futures::JsFuture;
@@ -42,9 +44,9 @@ enum Inbound {
         volume: Result<lineao_tracts::Volume, String>,
         from_url: bool,
     },
-    /// A track scalar file (.tsf) read whole: the values the tractogram is coloured by (or why
-    /// they cannot be).
-    Values(Result<lineao_cli::source::Sampled, String>),
+    /// A track scalar file (.tsf) or a volume read whole: the values the tractogram is coloured
+    /// by (or why they cannot be).
+    Values(Result<Sampled, String>),
     Readback {
         panel: usize,
         resolve: js_sys::Function,
@@ -107,12 +109,41 @@ pub async fn start(canvas_id: String, adapter: String) -> Result<(), JsValue> {
             post(Inbound::Anatomy { volume: fetch_volume(&url).await, from_url: true });
         });
     }
-    if let Some(url) = &page.url {
+    if page.url.is_some() {
         options.source = None;
-        let url = url.clone();
+    }
+    if page.url.is_some() || page.values.is_some() {
+        let (url, values) = (page.url.clone(), page.values.clone());
         wasm_bindgen_futures::spawn_local(async move {
-            if let Err(e) = fetch(&url).await {
-                post(Inbound::Failed(e));
+            // The values first: the tractogram takes them as it arrives (a volume is sampled at
+            // each chunk's points, which the page need not keep).
+            let values = match &values {
+                Some(color) => fetch_values(color).await,
+                None => Ok(None),
+            };
+            let error = match values {
+                Ok(values) => {
+                    if let Some(values) = values {
+                        post(Inbound::Values(Ok(values)));
+                    }
+                    None
+                }
+                Err(message) => Some(message),
+            };
+            let opened = match url {
+                Some(url) => match open_url(&url).await {
+                    Ok((body, feed)) => Some((url, body, feed)),
+                    Err(e) => return post(Inbound::Failed(e)),
+                },
+                None => None,
+            };
+            // Said after the tractogram's load began (which clears the error before), which
+            // goes on in its own colours.
+            if let Some(message) = error {
+                post(Inbound::Values(Err(message)));
+            }
+            if let Some((url, body, feed)) = opened {
+                read_stream(&url, body, &feed).await;
             }
         });
     }
@@ -150,6 +181,7 @@ pub async fn start(canvas_id: String, adapter: String) -> Result<(), JsValue> {
                     app,
                     source,
                     volume: page.volume,
+                    values: page.values.and_then(|color| color.field()),
                     adapter,
                     requests: Vec::new(),
                     readbacks: Vec::new(),
@@ -181,9 +213,9 @@ pub fn open_file(file: web_sys::File) {
             let bytes = bytes.map(|b| Uint8Array::new(&b).to_vec()).map_err(|e| format!("{name}: {}", js_message(&e)));
             post(match nifti {
                 true => Inbound::Anatomy { volume: bytes.and_then(|b| crate::volume(&name, &b)), from_url: false },
-                false => Inbound::Values(bytes.and_then(|b| {
-                    lineao_cli::source::Sampled::tsf_from_bytes(&name, &b).map_err(|e| format!("{e:#}"))
-                })),
+                false => Inbound::Values(
+                    bytes.and_then(|b| Sampled::tsf_from_bytes(&name, &b).map_err(|e| format!("{e:#}"))),
+                ),
             });
         });
     }
@@ -227,23 +259,40 @@ async fn get(url: &str) -> Result<(web_sys::Response, Option<u64>), String> {
     Ok((response, total))
 }
 
-/// Fetches the NIfTI volume at `url` (relative to the page), whole.
-async fn fetch_volume(url: &str) -> Result<lineao_tracts::Volume, String> {
+/// Fetches the file at `url` (relative to the page), whole.
+async fn fetch_whole(url: &str) -> Result<Vec<u8>, String> {
     let (response, _) = get(url).await?;
     let cannot = |e: JsValue| format!("{url}: cannot read: {}", js_message(&e));
     let bytes = JsFuture::from(response.array_buffer().map_err(cannot)?).await.map_err(cannot)?;
-    crate::volume(url, &Uint8Array::new(&bytes).to_vec())
+    Ok(Uint8Array::new(&bytes).to_vec())
 }
 
-/// Fetches `url` (relative to the page) into a feed the viewer opens as it arrives.
-async fn fetch(url: &str) -> Result<(), String> {
+/// Fetches the NIfTI volume at `url` (relative to the page), whole.
+async fn fetch_volume(url: &str) -> Result<lineao_tracts::Volume, String> {
+    crate::volume(url, &fetch_whole(url).await?)
+}
+
+/// Fetches the file of `color=volume:ADDRESS` or `color=tsf:ADDRESS`: the values the lines are
+/// coloured by (`None` for another colour).
+async fn fetch_values(color: &ColorArg) -> Result<Option<Sampled>, String> {
+    let Some(url) = color.values_file().map(|path| path.to_string_lossy().into_owned()) else { return Ok(None) };
+    let bytes = fetch_whole(&url).await.map_err(|e| format!("{e}; the lines keep their colours"))?;
+    let sampled = match color {
+        ColorArg::Volume(_) => crate::volume(&url, &bytes).map(|volume| Sampled::from_volume(&url, volume)),
+        _ => Sampled::tsf_from_bytes(&url, &bytes).map_err(|e| format!("{e:#}")),
+    };
+    sampled.map(Some).map_err(|e| format!("{e}; the lines keep their colours"))
+}
+
+/// Starts fetching `url` (relative to the page) into a feed the viewer opens as it arrives:
+/// the response's body, which [`read_stream`] reads into the feed.
+async fn open_url(url: &str) -> Result<(web_sys::ReadableStream, SharedFeed), String> {
     post(Inbound::Progress { name: url.to_string(), bytes: 0, total: None });
     let (response, total) = get(url).await?;
     let body = response.body().ok_or_else(|| format!("{url}: the response has no body"))?;
     let feed = SharedFeed::new(total, HOLD.with(|h| h.get()));
     post(Inbound::Open { name: url.to_string(), feed: feed.clone(), from_url: true });
-    read_stream(url, body, &feed).await;
-    Ok(())
+    Ok((body, feed))
 }
 
 /// Reads `stream` to its end into `feed`, a piece at a time as the browser hands them over,
@@ -320,6 +369,9 @@ struct Page {
     source: LinkSource,
     /// The URL's `volume=`, which the link keeps while its volume is shown.
     volume: Option<String>,
+    /// The field of the URL's `color=volume:ADDRESS` or `tsf:ADDRESS` (named so), which the
+    /// link keeps while the lines are coloured by it; no link names a file dropped.
+    values: Option<String>,
     adapter: String,
     /// Readbacks asked for, and those copying.
     requests: Vec<(usize, js_sys::Function, js_sys::Function)>,
@@ -346,8 +398,9 @@ impl eframe::App for Page {
                     }
                     self.app.set_anatomy(Arc::new(volume), SLICES.with(|s| s.get()));
                 }
-                // The tractogram is still shown, without slices.
-                Inbound::Anatomy { volume: Err(message), .. } => self.app.error = Some(message),
+                Inbound::Anatomy { volume: Err(message), .. } => {
+                    self.app.error = Some(format!("{message}; the tractogram is shown without slices"));
+                }
                 Inbound::Values(Ok(values)) => self.app.colour_by(Arc::new(values)),
                 Inbound::Values(Err(message)) => self.app.error = Some(message),
                 Inbound::Readback { panel, resolve, reject } => self.requests.push((panel, resolve, reject)),
@@ -527,7 +580,10 @@ impl Page {
         let methods: Vec<&str> = frame.view.panels.iter().map(|p| p.settings.method.name()).collect();
         let orbit = app.camera.as_ref().map(|c| c.orbit_values());
         let ortho = app.camera.as_ref().is_some_and(|c| c.orthographic);
-        let flags = app.controls.link_flags();
+        let mut flags = app.controls.link_flags();
+        // The colour of a file's values: an address only where the URL fetched it.
+        let named = |value: &String| self.values.as_ref() == Some(value);
+        flags.retain(|(flag, value)| flag != "color" || !colours_by_a_file(value) || named(value));
         let link =
             query::link((&self.source, self.volume.as_deref()), &methods, app.controls.preset, (orbit, ortho), &flags);
         if self.link.as_ref() != Some(&link) {

@@ -8,9 +8,11 @@
 //! name: a positional file (use `url=`), `screenshot`, `frames` and `size` (the page is the
 //! window), and object-space AO (CPU threads, see `lineao_cli::view::controls::WEB_LEAVES_OUT`).
 //! `volume=` is an address, as `url=` is: the anatomy fetched beside the tractogram, its slices
-//! where `slices=` puts them.
+//! where `slices=` puts them; and so are the files of `color=volume:ADDRESS` and
+//! `color=tsf:ADDRESS`, fetched before the tractogram, whose values colour it.
 
 use clap::Parser;
+use lineao_cli::args::ColorArg;
 use lineao_cli::cli::ViewArgs;
 
 /// What the page opens: a file fetched from `url` (relative to the page), or the options' source.
@@ -19,7 +21,11 @@ pub struct PageArgs {
     pub url: Option<String>,
     /// `volume=`: a NIfTI volume's address (relative to the page), shown as slices.
     pub volume: Option<String>,
-    /// The viewer's options; its `volume` is `None` (a page reads no file by name).
+    /// `color=volume:ADDRESS` or `color=tsf:ADDRESS`: a file's address (relative to the page)
+    /// whose values colour the lines.
+    pub values: Option<ColorArg>,
+    /// The viewer's options; its `volume` is `None` and its `color` no file's (a page reads no
+    /// file by name).
     pub view: ViewArgs,
     /// `hold=MIB`: the most of a file the page keeps to read it again (for the methods that
     /// work on every point on the CPU); default [`crate::HOLD_BYTES`].
@@ -68,6 +74,7 @@ pub fn parse(search: &str) -> Result<PageArgs, String> {
     let mut view = cli.view;
     // An address, which the page fetches (clap took it as `--volume`, for `slices`' sake).
     let volume = view.volume.take().map(|path| path.to_string_lossy().into_owned());
+    let values = view.color.values_file().is_some().then(|| std::mem::replace(&mut view.color, ColorArg::Tangent));
     if url.is_some() && view.scene.is_some() {
         return Err("the page's URL: url= and scene= exclude each other".into());
     }
@@ -78,7 +85,7 @@ pub fn parse(search: &str) -> Result<PageArgs, String> {
     if methods.iter().any(|m| m.volume.is_some()) {
         return Err(format!("the page's URL: {}", lineao_cli::view::controls::WEB_LEAVES_OUT));
     }
-    Ok(PageArgs { url, volume, view, hold_bytes })
+    Ok(PageArgs { url, volume, values, view, hold_bytes })
 }
 
 /// The query string of a view: the source and the options a link keeps (methods, preset,
@@ -153,6 +160,13 @@ mod tests {
         assert_eq!(anatomy.view.slices, Some([Some(0.0), None, Some(10.0)]));
         assert!(!anatomy.view.opaque_slices);
         assert!(parse("url=stroke.trk.gz&volume=t1.nii.gz&opaque-slices").unwrap().view.opaque_slices);
+        // A file whose values colour the lines is an address, fetched by the page.
+        let coloured = parse("url=stroke.trk.gz&color=volume:data%2Fz.nii.gz").unwrap();
+        assert_eq!(coloured.values, Some(ColorArg::Volume("data/z.nii.gz".into())));
+        assert_eq!(coloured.view.color, ColorArg::Tangent, "no file the viewer reads");
+        assert_eq!(parse("url=a.tck&color=tsf:a.tsf").unwrap().values, Some(ColorArg::Tsf("a.tsf".into())));
+        let field = parse("url=a.trk&color=field:fa").unwrap();
+        assert_eq!((field.values, field.view.color), (None, ColorArg::Field("fa".into())));
     }
 
     #[test]
@@ -216,7 +230,7 @@ mod tests {
     #[test]
     fn a_link_keeps_the_methods_settings_and_the_selection() {
         use lineao::method::setting::Value;
-        use lineao_cli::view::controls::{Controls, RAY_TRACED, RegionRule, methods};
+        use lineao_cli::view::controls::{ColorMode, Controls, RAY_TRACED, RegionRule, methods};
         use lineao_tracts::Region;
         let ssao = methods().into_iter().find(|m| m.screen == AoMethod::Ssao && m.volume.is_none()).unwrap();
         let mut controls = Controls::new([ssao, RAY_TRACED], true, lineao::Preset::Legible);
@@ -229,13 +243,16 @@ mod tests {
         // A switch its flag cannot give (the denoiser off where the viewer turns it on) is left out.
         controls.params.chain.raytraced.denoise = None;
         (controls.subset, controls.length) = (0.3, Some([20.0, 80.5]));
+        (controls.color, controls.colormap) = (ColorMode::Field("fa".into()), lineao::Colormap::CoolWarm);
+        controls.params.chain.slab = Some(lineao::Slab { axis: lineao::SlabAxis::Y, center: -12.5, thickness: 8.0 });
         controls.regions = vec![
             RegionRule { include: true, region: Region::Sphere { center: [1.5, -2.0, 0.1], radius: 7.25 } },
             RegionRule { include: false, region: Region::Box { min: [-1.0, -2.0, -3.0], max: [4.0, 5.0, 6.5] } },
         ];
         let flags = controls.link_flags();
         let keys: Vec<&str> = flags.iter().map(|(flag, _)| flag.as_str()).collect();
-        assert_eq!(keys, ["ssao-samples", "ssao-radius", "ssao-range", "subset", "length", "include", "exclude"]);
+        let kept = ["ssao-samples", "ssao-radius", "ssao-range", "colormap", "color", "slab", "subset", "length"];
+        assert_eq!(keys, [&kept[..], &["include", "exclude"]].concat());
         let query = link(
             (&LinkSource::Scene("bundles".into()), None),
             &["ssao", "raytraced"],
@@ -246,6 +263,8 @@ mod tests {
         let page = parse(&query).unwrap();
         let opened = lineao_cli::view::options(&page.view).controls;
         assert_eq!(opened.selection(), controls.selection());
+        assert_eq!((&opened.color, opened.colormap), (&controls.color, controls.colormap));
+        assert_eq!(opened.params.chain.slab, controls.params.chain.slab);
         assert_eq!(opened.params.chain.ssao, controls.params.chain.ssao);
         assert_eq!(opened.link_flags(), flags, "the link of the page it opens is the same");
     }

@@ -4,6 +4,10 @@
 //!
 //! `lineao-web-check --load FILE`: the page's parse of FILE (its bytes in memory, as a drop or a
 //! fetch leaves them) natively, the median of five, for the page's load time to be compared.
+//!
+//! `lineao-web-check --color-range FILE COLOR`: the colour range (JSON `[min, max]`) the native
+//! viewer and `lineao render` give FILE's lines coloured by `COLOR` (`volume:NII`, `tsf:TSF`,
+//! `field:NAME`), for the page's to be compared.
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -34,8 +38,35 @@ fn load(path: &str) -> ExitCode {
     ExitCode::SUCCESS
 }
 
+/// The range of [`lineao_cli::render::percentile_range`] over FILE's values of `color`.
+fn color_range(file: &str, color: &str) -> Result<[f32; 2], String> {
+    let color = lineao_cli::args::parse_color(color)?;
+    let mut tracts = lineao_tracts::load(file).map_err(|e| e.to_string())?.tractogram;
+    if let Some(sampled) = lineao_cli::source::Sampled::of(&color).map_err(|e| format!("{e:#}"))? {
+        sampled.add_to(&mut tracts, 0, file).map_err(|e| format!("{e:#}"))?;
+    }
+    let field = color.field().ok_or("a colour by no field has no range")?;
+    let values =
+        tracts.vertex_fields.iter().find(|f| f.name == field).ok_or_else(|| format!("{file}: no field {field}"))?;
+    Ok(lineao_cli::render::percentile_range(&values.values))
+}
+
 fn main() -> ExitCode {
     let args: Vec<String> = std::env::args().skip(1).collect();
+    if let [flag, file, color] = &args[..]
+        && flag == "--color-range"
+    {
+        return match color_range(file, color) {
+            Ok([min, max]) => {
+                println!("[{min}, {max}]");
+                ExitCode::SUCCESS
+            }
+            Err(e) => {
+                eprintln!("{e}");
+                ExitCode::FAILURE
+            }
+        };
+    }
     if let [flag, file] = &args[..]
         && flag == "--load"
     {
@@ -43,7 +74,9 @@ fn main() -> ExitCode {
     }
     let dirs: Vec<PathBuf> = args.iter().map(PathBuf::from).collect();
     if dirs.is_empty() {
-        eprintln!("usage: lineao-web-check DIR...  (frames the web page read back) | --load FILE");
+        eprintln!(
+            "usage: lineao-web-check DIR...  (frames the web page read back) | --load FILE | --color-range FILE COLOR"
+        );
         return ExitCode::from(2);
     }
     let mut failed = false;
