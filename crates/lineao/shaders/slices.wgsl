@@ -1,5 +1,6 @@
-// Anatomy slices (`lineao::passes::slices`): one quad an axis over the world box of the voxel
-// centres (of the voxels with data, where those without are transparent); each fragment
+// Anatomy slices (`lineao::passes::slices`): one convex polygon an axis, the rectangle of the
+// voxel centres or (where voxels without data are transparent) an outline around the data
+// near the plane, drawn as a fan of triangles; each fragment
 // samples the volume trilinearly between voxel centres through the inverse affine and writes
 // the G-buffer of CONTRACT.md with the value through the window and colormap (`base_color`,
 // color mode 2), unlit, the plane's normal turned toward the eye. Transparent: no fragment
@@ -8,21 +9,20 @@
 // texel, the value and 1 where the voxel holds data), else eight `textureLoad`s of an
 // `R32Float` one (`fs_slice`).
 #import shared/geometry.wgsl
-// SLICE_TILE: `lineao::targets::SLICE_TILE`.
+// SLICE_TILE: `lineao::targets::SLICE_TILE`; OUTLINE_SIDES: `lineao::passes::slices::OUTLINE_SIDES`.
 #import rust/constants.wgsl
 
 // Keep in sync with `lineao::passes::slices::SliceUniform`.
 struct SliceUniform {
     world_to_voxel: mat4x4<f32>,
-    // The box the quads span: around the voxel centres, or the data's box.
-    box_min: vec4<f32>,
-    box_max: vec4<f32>,
     // xyz: where each axis's slice lies (world units).
     positions: vec4<f32>,
-    // xyz: 1 where the axis has a slice; w: 1 where voxels without data are transparent.
+    // xyz: 1 where the axis shows a slice; w: 1 where voxels without data are transparent.
     shown: vec4<u32>,
     // xyz: the last voxel index on each axis.
     last_voxel: vec4<f32>,
+    // Each axis's polygon in its plane: OUTLINE_SIDES corners (u, w), two a vec4.
+    outline: array<vec4<f32>, 3 * OUTLINE_SIDES / 2>,
 }
 
 // r: the value; g (where the device filters f32): 1 where the voxel holds data (finite, not 0).
@@ -41,28 +41,25 @@ struct SliceOut {
     @location(2) @interpolate(flat) axis: u32,
 }
 
-// Vertex v (0..6: two triangles) of axis `axis`'s quad; every vertex at the origin (no area)
-// where the axis has no slice or it misses the box.
+// Vertex v of axis `axis`'s polygon, a fan (corner 0, corner t + 1, corner t + 2 make triangle
+// t = v / 3); every vertex at the origin (no area) where the axis shows no slice.
 @vertex
 fn vs_slice(@builtin(vertex_index) v: u32, @builtin(instance_index) axis: u32) -> SliceOut {
     var out: SliceOut;
     out.axis = axis;
-    let p = slice.positions[axis];
-    if slice.shown[axis] == 0u || p < slice.box_min[axis] || p > slice.box_max[axis] {
+    if slice.shown[axis] == 0u {
         out.clip = vec4<f32>(0.0, 0.0, 0.0, 1.0);
         return out;
     }
-    let corners = array<vec2<f32>, 6>(
-        vec2<f32>(0.0, 0.0), vec2<f32>(1.0, 0.0), vec2<f32>(1.0, 1.0),
-        vec2<f32>(0.0, 0.0), vec2<f32>(1.0, 1.0), vec2<f32>(0.0, 1.0),
-    );
-    let c = corners[v];
+    let corner = select(v / 3u + v % 3u, 0u, v % 3u == 0u);
+    let pair = slice.outline[axis * (OUTLINE_SIDES / 2u) + corner / 2u];
+    let c = select(pair.xy, pair.zw, corner % 2u == 1u);
     let u = (axis + 1u) % 3u;
     let w = (axis + 2u) % 3u;
     var world = vec3<f32>(0.0);
-    world[axis] = p;
-    world[u] = mix(slice.box_min[u], slice.box_max[u], c.x);
-    world[w] = mix(slice.box_min[w], slice.box_max[w], c.y);
+    world[axis] = slice.positions[axis];
+    world[u] = c.x;
+    world[w] = c.y;
     let view_pos = frame.view * vec4<f32>(world, 1.0);
     out.clip = frame.proj * view_pos;
     out.view_pos = view_pos.xyz;

@@ -59,7 +59,10 @@ pub const CONSTANTS: &str = "rust/constants.wgsl";
 
 /// The passes' shared numbers: the side of the tiles in which the slices mark their pixels for
 /// the bilateral blur.
-pub const PASS_CONSTANTS: &[(&str, Constant)] = &[("SLICE_TILE", Constant::U32(crate::targets::SLICE_TILE))];
+pub const PASS_CONSTANTS: &[(&str, Constant)] = &[
+    ("SLICE_TILE", Constant::U32(crate::targets::SLICE_TILE)),
+    ("OUTLINE_SIDES", Constant::U32(crate::passes::slices::OUTLINE_SIDES as u32)),
+];
 
 /// [`CONSTANTS`]' text: `const NAME: f32 = …;` per constant, each f32 written with as many
 /// digits as give it back exactly.

@@ -4,8 +4,10 @@
 //! to it and every method sees the slice as a surface: the contact cue that tells where the
 //! fibres are in the head.
 //!
-//! A slice is one quad per axis over the world box of the volume's voxel centres. Each
-//! fragment maps its world position to voxel coordinates through the inverse of the volume's
+//! A slice is a convex polygon in its plane: the rectangle of the world box of the volume's
+//! voxel centres, or, where voxels without data are transparent, an outline around the voxels
+//! with data near the plane ([`SliceVolume::outline`]: on the MNI template's default slices a
+//! quarter fewer fragments than their rectangles, none of them shown). Each fragment maps its world position to voxel coordinates through the inverse of the volume's
 //! affine (voxel indices → world, the convention of NIfTI and nibabel) and interpolates the
 //! values trilinearly between the eight voxel centres around it — the numbers
 //! `lineao_tracts::Volume::sample` gives on the CPU, which the tests compare. Fragments
@@ -28,7 +30,7 @@
 
 use std::sync::Arc;
 
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Vec2, Vec3};
 
 use crate::Error;
 use crate::binding::{self, Slot};
@@ -52,6 +54,9 @@ pub struct SliceVolume {
     /// The world box around the voxels with data (finite, not 0) and half a voxel beyond; none
     /// without such voxels.
     data_box: Option<(Vec3, Vec3)>,
+    voxel_to_world: Mat4,
+    /// A bit a voxel (NIfTI's order, 64 a word): 1 where it holds data.
+    data: Vec<u64>,
     percentiles: [f32; 2],
 }
 
@@ -110,6 +115,10 @@ impl SliceVolume {
         // around them (within the box) hold every fragment that a transparent slice keeps.
         let data_box = data_voxels(dims, values)
             .map(|(lo, hi)| world_box(voxel_to_world, (lo - 0.5).max(Vec3::ZERO), (hi + 0.5).min(last)));
+        let mut data = vec![0u64; values.len().div_ceil(64)];
+        for (n, _) in values.iter().enumerate().filter(|(_, v)| has_data(**v)) {
+            data[n / 64] |= 1 << (n % 64);
+        }
         Ok(SliceVolume {
             view,
             dims,
@@ -117,18 +126,118 @@ impl SliceVolume {
             box_min,
             box_max,
             data_box,
+            voxel_to_world,
+            data,
             percentiles: percentiles(values, [0.02, 0.98]),
         })
     }
 
-    /// The world box the slices' quads span: around the voxel centres, or with `slices`
-    /// transparent where no data is, around the data (empty without any).
-    fn drawn_box(&self, slices: &SliceSettings) -> (Vec3, Vec3) {
-        match (slices.opaque, self.data_box) {
-            (true, _) => (self.box_min, self.box_max),
-            (false, Some(data)) => data,
-            (false, None) => (Vec3::INFINITY, Vec3::NEG_INFINITY),
+    /// The polygons the slices of `slices` are drawn as, [`OUTLINE_SIDES`] corners (u, w) an
+    /// axis, two to a `vec4`, and whether each axis shows one: the rectangle of the voxel
+    /// centres (its last corner repeated), or where voxels without data are transparent the
+    /// [`SliceVolume::outline`].
+    fn polygons(&self, slices: &SliceSettings) -> Polygons {
+        let mut words = [[0.0; 4]; OUTLINE_WORDS];
+        let mut shown = [false; 3];
+        for (axis, p) in slices.positions.iter().enumerate() {
+            let Some(p) = *p else { continue };
+            let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
+            let inside = (self.box_min[axis]..=self.box_max[axis]).contains(&p);
+            let corners = match slices.opaque {
+                _ if !inside => None,
+                true => {
+                    let (lo, hi) = (self.box_min, self.box_max);
+                    let rectangle = [[lo[u], lo[w]], [hi[u], lo[w]], [hi[u], hi[w]], [lo[u], hi[w]]].map(Vec2::from);
+                    Some(std::array::from_fn(|k| rectangle[k.min(3)]))
+                }
+                false => self.outline(axis, p),
+            };
+            let Some(corners) = corners else { continue };
+            shown[axis] = true;
+            for (k, pair) in corners.chunks_exact(2).enumerate() {
+                words[axis * OUTLINE_SIDES / 2 + k] = [pair[0].x, pair[0].y, pair[1].x, pair[1].y];
+            }
         }
+        (words, shown)
+    }
+
+    /// A convex polygon in the plane `axis` = `p` (world) holding every point of it that a
+    /// transparent slice shows: [`OUTLINE_SIDES`] corners (u, w), the plane's other two world
+    /// axes in cyclic order; `None` where no voxel with data is near the plane.
+    ///
+    /// A fragment shows where the voxels with data weigh half or more of its trilinear sample,
+    /// so one of the eight voxels around it, v, holds data, and it lies in the cube of voxel
+    /// coordinates [v − 1, v + 1]³. The cubes that meet the plane are those of the voxels with
+    /// |n · v − c| ≤ |n|₁, n · x = c being the plane in voxel coordinates, found a column at a
+    /// time along the voxel axis that n leans on most (a few voxels a column). The polygon is
+    /// the intersection of the half-planes, one a direction 360°/[`OUTLINE_SIDES`] apart (its
+    /// four axis-aligned ones cut to the data's box), that hold every such
+    /// cube's cut: the largest projection of a cube's centre plus the cube's own reach along
+    /// the direction, with a little slack for f32 rounding.
+    pub fn outline(&self, axis: usize, p: f32) -> Option<[Vec2; OUTLINE_SIDES]> {
+        let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
+        let m = self.voxel_to_world;
+        let row = |r: usize| Vec3::new(m.x_axis[r], m.y_axis[r], m.z_axis[r]);
+        let (n, c) = (row(axis), p - m.w_axis[axis]);
+        let (ru, rw) = (row(u), row(w));
+        let reach = n.abs().element_sum();
+        let directions: [Vec2; OUTLINE_SIDES] = std::array::from_fn(|k| {
+            let angle = k as f32 * std::f32::consts::TAU / OUTLINE_SIDES as f32;
+            Vec2::new(angle.cos(), angle.sin())
+        });
+        // Along voxel axis `a`, the column's voxels near the plane; `b`, `d` the others.
+        let a = (0..3).max_by(|&i, &j| n[i].abs().total_cmp(&n[j].abs())).unwrap_or(0);
+        let (b, d) = ((a + 1) % 3, (a + 2) % 3);
+        let dims = self.dims.map(|d| d as usize);
+        let mut support = [f32::NEG_INFINITY; OUTLINE_SIDES];
+        for i_d in 0..dims[d] {
+            for i_b in 0..dims[b] {
+                let rest = n[b] * i_b as f32 + n[d] * i_d as f32;
+                let (lo, hi) = ((c - rest - reach) / n[a], (c - rest + reach) / n[a]);
+                let (lo, hi) = (lo.min(hi).ceil().max(0.0), lo.max(hi).floor().min(dims[a] as f32 - 1.0));
+                if lo > hi {
+                    continue;
+                }
+                for i_a in lo as usize..=hi as usize {
+                    let mut v = [0usize; 3];
+                    (v[a], v[b], v[d]) = (i_a, i_b, i_d);
+                    let index = v[0] + dims[0] * (v[1] + dims[1] * v[2]);
+                    if self.data[index / 64] & (1 << (index % 64)) == 0 {
+                        continue;
+                    }
+                    let v = Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32);
+                    let q = Vec2::new(ru.dot(v) + m.w_axis[u], rw.dot(v) + m.w_axis[w]);
+                    for (s, dir) in support.iter_mut().zip(&directions) {
+                        *s = s.max(dir.dot(q));
+                    }
+                }
+            }
+        }
+        if support[0] == f32::NEG_INFINITY {
+            return None;
+        }
+        let (box_min, box_max) = self.data_box?;
+        let extent = (self.box_max - self.box_min).max_element().max(1.0);
+        for (k, (s, dir)) in support.iter_mut().zip(&directions).enumerate() {
+            // The cube [−1, 1]³ of voxel coordinates reaches Σ |dir · (ru_i, rw_i)| along dir.
+            *s += (0..3).map(|i| (dir.x * ru[i] + dir.y * rw[i]).abs()).sum::<f32>() + 1e-4 * extent;
+            // No further than the box of the data (half a voxel beyond its last voxels: the
+            // voxels past them weigh half or more), within the voxel centres' (beyond, cut).
+            match k * 4 / OUTLINE_SIDES {
+                _ if k % (OUTLINE_SIDES / 4) != 0 => {}
+                0 => *s = s.min(box_max[u]),
+                1 => *s = s.min(box_max[w]),
+                2 => *s = s.min(-box_min[u]),
+                _ => *s = s.min(-box_min[w]),
+            }
+        }
+        // Corner k: where the sides of directions k and k + 1 meet.
+        Some(std::array::from_fn(|k| {
+            let (d0, d1) = (directions[k], directions[(k + 1) % OUTLINE_SIDES]);
+            let (s0, s1) = (support[k], support[(k + 1) % OUTLINE_SIDES]);
+            let det = d0.perp_dot(d1);
+            Vec2::new(s0 * d1.y - s1 * d0.y, d0.x * s1 - d1.x * s0) / det
+        }))
     }
 
     /// The 2nd and 98th percentiles of the finite values other than 0 (the default window: an
@@ -230,20 +339,24 @@ fn percentiles(values: &[f32], quantiles: [f32; 2]) -> [f32; 2] {
     if hi > lo { [lo, hi] } else { [lo, lo + 1.0] }
 }
 
+/// The corners of a slice's polygon ([`SliceVolume::outline`]; `OUTLINE_SIDES` in WGSL).
+pub const OUTLINE_SIDES: usize = 32;
+/// The `vec4`s of the three axes' polygons in [`SliceUniform`].
+const OUTLINE_WORDS: usize = 3 * OUTLINE_SIDES / 2;
+
 /// Keep in sync with `SliceUniform` in `shaders/slices.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 struct SliceUniform {
     world_to_voxel: [[f32; 4]; 4],
-    /// The box the quads span: around the voxel centres, or the data's box.
-    box_min: [f32; 4],
-    box_max: [f32; 4],
     /// xyz: where each axis's slice lies (world units).
     positions: [f32; 4],
     /// xyz: 1 where the axis has a slice; w: 1 where voxels without data are transparent.
     shown: [u32; 4],
     /// xyz: the last voxel index on each axis.
     last_voxel: [f32; 4],
+    /// Each axis's polygon in its plane: OUTLINE_SIDES corners (u, w), two a `vec4`.
+    outline: [[f32; 4]; OUTLINE_WORDS],
 }
 
 /// Draws a [`SliceVolume`]'s slices into the G-buffer of [`FrameTargets`], marking the tiles
@@ -262,7 +375,16 @@ pub struct SliceRenderer {
     tiles: wgpu::BindGroup,
     /// Trilinear, clamped to the edge: the volume's, where the device filters f32.
     sampler: wgpu::Sampler,
+    /// The last polygons drawn, and what they were drawn for (the volume's address, the
+    /// positions' bits, opaque): they change when a slice moves.
+    polygons: std::sync::Mutex<Option<(PolygonsOf, Polygons)>>,
 }
+
+/// What a slice's polygons depend on: the volume (by address), the positions' bits, opaque.
+type PolygonsOf = (usize, [Option<u32>; 3], bool);
+
+/// The three axes' polygons as the uniform holds them, and which axes show one.
+type Polygons = ([[f32; 4]; OUTLINE_WORDS], [bool; 3]);
 
 impl SliceRenderer {
     /// With `octants`, targets that have an `octants` texture get full visibility where a
@@ -309,7 +431,18 @@ impl SliceRenderer {
             min_filter: wgpu::FilterMode::Linear,
             ..Default::default()
         });
-        SliceRenderer { pipeline, octants, bindings, layout, uniform, volume: None, tiles_layout, tiles, sampler }
+        SliceRenderer {
+            pipeline,
+            octants,
+            bindings,
+            layout,
+            uniform,
+            volume: None,
+            tiles_layout,
+            tiles,
+            sampler,
+            polygons: Default::default(),
+        }
     }
 
     /// Marks the slices' tiles in `targets`' buffer (none without the blur's targets).
@@ -350,14 +483,18 @@ impl SliceRenderer {
         let color = LineColor::Scalar { colormap: slices.colormap, range };
         self.bindings.write(queue, &GeometryUniform::new(view, color, 0.0, 0.0), lighting);
         let [x, y, z] = slices.positions;
-        let (lo, hi) = volume.drawn_box(slices);
+        let of = (Arc::as_ptr(volume) as usize, slices.positions.map(|p| p.map(f32::to_bits)), slices.opaque);
+        let mut last = self.polygons.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+        let (outline, shown) = match &*last {
+            Some((drawn, polygons)) if *drawn == of => *polygons,
+            _ => last.insert((of, volume.polygons(slices))).1,
+        };
         let uniform = SliceUniform {
             world_to_voxel: volume.world_to_voxel.to_cols_array_2d(),
-            box_min: lo.extend(0.0).to_array(),
-            box_max: hi.extend(0.0).to_array(),
             positions: [x.unwrap_or(0.0), y.unwrap_or(0.0), z.unwrap_or(0.0), 0.0],
-            shown: [x.is_some() as u32, y.is_some() as u32, z.is_some() as u32, !slices.opaque as u32],
+            shown: [shown[0] as u32, shown[1] as u32, shown[2] as u32, !slices.opaque as u32],
             last_voxel: [volume.dims[0], volume.dims[1], volume.dims[2], 1].map(|d| d as f32 - 1.0),
+            outline,
         };
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
     }
@@ -374,8 +511,8 @@ impl SliceRenderer {
         pass.set_bind_group(0, &self.bindings.group, &[]);
         pass.set_bind_group(1, group, &[]);
         pass.set_bind_group(2, &self.tiles, &[]);
-        // One quad (two triangles) an axis.
-        pass.draw(0..6, 0..3);
+        // One polygon an axis: a fan of OUTLINE_SIDES − 2 triangles.
+        pass.draw(0..3 * (OUTLINE_SIDES as u32 - 2), 0..3);
     }
 }
 
@@ -389,7 +526,7 @@ mod tests {
             super::SliceUniform,
             "slices.wgsl",
             "SliceUniform",
-            [world_to_voxel, box_min, box_max, positions, shown, last_voxel]
+            [world_to_voxel, positions, shown, last_voxel, outline]
         );
     }
 
