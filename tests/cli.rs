@@ -83,6 +83,10 @@ fn exit_codes() {
         assert_eq!(out.status.code(), Some(1), "{bad:?}: {}", stderr(&out));
         assert!(stderr(&out).contains(needle), "{bad:?}: {}", stderr(&out));
     }
+    // A selection's error is said once (it was twice: its own words and its source's).
+    let out = lineao(&["render", "--vertices", "2000", "--field", "nope,0,1", "-o", png]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert_eq!(stderr(&out).matches("no per-streamline field 'nope'").count(), 1, "{}", stderr(&out));
 }
 
 /// `--timed-frames` prints each pass's median, `--timings-against` the cost of a change of

@@ -30,11 +30,11 @@ pub enum SourceError {
     #[error("{path}: a .{format} file, where --color tsf:FILE takes a track scalar file (.tsf)")]
     NotTsf { path: String, format: &'static str },
     /// The GPU refused the geometry (too large for its buffers, a lost device).
-    #[error("{name}: {source}")]
-    Gpu { name: String, source: lineao::Error },
+    #[error("{name}: {error}")]
+    Gpu { name: String, error: lineao::Error },
     /// Object-space AO could not be computed with these options.
-    #[error("{method}: {source}")]
-    Volume { method: &'static str, source: lineao::Error },
+    #[error("{method}: {error}")]
+    Volume { method: &'static str, error: lineao::Error },
     #[error("{name}: no per-vertex field '{field}' (the file has: {available})")]
     NoField { name: String, field: String, available: String },
     #[error("{name}: per-vertex field '{field}' has {columns} columns, not 1")]
@@ -46,9 +46,10 @@ pub enum SourceError {
     /// A file read as it arrived, whose bytes were not kept, cannot be read again.
     #[error("{0} was read as it arrived and not kept: open it again to use this")]
     NotReadable(String),
-    /// A selection rule names what the file lacks.
-    #[error("{name}: {source}")]
-    Selection { name: String, source: lineao_tracts::SelectionError },
+    /// A selection rule names what the file lacks. (Errors held as `error`, not `source`: the
+    /// message says them, and a chain printed whole would say them twice.)
+    #[error("{name}: {error}")]
+    Selection { name: String, error: lineao_tracts::SelectionError },
 }
 
 type Result<T> = std::result::Result<T, SourceError>;
@@ -329,7 +330,7 @@ pub fn geometry_options(gpu: &lineao::Gpu) -> GeometryOptions {
 /// when no point is finite.
 pub fn upload(name: &str, tracts: &Tractogram, on: &lineao::Gpu) -> Result<LineGeometry> {
     let (device, queue) = (&on.device, &on.queue);
-    let gpu = |source| SourceError::Gpu { name: name.to_string(), source };
+    let gpu = |error| SourceError::Gpu { name: name.to_string(), error };
     let mut geometry = LineGeometry::empty(device, geometry_options(on)).map_err(gpu)?;
     geometry.append(device, queue, &tracts.positions, &tracts.offsets).map_err(gpu)?;
     geometry.finish(device, queue).map_err(gpu)?;
@@ -418,7 +419,7 @@ impl VolumeCache {
             None => {
                 computing();
                 let computed = lineao::volume::vertex_visibility(&tracts.positions, &tracts.offsets, options)
-                    .map_err(|source| SourceError::Volume { method: options.method.name(), source })?;
+                    .map_err(|error| SourceError::Volume { method: options.method.name(), error })?;
                 if self.entries.len() == VOLUMES_KEPT {
                     self.entries.remove(0);
                 }
@@ -661,7 +662,7 @@ impl Lines {
     /// CPU what `keep` asks for.
     pub fn empty(name: String, keep: &Keep, on: &lineao::Gpu) -> Result<Lines> {
         let geometry = LineGeometry::empty(&on.device, geometry_options(on))
-            .map_err(|source| SourceError::Gpu { name: name.clone(), source })?;
+            .map_err(|error| SourceError::Gpu { name: name.clone(), error })?;
         Ok(Lines {
             name,
             // No offsets yet: the first chunk decides which of its fields are kept (`append`).
@@ -694,9 +695,8 @@ impl Lines {
         let name = &self.name;
         if let Some(selection) = &self.keep.selection {
             let first = self.geometry.streamlines as u64;
-            let chunk_selected = selection
-                .chunk(&chunk, first)
-                .map_err(|source| SourceError::Selection { name: name.clone(), source })?;
+            let chunk_selected =
+                selection.chunk(&chunk, first).map_err(|error| SourceError::Selection { name: name.clone(), error })?;
             self.selected.get_or_insert_default().extend(chunk_selected);
         }
         if self.keep.lengths {
@@ -708,7 +708,7 @@ impl Lines {
             VertexAttributes { scalar: values(&self.held.scalar)?, radius: values(&self.held.radius)?, octants: None };
         self.geometry
             .append_with(&on.device, &on.queue, &chunk.positions, &chunk.offsets, &attributes)
-            .map_err(|source| SourceError::Gpu { name: name.clone(), source })?;
+            .map_err(|error| SourceError::Gpu { name: name.clone(), error })?;
         append(&mut self.tracts, chunk, &self.keep);
         Ok(())
     }
@@ -726,7 +726,7 @@ impl Lines {
         self.geometry
             .finish_async(&on.device, &on.queue)
             .await
-            .map_err(|source| SourceError::Gpu { name: name.clone(), source })?;
+            .map_err(|error| SourceError::Gpu { name: name.clone(), error })?;
         if self.geometry.bounds.is_none() {
             return Err(SourceError::NoFinitePoints(name.clone()));
         }
@@ -744,18 +744,18 @@ impl Lines {
         let name = &self.name;
         selection
             .apply_groups(selected, groups)
-            .map_err(|source| SourceError::Selection { name: name.clone(), source })?;
+            .map_err(|error| SourceError::Selection { name: name.clone(), error })?;
         let shown = if selected.iter().all(|&s| s) { None } else { Some(&selected[..]) };
         self.geometry
             .set_selection(&on.device, &on.queue, shown)
-            .map_err(|source| SourceError::Gpu { name: name.clone(), source })
+            .map_err(|error| SourceError::Gpu { name: name.clone(), error })
     }
 
     /// Selects the streamlines of lines made whole ([`Lines::new`]) by `selection`.
     pub fn select(&mut self, selection: std::sync::Arc<lineao_tracts::Selection>, on: &lineao::Gpu) -> Result<()> {
         let name = &self.name;
         let selected =
-            selection.chunk(&self.tracts, 0).map_err(|source| SourceError::Selection { name: name.clone(), source })?;
+            selection.chunk(&self.tracts, 0).map_err(|error| SourceError::Selection { name: name.clone(), error })?;
         (self.keep.selection, self.selected) = (Some(selection), Some(selected));
         let groups = std::mem::take(&mut self.tracts.groups);
         let applied = self.apply_selection(&groups, on);
@@ -866,7 +866,7 @@ impl Lines {
         let attributes = VertexAttributes { octants, scalar, radius };
         geometry
             .set_attributes(device, queue, &attributes)
-            .map_err(|source| SourceError::Gpu { name: name.clone(), source })?;
+            .map_err(|error| SourceError::Gpu { name: name.clone(), error })?;
         self.held = wanted.clone();
         Ok(())
     }
