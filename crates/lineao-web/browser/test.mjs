@@ -235,6 +235,11 @@ await check('colour by a volume or a .tsf by ?color=volume: or tsf: (the range t
   const link = await page.evaluate(() => location.search);
   assert.match(link, /color=volume%3Adata%2F/, link);
   const range = status.colorRange;
+  // A built-in scene waits for the volume too: its points are sampled as they arrive (it keeps
+  // none to sample later).
+  ({ status } = await open(`?scene=bundles&vertices=20000&color=volume:${encodeURIComponent(z)}`));
+  assert.equal(status.state, 'ready', status.message);
+  assert.deepEqual(status.fields, [`volume:${z}`]);
   // A .tck's track scalar file, likewise.
   const tsf = SMALL.replace('tract.SLF1_R.tck', 'mni152.SLF1_R.tsf');
   ({ status } = await open(`?url=data/${encodeURIComponent(SMALL)}&color=tsf:data/${encodeURIComponent(tsf)}`));

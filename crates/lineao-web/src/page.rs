@@ -38,6 +38,8 @@ enum Inbound {
         from_url: bool,
     },
     Failed(String),
+    /// A built-in scene to open (once the values that colour it have arrived).
+    Scene(Source),
     /// A NIfTI volume read whole, to show as slices (or why it cannot be); whether it came from
     /// the URL's `volume=` (a link can name it) or was dropped or picked (no link can).
     Anatomy {
@@ -109,9 +111,13 @@ pub async fn start(canvas_id: String, adapter: String) -> Result<(), JsValue> {
             post(Inbound::Anatomy { volume: fetch_volume(&url).await, from_url: true });
         });
     }
-    if page.url.is_some() {
-        options.source = None;
-    }
+    // A file by its address replaces the scene; a built-in scene waits for the values that
+    // colour it (a volume is sampled at each chunk's points as they arrive: the viewer keeps
+    // none to sample later).
+    let scene = match (&page.url, &page.values) {
+        (None, None) => None,
+        (url, _) => options.source.take().filter(|_| url.is_none()),
+    };
     if page.url.is_some() || page.values.is_some() {
         let (url, values) = (page.url.clone(), page.values.clone());
         wasm_bindgen_futures::spawn_local(async move {
@@ -130,6 +136,9 @@ pub async fn start(canvas_id: String, adapter: String) -> Result<(), JsValue> {
                 }
                 Err(message) => Some(message),
             };
+            if let Some(scene) = scene {
+                post(Inbound::Scene(scene));
+            }
             let opened = match url {
                 Some(url) => match open_url(&url).await {
                     Ok((body, feed)) => Some((url, body, feed)),
@@ -392,6 +401,7 @@ impl eframe::App for Page {
                     self.app.load(Source::Feed { name, feed });
                 }
                 Inbound::Failed(message) => self.app.fail(message),
+                Inbound::Scene(source) => self.app.load(source),
                 Inbound::Anatomy { volume: Ok(volume), from_url } => {
                     if !from_url {
                         self.volume = None;
