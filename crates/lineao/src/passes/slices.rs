@@ -7,8 +7,8 @@
 //! A slice is a convex polygon in its plane: the rectangle of the world box of the volume's
 //! voxel centres, or, where voxels without data are transparent, an outline around the voxels
 //! with data near the plane ([`SliceVolume::outline`]: on the MNI template's default slices a
-//! quarter fewer fragments than their rectangles, none of them shown). Each fragment maps its world position to voxel coordinates through the inverse of the volume's
-//! affine (voxel indices → world, the convention of NIfTI and nibabel) and interpolates the
+//! quarter fewer fragments than their rectangles, none of them shown). Each fragment maps its
+//! world position to voxel coordinates through the inverse of the volume's affine (voxel indices → world, the convention of NIfTI and nibabel) and interpolates the
 //! values trilinearly between the eight voxel centres around it — the numbers
 //! `lineao_tracts::Volume::sample` gives on the CPU, which the tests compare. Fragments
 //! outside the box of the voxel centres are discarded, so an oblique affine shows its true,
@@ -171,9 +171,9 @@ impl SliceVolume {
     /// |n · v − c| ≤ |n|₁, n · x = c being the plane in voxel coordinates, found a column at a
     /// time along the voxel axis that n leans on most (a few voxels a column). The polygon is
     /// the intersection of the half-planes, one a direction 360°/[`OUTLINE_SIDES`] apart (its
-    /// four axis-aligned ones cut to the data's box), that hold every such
-    /// cube's cut: the largest projection of a cube's centre plus the cube's own reach along
-    /// the direction, with a little slack for f32 rounding.
+    /// four axis-aligned ones cut to the data's box), that hold every such cube's cut: the
+    /// largest projection of a cube's centre plus the cube's own reach along the direction,
+    /// with a little slack for f32 rounding.
     pub fn outline(&self, axis: usize, p: f32) -> Option<[Vec2; OUTLINE_SIDES]> {
         let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
         let m = self.voxel_to_world;
@@ -375,13 +375,13 @@ pub struct SliceRenderer {
     tiles: wgpu::BindGroup,
     /// Trilinear, clamped to the edge: the volume's, where the device filters f32.
     sampler: wgpu::Sampler,
-    /// The last polygons drawn, and what they were drawn for (the volume's address, the
-    /// positions' bits, opaque): they change when a slice moves.
+    /// The last polygons drawn and what they were drawn for (forgotten with the volume): they
+    /// change when a slice moves.
     polygons: std::sync::Mutex<Option<(PolygonsOf, Polygons)>>,
 }
 
-/// What a slice's polygons depend on: the volume (by address), the positions' bits, opaque.
-type PolygonsOf = (usize, [Option<u32>; 3], bool);
+/// What a volume's slices' polygons depend on: the positions' bits, and whether opaque.
+type PolygonsOf = ([Option<u32>; 3], bool);
 
 /// The three axes' polygons as the uniform holds them, and which axes show one.
 type Polygons = ([[f32; 4]; OUTLINE_WORDS], [bool; 3]);
@@ -457,6 +457,7 @@ impl SliceRenderer {
 
     /// The volume the slices cut, or none (nothing is drawn).
     pub fn set_volume(&mut self, device: &wgpu::Device, volume: Option<Arc<SliceVolume>>) {
+        *self.polygons.get_mut().unwrap_or_else(std::sync::PoisonError::into_inner) = None;
         self.volume = volume.map(|volume| {
             let group = binding::group(
                 device,
@@ -483,7 +484,7 @@ impl SliceRenderer {
         let color = LineColor::Scalar { colormap: slices.colormap, range };
         self.bindings.write(queue, &GeometryUniform::new(view, color, 0.0, 0.0), lighting);
         let [x, y, z] = slices.positions;
-        let of = (Arc::as_ptr(volume) as usize, slices.positions.map(|p| p.map(f32::to_bits)), slices.opaque);
+        let of = (slices.positions.map(|p| p.map(f32::to_bits)), slices.opaque);
         let mut last = self.polygons.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
         let (outline, shown) = match &*last {
             Some((drawn, polygons)) if *drawn == of => *polygons,
