@@ -146,8 +146,8 @@ pub async fn start(canvas_id: String, adapter: String) -> Result<(), JsValue> {
                 },
                 None => None,
             };
-            // Said after the tractogram's load began (which clears the error before), which
-            // goes on in its own colours.
+            // Said once the tractogram's load has begun (a load clears the error shown
+            // before); the tractogram goes on in its own colours.
             if let Some(message) = error {
                 post(Inbound::Values(Err(message)));
             }
