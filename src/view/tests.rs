@@ -319,6 +319,28 @@ fn a_tsf_opened_beside_its_tck_colours_it_and_another_tractogram_is_left_alone()
 }
 
 #[test]
+fn a_volume_given_after_a_streamed_tractogram_arrived_colours_it() {
+    // stroke.trk.gz streamed (its points not kept), then strokez.nii.gz's values asked for (a
+    // page's colour by address, were it to come late): read again for its points and sampled,
+    // the range the command line's.
+    let images = "niivue+niivue/packages/niivue/demos/images";
+    let (trk, nii) = (data(&format!("{images}/stroke.trk.gz")), data(&format!("{images}/strokez.nii.gz")));
+    let mut harness = harness(options(Source::File(trk.clone()), [methods()[1], methods()[4]], false));
+    settle(&mut harness);
+    let volume = lineao_tracts::Volume::load(&nii).unwrap();
+    let sampled = crate::source::Sampled::from_volume("strokez.nii.gz", volume.clone());
+    harness.state_mut().colour_by(std::sync::Arc::new(sampled));
+    settle(&mut harness);
+    let app = harness.state();
+    assert!(app.error.is_none(), "{:?}", app.error);
+    assert_eq!(app.controls.color, ColorMode::Field("volume:strokez.nii.gz".into()));
+    let fields = &app.dataset.as_ref().unwrap().fields;
+    let (_, range) = fields.iter().find(|(name, _)| name == "volume:strokez.nii.gz").expect("the volume's field");
+    let points = lineao_tracts::load(&trk).unwrap().tractogram.positions;
+    assert_eq!(*range, crate::render::percentile_range(&volume.sample_points(&points)));
+}
+
+#[test]
 fn a_real_file_opens_and_a_bad_one_says_why() {
     let path = data("niivue+niivue/packages/niivue/demos/images/stroke.trk.gz");
     let mut harness = harness(options(Source::File(path.clone()), [methods()[1], methods()[4]], false));

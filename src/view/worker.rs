@@ -346,8 +346,27 @@ impl Worker {
             }
         }
         for sampled in values {
+            // A volume is sampled at the points: those of a tractogram streamed without them
+            // are read again once it is whole (as for regions); one still arriving is too soon.
+            let volume = !sampled.is_for_one_tractogram();
             let (lines, complete) = match (&mut self.scene, &mut self.opening) {
+                (_, Some(opening)) if volume && !opening.lines.points_kept() => {
+                    let name = &opening.lines.name;
+                    send(FromWorker::Error(format!(
+                        "{}: a volume colours {name} once it has arrived whole; it is still arriving",
+                        sampled.field
+                    )));
+                    continue;
+                }
                 (_, Some(opening)) => (&mut opening.lines, false),
+                (Some(scene), None) if volume && !scene.lines.points_kept() => {
+                    send(FromWorker::Busy(format!("reading {} again for its points (a volume) …", scene.lines.name)));
+                    if let Err(e) = scene.lines.load_points(&scene.source) {
+                        send(FromWorker::Error(format!("{e:#}")));
+                        continue;
+                    }
+                    (&mut scene.lines, true)
+                }
                 (Some(scene), None) => (&mut scene.lines, true),
                 (None, None) => {
                     send(FromWorker::Error(format!("{}: no tractogram is open to colour", sampled.field)));
