@@ -46,8 +46,9 @@ pub struct Options {
     pub screenshot: Option<(PathBuf, u32)>,
     /// `--color volume:FILE`: the volume sampled at every vertex of each dataset opened.
     pub sampled: Option<Arc<crate::source::Sampled>>,
-    /// `--volume FILE`: the anatomy whose slices are shown with each dataset opened.
-    pub anatomy: Option<Arc<lineao_tracts::Volume>>,
+    /// `--volume FILE`: the anatomy whose slices are shown with each dataset opened, and the
+    /// name it was read from.
+    pub anatomy: Option<(String, Arc<lineao_tracts::Volume>)>,
 }
 
 /// How a session ended, for `--screenshot`'s exit status.
@@ -134,7 +135,12 @@ pub struct App {
     sampled: Option<Arc<crate::source::Sampled>>,
     /// Values sent to the worker for the dataset ([`ToWorker::Values`]) and not answered yet.
     values_pending: usize,
-    anatomy: Option<Arc<lineao_tracts::Volume>>,
+    /// The anatomy's volume sampled at every vertex, asked for while the dataset arrived: sent
+    /// once it is whole (a volume is sampled at the points, which a dataset streamed to the GPU
+    /// keeps only when it is whole and read again).
+    colour_when_whole: Option<Arc<crate::source::Sampled>>,
+    /// The anatomy whose slices are shown, and the name it was read from.
+    anatomy: Option<(String, Arc<lineao_tracts::Volume>)>,
     pub outcome: Arc<Mutex<Outcome>>,
     frames: u64,
     /// File ▸ Open… where the app has no file dialog of its own (the web page's file input).
@@ -204,13 +210,14 @@ impl App {
             screenshot: options.screenshot,
             sampled: options.sampled,
             values_pending: 0,
+            colour_when_whole: None,
             anatomy: options.anatomy,
             screenshot_requested: false,
             outcome: Arc::default(),
             frames: 0,
             open_file: None,
         };
-        if let Some(anatomy) = &app.anatomy {
+        if let Some((_, anatomy)) = &app.anatomy {
             app.send(ToWorker::Anatomy(Some(anatomy.clone())));
         }
         if let Some(source) = options.source {
@@ -269,22 +276,41 @@ impl App {
             Some(values) if values.is_for_one_tractogram() => self.sampled.take(),
             sampled => sampled.clone(),
         };
-        // Values sent for the dataset before are answered, or dropped with it.
+        // Values sent for the dataset before are answered, or dropped with it; the anatomy
+        // colours the new one as it arrives (`sampled`).
         self.values_pending = 0;
+        self.colour_when_whole = None;
         self.send(ToWorker::Load(source, sampled, self.controls.selection().regions()));
     }
 
-    /// Shows `volume`'s slices with every dataset from now on, at `positions` (default: three
-    /// through its centre): a volume opened or dropped beside the tractogram, which stays.
-    pub fn set_anatomy(&mut self, volume: Arc<lineao_tracts::Volume>, positions: Option<[Option<f32>; 3]>) {
-        self.controls.set_anatomy(volume.world_box(), positions);
-        self.anatomy = Some(volume.clone());
+    /// Shows `volume` (read from `name`)'s slices with every dataset from now on, at
+    /// `positions` (default: three through its centre): a volume opened or dropped beside the
+    /// tractogram, which stays.
+    pub fn set_anatomy(&mut self, name: &str, volume: Arc<lineao_tracts::Volume>, positions: Option<[Option<f32>; 3]>) {
+        self.controls.set_anatomy(name, volume.world_box(), positions);
+        self.anatomy = Some((name.to_string(), volume.clone()));
         self.send(ToWorker::Anatomy(Some(volume)));
     }
 
     /// The anatomy whose slices are shown, if any.
     pub fn anatomy(&self) -> Option<&lineao_tracts::Volume> {
-        self.anatomy.as_deref()
+        self.anatomy.as_ref().map(|(_, volume)| &**volume)
+    }
+
+    /// Colours the lines by the anatomy's values at their points (the side panel's colour
+    /// "anatomy", `--color volume:` of the anatomy's file): the dataset shown — read again for
+    /// its points where it was streamed without them — once it has arrived whole, and every
+    /// dataset opened after it as it arrives.
+    pub fn colour_by_anatomy(&mut self) {
+        let Some((name, volume)) = &self.anatomy else { return };
+        let values = Arc::new(crate::source::Sampled::from_volume(name, volume.clone()));
+        self.sampled = Some(values.clone());
+        if self.loading.is_some() {
+            self.controls.color = ColorMode::Field(values.field.clone());
+            self.colour_when_whole = Some(values);
+        } else {
+            self.colour_by(values);
+        }
     }
 
     /// Opens a file by its name: a NIfTI volume is the anatomy, a track scalar file (.tsf) the
@@ -300,7 +326,7 @@ impl App {
             return self.load(Source::File(path));
         }
         match lineao_tracts::Volume::load(&path) {
-            Ok(volume) => self.set_anatomy(Arc::new(volume), None),
+            Ok(volume) => self.set_anatomy(&path.display().to_string(), Arc::new(volume), None),
             Err(e) => self.error = Some(format!("{e}; the tractogram is shown without slices")),
         }
     }
@@ -441,12 +467,18 @@ impl App {
                     self.controls.max_length = dataset.max_length;
                     self.controls.set_groups(&dataset.groups, dataset.complete);
                     self.controls.set_streamline_fields(&dataset.streamline_fields);
+                    let waiting = self.colour_when_whole.as_ref().map(|values| &values.field);
                     if let ColorMode::Field(name) = &self.controls.color
                         && !dataset.fields.iter().any(|(f, _)| f == name)
+                        && waiting != Some(name)
                     {
                         self.controls.color = ColorMode::Tangent;
                     }
+                    let complete = dataset.complete;
                     self.dataset = Some(dataset);
+                    if complete && let Some(values) = self.colour_when_whole.take() {
+                        self.colour_by(values);
+                    }
                 }
                 FromWorker::Fields(fields) => {
                     self.values_pending = self.values_pending.saturating_sub(1);
@@ -903,6 +935,9 @@ impl App {
         egui::Panel::left("controls").default_size(300.0).show(ui, |ui| {
             egui::ScrollArea::vertical().show(ui, |ui| self.controls.ui(ui, &fields));
         });
+        if std::mem::take(&mut self.controls.colour_by_anatomy) {
+            self.colour_by_anatomy();
+        }
         egui::CentralPanel::no_frame().show(ui, |ui| self.viewport(ui));
         self.request_render(&ctx);
         self.files(&ctx);

@@ -31,6 +31,10 @@ pub fn methods() -> Vec<Method> {
 pub const WEB_LEAVES_OUT: &str = "Object-space AO (occlusion sweep, variance volume) is left out of the web page: it \
     computes on CPU threads, which a page does not have. `lineao view` has it.";
 
+/// What the colour list's "anatomy" does.
+const ANATOMY_COLOUR: &str = "the anatomy's value at each point (trilinear, as `--color volume:` of its file); a \
+    tractogram streamed to the GPU is read again for its points";
+
 /// The GPU ray tracer ([`lineao::method::raytraced`]), progressive.
 pub const RAY_TRACED: Method = Method { screen: AoMethod::RayTraced, volume: None };
 
@@ -150,6 +154,13 @@ pub struct Controls {
     pub slab_reach: f32,
     /// The world box of the anatomy's voxel centres (`--volume`), which its slices' sliders span.
     pub slice_box: Option<([f32; 3], [f32; 3])>,
+    /// The field the anatomy's values at the points are ([`ColorMode::Field`], `volume:FILE`),
+    /// which the colour list offers.
+    pub anatomy_field: Option<String>,
+    /// The colour list's "anatomy" was chosen: a request the viewer takes
+    /// ([`App::colour_by_anatomy`](super::app::App::colour_by_anatomy)), which samples the
+    /// volume at the points.
+    pub colour_by_anatomy: bool,
     /// Whether a volume's slices show its voxels without data (`--opaque-slices`, the page's
     /// `opaque-slices`), until the side panel's checkbox says otherwise.
     pub opaque_slices: bool,
@@ -207,6 +218,8 @@ impl Controls {
             slab: Slab { axis: SlabAxis::Z, center: 0.0, thickness: 10.0 },
             slab_reach: 100.0,
             slice_box: None,
+            anatomy_field: None,
+            colour_by_anatomy: false,
             opaque_slices: false,
             subset: 1.0,
             length: None,
@@ -274,9 +287,10 @@ impl Controls {
         }
     }
 
-    /// Slices of an anatomy whose voxel centres span `world_box`, at `positions` (default:
-    /// all three through its centre).
-    pub fn set_anatomy(&mut self, world_box: ([f32; 3], [f32; 3]), positions: Option<[Option<f32>; 3]>) {
+    /// Slices of an anatomy read from `name` whose voxel centres span `world_box`, at
+    /// `positions` (default: all three through its centre).
+    pub fn set_anatomy(&mut self, name: &str, world_box: ([f32; 3], [f32; 3]), positions: Option<[Option<f32>; 3]>) {
+        self.anatomy_field = ColorArg::Volume(name.into()).field();
         let (lo, hi) = world_box;
         let center = std::array::from_fn(|a| Some(0.5 * (lo[a] + hi[a])));
         let positions = positions.unwrap_or(center);
@@ -702,6 +716,13 @@ impl Controls {
                 );
                 for (name, _) in fields {
                     ui.selectable_value(&mut self.color, ColorMode::Field(name.clone()), format!("field: {name}"));
+                }
+                // The anatomy's values, until they are one of the fields above.
+                if let Some(field) = &self.anatomy_field
+                    && !fields.iter().any(|(name, _)| name == field)
+                    && ui.selectable_label(false, "anatomy").on_hover_text(ANATOMY_COLOUR).clicked()
+                {
+                    self.colour_by_anatomy = true;
                 }
                 if !self.groups.is_empty() {
                     ui.selectable_value(&mut self.color, ColorMode::Groups, "groups")

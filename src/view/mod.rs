@@ -44,7 +44,7 @@ pub fn options(args: &ViewArgs) -> app::Options {
     });
     // Likewise a volume for the slices (the lines are shown without them).
     let anatomy = args.volume.as_ref().and_then(|path| match lineao_tracts::Volume::load(path) {
-        Ok(volume) => Some(std::sync::Arc::new(volume)),
+        Ok(volume) => Some((path.display().to_string(), std::sync::Arc::new(volume))),
         Err(e) => {
             eprintln!("lineao: {e}; the tractogram is shown without its slices");
             None
@@ -85,8 +85,8 @@ pub fn options(args: &ViewArgs) -> app::Options {
         (controls.slab, controls.params.chain.slab) = (slab, Some(slab));
     }
     controls.opaque_slices = args.opaque_slices;
-    if let Some(volume) = &anatomy {
-        controls.set_anatomy(volume.world_box(), args.slices);
+    if let Some((name, volume)) = &anatomy {
+        controls.set_anatomy(name, volume.world_box(), args.slices);
     }
     app::Options {
         source: Some(source),

@@ -77,6 +77,16 @@ fn screen_vs_frame(screen: &image::RgbaImage, region: Rect, rect: Rect, image: &
     matched as f32 / total as f32
 }
 
+/// Opens the combo box showing `showing` and picks `item` in it, as a user does; then settles.
+fn choose(harness: &mut Harness<'_, App>, showing: &str, item: &str) {
+    let combo =
+        harness.get_all_by_role(egui::accesskit::Role::ComboBox).find(|n| n.value().as_deref() == Some(showing));
+    combo.unwrap_or_else(|| panic!("a combo box showing {showing}")).click();
+    harness.run_steps(2);
+    harness.get_by_label(item).click();
+    settle(harness);
+}
+
 /// Moves the pointer to `pos` and presses the primary button there.
 fn press_at(harness: &mut Harness<'_, App>, pos: Pos2) {
     harness.event(Event::PointerMoved(pos));
@@ -190,13 +200,7 @@ fn the_method_selector_switches_the_method() {
     let mut harness = harness(options(scene(SceneKind::Bundles, 60_000), [methods()[1], methods()[4]], false));
     settle(&mut harness);
     let lineao = harness.state().shown.as_ref().unwrap().images[0].clone();
-    // Open the combo box showing "LineAO" and pick "none".
-    let combo =
-        harness.get_all_by_role(egui::accesskit::Role::ComboBox).find(|n| n.value().as_deref() == Some("LineAO"));
-    combo.expect("the method combo box showing LineAO").click();
-    harness.run_steps(2);
-    harness.get_by_label("none").click();
-    settle(&mut harness);
+    choose(&mut harness, "LineAO", "none");
     let frame = harness.state().shown.as_ref().unwrap();
     assert_eq!(frame.view.panels[0].settings.method, AoMethod::None);
     let none = &frame.images[0];
@@ -338,6 +342,50 @@ fn a_volume_given_after_a_streamed_tractogram_arrived_colours_it() {
     let (_, range) = fields.iter().find(|(name, _)| name == "volume:strokez.nii.gz").expect("the volume's field");
     let points = lineao_tracts::load(&trk).unwrap().tractogram.positions;
     assert_eq!(*range, crate::render::percentile_range(&volume.sample_points(&points)));
+}
+
+#[test]
+fn the_anatomy_colours_the_lines_chosen_in_the_side_panel() {
+    // `view stroke.trk.gz`, strokez.nii.gz opened beside it as the anatomy, then "anatomy"
+    // chosen in the colour list: the lines (streamed, so read again for their points) take the
+    // volume's values, the range `--color volume:` gives; asked while a tractogram arrives, they
+    // follow once it is whole; a tractogram opened next takes them as it arrives.
+    let images = "niivue+niivue/packages/niivue/demos/images";
+    let (trk, nii) = (data(&format!("{images}/stroke.trk.gz")), data(&format!("{images}/strokez.nii.gz")));
+    let field = format!("volume:{}", nii.display());
+    let volume = lineao_tracts::Volume::load(&nii).unwrap();
+    let points = lineao_tracts::load(&trk).unwrap().tractogram.positions;
+    let expected = crate::render::percentile_range(&volume.sample_points(&points));
+    let coloured = |harness: &Harness<'_, App>| {
+        let app = harness.state();
+        assert!(app.error.is_none(), "{:?}", app.error);
+        assert_eq!(app.controls.color, ColorMode::Field(field.clone()));
+        let frame = app.shown.as_ref().unwrap();
+        let lineao::LineColor::Scalar { range, .. } = frame.view.panels[0].settings.line_color else {
+            panic!("{:?}", frame.view.panels[0].settings.line_color)
+        };
+        range
+    };
+    let mut harness = harness(options(Source::File(trk.clone()), [methods()[1], methods()[4]], false));
+    settle(&mut harness);
+    assert!(harness.query_by_label("anatomy").is_none(), "no anatomy, no such colour");
+    harness.state_mut().open_path(nii.clone());
+    settle(&mut harness);
+    choose(&mut harness, "direction", "anatomy");
+    assert_eq!(coloured(&harness), expected);
+    // The next tractogram opened: sampled as it arrives.
+    harness.state_mut().load(Source::File(trk.clone()));
+    settle(&mut harness);
+    assert_eq!(coloured(&harness), expected);
+    // `view stroke.trk.gz --volume strokez.nii.gz`, the colour asked for while the tractogram
+    // arrives: it follows once the tractogram is whole.
+    let mut options = options(Source::File(trk), [methods()[1], methods()[4]], false);
+    options.anatomy = Some((nii.display().to_string(), std::sync::Arc::new(volume)));
+    let mut harness = self::harness(options);
+    assert!(harness.state().is_loading());
+    harness.state_mut().colour_by_anatomy();
+    settle(&mut harness);
+    assert_eq!(coloured(&harness), expected);
 }
 
 #[test]

@@ -504,11 +504,12 @@ pub struct Sampled {
 
 #[derive(Debug)]
 enum SampledFrom {
-    /// Sampled trilinearly at every vertex.
-    Volume(lineao_tracts::Volume),
+    /// Sampled trilinearly at every vertex (shared: a viewer's anatomy colours by its slices'
+    /// volume).
+    Volume(std::sync::Arc<lineao_tracts::Volume>),
     /// A .tsf read whole (4 bytes a vertex): streamline k's values are its run k, in the order
     /// MRtrix writes a .tsf beside the .tck it belongs to.
-    Tsf { path: String, values: Tractogram },
+    Tsf { path: String, values: Box<Tractogram> },
 }
 
 impl SampledFrom {
@@ -517,7 +518,7 @@ impl SampledFrom {
         if loaded.format != lineao_tracts::Format::Tsf {
             return Err(SourceError::NotTsf { path, format: loaded.format.name() });
         }
-        Ok(SampledFrom::Tsf { path, values: loaded.tractogram })
+        Ok(SampledFrom::Tsf { path, values: Box::new(loaded.tractogram) })
     }
 }
 
@@ -528,7 +529,7 @@ impl Sampled {
         use crate::args::ColorArg;
         let from = match color {
             ColorArg::Volume(path) => {
-                SampledFrom::Volume(lineao_tracts::Volume::load(path).map_err(SourceError::Load)?)
+                SampledFrom::Volume(lineao_tracts::Volume::load(path).map_err(SourceError::Load)?.into())
             }
             ColorArg::Tsf(path) => SampledFrom::tsf(path.display().to_string(), lineao_tracts::load(path)?)?,
             _ => return Ok(None),
@@ -536,10 +537,11 @@ impl Sampled {
         Ok(Some(std::sync::Arc::new(Sampled { field: color.field().expect("a file's field"), from })))
     }
 
-    /// `volume`, read from `name` (fetched by a web page), sampled at every vertex.
-    pub fn from_volume(name: &str, volume: lineao_tracts::Volume) -> Sampled {
+    /// `volume`, read from `name` (fetched by a web page, or a viewer's anatomy), sampled at
+    /// every vertex.
+    pub fn from_volume(name: &str, volume: impl Into<std::sync::Arc<lineao_tracts::Volume>>) -> Sampled {
         let field = crate::args::ColorArg::Volume(name.into()).field().expect("a file's field");
-        Sampled { field, from: SampledFrom::Volume(volume) }
+        Sampled { field, from: SampledFrom::Volume(volume.into()) }
     }
 
     /// A .tsf's bytes named `name` (dropped on a web page or a window).

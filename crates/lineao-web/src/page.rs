@@ -40,9 +40,11 @@ enum Inbound {
     Failed(String),
     /// A built-in scene to open (once the values that colour it have arrived).
     Scene(Source),
-    /// A NIfTI volume read whole, to show as slices (or why it cannot be); whether it came from
-    /// the URL's `volume=` (a link can name it) or was dropped or picked (no link can).
+    /// A NIfTI volume read whole, to show as slices (or why it cannot be), by the name it came
+    /// by (its address, or a dropped file's name); whether it came from the URL's `volume=` (a
+    /// link can name it) or was dropped or picked (no link can).
     Anatomy {
+        name: String,
         volume: Result<lineao_tracts::Volume, String>,
         from_url: bool,
     },
@@ -108,7 +110,7 @@ pub async fn start(canvas_id: String, adapter: String) -> Result<(), JsValue> {
     SLICES.with(|s| s.set(page.view.slices));
     if let Some(url) = page.volume.clone() {
         wasm_bindgen_futures::spawn_local(async move {
-            post(Inbound::Anatomy { volume: fetch_volume(&url).await, from_url: true });
+            post(Inbound::Anatomy { volume: fetch_volume(&url).await, name: url, from_url: true });
         });
     }
     // A file by its address replaces the scene; a built-in scene waits for the values that
@@ -221,7 +223,9 @@ pub fn open_file(file: web_sys::File) {
             let bytes = JsFuture::from(file.array_buffer()).await;
             let bytes = bytes.map(|b| Uint8Array::new(&b).to_vec()).map_err(|e| format!("{name}: {}", js_message(&e)));
             post(match nifti {
-                true => Inbound::Anatomy { volume: bytes.and_then(|b| crate::volume(&name, &b)), from_url: false },
+                true => {
+                    Inbound::Anatomy { volume: bytes.and_then(|b| crate::volume(&name, &b)), name, from_url: false }
+                }
                 false => Inbound::Values(
                     bytes.and_then(|b| Sampled::tsf_from_bytes(&name, &b).map_err(|e| format!("{e:#}"))),
                 ),
@@ -402,11 +406,11 @@ impl eframe::App for Page {
                 }
                 Inbound::Failed(message) => self.app.fail(message),
                 Inbound::Scene(source) => self.app.load(source),
-                Inbound::Anatomy { volume: Ok(volume), from_url } => {
+                Inbound::Anatomy { volume: Ok(volume), name, from_url } => {
                     if !from_url {
                         self.volume = None;
                     }
-                    self.app.set_anatomy(Arc::new(volume), SLICES.with(|s| s.get()));
+                    self.app.set_anatomy(&name, Arc::new(volume), SLICES.with(|s| s.get()));
                 }
                 Inbound::Anatomy { volume: Err(message), .. } => {
                     self.app.error = Some(format!("{message}; the tractogram is shown without slices"));
@@ -591,8 +595,10 @@ impl Page {
         let orbit = app.camera.as_ref().map(|c| c.orbit_values());
         let ortho = app.camera.as_ref().is_some_and(|c| c.orthographic);
         let mut flags = app.controls.link_flags();
-        // The colour of a file's values: an address only where the URL fetched it.
-        let named = |value: &String| self.values.as_ref() == Some(value);
+        // The colour of a file's values: an address only where the URL fetched it (its `color=`,
+        // or its `volume=` coloured by from the side panel).
+        let anatomy = self.volume.as_ref().map(|url| format!("volume:{url}"));
+        let named = |value: &String| self.values.as_ref() == Some(value) || anatomy.as_ref() == Some(value);
         flags.retain(|(flag, value)| flag != "color" || !colours_by_a_file(value) || named(value));
         let link =
             query::link((&self.source, self.volume.as_deref()), &methods, app.controls.preset, (orbit, ortho), &flags);
