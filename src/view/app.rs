@@ -259,6 +259,17 @@ impl App {
         self.loading = Some(Loading { name: name.to_string(), bytes, total });
     }
 
+    /// Says `what` the viewer is busy with (a web page fetching the file that colours the lines
+    /// before it opens them), until a frame arrives or a load begins.
+    pub fn show_busy(&mut self, what: String) {
+        self.busy = Some(what);
+    }
+
+    /// What the viewer is busy with besides rendering, if anything (the status bar says it).
+    pub fn busy(&self) -> Option<&str> {
+        self.busy.as_deref()
+    }
+
     /// Opens a file or builds a scene (on the render thread).
     pub fn load(&mut self, source: Source) {
         let name = match &source {

@@ -222,7 +222,15 @@ await check('colour by a volume or a .tsf by ?color=volume: or tsf: (the range t
   // niivue's tracts.layer.voxel demo: stroke.trk.gz coloured by the z-map sampled at its points.
   const z = `data/${STROKEZ}`;
   const url = `?url=data/${encodeURIComponent(STROKE)}`;
-  let { status } = await open(`${url}&color=volume:${encodeURIComponent(z)}`);
+  // The volume held back a second and a half: meanwhile the status says it is being fetched.
+  const held = (route) => new Promise((r) => setTimeout(r, 1500)).then(() => route.continue());
+  await page.route('**/strokez.nii.gz', held);
+  await page.goto(`${base}/${url}&color=volume:${encodeURIComponent(z)}`);
+  await page.waitForFunction(() => /^fetching .*strokez\.nii\.gz/.test(window.lineaoStatus?.message ?? ''), null,
+    { timeout: 30_000 });
+  const fetching = await page.evaluate(() => window.lineaoStatus.message);
+  let status = await settle();
+  await page.unroute('**/strokez.nii.gz', held);
   assert.equal(status.state, 'ready', status.message);
   assert.equal(status.vertices, info(STROKE).vertices);
   assert.deepEqual(status.fields, [`volume:${z}`]);
@@ -256,7 +264,7 @@ await check('colour by a volume or a .tsf by ?color=volume: or tsf: (the range t
   status = await page.evaluate(() => window.lineaoStatus);
   assert.equal(status.vertices, info(STROKE).vertices, 'the tractogram is shown');
   assert.equal(status.colorRange, null, 'in its own colours');
-  results.colourByVolume = { range, native, link, missing: status.message };
+  results.colourByVolume = { range, native, link, fetching, missing: status.message };
 });
 
 await check('a file arrives in pieces: drawn while it loads, kept by the page only up to hold=', async () => {

@@ -38,6 +38,8 @@ enum Inbound {
         from_url: bool,
     },
     Failed(String),
+    /// What the page is doing before a dataset loads (fetching the file that colours it).
+    Busy(String),
     /// A built-in scene to open (once the values that colour it have arrived).
     Scene(Source),
     /// A NIfTI volume read whole, to show as slices (or why it cannot be), by the name it came
@@ -272,24 +274,54 @@ async fn get(url: &str) -> Result<(web_sys::Response, Option<u64>), String> {
     Ok((response, total))
 }
 
-/// Fetches the file at `url` (relative to the page), whole.
-async fn fetch_whole(url: &str) -> Result<Vec<u8>, String> {
-    let (response, _) = get(url).await?;
+/// Fetches the file at `url` (relative to the page), whole; with `progress`, the status bar
+/// says how much has arrived (a file the page waits for before the tractogram: the values
+/// that colour it as it arrives).
+async fn fetch_whole(url: &str, progress: bool) -> Result<Vec<u8>, String> {
+    if progress {
+        post(Inbound::Busy(format!("fetching {url} …")));
+    }
+    let (response, total) = get(url).await?;
     let cannot = |e: JsValue| format!("{url}: cannot read: {}", js_message(&e));
-    let bytes = JsFuture::from(response.array_buffer().map_err(cannot)?).await.map_err(cannot)?;
-    Ok(Uint8Array::new(&bytes).to_vec())
+    if !progress {
+        let bytes = JsFuture::from(response.array_buffer().map_err(cannot)?).await.map_err(cannot)?;
+        return Ok(Uint8Array::new(&bytes).to_vec());
+    }
+    let body = response.body().ok_or_else(|| format!("{url}: the response has no body"))?;
+    let reader: web_sys::ReadableStreamDefaultReader = body.get_reader().unchecked_into();
+    // Its stated size, which `get` checked, or what arrives: never more than the format's limit.
+    let mut bytes = Vec::with_capacity(total.unwrap_or(0) as usize);
+    let said = |bytes: usize| {
+        let mib = |b: u64| b as f64 / f64::from(1 << 20);
+        let of = total.map_or(String::new(), |t| format!(" of {:.1}", mib(t)));
+        post(Inbound::Busy(format!("fetching {url}: {:.1}{of} MiB", mib(bytes as u64))));
+    };
+    said(0);
+    loop {
+        let chunk = JsFuture::from(reader.read()).await.map_err(cannot)?;
+        if Reflect::get(&chunk, &"done".into()).ok().and_then(|d| d.as_bool()).unwrap_or(true) {
+            return Ok(bytes);
+        }
+        let value: Uint8Array = Reflect::get(&chunk, &"value".into()).map_err(cannot)?.unchecked_into();
+        bytes.extend_from_slice(&value.to_vec());
+        if let Some(message) = crate::too_large(url, bytes.len() as u64) {
+            let _ = reader.cancel();
+            return Err(message);
+        }
+        said(bytes.len());
+    }
 }
 
 /// Fetches the NIfTI volume at `url` (relative to the page), whole.
 async fn fetch_volume(url: &str) -> Result<lineao_tracts::Volume, String> {
-    crate::volume(url, &fetch_whole(url).await?)
+    crate::volume(url, &fetch_whole(url, false).await?)
 }
 
 /// Fetches the file of `color=volume:ADDRESS` or `color=tsf:ADDRESS`: the values the lines are
 /// coloured by (`None` for another colour).
 async fn fetch_values(color: &ColorArg) -> Result<Option<Sampled>, String> {
     let Some(url) = color.values_file().map(|path| path.to_string_lossy().into_owned()) else { return Ok(None) };
-    let bytes = fetch_whole(&url).await.map_err(|e| format!("{e}; the lines keep their colours"))?;
+    let bytes = fetch_whole(&url, true).await.map_err(|e| format!("{e}; the lines keep their colours"))?;
     let sampled = match color {
         ColorArg::Volume(_) => crate::volume(&url, &bytes).map(|volume| Sampled::from_volume(&url, volume)),
         _ => Sampled::tsf_from_bytes(&url, &bytes).map_err(|e| format!("{e:#}")),
@@ -405,6 +437,7 @@ impl eframe::App for Page {
                     self.app.load(Source::Feed { name, feed });
                 }
                 Inbound::Failed(message) => self.app.fail(message),
+                Inbound::Busy(what) => self.app.show_busy(what),
                 Inbound::Scene(source) => self.app.load(source),
                 Inbound::Anatomy { volume: Ok(volume), name, from_url } => {
                     if !from_url {
@@ -539,7 +572,7 @@ impl Page {
         let message = match (app.error(), state) {
             (Some(e), _) => e.to_string(),
             (None, "ready") => "ready".into(),
-            _ => "loading".into(),
+            _ => app.busy().unwrap_or("loading").into(),
         };
         let status = serde_json::json!({
             "state": state,
