@@ -21,7 +21,7 @@
 // the points pushed half a line width sideways on screen at the points' depth, so its fragments
 // lie within half a line width of the two points' box on screen and no nearer than the nearer
 // point (depth interpolates linearly on screen). A segment spans a few pixels: its box is
-// tight, and the pyramid is read at a fine level. A box in front of the eye projects within
+// tight, and the pyramid is read at a fine level (mostly the pixels themselves). A box in front of the eye projects within
 // its corners' projections, no nearer than its nearest corner.
 //
 // With `LOD` each visible piece is drawn at the coarsest level of detail that leaves it within
@@ -98,11 +98,13 @@ const OUTSIDE_ALL: u32 = 7u << OUTSIDE_SHIFT;
 const LOD_PIXELS: f32 = 0.5;
 // The coarsest level: every 8th point kept (a piece's ends).
 const LEVELS: u32 = 4u;
-// Texels across at most where a group's box reads the pyramid, and a segment's (a group's box
-// is large: read finer, it passes less often — at 10 M points 71 % of the groups of 16 for 91 %
-// at 2, for up to 256 reads a group).
+// Texels across at most where a group's box reads the pyramid, and a segment's (read finer, a
+// box passes less often: at 10 M points 71 % of the groups of 16 for 91 % at 2, for up to 256
+// reads a group; a segment's box, a few pixels and the line's width, read at 8 rather than 2
+// texels across — mostly the pixels themselves, not the farthest of 8 × 8 around them — leaves
+// 54 % fewer pieces to draw at 50 M points, 1.69 % of them, for 17 % more time culling).
 const GROUP_SPAN: u32 = 16u;
-const SEGMENT_SPAN: u32 = 2u;
+const SEGMENT_SPAN: u32 = 8u;
 
 fn cluster_count() -> u32 {
     return arrayLength(&clusters);
@@ -459,8 +461,7 @@ fn capsule_verdict(i: u32, p: u32, first: u32, last: u32) -> u32 {
     }
     // Read as a segment's box is: its rectangle holds theirs, so it is read at their level or
     // a coarser one, never finer, and hides no piece their test would show (the marks stay
-    // theirs; read finer, 4 × 4 texels, 34 % fewer pieces pass it at 10 M points, for 5 % of
-    // the cull).
+    // theirs).
     return box_verdict(rect.lo, rect.hi, SEGMENT_SPAN);
 }
 

@@ -204,7 +204,7 @@ struct Tester<'a> {
 /// Texels across at most where a group's box and a segment's read the pyramid (`GROUP_SPAN`,
 /// `SEGMENT_SPAN` in `cull.wgsl`).
 const GROUP_SPAN: usize = 16;
-const SEGMENT_SPAN: usize = 2;
+const SEGMENT_SPAN: usize = 8;
 
 impl Tester<'_> {
     /// `p` in NDC, none behind the eye.
