@@ -38,7 +38,13 @@ pub fn streamed(name: &str) -> bool {
 /// The refusal of a file of `bytes` bytes, before anything is allocated for it: a format read
 /// whole, over [`MAX_FILE_BYTES`].
 pub fn too_large(name: &str, bytes: u64) -> Option<String> {
-    (bytes > MAX_FILE_BYTES && !streamed(name)).then(|| {
+    if streamed(name) { None } else { too_large_whole(name, bytes) }
+}
+
+/// The refusal of `bytes` bytes of a file the page holds whole whatever its format (the file
+/// that colours the lines), over [`MAX_FILE_BYTES`].
+pub fn too_large_whole(name: &str, bytes: u64) -> Option<String> {
+    (bytes > MAX_FILE_BYTES).then(|| {
         let mib = |b: u64| b as f64 / (1 << 20) as f64;
         format!(
             "{name}: {:.0} MiB is more than this page can hold (at most {:.0} MiB a file): open it with `lineao view`",
@@ -63,9 +69,10 @@ mod tests {
         assert_eq!(super::too_large("a.trx", super::MAX_FILE_BYTES), None);
         let message = super::too_large("big.trx", 3 << 30).unwrap();
         assert!(message.contains("big.trx: 3072 MiB") && message.contains("at most 1024 MiB"), "{message}");
-        // What is decoded as it arrives has no limit.
+        // What is decoded as it arrives has no limit, unless the page holds it whole.
         for name in ["big.trk", "big.tck.gz", "big.TSF"] {
             assert_eq!(super::too_large(name, 3 << 30), None, "{name}");
+            assert!(super::too_large_whole(name, 3 << 30).is_some_and(|m| m.contains("3072 MiB")), "{name}");
         }
     }
 

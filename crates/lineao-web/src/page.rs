@@ -287,10 +287,14 @@ async fn fetch_whole(url: &str, progress: bool) -> Result<Vec<u8>, String> {
         let bytes = JsFuture::from(response.array_buffer().map_err(cannot)?).await.map_err(cannot)?;
         return Ok(Uint8Array::new(&bytes).to_vec());
     }
+    if let Some(message) = total.and_then(|t| crate::too_large_whole(url, t)) {
+        return Err(message);
+    }
     let body = response.body().ok_or_else(|| format!("{url}: the response has no body"))?;
     let reader: web_sys::ReadableStreamDefaultReader = body.get_reader().unchecked_into();
-    // Its stated size, which `get` checked, or what arrives: never more than the format's limit.
-    let mut bytes = Vec::with_capacity(total.unwrap_or(0) as usize);
+    // Room for its stated size up to 64 MiB (a header may lie; past that the vector grows as
+    // the bytes arrive), never more than the page holds of a file.
+    let mut bytes = Vec::with_capacity(total.unwrap_or(0).min(64 << 20) as usize);
     let said = |bytes: usize| {
         let mib = |b: u64| b as f64 / f64::from(1 << 20);
         let of = total.map_or(String::new(), |t| format!(" of {:.1}", mib(t)));
@@ -303,11 +307,13 @@ async fn fetch_whole(url: &str, progress: bool) -> Result<Vec<u8>, String> {
             return Ok(bytes);
         }
         let value: Uint8Array = Reflect::get(&chunk, &"value".into()).map_err(cannot)?.unchecked_into();
-        bytes.extend_from_slice(&value.to_vec());
-        if let Some(message) = crate::too_large(url, bytes.len() as u64) {
+        if let Some(message) = crate::too_large_whole(url, (bytes.len() + value.length() as usize) as u64) {
             let _ = reader.cancel();
             return Err(message);
         }
+        let start = bytes.len();
+        bytes.resize(start + value.length() as usize, 0);
+        value.copy_to(&mut bytes[start..]);
         said(bytes.len());
     }
 }
