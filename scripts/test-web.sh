@@ -18,14 +18,16 @@ cargo test --workspace --no-run --quiet 2> /dev/null || cargo test --workspace -
 (cd crates/lineao-web/browser && npm ci --no-audit --no-fund --silent)
 out=target/web-test
 rm -rf "$out"
-# A file of a format read whole over the page's limit, sparse (no disk): the server states its
-# size, the page refuses it. And a whole brain of 2 M points, which the page decodes as it arrives.
+# Files the page reads whole over its limit (a tractogram, a colour file), sparse (no disk):
+# the server states their size, the page refuses them. And a whole brain of 2 M points, which
+# the page decodes as it arrives.
 truncate -s 1100M target/web/too-large.trx
+truncate -s 1100M target/web/too-large.tsf
 target/debug/lineao convert --scene wholebrain --vertices 2000000 target/web/wholebrain.tck
 port=$(python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
 python3 -m http.server --bind 127.0.0.1 --directory target/web "$port" > /dev/null 2>&1 &
 server=$!
-trap 'kill $server 2>/dev/null || true; rm -f target/web/too-large.trx target/web/wholebrain.tck' EXIT
+trap 'kill $server 2>/dev/null || true; rm -f target/web/too-large.trx target/web/too-large.tsf target/web/wholebrain.tck' EXIT
 for _ in $(seq 50); do python3 -c "import urllib.request; urllib.request.urlopen('http://127.0.0.1:$port/')" 2>/dev/null && break; sleep 0.2; done
 t2=$(date +%s)
 node crates/lineao-web/browser/test.mjs "http://127.0.0.1:$port" "$out" target/debug/lineao ../shared/data \

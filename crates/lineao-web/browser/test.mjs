@@ -296,7 +296,7 @@ await check('a file arrives in pieces: drawn while it loads, kept by the page on
   results.streamed = { status, ms: Date.now() - start };
 });
 
-await check('a URL that fails: the HTTP status; a file read whole over the limit: refused by its size', async () => {
+await check('a URL that fails: the HTTP status; a file read whole over the limit (a tractogram, a colour file): refused by its size', async () => {
   let { status } = await open('?url=data/no-such-file.trk');
   assert.equal(status.state, 'error');
   assert.match(status.message, /HTTP 404/, status.message);
@@ -305,6 +305,11 @@ await check('a URL that fails: the HTTP status; a file read whole over the limit
   assert.equal(status.state, 'error');
   assert.match(status.message, /too-large\.trx: \d+ MiB is more than this page can hold/, status.message);
   results.tooLarge = status.message;
+  // A colour file is held whole whatever its format (a .tsf dropped beside its .tck too).
+  ({ status } = await open('?scene=spiral&vertices=20000&color=tsf:too-large.tsf', ['error']));
+  assert.match(status.message, /too-large\.tsf: \d+ MiB is more than this page can hold.*keep their colours/,
+    status.message);
+  results.tooLargeValues = status.message;
   ({ status } = await open('?method=lineoa'));
   assert.equal(status.state, 'error');
   assert.match(status.message, /lineoa/);

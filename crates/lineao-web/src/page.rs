@@ -221,6 +221,10 @@ pub fn open_file(file: web_sys::File) {
     }
     let nifti = lineao_tracts::Volume::is_nifti_name(&name);
     if nifti || lineao_cli::view::app::is_tsf(std::path::Path::new(&name)) {
+        // Read whole: a .tsf too, though a tractogram of its format would be streamed.
+        if let Some(message) = crate::too_large_whole(&name, size) {
+            return post(Inbound::Values(Err(format!("{message}; the lines keep their colours"))));
+        }
         return wasm_bindgen_futures::spawn_local(async move {
             let bytes = JsFuture::from(file.array_buffer()).await;
             let bytes = bytes.map(|b| Uint8Array::new(&b).to_vec()).map_err(|e| format!("{name}: {}", js_message(&e)));
