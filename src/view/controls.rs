@@ -704,7 +704,7 @@ impl Controls {
     fn color_ui(&mut self, ui: &mut Ui, fields: &[(String, [f32; 2])]) {
         let label = match &self.color {
             ColorMode::Tangent => "direction".to_string(),
-            ColorMode::Field(name) => format!("field: {name}"),
+            ColorMode::Field(name) => self.field_label(name),
             ColorMode::Constant(_) => "constant".into(),
             ColorMode::Groups => "groups".into(),
         };
@@ -715,7 +715,8 @@ impl Controls {
                     "|tangent| as RGB: left-right red, anterior-posterior green, superior-inferior blue",
                 );
                 for (name, _) in fields {
-                    ui.selectable_value(&mut self.color, ColorMode::Field(name.clone()), format!("field: {name}"));
+                    let label = self.field_label(name);
+                    ui.selectable_value(&mut self.color, ColorMode::Field(name.clone()), label);
                 }
                 // The anatomy's values, until they are one of the fields above.
                 if let Some(field) = &self.anatomy_field
@@ -748,6 +749,14 @@ impl Controls {
                 ui.color_edit_button_srgb(rgb);
             }
             ColorMode::Tangent | ColorMode::Groups => {}
+        }
+    }
+
+    /// What the colour list calls the field `name`: "anatomy" for the anatomy's values.
+    fn field_label(&self, name: &str) -> String {
+        match &self.anatomy_field {
+            Some(field) if field == name => "anatomy".into(),
+            _ => format!("field: {name}"),
         }
     }
 

@@ -373,6 +373,9 @@ fn the_anatomy_colours_the_lines_chosen_in_the_side_panel() {
     settle(&mut harness);
     choose(&mut harness, "direction", "anatomy");
     assert_eq!(coloured(&harness), expected);
+    let combo =
+        harness.get_all_by_role(egui::accesskit::Role::ComboBox).find(|n| n.value().as_deref() == Some("anatomy"));
+    assert!(combo.is_some(), "the colour list says what colours the lines");
     // The next tractogram opened: sampled as it arrives.
     harness.state_mut().load(Source::File(trk.clone()));
     settle(&mut harness);
