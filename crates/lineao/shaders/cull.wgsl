@@ -21,8 +21,8 @@
 // the points pushed half a line width sideways on screen at the points' depth, so its fragments
 // lie within half a line width of the two points' box on screen and no nearer than the nearer
 // point (depth interpolates linearly on screen). A segment spans a few pixels: its box is
-// tight, and the pyramid is read at a fine level (mostly the pixels themselves). A box in front of the eye projects within
-// its corners' projections, no nearer than its nearest corner.
+// tight, and the pyramid is read at a fine level (mostly the pixels themselves). A box in
+// front of the eye projects within its corners' projections, no nearer than its nearest corner.
 //
 // With `LOD` each visible piece is drawn at the coarsest level of detail that leaves it within
 // LOD_PIXELS of its full strip (or tube) on screen (`piece_level`): every 2nd, 4th or 8th point
