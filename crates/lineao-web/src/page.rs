@@ -278,33 +278,30 @@ async fn get(url: &str) -> Result<(web_sys::Response, Option<u64>), String> {
     Ok((response, total))
 }
 
-/// Fetches the file at `url` (relative to the page), whole; with `progress`, the status bar
-/// says how much has arrived (a file the page waits for before the tractogram: the values
-/// that colour it as it arrives).
+/// Fetches the file at `url` (relative to the page), whole, refused past what the page holds
+/// of a file; with `progress`, the status bar says how much has arrived (a file the page waits
+/// for before the tractogram: the values that colour it as it arrives).
 async fn fetch_whole(url: &str, progress: bool) -> Result<Vec<u8>, String> {
     if progress {
         post(Inbound::Busy(format!("fetching {url} …")));
     }
     let (response, total) = get(url).await?;
-    let cannot = |e: JsValue| format!("{url}: cannot read: {}", js_message(&e));
-    if !progress {
-        let bytes = JsFuture::from(response.array_buffer().map_err(cannot)?).await.map_err(cannot)?;
-        return Ok(Uint8Array::new(&bytes).to_vec());
-    }
     if let Some(message) = total.and_then(|t| crate::too_large_whole(url, t)) {
         return Err(message);
     }
+    let mib = |b: u64| b as f64 / f64::from(1 << 20);
+    let of = total.map_or(String::new(), |t| format!(" of {:.1}", mib(t)));
+    let said = |bytes: usize| {
+        if progress {
+            post(Inbound::Busy(format!("fetching {url}: {:.1}{of} MiB", mib(bytes as u64))));
+        }
+    };
+    let cannot = |e: JsValue| format!("{url}: cannot read: {}", js_message(&e));
     let body = response.body().ok_or_else(|| format!("{url}: the response has no body"))?;
     let reader: web_sys::ReadableStreamDefaultReader = body.get_reader().unchecked_into();
     // Room for its stated size up to 64 MiB (a header may lie; past that the vector grows as
-    // the bytes arrive), never more than the page holds of a file.
+    // the bytes arrive).
     let mut bytes = Vec::with_capacity(total.unwrap_or(0).min(64 << 20) as usize);
-    let said = |bytes: usize| {
-        let mib = |b: u64| b as f64 / f64::from(1 << 20);
-        let of = total.map_or(String::new(), |t| format!(" of {:.1}", mib(t)));
-        post(Inbound::Busy(format!("fetching {url}: {:.1}{of} MiB", mib(bytes as u64))));
-    };
-    said(0);
     loop {
         let chunk = JsFuture::from(reader.read()).await.map_err(cannot)?;
         if Reflect::get(&chunk, &"done".into()).ok().and_then(|d| d.as_bool()).unwrap_or(true) {
