@@ -106,15 +106,27 @@ pub struct FrameView {
     pub orthographic: bool,
     /// Radius of the scene's bounding sphere, world units.
     pub scene_radius: f32,
+    /// Where this frame lies in the picture it is a tile of ([`FrameView::tile`]); untiled,
+    /// the whole picture is the frame.
+    #[cfg_attr(feature = "serde", serde(default))]
+    pub tile: Option<Tile>,
+}
+
+/// A frame that is one tile of a larger picture: the picture's size and the tile's top-left
+/// pixel in it. The tile's view is the picture's, cut to the tile and its own guard band, so
+/// that the tiles stitch into the picture a single frame of its size would show.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+pub struct Tile {
+    pub picture: [u32; 2],
+    pub origin: [u32; 2],
 }
 
 impl FrameView {
     pub fn new(camera: &Camera, bounds: &Bounds, width: u32, height: u32, guard: u32, zoom_unit: f32) -> Self {
         let view = camera.view_matrix();
-        let c_z = view.transform_point3(bounds.center).z;
+        let (near, far) = depth_range(&view, bounds);
         let r = bounds.radius;
-        let near = (-c_z - r).max(1e-3 * r);
-        let far = (-c_z + r).max(near * (1.0 + 1e-4) + 1e-6);
         let (w, h) = (width.max(1) as f32, height.max(1) as f32);
         let (gw, gh) = (w + 2.0 * guard as f32, h + 2.0 * guard as f32);
         // Clip a little outside [near, far] so geometry on the bounding sphere is never clipped.
@@ -143,7 +155,78 @@ impl FrameView {
             zoom_unit,
             orthographic: matches!(camera.projection, Projection::Orthographic { .. }),
             scene_radius: r,
+            tile: None,
         }
+    }
+
+    /// The view of `tile` (`width` × `height` visible pixels at `tile.origin` of a picture of
+    /// `tile.picture`) with a `guard` band: the picture's camera, depth range and focal
+    /// length, its projection cut off axis to the tile's guard-banded window.
+    pub fn tile(
+        camera: &Camera,
+        bounds: &Bounds,
+        tile: Tile,
+        (width, height): (u32, u32),
+        guard: u32,
+        zoom_unit: f32,
+    ) -> Self {
+        let (near, far) = depth_range(&camera.view_matrix(), bounds);
+        let [pw, ph] = tile.picture.map(|v| v.max(1) as f32);
+        let [x0, y0] = tile.origin.map(|v| v as f32);
+        let g = guard as f32;
+        // The guard-banded window in pixels of the picture, from its centre (y up).
+        let (left, right) = (x0 - g - 0.5 * pw, x0 + width as f32 + g - 0.5 * pw);
+        let (top, bottom) = (0.5 * ph - (y0 - g), 0.5 * ph - (y0 + height as f32 + g));
+        let (clip_near, clip_far) = (near * (1.0 - 1e-3), far * (1.0 + 1e-3));
+        let (proj, f_px) = match camera.projection {
+            Projection::Perspective { fov_y_deg } => {
+                let tan_half = (fov_y_deg.to_radians() * 0.5).tan();
+                let f_px = ph / (2.0 * tan_half);
+                // An off-axis frustum in tangents of the angle from the axis (x/−z, y/−z).
+                let (l, r, t, b) = (left / f_px, right / f_px, top / f_px, bottom / f_px);
+                let depth = clip_far / (clip_near - clip_far);
+                let proj = Mat4::from_cols(
+                    glam::Vec4::new(2.0 / (r - l), 0.0, 0.0, 0.0),
+                    glam::Vec4::new(0.0, 2.0 / (t - b), 0.0, 0.0),
+                    glam::Vec4::new((r + l) / (r - l), (t + b) / (t - b), depth, -1.0),
+                    glam::Vec4::new(0.0, 0.0, depth * clip_near, 0.0),
+                );
+                (proj, f_px)
+            }
+            Projection::Orthographic { height: view_h } => {
+                let f_px = ph / view_h;
+                let (l, r, t, b) = (left / f_px, right / f_px, top / f_px, bottom / f_px);
+                (directx::orthographic(l, r, b, t, clip_near, clip_far), f_px)
+            }
+        };
+        let untiled = FrameView::new(camera, bounds, width, height, guard, zoom_unit);
+        FrameView { proj, f_px, tile: Some(tile), ..untiled }
+    }
+
+    /// The size of the picture this frame shows (or is a tile of).
+    pub fn picture_size(&self) -> (u32, u32) {
+        self.tile.map_or((self.width, self.height), |t| (t.picture[0], t.picture[1]))
+    }
+
+    /// The visible window's top-left pixel in the picture: (0, 0) untiled.
+    pub fn origin(&self) -> [u32; 2] {
+        self.tile.map_or([0, 0], |t| t.origin)
+    }
+
+    /// The optical axis in pixels of the guard-banded frame: its centre untiled, the
+    /// picture's centre moved to the tile otherwise.
+    pub fn center(&self) -> [f32; 2] {
+        let (w, h) = self.picture_size();
+        let [x0, y0] = self.origin();
+        let g = 2 * self.guard;
+        [(w + g) as f32 * 0.5 - x0 as f32, (h + g) as f32 * 0.5 - y0 as f32]
+    }
+
+    /// The noise tiles' origin in pixels of the guard-banded frame: the picture's top-left
+    /// visible pixel, so that every tile of a picture sees the picture's noise.
+    pub fn noise_origin(&self) -> [i32; 2] {
+        let [x0, y0] = self.origin();
+        [self.guard as i32 - x0 as i32, self.guard as i32 - y0 as i32]
     }
 
     /// The view of a host renderer's own `view` and `proj` matrices (wgpu clip space; any depth
@@ -155,10 +238,8 @@ impl FrameView {
     /// The zoom unit is the chain's ([`crate::ChainSettings::zoom_unit`]): [`crate::HostAo::prepare`]
     /// sets it, so it is said in one place; this view holds 1 until then.
     pub fn from_matrices(view: Mat4, proj: Mat4, width: u32, height: u32, bounds: &Bounds) -> Self {
-        let c_z = view.transform_point3(bounds.center).z;
+        let (near, far) = depth_range(&view, bounds);
         let r = bounds.radius;
-        let near = (-c_z - r).max(1e-3 * r);
-        let far = (-c_z + r).max(near * (1.0 + 1e-4) + 1e-6);
         FrameView {
             view,
             proj,
@@ -171,6 +252,7 @@ impl FrameView {
             zoom_unit: 1.0,
             orthographic: proj.row(3) == glam::Vec4::W,
             scene_radius: r,
+            tile: None,
         }
     }
 
@@ -187,13 +269,23 @@ impl FrameView {
     /// The zoom at which the scene's bounding sphere just fills the shorter side of the view:
     /// the "home view" that the authors' zoom factor of 1 stands for (variant `reference`).
     pub fn zoom_fit(&self) -> f32 {
-        self.width.min(self.height).max(1) as f32 * self.zoom_unit / (2.0 * self.scene_radius)
+        let (w, h) = self.picture_size();
+        w.min(h).max(1) as f32 * self.zoom_unit / (2.0 * self.scene_radius)
     }
 
     /// Normalized linear depth of a view-space z (CONTRACT.md).
     pub fn normalized_depth(&self, z_view: f32) -> f32 {
         ((-z_view - self.near) / (self.far - self.near)).clamp(0.0, 1.0)
     }
+}
+
+/// The normalized depth range (near, far) as −z_view: the bounding sphere's, in front of the eye.
+fn depth_range(view: &Mat4, bounds: &Bounds) -> (f32, f32) {
+    let c_z = view.transform_point3(bounds.center).z;
+    let r = bounds.radius;
+    let near = (-c_z - r).max(1e-3 * r);
+    let far = (-c_z + r).max(near * (1.0 + 1e-4) + 1e-6);
+    (near, far)
 }
 
 /// How far, in full-resolution pixels, a nearest-texel read of pyramid level `level` reaches

@@ -106,7 +106,7 @@ pub use glam;
 pub use wgpu;
 
 // What an embedding needs first, at the root.
-pub use camera::{Bounds, Camera, FrameView, Projection};
+pub use camera::{Bounds, Camera, FrameView, Projection, Tile};
 pub use chain::{AoChain, HostAo, OverlayAo};
 pub use colormap::{COLORMAP_ENTRIES, Colormap};
 pub use gpu::{Gpu, Lacking, check_adapter};

@@ -15,19 +15,19 @@ pub struct ViewParams {
     /// Focal length in pixels (perspective) or pixels per world unit (orthographic).
     pub f_px: f32,
     pub orthographic: bool,
-    /// The optical axis in pixel coordinates of the guard-banded image: (W, H) / 2.
+    /// The optical axis in pixel coordinates of the guard-banded image: (W, H) / 2, or a
+    /// tile's share of its picture's ([`FrameView::center`]).
     pub center: [f32; 2],
 }
 
 impl ViewParams {
     pub fn of(view: &FrameView) -> ViewParams {
-        let (w, h) = view.banded_size();
         ViewParams {
             near: view.near,
             far: view.far,
             f_px: view.f_px,
             orthographic: view.orthographic,
-            center: [w as f32 * 0.5, h as f32 * 0.5],
+            center: view.center(),
         }
     }
 

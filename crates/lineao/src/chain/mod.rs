@@ -46,7 +46,7 @@ use std::sync::Arc;
 
 use crate::Error;
 use crate::LineGeometry;
-use crate::camera::{self, Bounds, Camera, FrameView};
+use crate::camera::{self, Bounds, Camera, FrameView, Tile};
 use crate::gbuffer::Load;
 use crate::lighting::LightingShape;
 use crate::method::raytraced::RayProgress;
@@ -93,6 +93,8 @@ pub struct AoChain {
     /// The composite's target format.
     format: wgpu::TextureFormat,
     size: (u32, u32),
+    /// Where the frame lies in a larger picture rendered as tiles ([`AoChain::set_tile`]).
+    tile: Option<Tile>,
     /// The device's limits, which the sizes are checked against.
     limits: wgpu::Limits,
     targets: Option<FrameTargets>,
@@ -144,6 +146,7 @@ impl AoChain {
             format,
             settings,
             size: (0, 0),
+            tile: None,
             limits: device.limits(),
             targets: None,
             view: None,
@@ -317,6 +320,25 @@ impl AoChain {
         Ok(())
     }
 
+    /// Renders the chain's size as one tile of a larger picture (`None`: the frame is the
+    /// picture): at `tile.origin` of a picture of `tile.picture`, seen by the picture's camera,
+    /// with the guard band, noise and levels of detail of the picture, so that tiles stitch
+    /// into what one frame of the picture's size shows. The tile must lie inside the picture.
+    pub fn set_tile(&mut self, tile: Option<Tile>) -> Result<(), Error> {
+        if let Some(t) = tile {
+            let (w, h) = self.size;
+            let fits = |origin: u32, size: u32, picture: u32| origin as u64 + size as u64 <= picture as u64;
+            if !fits(t.origin[0], w, t.picture[0]) || !fits(t.origin[1], h, t.picture[1]) {
+                return Err(Error::Usage(format!(
+                    "a {w}×{h} tile at ({}, {}) lies outside its {}×{} picture: resize the chain to the tile first",
+                    t.origin[0], t.origin[1], t.picture[0], t.picture[1]
+                )));
+            }
+        }
+        self.tile = tile;
+        Ok(())
+    }
+
     /// Whether `settings` fit the adapter at `width` × `height` with the largest guard band.
     fn check_size(&self, settings: &ChainSettings, width: u32, height: u32) -> Result<(), Error> {
         let guard = settings.guard_max_px;
@@ -339,7 +361,9 @@ impl AoChain {
         let s = &self.settings;
         // Plain lines read no neighbours on screen.
         let Some(stage) = self.stages.active() else { return 0 };
-        let unguarded = FrameView::new(camera, bounds, self.size.0, self.size.1, 0, s.zoom_unit);
+        // A tile's reach is its picture's: every tile has the same band.
+        let (width, height) = self.tile.map_or(self.size, |t| (t.picture[0], t.picture[1]));
+        let unguarded = FrameView::new(camera, bounds, width, height, 0, s.zoom_unit);
         match stage.reach(s, &unguarded) {
             Reach::Unbounded => s.guard_max_px,
             // The bilateral blur reaches its radius further.
@@ -366,7 +390,11 @@ impl AoChain {
             return None;
         }
         let guard = self.guard_for(camera, bounds);
-        let view = FrameView::new(camera, bounds, width, height, guard, self.settings.zoom_unit);
+        let zoom_unit = self.settings.zoom_unit;
+        let view = match self.tile {
+            Some(tile) => FrameView::tile(camera, bounds, tile, (width, height), guard, zoom_unit),
+            None => FrameView::new(camera, bounds, width, height, guard, zoom_unit),
+        };
         self.prepare_frame(device, queue, view)
     }
 

@@ -36,8 +36,10 @@ pub(crate) fn max_px_per_world(view: &FrameView) -> f32 {
     if view.orthographic {
         return view.f_px;
     }
+    // A tile's is its picture's: every tile draws the same strips.
     let guard = 2.0 * view.guard as f32;
-    let half_diagonal = 0.5 * (view.width as f32 + guard).hypot(view.height as f32 + guard) / view.f_px;
+    let (w, h) = view.picture_size();
+    let half_diagonal = 0.5 * (w as f32 + guard).hypot(h as f32 + guard) / view.f_px;
     view.f_px / view.near * (1.0 + half_diagonal * half_diagonal).sqrt()
 }
 

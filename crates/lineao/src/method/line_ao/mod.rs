@@ -122,7 +122,8 @@ pub struct LineAoUniform {
 
 /// The `reference` variant's base radius per axis, in pixels per unit of zoom z(P) at d = 0.
 pub fn reference_scale(view: &FrameView, radius_px: f32) -> [f32; 2] {
-    let (w, h) = (view.width.max(1) as f32, view.height.max(1) as f32);
+    let (w, h) = view.picture_size();
+    let (w, h) = (w.max(1) as f32, h.max(1) as f32);
     let k = radius_px / view.zoom_fit() / w.max(h);
     [k * w, k * h]
 }
@@ -333,10 +334,10 @@ impl LineAo {
         r0: crate::R0,
         lighting: &Lighting,
     ) {
-        let guard = targets.guard as i32;
+        debug_assert_eq!(targets.guard, view.guard);
         let uniform = LineAoUniform {
             levels: targets.levels_uniform(),
-            noise_origin: [guard, guard],
+            noise_origin: view.noise_origin(),
             r0_px: r0.px,
             delta0: settings.delta0,
             reference_scale: reference_scale(view, settings.reference_radius_px),

@@ -59,7 +59,7 @@ impl LineAoParams {
             kd: settings.lighting.kd,
             ks: settings.lighting.ks,
             shininess: settings.lighting.shininess,
-            noise_origin: [view.guard as i32; 2],
+            noise_origin: view.noise_origin(),
         }
     }
 }

@@ -302,7 +302,7 @@ pub(crate) fn preset(preset: Preset, settings: &mut ChainSettings) {
     match (preset, ao.variant) {
         (Preset::Paper, _) => {}
         // The most legible settings that keep every view readable (`lineao score --fit --width
-        // 640 --height 512 --views 2 --rays 32`): two hemispheres, the first reaching past a
+        // 640 --height 512 --fit-views 2 --rays 32`): two hemispheres, the first reaching past a
         // line's own width to its neighbours (r0 4.5 × the width), the paper's δ (occluders far
         // in front count: depth order is the question); held-out legibility +0.371 (the papers'
         // values +0.29 on the real files), never near-black. The authors' variant is more

@@ -139,10 +139,10 @@ impl Ssao {
     }
 
     pub fn prepare(&self, queue: &wgpu::Queue, targets: &FrameTargets, view: &FrameView, settings: &SsaoSettings) {
-        let guard = targets.guard as i32;
+        debug_assert_eq!(targets.guard, view.guard);
         let uniform = SsaoUniform {
             view: ViewParams::of(view).into(),
-            noise_origin: [guard, guard],
+            noise_origin: view.noise_origin(),
             radius: settings.radius_world,
             range: settings.range_world,
         };

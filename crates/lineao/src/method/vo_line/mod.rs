@@ -87,10 +87,10 @@ impl VoUniform {
     /// The uniform for a frame; `max_level` is the moments pyramid's deepest level (area
     /// sampling; 0 for lines).
     pub fn new(targets: &FrameTargets, view: &FrameView, settings: &VoSettings, max_level: u32) -> VoUniform {
-        let guard = targets.guard as i32;
+        debug_assert_eq!(targets.guard, view.guard);
         VoUniform {
             view: ViewParams::of(view).into(),
-            noise_origin: [guard, guard],
+            noise_origin: view.noise_origin(),
             radius: [settings.radius_world, settings.radius2_world.unwrap_or(settings.radius_world)],
             zoom_unit: view.zoom_unit,
             thickness: settings.thickness_world,

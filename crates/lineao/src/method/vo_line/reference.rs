@@ -34,7 +34,10 @@ impl VoParams {
             zoom_unit: view.zoom_unit,
             normal_clamp: settings.normal_clamp,
             thickness: settings.thickness_world,
-            noise_origin: [guard as i32; 2],
+            noise_origin: {
+                let [x0, y0] = view.origin();
+                [guard as i32 - x0 as i32, guard as i32 - y0 as i32]
+            },
         }
     }
 }
