@@ -1,7 +1,7 @@
 //! `lineao score --fit`: the calibration behind the default preset, by legibility.
 //!
 //! Views: every built-in scene and every tractogram found under `--data` (at least 10
-//! streamlines), each from `--views` cameras orbiting its own about the up axis. Even views fit,
+//! streamlines), each from `--fit-views` cameras orbiting its own about the up axis. Even views fit,
 //! odd views report (held out). On each view the bundle-scale truth is traced once (obscurance
 //! with the linear falloff to a fifth of the scene's longest side); every candidate setting of
 //! a method is rendered and its raw AO read back; then, on the CPU, every strength s of a grid
@@ -195,6 +195,7 @@ impl Frame {
 }
 
 pub fn run(args: &ScoreArgs) -> Result<()> {
+    lineao_session::figure::refuse_in_score(&args.render.figure)?;
     // The candidates change the paper's values, the strength is searched apart.
     let mut base = args.render.clone();
     base.shown.preset = lineao::Preset::Paper;
@@ -227,8 +228,8 @@ pub fn run(args: &ScoreArgs) -> Result<()> {
             vo: None,
             ..crate::truth::settings(base, session.longest_side)
         };
-        for k in 0..args.views {
-            let angle = std::f32::consts::TAU * k as f32 / args.views as f32;
+        for k in 0..args.fit_views {
+            let angle = std::f32::consts::TAU * k as f32 / args.fit_views as f32;
             let turn = Quat::from_axis_angle(home.up.normalize(), angle);
             session.camera.eye = home.target + turn * (home.eye - home.target);
             let Some((frame, truth)) = frame(&session, source, &bundle)? else { continue };

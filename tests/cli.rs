@@ -1064,3 +1064,90 @@ fn only_its_folder_and_its_registry_line_name_the_toy() {
     }
     assert!(named.is_empty(), "the toy is named outside its folder:\n{}", named.join("\n"));
 }
+
+/// `--turntable N`: a PNG a frame, their cameras, and an animated PNG of them that an outside
+/// reader (the `png` crate's APNG decoder) finds N frames of in; frame k is what `render`
+/// draws from frame k's camera, read from the cameras' file.
+#[test]
+fn a_turntable_writes_its_frames_cameras_and_movie() {
+    let dir = scratch("turntable");
+    let output = dir.join("spin.png");
+    let size = ["--vertices", "30000", "--width", "96", "--height", "64"];
+    let mut argv = vec!["render", "--turntable", "3", "--fps", "12", "-o", output.to_str().unwrap()];
+    argv.extend(size);
+    let out = lineao(&argv);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let cameras: Value = serde_json::from_str(&std::fs::read_to_string(dir.join("spin.json")).unwrap()).unwrap();
+    assert_eq!((cameras["frames"].as_u64(), cameras["fps"].as_u64()), (Some(3), Some(12)));
+    // The movie, frame by frame, against the PNGs.
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(dir.join("spin.apng")).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    let control = reader.info().animation_control.expect("an animated PNG");
+    assert_eq!((control.num_frames, control.num_plays), (3, 0));
+    for k in 0..3 {
+        let mut frame = vec![0; reader.output_buffer_size().unwrap()];
+        let info = reader.next_frame(&mut frame).unwrap();
+        assert_eq!((info.width, info.height), (96, 64));
+        let ((w, h), png) = common::read_png(&dir.join(format!("spin-00{k}.png")));
+        assert_eq!(((w, h), &png[..]), ((96, 64), &frame[..info.buffer_size()]), "frame {k}");
+    }
+    // Frame 1 again, by `render` from its camera.
+    let camera = &cameras["cameras"][1];
+    assert_eq!(camera["file"], "spin-001.png");
+    let vec3 = |key: &str| {
+        let v: Vec<String> = camera[key].as_array().unwrap().iter().map(|c| c.to_string()).collect();
+        v.join(",")
+    };
+    let (eye, target, up) = (vec3("eye"), vec3("target"), vec3("up"));
+    let single = dir.join("single.png");
+    let mut argv = vec!["render", "--eye", &eye, "--target", &target, "--up", &up, "-o", single.to_str().unwrap()];
+    argv.extend(size);
+    let out = lineao(&argv);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(common::read_png(&single), common::read_png(&dir.join("spin-001.png")));
+    assert_ne!(common::read_png(&single), common::read_png(&dir.join("spin-000.png")), "the frames turn");
+}
+
+/// Figures and movies refuse what they cannot do, naming the flag; a movie that cannot be
+/// written loses no frame.
+#[test]
+fn figures_and_movies_refuse_bad_input() {
+    for (bad, said) in [
+        (&["render", "--turntable", "0"][..], "--turntable"),
+        (&["render", "--turntable=-3"], "--turntable"),
+        (&["render", "--fps", "30"], "--turntable"),
+        (&["render", "--views", "left,sideways"], "'sideways' is not a view"),
+        (&["render", "--views", "left", "--grid"], "--grid"),
+        (&["render", "--tile", "100"], "a multiple of 64"),
+        (&["render", "--width", "70000"], "--width"),
+    ] {
+        let out = lineao(bad);
+        assert_eq!(out.status.code(), Some(2), "{bad:?}: {}", stderr(&out));
+        assert!(stderr(&out).contains(said), "{bad:?}: {}", stderr(&out));
+    }
+    let dir = scratch("movie-refused");
+    let output = dir.join("spin.png");
+    let tiny = ["--vertices", "3000", "--width", "32", "--height", "32", "-o", output.to_str().unwrap()];
+    let run = |extra: &[&str]| {
+        let mut argv = vec!["render", "--turntable", "2"];
+        argv.extend(extra);
+        argv.extend(tiny);
+        lineao(&argv)
+    };
+    let out = run(&["--movie", "spin.avi"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr(&out).contains("--movie spin.avi"), "{}", stderr(&out));
+    let ffmpeg = std::process::Command::new("ffmpeg").arg("-version").output().is_ok_and(|o| o.status.success());
+    if !ffmpeg {
+        let out = run(&["--movie", "spin.mp4"]);
+        assert_eq!(out.status.code(), Some(1));
+        assert!(stderr(&out).contains("--movie spin.mp4") && stderr(&out).contains("ffmpeg"), "{}", stderr(&out));
+        assert!(!dir.join("spin-000.png").exists(), "refused before anything is rendered");
+    }
+    let unwritable = dir.join("no-such-folder").join("spin.apng");
+    let out = run(&["--movie", unwritable.to_str().unwrap()]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr(&out).contains("the 2 PNG frames are written"), "{}", stderr(&out));
+    assert!(dir.join("spin-000.png").exists() && dir.join("spin-001.png").exists());
+    assert!(lineao(&["score", "--views", "left"]).status.code() != Some(0), "score refuses --views");
+}

@@ -392,6 +392,11 @@ fn parse(settings: &Bound<'_, PyDict>, file: Option<&PathBuf>) -> PyResult<Rende
         KwargError::Invalid(_) => PyValueError::new_err(e.to_string()),
     })?;
     args.file = file.cloned();
+    if args.figure.turntable.is_some() {
+        return Err(PyValueError::new_err(
+            "'turntable' is the command line's: Renderer.orbit(n_frames, movie=...) renders a turntable",
+        ));
+    }
     if args.style.tube_radius_field.is_some() && args.file.is_none() {
         return Err(PyValueError::new_err("'tube_radius_field' needs a file"));
     }
@@ -619,6 +624,39 @@ fn encode_png(
     .map_err(|e| PyRuntimeError::new_err(format!("{e:#}")))
 }
 
+/// The eyes of a turntable of `frames` from a camera (eye, target, up), `degrees` in all:
+/// `lineao render --turntable`'s cameras.
+#[pyfunction]
+fn turntable(eye: [f32; 3], target: [f32; 3], up: [f32; 3], frames: u32, degrees: f32) -> Vec<[f32; 3]> {
+    let camera = lineao::Camera {
+        eye: eye.into(),
+        target: target.into(),
+        up: up.into(),
+        projection: lineao::Projection::Perspective { fov_y_deg: 30.0 },
+    };
+    lineao_session::figure::turntable(&camera, frames, degrees).iter().map(|c| c.eye.to_array()).collect()
+}
+
+/// Writes `frames` ((H, W, 4) uint8 each, one size) as the movie `path` names at `fps`:
+/// `lineao render --turntable`'s `--movie` (an animated PNG, or a file ffmpeg writes).
+#[pyfunction]
+fn write_movie(py: Python<'_>, frames: Vec<numpy::PyReadonlyArray3<'_, u8>>, path: PathBuf, fps: u32) -> PyResult<()> {
+    let mut images = Vec::with_capacity(frames.len());
+    for frame in &frames {
+        let shape = frame.shape();
+        if shape[2] != 4 {
+            return Err(PyValueError::new_err(format!("frames: expected shape (height, width, 4), got {shape:?}")));
+        }
+        let data = match frame.as_slice() {
+            Ok(bytes) => bytes.to_vec(),
+            Err(_) => frame.as_array().iter().copied().collect(),
+        };
+        images.push(lineao_session::label::Rgba8 { width: shape[1] as u32, height: shape[0] as u32, data });
+    }
+    py.detach(|| lineao_session::figure::write_movie(&images, &path, fps))
+        .map_err(|e| PyValueError::new_err(format!("{e:#}")))
+}
+
 #[pymodule]
 fn _lineao(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("LoadError", m.py().get_type::<LoadError>())?;
@@ -630,6 +668,8 @@ fn _lineao(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(settings, m)?)?;
     m.add_function(wrap_pyfunction!(methods, m)?)?;
     m.add_function(wrap_pyfunction!(encode_png, m)?)?;
+    m.add_function(wrap_pyfunction!(turntable, m)?)?;
+    m.add_function(wrap_pyfunction!(write_movie, m)?)?;
     m.add_class::<Renderer>()?;
     Ok(())
 }

@@ -281,3 +281,28 @@ def test_the_render_trk_example_runs(tmp_path):
     assert written == ["tracks300-orbit-%d.png" % i for i in range(8)] + ["tracks300.png"]
     split = np.asarray(PilImage.open(tmp_path / "tracks300.png"))
     assert split.shape == (1024, 1280, 4)
+
+
+def test_orbit_writes_the_command_lines_turntable(lineao_bin, tmp_path):
+    """Renderer.orbit's frames and movie are `lineao render --turntable`'s, byte for byte."""
+    out = tmp_path / "spin.png"
+    args = ["render", TRK, "--turntable", "3", "--fps", "10", "--width", "160", "--height", "128", "-o", out]
+    subprocess.run([str(lineao_bin), *map(str, args)], check=True, capture_output=True)
+    r = lineao.Renderer(TRK, width=160, height=128)
+    frames = r.orbit(3, movie=tmp_path / "orbit.apng", fps=10)
+    for k, frame in enumerate(frames):
+        expected = np.asarray(PilImage.open(tmp_path / f"spin-00{k}.png").convert("RGBA"))
+        assert (frame != expected).sum() == 0, k
+    assert (tmp_path / "orbit.apng").read_bytes() == (tmp_path / "spin.apng").read_bytes()
+    with pytest.raises(ValueError, match="fps"):
+        r.orbit(2, movie=tmp_path / "bad.apng", fps=0)
+    with pytest.raises(ValueError, match="Renderer.orbit"):
+        r.render(turntable=3)
+
+
+def test_views_are_a_keyword_as_on_the_command_line(lineao_bin, tmp_path):
+    expected = cli_render(lineao_bin, tmp_path, TRK, "--views", "left,top", "--width", 160, "--height", 128)
+    image = lineao.render(TRK, views=("left", "top"), width=160, height=128)
+    assert image.shape == (128, 320, 4) and (image != expected).sum() == 0
+    with pytest.raises(ValueError, match="not a view"):
+        lineao.render(TRK, views="left,sideways", width=32, height=32)

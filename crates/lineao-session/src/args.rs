@@ -28,7 +28,7 @@ pub struct ScoreArgs {
     #[arg(long, default_value = "20%", value_parser = parse_ao_distance)]
     pub bundle_distance: AoDistance,
     /// Calibrate: search each method's main parameters and strength for the least RMSE against
-    /// the truth over every built-in scene and every tractogram under --data, --views cameras
+    /// the truth over every built-in scene and every tractogram under --data, --fit-views cameras
     /// each; fit on half the views, report on the other half.
     #[arg(long)]
     pub fit: bool,
@@ -38,7 +38,7 @@ pub struct ScoreArgs {
     /// --fit: cameras per scene, orbiting the scene's own about its up axis (even ones fit, odd
     /// ones report).
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(2..=64), requires = "fit")]
-    pub views: u32,
+    pub fit_views: u32,
 }
 
 /// A method `score` compares with the truth.
@@ -295,6 +295,9 @@ pub struct RenderArgs {
     #[command(flatten)]
     #[serde(flatten)]
     pub truth: TruthArgs,
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub figure: crate::figure::FigureArgs,
 }
 
 /// Where the streamlines come from: a built-in scene (the file is the positional argument).
@@ -369,9 +372,12 @@ pub struct ImageArgs {
     /// Output PNG [default: lineao.png; `score`: no grid].
     #[arg(short, long)]
     pub output: Option<PathBuf>,
-    #[arg(long, default_value_t = 1280, value_parser = clap::value_parser!(u32).range(1..=8192))]
+    /// The picture's width in pixels; past the device's textures it is rendered as tiles
+    /// (--tile).
+    #[arg(long, default_value_t = 1280, value_parser = clap::value_parser!(u32).range(1..=crate::figure::MAX_SIDE as i64))]
     pub width: u32,
-    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=8192))]
+    /// The picture's height in pixels.
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=crate::figure::MAX_SIDE as i64))]
     pub height: u32,
     /// What to show: final, ao, normals, depth, zoom, level:K (pyramid level K), pieces (the
     /// final image, each culled piece of line colored by its level of detail: blue every point,
@@ -765,6 +771,7 @@ defaults_from_render_args! {
     chain: ChainArgs,
     volume: VolumeArgs,
     truth: TruthArgs,
+    figure: crate::figure::FigureArgs,
 }
 
 #[derive(Clone, Debug, PartialEq)]

@@ -110,9 +110,11 @@ impl RenderArgs {
     /// the options that exclude (`conflicts_with`) or need (`requires`) another.
     fn check(&self, given: &BTreeSet<String>) -> Result<(), String> {
         let ranges = [
-            ("width", self.image.width, 1, 8192),
-            ("height", self.image.height, 1, 8192),
+            ("width", self.image.width, 1, crate::figure::MAX_SIDE),
+            ("height", self.image.height, 1, crate::figure::MAX_SIDE),
             ("volume_resolution", self.volume.volume_resolution, 8, 1024),
+            ("turntable", self.figure.turntable.unwrap_or(1), 1, 100_000),
+            ("fps", self.figure.fps, 1, 240),
         ];
         for (name, value, lo, hi) in ranges {
             if !(lo..=hi).contains(&value) {
@@ -144,13 +146,16 @@ impl RenderArgs {
 }
 
 /// The options that need another (clap's `requires`, which it does not expose).
-const REQUIRES: [(&str, &str); 6] = [
+const REQUIRES: [(&str, &str); 9] = [
     ("combine", "radius2"),
     ("bilateral_radius", "bilateral"),
     ("bilateral_sigma", "bilateral"),
     ("slices", "volume"),
     ("window", "volume"),
     ("opaque_slices", "volume"),
+    ("turntable_degrees", "turntable"),
+    ("movie", "turntable"),
+    ("fps", "turntable"),
 ];
 
 /// `deserialize_with` functions: the value's text through the command line's parser of the
@@ -194,6 +199,7 @@ optional! {
     opt_slab: lineao::Slab = crate::args::parse_slab;
     opt_share: f64 = crate::args::parse_share;
     opt_field_range: (String, [f32; 2]) = crate::args::parse_field_range;
+    opt_tile: u32 = crate::figure::parse_tile;
 }
 
 /// A repeatable option: one value (its text) or a sequence of values, each through `parse`.
@@ -217,6 +223,13 @@ fn repeated<'de, D: serde::Deserializer<'de>, T>(
 /// `group`: one name or several.
 pub(crate) fn strings<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<String>, D::Error> {
     repeated(d, |s| Ok(s.to_string()))
+}
+
+/// `views`: one name, a list of names, or names separated by commas.
+pub(crate) fn views<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<crate::figure::AnatomicalView>, D::Error> {
+    let names = repeated(d, |s| Ok(s.to_string()))?;
+    let views = names.iter().flat_map(|n| n.split(',')).map(crate::figure::parse_view);
+    views.collect::<Result<_, _>>().map_err(serde::de::Error::custom)
 }
 
 /// `include`, `exclude`: one region or several.
@@ -327,7 +340,7 @@ mod tests {
         assert!(
             err(json!({"linewidth": 2})).starts_with("unexpected keyword argument 'linewidth'; the settings are: ")
         );
-        assert_eq!(err(json!({"width": 0})), "invalid value '0' for 'width': 0 is not in 1..=8192");
+        assert_eq!(err(json!({"width": 0})), "invalid value '0' for 'width': 0 is not in 1..=65536");
         assert!(
             err(json!({"method": "bogus"})).starts_with("method: unknown method 'bogus'"),
             "{}",

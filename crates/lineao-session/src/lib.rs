@@ -8,6 +8,7 @@
 
 pub mod args;
 pub mod dump;
+pub mod figure;
 pub mod info;
 pub mod kwargs;
 pub mod label;

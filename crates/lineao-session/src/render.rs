@@ -364,8 +364,14 @@ impl Session {
 
 pub fn run(args: &RenderArgs) -> Result<()> {
     let mut session = Session::open(args)?;
-    let (image, panels) = session.compose(args, &mut Vec::new())?;
+    if let Some(frames) = args.figure.turntable {
+        return crate::figure::run_turntable(args, &mut session, frames);
+    }
     let output = args.image.output.clone().unwrap_or_else(|| "lineao.png".into());
+    if crate::figure::write_tiled_picture(args, &mut session, &output)? {
+        return Ok(());
+    }
+    let (image, panels) = session.compose(args, &mut Vec::new())?;
     crate::output::write_png(&output, image.width, image.height, &image.data)?;
     let methods: Vec<&str> = panels.iter().map(|p| p.label.as_str()).collect();
     if session.lines.selected.is_some() {
@@ -388,10 +394,18 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 
 impl Session {
     /// The image the command line asks for: one method, a split screen (--compare) or the
-    /// labelled grid (--grid), with the panels it shows. `chains` keeps a chain per panel
-    /// between calls (pipelines and targets are made once for many frames); pass an empty
-    /// `Vec` for one image.
+    /// labelled grid (--grid), or with --views a figure of such images, one a view; with the
+    /// panels it shows. `chains` keeps a chain per panel between calls (pipelines and targets
+    /// are made once for many frames); pass an empty `Vec` for one image.
     pub fn compose(&mut self, args: &RenderArgs, chains: &mut Vec<AoChain>) -> Result<(Rgba8, Vec<Panel>)> {
+        match &args.figure.views[..] {
+            [] => self.compose_panels(args, chains),
+            views => crate::figure::compose_views(self, args, views, chains),
+        }
+    }
+
+    /// [`Session::compose`] seen by the session's camera alone.
+    pub fn compose_panels(&mut self, args: &RenderArgs, chains: &mut Vec<AoChain>) -> Result<(Rgba8, Vec<Panel>)> {
         let mut panels = panels(args, self.lines.hint.zoom_unit, self.sky, self.longest_side);
         for panel in &mut panels {
             panel.settings.validate().with_context(|| format!("method {}", panel.label))?;
@@ -535,12 +549,23 @@ impl Session {
             }
             None => AoChain::new(&gpu.device, format, panel.settings.clone())?,
         };
+        let gpu_rays = panel.settings.method == AoMethod::RayTraced && !args.truth.cpu;
+        let options = FrameOptions { gpu_rays, settled: true, timings: args.image.timings };
+        if let Some(tile) = crate::figure::tile_size(args, &gpu.device.limits(), &panel.settings) {
+            crate::figure::check_tiled(args, panel, dump)?;
+            let (width, height) = (args.image.width, args.image.height);
+            let mut image = Rgba8::filled(width, height, [0, 0, 0, 0]);
+            crate::figure::render_tiles(self, args, &mut chain, tile, options, |y, band| {
+                image.paste(&band, 0, y);
+                Ok(())
+            })?;
+            return Ok(Rendered { image, chain });
+        }
+        chain.set_tile(None)?;
         chain.resize(args.image.width, args.image.height)?;
         let size = (args.image.width, args.image.height);
         let target = lineao::targets::Target::output(&gpu.device, "lineao::render::output", size, format);
         let start = std::time::Instant::now();
-        let gpu_rays = panel.settings.method == AoMethod::RayTraced && !args.truth.cpu;
-        let options = FrameOptions { gpu_rays, settled: true, timings: args.image.timings };
         self.frame(&mut chain, &target.view, options)?;
         if args.image.timings {
             gpu.wait()?;

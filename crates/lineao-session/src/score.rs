@@ -257,6 +257,7 @@ pub fn read_frame(session: &Session, chain: &lineao::AoChain) -> Result<(NdImage
 
 pub fn run(args: &ScoreArgs) -> Result<()> {
     let render = &args.render;
+    crate::figure::refuse_in_score(&render.figure)?;
     let methods = if args.methods.is_empty() { ScoreMethod::all() } else { args.methods.clone() };
     let session = Session::open_with_points(render)?;
     let report = score(&session, render, &methods, args.bundle_distance)?;

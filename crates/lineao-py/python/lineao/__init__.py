@@ -20,9 +20,8 @@ is converted once to float32 C order — a copy, as ``np.ascontiguousarray(x, np
 
 from __future__ import annotations
 
-import math
 import os
-from typing import Any, Iterable, Optional
+from typing import Any, Iterable, Optional, Union
 
 import numpy as np
 
@@ -353,29 +352,30 @@ class Renderer:
         """The GPU adapter, e.g. ``llvmpipe (LLVM 19.1.7, 256 bits) (Vulkan, Cpu)``."""
         return self._native.device()
 
-    def orbit(self, n_frames: int, *, degrees: float = 360.0, **settings: Any) -> list:
+    def orbit(
+        self,
+        n_frames: int,
+        *,
+        degrees: float = 360.0,
+        movie: Optional[Union[str, os.PathLike]] = None,
+        fps: int = 30,
+        **settings: Any,
+    ) -> list:
         """A turntable: `n_frames` images with the eye turned about the target around the
-        camera's up axis, `degrees` in all (the last frame one step short of a full turn)."""
+        camera's up axis, `degrees` in all (the last frame one step short of a full turn), the
+        cameras of ``lineao render --turntable``. With `movie` (a ``.apng``/``.png`` file, or
+        ``.mp4``, ``.webm``… through the ffmpeg program) the frames are also written there at
+        `fps`, as ``--movie`` writes them."""
         if n_frames < 1:
             raise ValueError(f"n_frames: expected at least 1, got {n_frames}")
         start = self.camera
         settings = dict(settings)
         camera = _camera_settings(settings.pop("camera", None))
         start.update(camera)
-        eye, target, up = (np.asarray(start[k], np.float64) for k in ("eye", "target", "up"))
-        axis = up / np.linalg.norm(up)
-        frames = []
-        for i in range(n_frames):
-            angle = math.radians(degrees) * i / n_frames
-            v = eye - target
-            # Rodrigues' rotation of the eye about the axis through the target.
-            rotated = (
-                v * math.cos(angle)
-                + np.cross(axis, v) * math.sin(angle)
-                + axis * np.dot(axis, v) * (1 - math.cos(angle))
-            )
-            camera = {**start, "eye": tuple(target + rotated)}
-            frames.append(self.render(camera=camera, **settings))
+        eyes = _lineao.turntable(start["eye"], start["target"], start["up"], n_frames, float(degrees))
+        frames = [self.render(camera={**start, "eye": tuple(eye)}, **settings) for eye in eyes]
+        if movie is not None:
+            _lineao.write_movie([np.asarray(f) for f in frames], os.fspath(movie), int(fps))
         return frames
 
 
