@@ -114,8 +114,14 @@ pub struct ViewArgs {
     /// then exit: scripted use, and tests under Xvfb.
     #[arg(long, value_name = "PNG")]
     pub screenshot: Option<PathBuf>,
-    /// With --screenshot: UI frames to run at least before saving.
-    #[arg(long, default_value_t = 3, requires = "screenshot")]
+    /// Record what the window shows into this movie (.apng, or .mp4, .webm… through ffmpeg), its
+    /// frames as PNGs beside it: --frames of them once the image is complete, then exit (File ▸
+    /// Record movie… and M record in the window).
+    #[arg(long, value_name = "MOVIE", conflicts_with = "screenshot")]
+    pub record: Option<PathBuf>,
+    /// With --screenshot: UI frames to run at least before saving; with --record: the frames
+    /// recorded.
+    #[arg(long, default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..=100_000))]
     pub frames: u32,
     /// The methods' own settings, from their descriptions (as `render`'s).
     #[command(flatten)]

@@ -101,3 +101,28 @@ fn a_real_file_opens_and_a_bad_one_exits_1_naming_it() {
     // The window showed the message, and the screenshot has it.
     assert_eq!(read_png(&shot).0, (800, 600));
 }
+
+/// `--record MOVIE --frames N` records what the window shows: N PNG frames of the window
+/// beside the movie, and an animated PNG of them that the `png` crate's decoder reads back.
+#[test]
+fn the_viewer_records_what_it_shows() {
+    let dir = scratch("view_record");
+    let movie = dir.join("rec.apng");
+    let out = view(&["--vertices", "30000", "--size", "640x480", "--record", movie.to_str().unwrap(), "--frames", "4"]);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    assert!(stderr(&out).contains("4 frames"), "{}", stderr(&out));
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&movie).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    assert_eq!(reader.info().animation_control.map(|a| a.num_frames), Some(4));
+    for k in 0..4 {
+        let mut frame = vec![0; reader.output_buffer_size().unwrap()];
+        let info = reader.next_frame(&mut frame).unwrap();
+        let png = read_png(&dir.join(format!("rec-0000{k}.png")));
+        assert_eq!((png.0, &png.1[..]), ((640, 480), &frame[..info.buffer_size()]), "frame {k}");
+        assert!(lines_fraction(&png, 360, 620) > 0.02, "frame {k} shows the tracts");
+    }
+    // A movie it cannot write is refused before anything is recorded, naming it.
+    let out = view(&["--vertices", "3000", "--size", "320x240", "--record", "rec.avi", "--frames", "2"]);
+    assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
+    assert!(stderr(&out).contains("--record rec.avi"), "{}", stderr(&out));
+}

@@ -44,6 +44,9 @@ pub struct Options {
     /// `--screenshot PNG --frames N`: save the window after N frames once the image is complete,
     /// then close.
     pub screenshot: Option<(PathBuf, u32)>,
+    /// `--record MOVIE --frames N`: record N frames of the window once the image is complete,
+    /// write the movie, then close.
+    pub record: Option<(PathBuf, u32)>,
     /// `--color volume:FILE`: the volume sampled at every vertex of each dataset opened.
     pub sampled: Option<Arc<crate::source::Sampled>>,
     /// `--volume FILE`: the anatomy whose slices are shown with each dataset opened, and the
@@ -55,6 +58,8 @@ pub struct Options {
 #[derive(Debug, Default)]
 pub struct Outcome {
     pub saved: Option<PathBuf>,
+    /// What a recording wrote (`--record`).
+    pub recorded: Option<String>,
     pub error: Option<String>,
 }
 
@@ -130,6 +135,14 @@ pub struct App {
     save_dialog: FileDialog,
     screenshot: Option<(PathBuf, u32)>,
     screenshot_requested: bool,
+    /// `--record`'s movie and frames, until its recording starts.
+    record_at_start: Option<(PathBuf, u32)>,
+    /// The recording under way (File ▸ Record movie…, or M).
+    recording: Option<super::record::Recording>,
+    record_dialog: FileDialog,
+    /// The page's recording of its canvas is under way (index.html).
+    #[cfg(target_arch = "wasm32")]
+    page_recording: bool,
     /// The volume each dataset opened is coloured by (`--color volume:FILE`), or the values of
     /// a .tsf opened before its tractogram, for the next one opened.
     sampled: Option<Arc<crate::source::Sampled>>,
@@ -208,6 +221,13 @@ impl App {
                 .default_file_filter("Tractograms, meshes and volumes"),
             save_dialog: FileDialog::new().title("Save a screenshot (PNG)").default_file_name("lineao-view.png"),
             screenshot: options.screenshot,
+            record_at_start: options.record,
+            recording: None,
+            #[cfg(target_arch = "wasm32")]
+            page_recording: false,
+            record_dialog: FileDialog::new()
+                .title("Record a movie (.apng; .mp4 or .webm with ffmpeg)")
+                .default_file_name("lineao-recording.apng"),
             sampled: options.sampled,
             values_pending: 0,
             colour_when_whole: None,
@@ -607,11 +627,31 @@ impl App {
                             }
                         }
                     });
-                    // A page has no file system to save to (the browser saves its screenshots) and
-                    // is closed as a tab.
+                    // A page has no file system to save to: the browser downloads its picture
+                    // and movie (index.html), and a page is closed as a tab.
+                    #[cfg(target_arch = "wasm32")]
+                    {
+                        if ui.button("Save picture").clicked() {
+                            page_call("lineaoSavePicture");
+                            ui.close();
+                        }
+                        let label = if self.page_recording { "Stop recording (M)" } else { "Record movie (M)" };
+                        if ui.button(label).clicked() {
+                            self.page_recording = page_call("lineaoToggleRecording");
+                            ui.close();
+                        }
+                    }
                     if matches!(self.backend, Backend::Thread { .. }) {
                         if ui.button("Save screenshot…").clicked() {
                             self.save_dialog.save_file();
+                            ui.close();
+                        }
+                        let label = if self.recording.is_some() { "Stop recording (M)" } else { "Record movie… (M)" };
+                        if ui.button(label).clicked() {
+                            match self.recording.is_some() {
+                                true => self.stop_recording(),
+                                false => self.record_dialog.save_file(),
+                            }
                             ui.close();
                         }
                         if ui.button("Quit").clicked() {
@@ -662,6 +702,11 @@ impl App {
                             ui.label(format!("loading {}: {mib:.1} MiB", loading.name));
                         }
                     }
+                } else if let Some(recording) = &self.recording {
+                    ui.colored_label(
+                        egui::Color32::from_rgb(200, 30, 30),
+                        format!("REC {} frames (M stops)", recording.frames),
+                    );
                 } else if let Some(error) = &self.error {
                     ui.colored_label(ui.visuals().error_fg_color, error);
                 } else if let Some(busy) = &self.busy {
@@ -819,6 +864,7 @@ impl App {
         if response.double_clicked() {
             camera.reset();
         }
+        let mut record_key = false;
         if !ui.ctx().egui_wants_keyboard_input() {
             let step = 5f32.to_radians();
             ui.input(|i| {
@@ -854,11 +900,47 @@ impl App {
                         self.controls.move_slab(steps);
                     }
                 }
+                record_key = i.key_pressed(Key::M);
             });
             self.orthographic = camera.orthographic;
         }
         if *camera != before {
             self.last_motion = Some(Instant::now());
+        }
+        // M starts recording into lineao-recording.apng (the menu asks where), or stops; in a
+        // page the browser records its canvas.
+        if record_key && matches!(self.backend, Backend::Thread { .. }) {
+            match self.recording.is_some() {
+                true => self.stop_recording(),
+                false => _ = self.start_recording(PathBuf::from("lineao-recording.apng"), None),
+            }
+        }
+        #[cfg(target_arch = "wasm32")]
+        if record_key {
+            self.page_recording = page_call("lineaoToggleRecording");
+        }
+    }
+
+    /// Starts recording into `movie` (`limit` frames, then the window closes: `--record`); a
+    /// movie that cannot be written is said and nothing is recorded.
+    fn start_recording(&mut self, movie: PathBuf, limit: Option<u32>) -> bool {
+        match super::record::Recording::start(&movie, limit) {
+            Ok(recording) => self.recording = Some(recording),
+            Err(e) => self.fail(format!("{e:#}")),
+        }
+        self.recording.is_some()
+    }
+
+    /// Stops recording and writes the movie of the frames recorded.
+    fn stop_recording(&mut self) {
+        let Some(recording) = self.recording.take() else { return };
+        match recording.finish() {
+            Ok(written) => {
+                eprintln!("lineao: recorded {written}");
+                let mut outcome = self.outcome.lock().expect("not poisoned");
+                outcome.recorded = Some(written);
+            }
+            Err(e) => self.fail(format!("the recording: {e:#}")),
         }
     }
 
@@ -872,6 +954,26 @@ impl App {
         if let Some(path) = self.save_dialog.take_picked() {
             ctx.send_viewport_cmd(egui::ViewportCommand::Screenshot(egui::UserData::new(path)));
         }
+        self.record_dialog.update(ctx);
+        if let Some(path) = self.record_dialog.take_picked() {
+            self.start_recording(path, None);
+        }
+        // --record: once the image is complete.
+        if self.recording.is_none()
+            && self.complete()
+            && let Some((path, frames)) = self.record_at_start.take()
+            && !self.start_recording(path, Some(frames))
+        {
+            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+        }
+        if let Some(recording) = &mut self.recording {
+            if !recording.pending {
+                recording.pending = true;
+                let capture = egui::UserData::new(super::record::RecordFrame);
+                ctx.send_viewport_cmd(egui::ViewportCommand::Screenshot(capture));
+            }
+            ctx.request_repaint();
+        }
         // Several files at once: a volume and a tractogram dropped together are both opened, a
         // .tsf after the tractogram it colours.
         let mut dropped: Vec<PathBuf> =
@@ -879,6 +981,30 @@ impl App {
         dropped.sort_by_key(|path| is_tsf(path));
         for path in dropped {
             self.open_path(path);
+        }
+        let captures: Vec<Arc<ColorImage>> = ctx.input(|i| {
+            let captures = i.events.iter().filter_map(|e| match e {
+                egui::Event::Screenshot { user_data, image, .. } => {
+                    user_data.data.as_ref()?.downcast_ref::<super::record::RecordFrame>()?;
+                    Some(image.clone())
+                }
+                _ => None,
+            });
+            captures.collect()
+        });
+        for image in captures {
+            let Some(recording) = &mut self.recording else { break };
+            let rgba: Vec<u8> = image.pixels.iter().flat_map(|c| c.to_array()).collect();
+            let [w, h] = image.size.map(|s| s as u32);
+            if let Err(e) = recording.push(w, h, &rgba) {
+                self.recording = None;
+                self.fail(format!("recording stopped: {e:#}"));
+                break;
+            }
+            if recording.done() {
+                self.stop_recording();
+                ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+            }
         }
         let shots: Vec<(PathBuf, Arc<ColorImage>)> = ctx.input(|i| {
             i.events
@@ -1045,4 +1171,13 @@ fn badge(painter: &egui::Painter, anchor: Pos2, align: Align2, text: &str) {
 /// not, any case): values for the tractogram shown, not a dataset.
 pub fn is_tsf(path: &std::path::Path) -> bool {
     lineao_tracts::Format::from_path(path) == Some(lineao_tracts::Format::Tsf)
+}
+
+/// Calls the page's `window.NAME()` (index.html); whether it answered true.
+#[cfg(target_arch = "wasm32")]
+fn page_call(name: &str) -> bool {
+    use wasm_bindgen::JsCast;
+    let global = js_sys::global();
+    let function = js_sys::Reflect::get(&global, &name.into()).ok().and_then(|f| f.dyn_into::<js_sys::Function>().ok());
+    function.and_then(|f| f.call0(&global).ok()).is_some_and(|answer| answer.is_truthy())
 }

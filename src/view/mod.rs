@@ -14,6 +14,7 @@ pub mod app;
 pub mod camera;
 pub mod controls;
 mod loading;
+pub mod record;
 #[cfg(test)]
 mod tests;
 pub mod worker;
@@ -94,6 +95,7 @@ pub fn options(args: &ViewArgs) -> app::Options {
         orthographic: args.ortho,
         orbit: args.orbit,
         screenshot: args.screenshot.clone().map(|path| (path, args.frames)),
+        record: args.record.clone().map(|path| (path, args.frames)),
         sampled,
         anatomy,
     }
@@ -125,6 +127,12 @@ pub fn run(args: &ViewArgs) -> Result<()> {
     .map_err(|e| anyhow::anyhow!("{e}"))
     .context("cannot open the viewer's window (no display? run under xvfb-run, or use `lineao render`)")?;
     let outcome = outcome.lock().expect("not poisoned");
+    if args.record.is_some() {
+        if let Some(error) = &outcome.error {
+            anyhow::bail!("{error}");
+        }
+        anyhow::ensure!(outcome.recorded.is_some(), "the window closed before the recording was written");
+    }
     if let Some((path, _)) = screenshot {
         if let Some(error) = &outcome.error {
             anyhow::bail!("{error} (the screenshot {} shows it)", path.display());

@@ -28,6 +28,7 @@ fn options(source: Source, methods: [crate::cli::Method; 2], compare: bool) -> O
         orthographic: false,
         orbit: None,
         screenshot: None,
+        record: None,
         sampled: None,
     }
 }

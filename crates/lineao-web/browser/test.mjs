@@ -166,6 +166,36 @@ await check('the progressive GPU ray tracer gains rays; a debug view', async () 
   assert.equal(status.state, 'ready', status.message);
 });
 
+await check('File ▸ Save picture downloads the canvas as a PNG; M records a WebM movie of it', async () => {
+  const { status } = await open('?scene=bundles&vertices=30000');
+  assert.equal(status.state, 'ready', status.message);
+  // The menu's item calls this; a download, as a user's browser saves it.
+  let download = page.waitForEvent('download');
+  await page.evaluate(() => window.lineaoSavePicture());
+  const picture = path.join(out, 'saved-picture.png');
+  await (await download).saveAs(picture);
+  const png = fs.readFileSync(picture);
+  assert.equal(png.subarray(1, 4).toString(), 'PNG');
+  const size = [png.readUInt32BE(16), png.readUInt32BE(20)];
+  const canvas = await page.evaluate(() => [document.getElementById('lineao-canvas').width,
+    document.getElementById('lineao-canvas').height]);
+  assert.deepEqual(size, canvas);
+  // M, as a user presses it over the picture: recording; again: the movie downloads.
+  await page.mouse.click(900, 400);
+  download = page.waitForEvent('download');
+  await page.keyboard.press('m');
+  await new Promise((r) => setTimeout(r, 1500));
+  await page.keyboard.press('m');
+  const movie = path.join(out, 'recorded.webm');
+  await (await download).saveAs(movie);
+  const webm = fs.readFileSync(movie);
+  // The EBML header of a WebM (Matroska) file.
+  assert.equal(webm.readUInt32BE(0), 0x1a45dfa3, `not a WebM: ${webm.subarray(0, 8).toString('hex')}`);
+  const last = await page.evaluate(() => window.lineaoLastMovie);
+  assert.ok(last.size === webm.length && /webm/.test(last.type), JSON.stringify(last));
+  results.recorded = { picture: size, movieBytes: webm.length, type: last.type };
+});
+
 await check('a file dropped on the page opens; a bad one is an error, and the page goes on; the file picker', async () => {
   await open('?scene=spiral&vertices=20000');
   const bad = Buffer.from('TRACK\0this is not a TrackVis header at all');
