@@ -325,9 +325,15 @@ mod tests {
             assert!(refuses(&[&flag(a), value]), "{a} without {b}");
             assert!(from(json!({a: value})).is_err(), "{a} without {b}");
         }
-        for (name, out) in
-            [("width", 0), ("width", 8193), ("height", 0), ("s_h", 257), ("volume_resolution", 7), ("rays", 0)]
-        {
+        for (name, out) in [
+            ("width", 0),
+            ("width", 65537),
+            ("height", 0),
+            ("s_h", 257),
+            ("volume_resolution", 7),
+            ("rays", 0),
+            ("turntable", 0),
+        ] {
             let text = out.to_string();
             assert!(refuses(&[&flag(name), &text]), "{name} {out}");
             assert!(from(json!({name: out})).is_err(), "{name} {out}");
