@@ -1151,3 +1151,35 @@ fn figures_and_movies_refuse_bad_input() {
     assert!(dir.join("spin-000.png").exists() && dir.join("spin-001.png").exists());
     assert!(lineao(&["score", "--views", "left"]).status.code() != Some(0), "score refuses --views");
 }
+
+/// `--orbit AZIMUTH,ELEVATION,ZOOM` places the camera as the viewer's and the page's links do;
+/// given twice or more with --turntable, the keyframes of a camera path whose first and last
+/// frames are the pictures of the first and last keyframes.
+#[test]
+fn orbit_keyframes_make_a_camera_path() {
+    let dir = scratch("keyframes");
+    let size = ["--vertices", "30000", "--width", "96", "--height", "64"];
+    let render = |extra: &[&str], output: &Path| {
+        let mut argv = vec!["render", "-o", output.to_str().unwrap()];
+        argv.extend(extra);
+        argv.extend(size);
+        let out = lineao(&argv);
+        assert!(out.status.success(), "{extra:?}: {}", stderr(&out));
+    };
+    render(
+        &["--turntable", "4", "--orbit", "0,10,1", "--orbit=-60,30,0.8", "--orbit", "90,-20,1.2"],
+        &dir.join("path.png"),
+    );
+    render(&["--orbit", "0,10,1"], &dir.join("first.png"));
+    render(&["--orbit=90,-20,1.2"], &dir.join("last.png"));
+    assert_eq!(common::read_png(&dir.join("path-000.png")), common::read_png(&dir.join("first.png")));
+    assert_eq!(common::read_png(&dir.join("path-003.png")), common::read_png(&dir.join("last.png")));
+    assert_ne!(common::read_png(&dir.join("path-001.png")), common::read_png(&dir.join("first.png")));
+    let cameras: Value = serde_json::from_str(&std::fs::read_to_string(dir.join("path.json")).unwrap()).unwrap();
+    assert_eq!(cameras["keyframes"].as_array().map(Vec::len), Some(3));
+    let out = lineao(&["render", "--orbit", "0,10,1", "--eye", "1,2,3"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr(&out).contains("--orbit"), "{}", stderr(&out));
+    let out = lineao(&["render", "--orbit", "0,95,1"]);
+    assert_eq!(out.status.code(), Some(2), "{}", stderr(&out));
+}

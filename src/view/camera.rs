@@ -49,9 +49,7 @@ impl OrbitCamera {
     }
 
     pub fn eye(&self) -> Vec3 {
-        let (a, b) = basis(self.up);
-        let horizontal = a * self.yaw.cos() + b * self.yaw.sin();
-        self.target + self.distance * (horizontal * self.pitch.cos() + self.up * self.pitch.sin())
+        lineao_session::figure::orbit_eye(self.target, self.up, self.distance, self.yaw, self.pitch)
     }
 
     /// The lineao camera of this view.

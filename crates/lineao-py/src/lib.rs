@@ -590,6 +590,7 @@ impl Renderer {
             || args.camera.up.is_some()
             || args.camera.fov.is_some()
             || args.camera.ortho.is_some()
+            || !args.figure.orbit.is_empty()
         {
             let hint = self.session.lines.hint;
             self.session.camera = lineao_session::render::camera(&args, &hint).map_err(render_error)?;

@@ -306,3 +306,11 @@ def test_views_are_a_keyword_as_on_the_command_line(lineao_bin, tmp_path):
     assert image.shape == (128, 320, 4) and (image != expected).sum() == 0
     with pytest.raises(ValueError, match="not a view"):
         lineao.render(TRK, views="left,sideways", width=32, height=32)
+
+
+def test_orbit_places_the_camera_as_on_the_command_line(lineao_bin, tmp_path):
+    expected = cli_render(lineao_bin, tmp_path, TRK, "--orbit", "60,20,0.8", "--width", 160, "--height", 128)
+    image = lineao.render(TRK, orbit=(60, 20, 0.8), width=160, height=128)
+    assert (image != expected).sum() == 0
+    with pytest.raises(ValueError, match="AZIMUTH,ELEVATION,ZOOM"):
+        lineao.render(TRK, orbit="60,95,1", width=32, height=32)

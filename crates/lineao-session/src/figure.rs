@@ -3,7 +3,9 @@
 //!
 //! A turntable turns the eye about the target around the camera's up axis (Rodrigues'
 //! rotation, in f64), N frames over `--turntable-degrees` (a whole turn by default, the last
-//! frame one step short of the first). The session loads the data once and keeps one chain per
+//! frame one step short of the first); with two or more `--orbit` keyframes (the viewer's and
+//! the page's azimuth, elevation and zoom around the data's own camera) the N frames run from
+//! the first keyframe to the last, linear in each between two. The session loads the data once and keeps one chain per
 //! panel across the frames, so a frame costs what a still picture costs; the ray-traced method
 //! accumulates each frame to its `--rays`.
 //!
@@ -38,10 +40,18 @@ pub struct FigureArgs {
     #[serde(deserialize_with = "crate::kwargs::views")]
     pub views: Vec<AnatomicalView>,
     /// A turntable: N frames with the eye turned about the target around the camera's up
-    /// axis, written as OUTPUT-000.png, OUTPUT-001.png, … with their cameras (OUTPUT.json)
-    /// and a movie (--movie).
+    /// axis (or along the --orbit keyframes), written as OUTPUT-000.png, OUTPUT-001.png, …
+    /// with their cameras (OUTPUT.json) and a movie (--movie).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=100_000), conflicts_with = "dump")]
     pub turntable: Option<u32>,
+    /// The camera as the viewer's and the page's `--orbit`: AZIMUTH and ELEVATION (degrees
+    /// around the data's up) and ZOOM (times the data's default distance), around the data's
+    /// default target; given twice or more with --turntable N, the keyframes of a camera path
+    /// (N frames from the first to the last, each stretch between two keyframes as many frames
+    /// as its share of the turn).
+    #[arg(long, value_name = "AZIMUTH,ELEVATION,ZOOM", value_parser = parse_orbit, allow_hyphen_values = true)]
+    #[serde(deserialize_with = "crate::kwargs::orbits")]
+    pub orbit: Vec<[f32; 3]>,
     /// The turntable's turn in degrees, counter-clockwise seen from above its up axis (negative:
     /// clockwise); the last frame is one step short of it.
     #[arg(long, default_value_t = 360.0, allow_hyphen_values = true, requires = "turntable")]
@@ -166,6 +176,54 @@ pub fn check_views(views: &[AnatomicalView]) -> Result<(), String> {
         Some((_, view)) => Err(format!("--views names the view '{}' twice", view.name())),
         None => Ok(()),
     }
+}
+
+/// `--orbit`: AZIMUTH,ELEVATION,ZOOM (degrees, degrees within ±90, a factor > 0).
+pub fn parse_orbit(s: &str) -> Result<[f32; 3], String> {
+    let values: Vec<Option<f32>> =
+        s.split(',').map(|v| v.trim().parse::<f32>().ok().filter(|v| v.is_finite())).collect();
+    match values[..] {
+        [Some(azimuth), Some(elevation), Some(zoom)] if zoom > 0.0 && elevation.abs() <= 90.0 => {
+            Ok([azimuth, elevation, zoom])
+        }
+        _ => Err(format!("expected AZIMUTH,ELEVATION,ZOOM (degrees, degrees within ±90, a factor > 0), got '{s}'")),
+    }
+}
+
+/// The viewer's orbit: the eye at `distance` from `target`, `yaw` radians around `up` (from
+/// the first of `up`'s orthonormal pair toward the second) and `pitch` above the plane
+/// perpendicular to it. One definition for the viewer, the page's links and `render --orbit`.
+pub fn orbit_eye(target: Vec3, up: Vec3, distance: f32, yaw: f32, pitch: f32) -> Vec3 {
+    let (a, b) = up.any_orthonormal_pair();
+    let horizontal = a * yaw.cos() + b * yaw.sin();
+    target + distance * (horizontal * pitch.cos() + up * pitch.sin())
+}
+
+/// `home` (the data's default camera) turned to `--orbit`'s values: its target and up, the
+/// azimuth and elevation around that up, the distance times the zoom.
+pub fn orbit_camera(home: &Camera, [azimuth, elevation, zoom]: [f32; 3]) -> Camera {
+    let up = home.up.normalize_or(Vec3::Z);
+    let distance = (home.eye - home.target).length().max(1e-3);
+    let limit = 89f32.to_radians();
+    let pitch = elevation.to_radians().clamp(-limit, limit);
+    let eye = orbit_eye(home.target, up, (distance * zoom).clamp(1e-3, 1e7), azimuth.to_radians(), pitch);
+    Camera { eye, up, ..*home }
+}
+
+/// `frames` cameras along the keyframes `orbits` (at least two): frame k at k / (frames − 1)
+/// of the path, linear in azimuth, elevation and zoom between the keyframes it lies between;
+/// the first frame is the first keyframe, the last the last.
+pub fn camera_path(home: &Camera, orbits: &[[f32; 3]], frames: u32) -> Vec<Camera> {
+    let stretches = (orbits.len() - 1) as f64;
+    (0..frames)
+        .map(|k| {
+            let t = if frames > 1 { k as f64 / (frames - 1) as f64 * stretches } else { 0.0 };
+            let i = (t.floor() as usize).min(orbits.len() - 2);
+            let f = (t - i as f64) as f32;
+            let (a, b) = (orbits[i], orbits[i + 1]);
+            orbit_camera(home, [0, 1, 2].map(|c| a[c] + (b[c] - a[c]) * f))
+        })
+        .collect()
 }
 
 /// `frames` cameras turned from `camera` about its target around its up axis, `degrees` in
@@ -415,7 +473,10 @@ pub fn run_turntable(args: &crate::args::RenderArgs, session: &mut Session, fram
     let figure = &args.figure;
     let output = args.image.output.clone().unwrap_or_else(|| "lineao.png".into());
     let movie = Movie::of(figure, &output)?;
-    let cameras = turntable(&session.camera, frames, figure.turntable_degrees);
+    let cameras = match &figure.orbit[..] {
+        [_, _, ..] => camera_path(&session.camera, &figure.orbit, frames),
+        _ => turntable(&session.camera, frames, figure.turntable_degrees),
+    };
     let start = std::time::Instant::now();
     let mut render_seconds = 0.0;
     let (send, receive) = std::sync::mpsc::sync_channel::<(u32, Rgba8)>(2);
@@ -465,7 +526,8 @@ pub fn run_turntable(args: &crate::args::RenderArgs, session: &mut Session, fram
     let document = serde_json::json!({
         "frames": frames,
         "fps": figure.fps,
-        "degrees": figure.turntable_degrees,
+        "degrees": if figure.orbit.len() >= 2 { None } else { Some(figure.turntable_degrees) },
+        "keyframes": figure.orbit,
         "cameras": records,
     });
     std::fs::write(&cameras_file, serde_json::to_string_pretty(&document)? + "\n")
@@ -481,10 +543,13 @@ pub fn run_turntable(args: &crate::args::RenderArgs, session: &mut Session, fram
         Movie::None => None,
     };
     let seconds = start.elapsed().as_secs_f64();
+    let path = match figure.orbit.len() {
+        0 | 1 => format!("{} degrees", figure.turntable_degrees),
+        n => format!("through {n} keyframes"),
+    };
     eprintln!(
-        "lineao: turntable of {frames} frames ({} degrees) of {} on {} in {seconds:.2} s ({:.1} ms a frame, {:.1} of \
-         them rendering) -> {} .. {}, {}{}",
-        figure.turntable_degrees,
+        "lineao: turntable of {frames} frames ({path}) of {} on {} in {seconds:.2} s ({:.1} ms a frame, {:.1} of them \
+         rendering) -> {} .. {}, {}{}",
         session.lines.name,
         session.gpu.describe(),
         1e3 * seconds / frames as f64,
@@ -800,8 +865,10 @@ mod tests {
     /// tile's border misses what lies beyond).
     #[test]
     fn tiles_stitch_into_the_picture_without_a_seam() {
-        let cases: [(&[&str], u32, f64); 5] = [
+        // Dense tubes tie in depth where two nearly coincide, and a tie goes either way.
+        let cases: [(&[&str], u32, f64); 6] = [
             (&["--method", "none"], 128, 0.0002),
+            (&["--geometry", "tubes"], 128, 0.05),
             (&["--method", "lineao"], 128, 0.001),
             (&["--method", "lineao"], 192, 0.001),
             (&["--method", "vo-line"], 128, 0.002),

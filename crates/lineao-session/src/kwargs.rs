@@ -232,6 +232,18 @@ pub(crate) fn views<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<crate:
     views.collect::<Result<_, _>>().map_err(serde::de::Error::custom)
 }
 
+/// `orbit`: one AZIMUTH,ELEVATION,ZOOM (text or three numbers) or several (a list of them).
+pub(crate) fn orbits<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<[f32; 3]>, D::Error> {
+    let value = serde_json::Value::deserialize(d)?;
+    let items = match &value {
+        serde_json::Value::Array(items) if items.iter().all(|i| !i.is_number()) => items.clone(),
+        _ => vec![value],
+    };
+    let texts = items.into_iter().map(|item| Text::deserialize(item).map(|Text(t)| t));
+    let texts: Vec<String> = texts.collect::<Result<_, _>>().map_err(serde::de::Error::custom)?;
+    texts.iter().map(|t| crate::figure::parse_orbit(t)).collect::<Result<_, _>>().map_err(serde::de::Error::custom)
+}
+
 /// `include`, `exclude`: one region or several.
 pub(crate) fn regions<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<lineao_tracts::Region>, D::Error> {
     repeated(d, crate::args::parse_region)

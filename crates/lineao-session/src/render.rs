@@ -794,8 +794,14 @@ fn longest_side<'a>(points: impl Iterator<Item = &'a [f32; 3]>) -> f32 {
     lineao::Bounds::corners_of(points).map_or(0.0, |(lo, hi)| (hi - lo).max_element())
 }
 
-/// The camera of the command line (--eye, --target, --up, --fov, --ortho), the rest from `hint`.
+/// The camera of the command line (--eye, --target, --up, --fov, --ortho; or one --orbit around
+/// the data's own), the rest from `hint`.
 pub fn camera(args: &RenderArgs, hint: &ViewHint) -> Result<Camera> {
+    let given = args.camera.eye.is_some() || args.camera.target.is_some() || args.camera.up.is_some();
+    anyhow::ensure!(
+        args.figure.orbit.is_empty() || !given,
+        "--orbit places the camera around the data's: not with --eye, --target or --up"
+    );
     let camera = Camera {
         eye: Vec3::from_array(args.camera.eye.unwrap_or(hint.eye)),
         target: Vec3::from_array(args.camera.target.unwrap_or(hint.target)),
@@ -806,7 +812,10 @@ pub fn camera(args: &RenderArgs, hint: &ViewHint) -> Result<Camera> {
         },
     };
     validate_camera(&camera)?;
-    Ok(camera)
+    match args.figure.orbit[..] {
+        [orbit] => Ok(crate::figure::orbit_camera(&camera, orbit)),
+        _ => Ok(camera),
+    }
 }
 
 /// The camera a built-in scene suggests.
