@@ -114,6 +114,11 @@ pub struct ViewArgs {
     /// then exit: scripted use, and tests under Xvfb.
     #[arg(long, value_name = "PNG")]
     pub screenshot: Option<PathBuf>,
+    /// Pictures saved (File ▸ Save picture at K×…, and --screenshot) are the view rendered at K ×
+    /// the image's size, by `render`'s own path from the same data, camera and settings (tiles
+    /// past 4096 px); 1: --screenshot saves the window.
+    #[arg(long, value_name = "K", default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..=64))]
+    pub scale: u32,
     /// Record what the window shows into this movie (.apng, or .mp4, .webm… through ffmpeg), its
     /// frames as PNGs beside it: --frames of them once the image is complete, then exit (File ▸
     /// Record movie… and M record in the window).

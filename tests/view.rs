@@ -126,3 +126,22 @@ fn the_viewer_records_what_it_shows() {
     assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
     assert!(stderr(&out).contains("--record rec.avi"), "{}", stderr(&out));
 }
+
+/// `--scale K --screenshot PNG` saves the view on screen rendered at K × the image's size by
+/// `render`'s own path (the same data, camera and settings), not the window.
+#[test]
+fn a_picture_at_a_scale_is_the_view_at_that_size() {
+    let dir = scratch("view_scale");
+    let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/data");
+    let file = data.join("dipy+dipy/dipy/data/files/tracks300.trk");
+    let png = dir.join("scaled.png");
+    let args = [file.to_str().unwrap(), "--size", "800x600", "--scale", "2", "--screenshot", png.to_str().unwrap()];
+    let out = view(&args);
+    assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+    let image = read_png(&png);
+    let (w, h) = image.0;
+    // Twice the image beside the side panel, below the menu: not the window's 800 × 600.
+    assert!(w % 2 == 0 && h % 2 == 0 && (300..800).contains(&(w / 2)) && (400..600).contains(&(h / 2)), "{w} x {h}");
+    assert!(lines_fraction(&image, 0, w) > 0.02, "the tracts are in the picture");
+    assert!(stderr(&out).contains(&format!("at {w} x {h}")), "{}", stderr(&out));
+}

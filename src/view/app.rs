@@ -47,6 +47,9 @@ pub struct Options {
     /// `--record MOVIE --frames N`: record N frames of the window once the image is complete,
     /// write the movie, then close.
     pub record: Option<(PathBuf, u32)>,
+    /// `--scale K`: pictures saved (File ▸ Save picture at K×…, `--screenshot`) are the view
+    /// rendered at K × the image's size; 1: `--screenshot` saves the window.
+    pub scale: u32,
     /// `--color volume:FILE`: the volume sampled at every vertex of each dataset opened.
     pub sampled: Option<Arc<crate::source::Sampled>>,
     /// `--volume FILE`: the anatomy whose slices are shown with each dataset opened, and the
@@ -140,6 +143,12 @@ pub struct App {
     /// The recording under way (File ▸ Record movie…, or M).
     recording: Option<super::record::Recording>,
     record_dialog: FileDialog,
+    /// `--scale`, the source a picture at a scale reads again (a file or a scene), the picture
+    /// being rendered, and where to save one.
+    scale: u32,
+    picture_source: Option<Source>,
+    picture: Option<(PathBuf, std::thread::JoinHandle<Result<PathBuf, String>>)>,
+    picture_dialog: FileDialog,
     /// The page's recording of its canvas is under way (index.html).
     #[cfg(target_arch = "wasm32")]
     page_recording: bool,
@@ -222,6 +231,10 @@ impl App {
             save_dialog: FileDialog::new().title("Save a screenshot (PNG)").default_file_name("lineao-view.png"),
             screenshot: options.screenshot,
             record_at_start: options.record,
+            scale: options.scale.max(1),
+            picture_source: None,
+            picture: None,
+            picture_dialog: FileDialog::new().title("Save the view as a picture (PNG)").default_file_name("lineao.png"),
             recording: None,
             #[cfg(target_arch = "wasm32")]
             page_recording: false,
@@ -292,6 +305,7 @@ impl App {
 
     /// Opens a file or builds a scene (on the render thread).
     pub fn load(&mut self, source: Source) {
+        self.picture_source = matches!(source, Source::File(_) | Source::Scene { .. }).then(|| source.clone());
         let name = match &source {
             Source::Scene { kind, .. } => format!("scene {}", kind.name()),
             source => source.name(),
@@ -646,6 +660,10 @@ impl App {
                             self.save_dialog.save_file();
                             ui.close();
                         }
+                        if ui.button(format!("Save picture at {}×…", self.scale)).clicked() {
+                            self.picture_dialog.save_file();
+                            ui.close();
+                        }
                         let label = if self.recording.is_some() { "Stop recording (M)" } else { "Record movie… (M)" };
                         if ui.button(label).clicked() {
                             match self.recording.is_some() {
@@ -931,6 +949,43 @@ impl App {
         self.recording.is_some()
     }
 
+    /// Renders the view on screen at `--scale` × the image's size into `path`, on a thread.
+    fn save_picture(&mut self, ctx: &egui::Context, path: PathBuf) {
+        let Some(rect) = self.image_rect else { return };
+        let ppp = ctx.pixels_per_point();
+        let size = ((rect.width() * ppp).round().max(1.0) as u32, (rect.height() * ppp).round().max(1.0) as u32);
+        let (Some(view), Some(source)) = (self.view(size), &self.picture_source) else {
+            return self.fail("a picture needs a tractogram read from a file, or a scene".into());
+        };
+        match super::export::render_args(source, &view, self.scale, path.clone()) {
+            Ok(args) => {
+                self.busy = Some(format!("rendering {} at {}× …", path.display(), self.scale));
+                self.picture = Some((path, super::export::save(args)));
+            }
+            Err(e) => self.fail(e),
+        }
+    }
+
+    /// A picture at a scale that finished: saved (and, for --screenshot, the window closed).
+    fn picture_done(&mut self, ctx: &egui::Context) {
+        let finished = self.picture.as_ref().is_some_and(|(_, thread)| thread.is_finished());
+        if !finished {
+            if self.picture.is_some() {
+                ctx.request_repaint_after(Duration::from_millis(100));
+            }
+            return;
+        }
+        let (path, thread) = self.picture.take().expect("finished");
+        self.busy = None;
+        match thread.join().unwrap_or_else(|_| Err("the picture's thread failed".into())) {
+            Ok(saved) => self.outcome.lock().expect("not poisoned").saved = Some(saved),
+            Err(e) => self.fail(e),
+        }
+        if self.screenshot.as_ref().is_some_and(|(p, _)| *p == path) {
+            ctx.send_viewport_cmd(egui::ViewportCommand::Close);
+        }
+    }
+
     /// Stops recording and writes the movie of the frames recorded.
     fn stop_recording(&mut self) {
         let Some(recording) = self.recording.take() else { return };
@@ -954,6 +1009,11 @@ impl App {
         if let Some(path) = self.save_dialog.take_picked() {
             ctx.send_viewport_cmd(egui::ViewportCommand::Screenshot(egui::UserData::new(path)));
         }
+        self.picture_dialog.update(ctx);
+        if let Some(path) = self.picture_dialog.take_picked() {
+            self.save_picture(ctx, path);
+        }
+        self.picture_done(ctx);
         self.record_dialog.update(ctx);
         if let Some(path) = self.record_dialog.take_picked() {
             self.start_recording(path, None);
@@ -1029,11 +1089,15 @@ impl App {
                 ctx.send_viewport_cmd(egui::ViewportCommand::Close);
             }
         }
-        // --screenshot: once N frames have passed and the image is complete.
-        if let Some((path, frames)) = &self.screenshot {
-            if !self.screenshot_requested && self.frames >= u64::from(*frames) && self.complete() {
+        // --screenshot: once N frames have passed and the image is complete (with --scale, the
+        // view at that scale).
+        if let Some((path, frames)) = self.screenshot.clone() {
+            if !self.screenshot_requested && self.frames >= u64::from(frames) && self.complete() {
                 self.screenshot_requested = true;
-                ctx.send_viewport_cmd(egui::ViewportCommand::Screenshot(egui::UserData::new(path.clone())));
+                match self.scale {
+                    1 => ctx.send_viewport_cmd(egui::ViewportCommand::Screenshot(egui::UserData::new(path))),
+                    _ => self.save_picture(ctx, path),
+                }
             }
             ctx.request_repaint();
         }

@@ -13,6 +13,7 @@
 pub mod app;
 pub mod camera;
 pub mod controls;
+mod export;
 mod loading;
 pub mod record;
 #[cfg(test)]
@@ -96,6 +97,7 @@ pub fn options(args: &ViewArgs) -> app::Options {
         orbit: args.orbit,
         screenshot: args.screenshot.clone().map(|path| (path, args.frames)),
         record: args.record.clone().map(|path| (path, args.frames)),
+        scale: args.scale,
         sampled,
         anatomy,
     }
@@ -138,7 +140,10 @@ pub fn run(args: &ViewArgs) -> Result<()> {
             anyhow::bail!("{error} (the screenshot {} shows it)", path.display());
         }
         anyhow::ensure!(outcome.saved.as_ref() == Some(&path), "the window closed before the screenshot was taken");
-        eprintln!("lineao: saved the window to {}", path.display());
+        match args.scale {
+            1 => eprintln!("lineao: saved the window to {}", path.display()),
+            k => eprintln!("lineao: saved the view at {k}× to {}", path.display()),
+        }
     }
     Ok(())
 }

@@ -29,6 +29,7 @@ fn options(source: Source, methods: [crate::cli::Method; 2], compare: bool) -> O
         orbit: None,
         screenshot: None,
         record: None,
+        scale: 1,
         sampled: None,
     }
 }
