@@ -693,7 +693,8 @@ pub fn render_tiles(
 /// --grid, --views or --legend). `Ok(false)`: the picture is not tiled, or is composed.
 pub fn write_tiled_picture(args: &crate::args::RenderArgs, session: &mut Session, output: &Path) -> Result<bool> {
     let composed = args.shown.compare.is_some() || args.shown.grid || !args.figure.views.is_empty();
-    if composed || args.image.legend {
+    // Object-space AO's visibilities are the session's to compute first: the composed path.
+    if composed || args.image.legend || args.shown.method.volume.is_some() {
         return Ok(false);
     }
     let method = args.shown.method;
@@ -702,7 +703,6 @@ pub fn write_tiled_picture(args: &crate::args::RenderArgs, session: &mut Session
     let Some(tile) = tile_size(args, &session.gpu.device.limits(), &settings) else { return Ok(false) };
     let panel = crate::render::Panel::new(method, settings);
     check_tiled(args, &panel, args.image.dump.as_deref())?;
-    anyhow::ensure!(panel.volume.is_none(), "tiles (--tile) do not take object-space AO yet: render it whole");
     let format = wgpu::TextureFormat::Rgba8UnormSrgb;
     let mut chain = lineao::AoChain::new(&session.gpu.device, format, panel.settings.clone())?;
     let (width, height) = (args.image.width, args.image.height);
