@@ -102,7 +102,7 @@ pub struct ViewArgs {
     pub ortho: bool,
     /// Start the orbit camera at AZIMUTH and ELEVATION (degrees around the data's up) and ZOOM
     /// times the data's default distance: what a web page's link keeps of the view.
-    #[arg(long, value_name = "AZIMUTH,ELEVATION,ZOOM", value_parser = parse_orbit)]
+    #[arg(long, value_name = "AZIMUTH,ELEVATION,ZOOM", value_parser = lineao_session::cameras::parse_orbit)]
     pub orbit: Option<[f32; 3]>,
     /// Show each pass's GPU time over the image.
     #[arg(long)]
@@ -134,17 +134,6 @@ pub struct ViewArgs {
     /// The streamlines shown (as `render`'s; the side panel changes them).
     #[command(flatten)]
     pub select: SelectArgs,
-}
-
-fn parse_orbit(s: &str) -> Result<[f32; 3], String> {
-    let values: Vec<Option<f32>> =
-        s.split(',').map(|v| v.trim().parse::<f32>().ok().filter(|v| v.is_finite())).collect();
-    match values[..] {
-        [Some(azimuth), Some(elevation), Some(zoom)] if zoom > 0.0 && elevation.abs() <= 90.0 => {
-            Ok([azimuth, elevation, zoom])
-        }
-        _ => Err(format!("expected AZIMUTH,ELEVATION,ZOOM (degrees, degrees within ±90, a factor > 0), got '{s}'")),
-    }
 }
 
 fn parse_size(s: &str) -> Result<[u32; 2], String> {

@@ -12,4 +12,4 @@ pub mod fit;
 #[cfg(feature = "viewer")]
 pub mod view;
 
-pub use lineao_session::{args, dump, info, kwargs, label, output, render, score, source, truth};
+pub use lineao_session::{args, cameras, dump, figure, info, kwargs, label, output, render, score, source, truth};

@@ -6,7 +6,7 @@
 use std::process::ExitCode;
 
 use clap::Parser;
-use lineao_cli::{bench, bench_load, cli, fit, info, render, score};
+use lineao_cli::{bench, bench_load, cli, figure, fit, info, score};
 
 fn main() -> ExitCode {
     if std::env::var_os("XDG_RUNTIME_DIR").is_none() {
@@ -15,7 +15,7 @@ fn main() -> ExitCode {
     }
     let cli = cli::Cli::parse();
     let result = std::panic::catch_unwind(|| match cli.command {
-        cli::Command::Render(args) => render::run(&args),
+        cli::Command::Render(args) => figure::run(&args),
         cli::Command::Bench(args) => bench::run(&args),
         cli::Command::Info(args) => info::run(&args),
         cli::Command::Convert(args) => info::convert(&args),

@@ -49,7 +49,7 @@ impl OrbitCamera {
     }
 
     pub fn eye(&self) -> Vec3 {
-        lineao_session::figure::orbit_eye(self.target, self.up, self.distance, self.yaw, self.pitch)
+        lineao_session::cameras::orbit_eye(self.target, self.up, self.distance, self.yaw, self.pitch)
     }
 
     /// The lineao camera of this view.

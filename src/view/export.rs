@@ -100,6 +100,6 @@ pub fn render_args(source: &Source, view: &View, scale: u32, output: PathBuf) ->
 pub fn save(args: RenderArgs) -> std::thread::JoinHandle<Result<PathBuf, String>> {
     std::thread::spawn(move || {
         let output = args.image.output.clone().unwrap_or_else(|| "lineao.png".into());
-        lineao_session::render::run(&args).map(|()| output).map_err(|e| format!("{e:#}"))
+        lineao_session::figure::run(&args).map(|()| output).map_err(|e| format!("{e:#}"))
     })
 }

@@ -635,7 +635,7 @@ fn turntable(eye: [f32; 3], target: [f32; 3], up: [f32; 3], frames: u32, degrees
         up: up.into(),
         projection: lineao::Projection::Perspective { fov_y_deg: 30.0 },
     };
-    lineao_session::figure::turntable(&camera, frames, degrees).iter().map(|c| c.eye.to_array()).collect()
+    lineao_session::cameras::turntable(&camera, frames, degrees).iter().map(|c| c.eye.to_array()).collect()
 }
 
 /// Writes `frames` ((H, W, 4) uint8 each, one size) as the movie `path` names at `fps`:

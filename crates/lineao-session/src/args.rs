@@ -297,7 +297,7 @@ pub struct RenderArgs {
     pub truth: TruthArgs,
     #[command(flatten)]
     #[serde(flatten)]
-    pub figure: crate::figure::FigureArgs,
+    pub figure: FigureArgs,
 }
 
 /// Where the streamlines come from: a built-in scene (the file is the positional argument).
@@ -374,10 +374,10 @@ pub struct ImageArgs {
     pub output: Option<PathBuf>,
     /// The picture's width in pixels; past the device's textures it is rendered as tiles
     /// (--tile).
-    #[arg(long, default_value_t = 1280, value_parser = clap::value_parser!(u32).range(1..=crate::figure::MAX_SIDE as i64))]
+    #[arg(long, default_value_t = 1280, value_parser = clap::value_parser!(u32).range(1..=MAX_SIDE as i64))]
     pub width: u32,
     /// The picture's height in pixels.
-    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=crate::figure::MAX_SIDE as i64))]
+    #[arg(long, default_value_t = 1024, value_parser = clap::value_parser!(u32).range(1..=MAX_SIDE as i64))]
     pub height: u32,
     /// What to show: final, ao, normals, depth, zoom, level:K (pyramid level K), pieces (the
     /// final image, each culled piece of line colored by its level of detail: blue every point,
@@ -771,7 +771,7 @@ defaults_from_render_args! {
     chain: ChainArgs,
     volume: VolumeArgs,
     truth: TruthArgs,
-    figure: crate::figure::FigureArgs,
+    figure: FigureArgs,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -1051,3 +1051,70 @@ mod tests {
         assert_eq!(args.context.slices, Some([None, None, Some(12.0)]));
     }
 }
+
+/// Figures and movies: views in one figure, turntables.
+#[derive(Args, Clone, Debug, serde::Deserialize)]
+#[command(next_help_heading = "Figures and movies")]
+#[serde(default)]
+pub struct FigureArgs {
+    /// Standard anatomical views of the same data in one labelled figure, a panel each, seen
+    /// from the view's side of RAS+ world space at the camera's distance from its target:
+    /// left, right, front, back, top, bottom (or anterior, posterior, superior, inferior),
+    /// e.g. `left,right,top,front`; with --compare each panel shows both methods.
+    #[arg(long, value_name = "VIEW,...", value_delimiter = ',', value_parser = crate::cameras::parse_view, conflicts_with_all = ["grid", "dump", "turntable"])]
+    #[serde(deserialize_with = "crate::kwargs::views")]
+    pub views: Vec<crate::cameras::AnatomicalView>,
+    /// A turntable: N frames with the eye turned about the target around the camera's up
+    /// axis (or along the --orbit keyframes), written as OUTPUT-000.png, OUTPUT-001.png, …
+    /// with their cameras (OUTPUT.json) and a movie (--movie).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=100_000), conflicts_with = "dump")]
+    pub turntable: Option<u32>,
+    /// The camera as the viewer's and the page's `--orbit`: AZIMUTH and ELEVATION (degrees
+    /// around the data's up) and ZOOM (times the data's default distance), around the data's
+    /// default target; given twice or more with --turntable N, the keyframes of a camera path
+    /// (N frames from the first to the last, each stretch between two keyframes as many frames
+    /// as its share of the turn).
+    #[arg(long, value_name = "AZIMUTH,ELEVATION,ZOOM", value_parser = crate::cameras::parse_orbit, allow_hyphen_values = true)]
+    #[serde(deserialize_with = "crate::kwargs::orbits")]
+    pub orbit: Vec<[f32; 3]>,
+    /// The turntable's turn in degrees, counter-clockwise seen from above its up axis (negative:
+    /// clockwise); the last frame is one step short of it.
+    #[arg(long, default_value_t = 360.0, allow_hyphen_values = true, requires = "turntable")]
+    pub turntable_degrees: f32,
+    /// The turntable's movie: a .png or .apng file (an animated PNG, written by lineao), a
+    /// file the `ffmpeg` program writes (.mp4, .mkv, .mov: H.264; .webm: VP9; .gif), or
+    /// `none` (the PNG frames only) [default: OUTPUT with the extension .apng].
+    #[arg(long, value_name = "FILE|none", requires = "turntable")]
+    pub movie: Option<PathBuf>,
+    /// The movie's frames per second.
+    #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..=240), requires = "turntable")]
+    pub fps: u32,
+    /// Render the picture as tiles of at most SIZE × SIZE pixels (a multiple of 64), each seen
+    /// through the picture's camera with its own guard band, stitched without a seam: the
+    /// picture a single frame of its size shows, in the memory of one row of tiles [default:
+    /// tiles of 4096 px where --width or --height exceeds it].
+    #[arg(long, value_name = "SIZE", value_parser = parse_tile, conflicts_with = "dump")]
+    #[serde(deserialize_with = "crate::kwargs::opt_tile")]
+    pub tile: Option<u32>,
+}
+
+/// The largest --width and --height: 64 K pixels a side (tiles reach any size; a PNG's rows
+/// of 64 K RGBA pixels are 256 KiB).
+pub const MAX_SIDE: u32 = 65_536;
+
+/// The alignment of tiles: their origins in the picture are multiples of it, so that every
+/// level of every pyramid (LineAO's ND pyramid, VO's moments) covers the same pixels in a tile
+/// as in the picture.
+pub const TILE_ALIGN: u32 = 64;
+
+/// `--tile`: a multiple of 64, at least 64.
+pub fn parse_tile(s: &str) -> Result<u32, String> {
+    match s.trim().parse::<u32>() {
+        Ok(size) if size >= TILE_ALIGN && size % TILE_ALIGN == 0 => Ok(size),
+        _ => Err(format!("expected a tile size in pixels, a multiple of {TILE_ALIGN} (64, 128, … 4096), got '{s}'")),
+    }
+}
+
+/// The tiles of a picture wider or taller than this, unless --tile says otherwise: a frame's
+/// targets at 4096² (and the guard band) take about 1 GiB, as much as a device is sure to give.
+pub const DEFAULT_TILE: u32 = 4096;

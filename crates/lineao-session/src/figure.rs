@@ -20,233 +20,10 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use clap::Args;
-use glam::{DVec3, Vec3};
-use lineao::Camera;
 
+use crate::args::{FigureArgs, RenderArgs};
 use crate::label::Rgba8;
 use crate::render::Session;
-
-/// Figures and movies: views in one figure, turntables.
-#[derive(Args, Clone, Debug, serde::Deserialize)]
-#[command(next_help_heading = "Figures and movies")]
-#[serde(default)]
-pub struct FigureArgs {
-    /// Standard anatomical views of the same data in one labelled figure, a panel each, seen
-    /// from the view's side of RAS+ world space at the camera's distance from its target:
-    /// left, right, front, back, top, bottom (or anterior, posterior, superior, inferior),
-    /// e.g. `left,right,top,front`; with --compare each panel shows both methods.
-    #[arg(long, value_name = "VIEW,...", value_delimiter = ',', value_parser = parse_view, conflicts_with_all = ["grid", "dump", "turntable"])]
-    #[serde(deserialize_with = "crate::kwargs::views")]
-    pub views: Vec<AnatomicalView>,
-    /// A turntable: N frames with the eye turned about the target around the camera's up
-    /// axis (or along the --orbit keyframes), written as OUTPUT-000.png, OUTPUT-001.png, …
-    /// with their cameras (OUTPUT.json) and a movie (--movie).
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=100_000), conflicts_with = "dump")]
-    pub turntable: Option<u32>,
-    /// The camera as the viewer's and the page's `--orbit`: AZIMUTH and ELEVATION (degrees
-    /// around the data's up) and ZOOM (times the data's default distance), around the data's
-    /// default target; given twice or more with --turntable N, the keyframes of a camera path
-    /// (N frames from the first to the last, each stretch between two keyframes as many frames
-    /// as its share of the turn).
-    #[arg(long, value_name = "AZIMUTH,ELEVATION,ZOOM", value_parser = parse_orbit, allow_hyphen_values = true)]
-    #[serde(deserialize_with = "crate::kwargs::orbits")]
-    pub orbit: Vec<[f32; 3]>,
-    /// The turntable's turn in degrees, counter-clockwise seen from above its up axis (negative:
-    /// clockwise); the last frame is one step short of it.
-    #[arg(long, default_value_t = 360.0, allow_hyphen_values = true, requires = "turntable")]
-    pub turntable_degrees: f32,
-    /// The turntable's movie: a .png or .apng file (an animated PNG, written by lineao), a
-    /// file the `ffmpeg` program writes (.mp4, .mkv, .mov: H.264; .webm: VP9; .gif), or
-    /// `none` (the PNG frames only) [default: OUTPUT with the extension .apng].
-    #[arg(long, value_name = "FILE|none", requires = "turntable")]
-    pub movie: Option<PathBuf>,
-    /// The movie's frames per second.
-    #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..=240), requires = "turntable")]
-    pub fps: u32,
-    /// Render the picture as tiles of at most SIZE × SIZE pixels (a multiple of 64), each seen
-    /// through the picture's camera with its own guard band, stitched without a seam: the
-    /// picture a single frame of its size shows, in the memory of one row of tiles [default:
-    /// tiles of 4096 px where --width or --height exceeds it].
-    #[arg(long, value_name = "SIZE", value_parser = parse_tile, conflicts_with = "dump")]
-    #[serde(deserialize_with = "crate::kwargs::opt_tile")]
-    pub tile: Option<u32>,
-}
-
-/// The largest --width and --height: 64 K pixels a side (tiles reach any size; a PNG's rows
-/// of 64 K RGBA pixels are 256 KiB).
-pub const MAX_SIDE: u32 = 65_536;
-
-/// The alignment of tiles: their origins in the picture are multiples of it, so that every
-/// level of every pyramid (LineAO's ND pyramid, VO's moments) covers the same pixels in a tile
-/// as in the picture.
-pub const TILE_ALIGN: u32 = 64;
-
-/// `--tile`: a multiple of 64, at least 64.
-pub fn parse_tile(s: &str) -> Result<u32, String> {
-    match s.trim().parse::<u32>() {
-        Ok(size) if size >= TILE_ALIGN && size % TILE_ALIGN == 0 => Ok(size),
-        _ => Err(format!("expected a tile size in pixels, a multiple of {TILE_ALIGN} (64, 128, … 4096), got '{s}'")),
-    }
-}
-
-/// A standard anatomical view: which side of RAS+ world space the eye is on.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum AnatomicalView {
-    Left,
-    Right,
-    Front,
-    Back,
-    Top,
-    Bottom,
-}
-
-impl AnatomicalView {
-    pub const ALL: [AnatomicalView; 6] = [
-        AnatomicalView::Left,
-        AnatomicalView::Right,
-        AnatomicalView::Front,
-        AnatomicalView::Back,
-        AnatomicalView::Top,
-        AnatomicalView::Bottom,
-    ];
-
-    /// Its name, as `--views` takes it and the figure labels it.
-    pub fn name(self) -> &'static str {
-        match self {
-            AnatomicalView::Left => "left",
-            AnatomicalView::Right => "right",
-            AnatomicalView::Front => "front",
-            AnatomicalView::Back => "back",
-            AnatomicalView::Top => "top",
-            AnatomicalView::Bottom => "bottom",
-        }
-    }
-
-    /// The view of a name or its anatomical synonym (any case).
-    pub fn from_name(name: &str) -> Option<AnatomicalView> {
-        let name = name.trim().to_ascii_lowercase();
-        let synonym = match name.as_str() {
-            "anterior" => "front",
-            "posterior" => "back",
-            "superior" => "top",
-            "inferior" => "bottom",
-            other => other,
-        };
-        AnatomicalView::ALL.into_iter().find(|v| v.name() == synonym)
-    }
-
-    /// From the target toward the eye, and the camera's up: the sides look along x with
-    /// superior up, front and back along y with superior up, top and bottom along z with
-    /// anterior up (radiological conventions aside, each as a person standing there sees it).
-    fn axes(self) -> (Vec3, Vec3) {
-        match self {
-            AnatomicalView::Left => (Vec3::NEG_X, Vec3::Z),
-            AnatomicalView::Right => (Vec3::X, Vec3::Z),
-            AnatomicalView::Front => (Vec3::Y, Vec3::Z),
-            AnatomicalView::Back => (Vec3::NEG_Y, Vec3::Z),
-            AnatomicalView::Top => (Vec3::Z, Vec3::Y),
-            AnatomicalView::Bottom => (Vec3::NEG_Z, Vec3::Y),
-        }
-    }
-
-    /// `base` moved to this view: the same target, distance and projection.
-    pub fn camera(self, base: &Camera) -> Camera {
-        let (toward_eye, up) = self.axes();
-        let distance = (base.eye - base.target).length();
-        Camera { eye: base.target + toward_eye * distance, target: base.target, up, projection: base.projection }
-    }
-}
-
-/// One of `--views`, by name or synonym.
-pub fn parse_view(name: &str) -> Result<AnatomicalView, String> {
-    AnatomicalView::from_name(name).ok_or_else(|| {
-        let known: Vec<&str> = AnatomicalView::ALL.iter().map(|v| v.name()).collect();
-        format!(
-            "'{}' is not a view (one of {}, or anterior, posterior, superior, inferior)",
-            name.trim(),
-            known.join(", ")
-        )
-    })
-}
-
-/// `--views`' list: each view once.
-pub fn check_views(views: &[AnatomicalView]) -> Result<(), String> {
-    match views.iter().enumerate().find(|(k, v)| views[..*k].contains(v)) {
-        Some((_, view)) => Err(format!("--views names the view '{}' twice", view.name())),
-        None => Ok(()),
-    }
-}
-
-/// `--orbit`: AZIMUTH,ELEVATION,ZOOM (degrees, degrees within ±90, a factor > 0).
-pub fn parse_orbit(s: &str) -> Result<[f32; 3], String> {
-    let values: Vec<Option<f32>> =
-        s.split(',').map(|v| v.trim().parse::<f32>().ok().filter(|v| v.is_finite())).collect();
-    match values[..] {
-        [Some(azimuth), Some(elevation), Some(zoom)] if zoom > 0.0 && elevation.abs() <= 90.0 => {
-            Ok([azimuth, elevation, zoom])
-        }
-        _ => Err(format!("expected AZIMUTH,ELEVATION,ZOOM (degrees, degrees within ±90, a factor > 0), got '{s}'")),
-    }
-}
-
-/// The viewer's orbit: the eye at `distance` from `target`, `yaw` radians around `up` (from
-/// the first of `up`'s orthonormal pair toward the second) and `pitch` above the plane
-/// perpendicular to it. One definition for the viewer, the page's links and `render --orbit`.
-pub fn orbit_eye(target: Vec3, up: Vec3, distance: f32, yaw: f32, pitch: f32) -> Vec3 {
-    let (a, b) = up.any_orthonormal_pair();
-    let horizontal = a * yaw.cos() + b * yaw.sin();
-    target + distance * (horizontal * pitch.cos() + up * pitch.sin())
-}
-
-/// `home` (the data's default camera) turned to `--orbit`'s values: its target and up, the
-/// azimuth and elevation around that up, the distance times the zoom.
-pub fn orbit_camera(home: &Camera, [azimuth, elevation, zoom]: [f32; 3]) -> Camera {
-    let up = home.up.normalize_or(Vec3::Z);
-    let distance = (home.eye - home.target).length().max(1e-3);
-    let limit = 89f32.to_radians();
-    let pitch = elevation.to_radians().clamp(-limit, limit);
-    let eye = orbit_eye(home.target, up, (distance * zoom).clamp(1e-3, 1e7), azimuth.to_radians(), pitch);
-    Camera { eye, up, ..*home }
-}
-
-/// `frames` cameras along the keyframes `orbits` (at least two): frame k at k / (frames − 1)
-/// of the path, linear in azimuth, elevation and zoom between the keyframes it lies between;
-/// the first frame is the first keyframe, the last the last.
-pub fn camera_path(home: &Camera, orbits: &[[f32; 3]], frames: u32) -> Vec<Camera> {
-    let stretches = (orbits.len() - 1) as f64;
-    (0..frames)
-        .map(|k| {
-            let t = if frames > 1 { k as f64 / (frames - 1) as f64 * stretches } else { 0.0 };
-            let i = (t.floor() as usize).min(orbits.len() - 2);
-            let f = (t - i as f64) as f32;
-            let (a, b) = (orbits[i], orbits[i + 1]);
-            orbit_camera(home, [0, 1, 2].map(|c| a[c] + (b[c] - a[c]) * f))
-        })
-        .collect()
-}
-
-/// `frames` cameras turned from `camera` about its target around its up axis, `degrees` in
-/// all, frame k at k / frames of the turn (frame 0 is `camera`).
-pub fn turntable(camera: &Camera, frames: u32, degrees: f32) -> Vec<Camera> {
-    let (eye, target, up) = (camera.eye.as_dvec3(), camera.target.as_dvec3(), camera.up.as_dvec3());
-    let axis = up.normalize();
-    let v = eye - target;
-    (0..frames)
-        .map(|k| {
-            let angle = (degrees as f64).to_radians() * k as f64 / frames as f64;
-            let (sin, cos) = angle.sin_cos();
-            // Rodrigues' rotation of v about the axis.
-            let rotated: DVec3 = v * cos + axis.cross(v) * sin + axis * axis.dot(v) * (1.0 - cos);
-            Camera { eye: (target + rotated).as_vec3(), ..*camera }
-        })
-        .collect()
-}
-
-/// The grid of a figure of `n` panels: as square as it goes, rows no longer than columns.
-pub fn columns(n: usize) -> u32 {
-    (n as f64).sqrt().ceil().max(1.0) as u32
-}
 
 /// The file of frame `k` of `frames` beside `output`: `NAME-007.png` (at least three digits).
 pub fn frame_path(output: &Path, k: u32, frames: u32) -> PathBuf {
@@ -466,16 +243,30 @@ fn encode_with_ffmpeg(pattern: &Path, path: &Path, fps: u32) -> Result<()> {
     Ok(())
 }
 
+/// `lineao render`: a turntable (`--turntable`), a picture as tiles straight into its PNG, or
+/// the picture the session composes.
+pub fn run(args: &RenderArgs) -> Result<()> {
+    let mut session = Session::open(args)?;
+    if let Some(frames) = args.figure.turntable {
+        return run_turntable(args, &mut session, frames);
+    }
+    let output = args.image.output.clone().unwrap_or_else(|| "lineao.png".into());
+    if write_tiled_picture(args, &mut session, &output)? {
+        return Ok(());
+    }
+    crate::render::write(args, &mut session, &output)
+}
+
 /// `render --turntable N`: every frame's PNG as it is rendered, the cameras, then the movie.
 /// A second thread encodes and writes each frame while the next one renders (at most two
 /// frames wait for it).
-pub fn run_turntable(args: &crate::args::RenderArgs, session: &mut Session, frames: u32) -> Result<()> {
+pub fn run_turntable(args: &RenderArgs, session: &mut Session, frames: u32) -> Result<()> {
     let figure = &args.figure;
     let output = args.image.output.clone().unwrap_or_else(|| "lineao.png".into());
     let movie = Movie::of(figure, &output)?;
     let cameras = match &figure.orbit[..] {
-        [_, _, ..] => camera_path(&session.camera, &figure.orbit, frames),
-        _ => turntable(&session.camera, frames, figure.turntable_degrees),
+        [_, _, ..] => crate::cameras::camera_path(&session.camera, &figure.orbit, frames),
+        _ => crate::cameras::turntable(&session.camera, frames, figure.turntable_degrees),
     };
     let start = std::time::Instant::now();
     let mut render_seconds = 0.0;
@@ -614,84 +405,10 @@ fn frame_pattern(output: &Path, frames: u32) -> PathBuf {
     output.with_file_name(format!("{stem}-%0{digits}d.png"))
 }
 
-/// The tiles of a picture wider or taller than this, unless --tile says otherwise: a frame's
-/// targets at 4096² (and the guard band) take about 1 GiB, as much as a device is sure to give.
-pub const DEFAULT_TILE: u32 = 4096;
-
-/// The size of the tiles a picture of `args`' size is rendered in: --tile, or where a side
-/// exceeds [`DEFAULT_TILE`] or what the device renders in one frame (its textures less the
-/// largest guard band `settings` allow), tiles of that size; `None`: one frame.
-pub fn tile_size(
-    args: &crate::args::RenderArgs,
-    limits: &wgpu::Limits,
-    settings: &lineao::ChainSettings,
-) -> Option<u32> {
-    let (width, height) = (args.image.width, args.image.height);
-    let fits = limits.max_texture_dimension_2d.saturating_sub(2 * settings.guard_max_px) / TILE_ALIGN * TILE_ALIGN;
-    let tile = args.figure.tile.unwrap_or(DEFAULT_TILE).min(fits).max(TILE_ALIGN);
-    (width > tile || height > tile).then_some(tile)
-}
-
-/// What tiles do not take: an error naming the flag.
-pub fn check_tiled(args: &crate::args::RenderArgs, panel: &crate::render::Panel, dump: Option<&Path>) -> Result<()> {
-    let what = if dump.is_some() {
-        Some("--dump (one G-buffer a frame)")
-    } else if args.image.timings {
-        Some("--timings (time a frame of the device's size)")
-    } else if panel.settings.method == lineao::AoMethod::RayTraced {
-        Some("the ray-traced method (its rays are seeded per frame)")
-    } else {
-        None
-    };
-    match what {
-        Some(what) => anyhow::bail!(
-            "--width {} --height {} is rendered as tiles (--tile), which do not take {what}",
-            args.image.width,
-            args.image.height
-        ),
-        None => Ok(()),
-    }
-}
-
-/// Renders the picture `args` asks for with `chain` (set for its panel) as tiles of `tile`
-/// pixels, row by row: each row of tiles is handed to `band` (its first row in the picture,
-/// its pixels) once its tiles are read back, so at most one row is held. The chain is left
-/// untiled, at the last tile's size.
-pub fn render_tiles(
-    session: &Session,
-    args: &crate::args::RenderArgs,
-    chain: &mut lineao::AoChain,
-    tile: u32,
-    options: crate::render::FrameOptions,
-    mut band: impl FnMut(u32, Rgba8) -> Result<()>,
-) -> Result<()> {
-    let gpu = &session.gpu;
-    let (width, height) = (args.image.width, args.image.height);
-    let format = wgpu::TextureFormat::Rgba8UnormSrgb;
-    let picture = [width, height];
-    for y in (0..height).step_by(tile as usize) {
-        let rows = tile.min(height - y);
-        let mut row = Rgba8::filled(width, rows, [0, 0, 0, 0]);
-        for x in (0..width).step_by(tile as usize) {
-            let size = (tile.min(width - x), rows);
-            chain.set_tile(None)?;
-            chain.resize(size.0, size.1)?;
-            chain.set_tile(Some(lineao::Tile { picture, origin: [x, y] }))?;
-            let target = lineao::targets::Target::output(&gpu.device, "lineao::render::tile", size, format);
-            session.frame(chain, &target.view, options).with_context(|| format!("the tile at ({x}, {y})"))?;
-            let pixels = lineao::readback::read_texture(&gpu.device, &gpu.queue, &target.texture)?;
-            row.paste(&Rgba8 { width: size.0, height: size.1, data: pixels.bytes }, x, 0);
-        }
-        band(y, row)?;
-    }
-    chain.set_tile(None)?;
-    Ok(())
-}
-
 /// `render` of one method as tiles straight into its PNG, a row of tiles at a time (what a
 /// picture larger than memory needs), where nothing is composed over it (no --compare,
 /// --grid, --views or --legend). `Ok(false)`: the picture is not tiled, or is composed.
-pub fn write_tiled_picture(args: &crate::args::RenderArgs, session: &mut Session, output: &Path) -> Result<bool> {
+pub fn write_tiled_picture(args: &RenderArgs, session: &mut Session, output: &Path) -> Result<bool> {
     let composed = args.shown.compare.is_some() || args.shown.grid || !args.figure.views.is_empty();
     // Object-space AO's visibilities are the session's to compute first: the composed path.
     if composed || args.image.legend || args.shown.method.volume.is_some() {
@@ -700,9 +417,9 @@ pub fn write_tiled_picture(args: &crate::args::RenderArgs, session: &mut Session
     let method = args.shown.method;
     let settings = session.settings(args, method);
     settings.validate().with_context(|| format!("method {}", method.name()))?;
-    let Some(tile) = tile_size(args, &session.gpu.device.limits(), &settings) else { return Ok(false) };
+    let Some(tile) = crate::render::tile_size(args, &session.gpu.device.limits(), &settings) else { return Ok(false) };
     let panel = crate::render::Panel::new(method, settings);
-    check_tiled(args, &panel, args.image.dump.as_deref())?;
+    crate::render::check_tiled(args, &panel, args.image.dump.as_deref())?;
     let format = wgpu::TextureFormat::Rgba8UnormSrgb;
     let mut chain = lineao::AoChain::new(&session.gpu.device, format, panel.settings.clone())?;
     let (width, height) = (args.image.width, args.image.height);
@@ -713,7 +430,7 @@ pub fn write_tiled_picture(args: &crate::args::RenderArgs, session: &mut Session
     encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
     let mut rows = encoder.write_header()?.into_stream_writer()?;
     let options = crate::render::FrameOptions { settled: true, ..Default::default() };
-    render_tiles(session, args, &mut chain, tile, options, |_, band| {
+    session.render_tiles(args, &mut chain, tile, options, |_, band| {
         std::io::Write::write_all(&mut rows, &band.data).with_context(|| format!("writing {}", output.display()))
     })?;
     rows.finish().with_context(|| format!("writing {}", output.display()))?;
@@ -738,33 +455,12 @@ pub fn refuse_in_score(figure: &FigureArgs) -> Result<()> {
     }
 }
 
-/// The figure of `--views`: each view's image (one method, or the split of --compare) in a
-/// labelled grid, the session's camera put back after.
-pub fn compose_views(
-    session: &mut Session,
-    args: &crate::args::RenderArgs,
-    views: &[AnatomicalView],
-    chains: &mut Vec<lineao::AoChain>,
-) -> Result<(Rgba8, Vec<crate::render::Panel>)> {
-    check_views(views).map_err(anyhow::Error::msg)?;
-    let base = session.camera;
-    let mut images = Vec::new();
-    let mut panels = Vec::new();
-    for view in views {
-        session.camera = view.camera(&base);
-        let composed = session.compose_panels(args, chains);
-        session.camera = base;
-        let (image, shown) = composed.with_context(|| format!("the view from the {}", view.name()))?;
-        images.push(image);
-        panels = shown;
-    }
-    let labelled: Vec<(&str, &Rgba8)> = views.iter().map(|v| v.name()).zip(&images).collect();
-    Ok((crate::label::grid(&labelled, columns(views.len())), panels))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::cameras::{AnatomicalView, check_views, parse_view, turntable};
+    use glam::Vec3;
+    use lineao::Camera;
 
     #[test]
     fn views_parse_by_name_and_synonym_once_each() {
@@ -813,9 +509,9 @@ mod tests {
         assert_eq!(frame_path(out, 7, 36), Path::new("/tmp/spin-007.png"));
         assert_eq!(frame_path(out, 12, 2000), Path::new("/tmp/spin-0012.png"));
         assert_eq!(frame_pattern(out, 36), Path::new("/tmp/spin-%03d.png"));
-        assert_eq!(columns(4), 2);
-        assert_eq!(columns(5), 3);
-        assert_eq!(columns(1), 1);
+        assert_eq!(crate::render::columns(4), 2);
+        assert_eq!(crate::render::columns(5), 3);
+        assert_eq!(crate::render::columns(1), 1);
     }
 
     #[test]
@@ -851,7 +547,7 @@ mod tests {
         differ
     }
 
-    fn session(extra: &[&str]) -> (Box<crate::args::RenderArgs>, Session) {
+    fn session(extra: &[&str]) -> (Box<RenderArgs>, Session) {
         let argv = ["lineao", "render", "--vertices", "60000", "--width", "320", "--height", "256"];
         let args = crate::args::parse_render(argv.iter().chain(extra));
         let session = Session::open(&args).unwrap();
@@ -901,7 +597,7 @@ mod tests {
             assert!(at_seams <= differ / 4 + 2, "{extra:?} --tile {tile}: {at_seams} of {differ} at seams");
             // The same without a guard band: seams.
             if extra.contains(&"lineao") && tile == 128 {
-                let no_guard = |mut a: Box<crate::args::RenderArgs>| {
+                let no_guard = |mut a: Box<RenderArgs>| {
                     a.chain.guard_max = 0;
                     a
                 };

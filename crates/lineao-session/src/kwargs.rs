@@ -110,8 +110,8 @@ impl RenderArgs {
     /// the options that exclude (`conflicts_with`) or need (`requires`) another.
     fn check(&self, given: &BTreeSet<String>) -> Result<(), String> {
         let ranges = [
-            ("width", self.image.width, 1, crate::figure::MAX_SIDE),
-            ("height", self.image.height, 1, crate::figure::MAX_SIDE),
+            ("width", self.image.width, 1, crate::args::MAX_SIDE),
+            ("height", self.image.height, 1, crate::args::MAX_SIDE),
             ("volume_resolution", self.volume.volume_resolution, 8, 1024),
             ("turntable", self.figure.turntable.unwrap_or(1), 1, 100_000),
             ("fps", self.figure.fps, 1, 240),
@@ -199,7 +199,7 @@ optional! {
     opt_slab: lineao::Slab = crate::args::parse_slab;
     opt_share: f64 = crate::args::parse_share;
     opt_field_range: (String, [f32; 2]) = crate::args::parse_field_range;
-    opt_tile: u32 = crate::figure::parse_tile;
+    opt_tile: u32 = crate::args::parse_tile;
 }
 
 /// A repeatable option: one value (its text) or a sequence of values, each through `parse`.
@@ -226,9 +226,9 @@ pub(crate) fn strings<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<Stri
 }
 
 /// `views`: one name, a list of names, or names separated by commas.
-pub(crate) fn views<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<crate::figure::AnatomicalView>, D::Error> {
+pub(crate) fn views<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<crate::cameras::AnatomicalView>, D::Error> {
     let names = repeated(d, |s| Ok(s.to_string()))?;
-    let views = names.iter().flat_map(|n| n.split(',')).map(crate::figure::parse_view);
+    let views = names.iter().flat_map(|n| n.split(',')).map(crate::cameras::parse_view);
     views.collect::<Result<_, _>>().map_err(serde::de::Error::custom)
 }
 
@@ -241,7 +241,7 @@ pub(crate) fn orbits<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<[f32;
     };
     let texts = items.into_iter().map(|item| Text::deserialize(item).map(|Text(t)| t));
     let texts: Vec<String> = texts.collect::<Result<_, _>>().map_err(serde::de::Error::custom)?;
-    texts.iter().map(|t| crate::figure::parse_orbit(t)).collect::<Result<_, _>>().map_err(serde::de::Error::custom)
+    texts.iter().map(|t| crate::cameras::parse_orbit(t)).collect::<Result<_, _>>().map_err(serde::de::Error::custom)
 }
 
 /// `include`, `exclude`: one region or several.

@@ -7,6 +7,7 @@
 //! subcommands and the viewer (egui, eframe).
 
 pub mod args;
+pub mod cameras;
 pub mod dump;
 pub mod figure;
 pub mod info;

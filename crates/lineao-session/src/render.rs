@@ -362,17 +362,11 @@ impl Session {
     }
 }
 
-pub fn run(args: &RenderArgs) -> Result<()> {
-    let mut session = Session::open(args)?;
-    if let Some(frames) = args.figure.turntable {
-        return crate::figure::run_turntable(args, &mut session, frames);
-    }
-    let output = args.image.output.clone().unwrap_or_else(|| "lineao.png".into());
-    if crate::figure::write_tiled_picture(args, &mut session, &output)? {
-        return Ok(());
-    }
+/// The picture `args` asks for, composed by `session`, written to `output` (`lineao render`
+/// without a turntable: [`crate::figure::run`]).
+pub fn write(args: &RenderArgs, session: &mut Session, output: &Path) -> Result<()> {
     let (image, panels) = session.compose(args, &mut Vec::new())?;
-    crate::output::write_png(&output, image.width, image.height, &image.data)?;
+    crate::output::write_png(output, image.width, image.height, &image.data)?;
     let methods: Vec<&str> = panels.iter().map(|p| p.label.as_str()).collect();
     if session.lines.selected.is_some() {
         let (shown, all) = (session.lines.selected_count(), session.lines.geometry.streamlines);
@@ -400,7 +394,7 @@ impl Session {
     pub fn compose(&mut self, args: &RenderArgs, chains: &mut Vec<AoChain>) -> Result<(Rgba8, Vec<Panel>)> {
         match &args.figure.views[..] {
             [] => self.compose_panels(args, chains),
-            views => crate::figure::compose_views(self, args, views, chains),
+            views => self.compose_views(args, views, chains),
         }
     }
 
@@ -471,6 +465,104 @@ impl Session {
             }
         }
         Ok((image, panels))
+    }
+}
+
+/// The grid of a figure of `n` panels: as square as it goes, rows no longer than columns.
+pub fn columns(n: usize) -> u32 {
+    (n as f64).sqrt().ceil().max(1.0) as u32
+}
+
+/// The size of the tiles a picture of `args`' size is rendered in: --tile, or where a side
+/// exceeds [`crate::args::DEFAULT_TILE`] or what the device renders in one frame (its textures less the
+/// largest guard band `settings` allow), tiles of that size; `None`: one frame.
+pub fn tile_size(args: &RenderArgs, limits: &wgpu::Limits, settings: &lineao::ChainSettings) -> Option<u32> {
+    let (width, height) = (args.image.width, args.image.height);
+    let fits = limits.max_texture_dimension_2d.saturating_sub(2 * settings.guard_max_px) / crate::args::TILE_ALIGN
+        * crate::args::TILE_ALIGN;
+    let tile = args.figure.tile.unwrap_or(crate::args::DEFAULT_TILE).min(fits).max(crate::args::TILE_ALIGN);
+    (width > tile || height > tile).then_some(tile)
+}
+
+/// What tiles do not take: an error naming the flag.
+pub fn check_tiled(args: &RenderArgs, panel: &Panel, dump: Option<&Path>) -> Result<()> {
+    let what = if dump.is_some() {
+        Some("--dump (one G-buffer a frame)")
+    } else if args.image.timings {
+        Some("--timings (time a frame of the device's size)")
+    } else if panel.settings.method == lineao::AoMethod::RayTraced {
+        Some("the ray-traced method (its rays are seeded per frame)")
+    } else {
+        None
+    };
+    match what {
+        Some(what) => anyhow::bail!(
+            "--width {} --height {} is rendered as tiles (--tile), which do not take {what}",
+            args.image.width,
+            args.image.height
+        ),
+        None => Ok(()),
+    }
+}
+
+impl Session {
+    /// The figure of `--views`: each view's image (one method, or the split of --compare) in a
+    /// labelled grid, the session's camera put back after.
+    pub fn compose_views(
+        &mut self,
+        args: &RenderArgs,
+        views: &[crate::cameras::AnatomicalView],
+        chains: &mut Vec<AoChain>,
+    ) -> Result<(Rgba8, Vec<Panel>)> {
+        crate::cameras::check_views(views).map_err(anyhow::Error::msg)?;
+        let base = self.camera;
+        let mut images = Vec::new();
+        let mut panels = Vec::new();
+        for view in views {
+            self.camera = view.camera(&base);
+            let composed = self.compose_panels(args, chains);
+            self.camera = base;
+            let (image, shown) = composed.with_context(|| format!("the view from the {}", view.name()))?;
+            images.push(image);
+            panels = shown;
+        }
+        let labelled: Vec<(&str, &Rgba8)> = views.iter().map(|v| v.name()).zip(&images).collect();
+        Ok((crate::label::grid(&labelled, columns(views.len())), panels))
+    }
+
+    /// Renders the picture `args` asks for with `chain` (set for its panel) as tiles of `tile`
+    /// pixels, row by row: each row of tiles is handed to `band` (its first row in the picture,
+    /// its pixels) once its tiles are read back, so at most one row is held. The chain is left
+    /// untiled, at the last tile's size.
+    pub fn render_tiles(
+        &self,
+        args: &RenderArgs,
+        chain: &mut lineao::AoChain,
+        tile: u32,
+        options: FrameOptions,
+        mut band: impl FnMut(u32, Rgba8) -> Result<()>,
+    ) -> Result<()> {
+        let gpu = &self.gpu;
+        let (width, height) = (args.image.width, args.image.height);
+        let format = wgpu::TextureFormat::Rgba8UnormSrgb;
+        let picture = [width, height];
+        for y in (0..height).step_by(tile as usize) {
+            let rows = tile.min(height - y);
+            let mut row = Rgba8::filled(width, rows, [0, 0, 0, 0]);
+            for x in (0..width).step_by(tile as usize) {
+                let size = (tile.min(width - x), rows);
+                chain.set_tile(None)?;
+                chain.resize(size.0, size.1)?;
+                chain.set_tile(Some(lineao::Tile { picture, origin: [x, y] }))?;
+                let target = lineao::targets::Target::output(&gpu.device, "lineao::render::tile", size, format);
+                self.frame(chain, &target.view, options).with_context(|| format!("the tile at ({x}, {y})"))?;
+                let pixels = lineao::readback::read_texture(&gpu.device, &gpu.queue, &target.texture)?;
+                row.paste(&Rgba8 { width: size.0, height: size.1, data: pixels.bytes }, x, 0);
+            }
+            band(y, row)?;
+        }
+        chain.set_tile(None)?;
+        Ok(())
     }
 }
 
@@ -551,11 +643,11 @@ impl Session {
         };
         let gpu_rays = panel.settings.method == AoMethod::RayTraced && !args.truth.cpu;
         let options = FrameOptions { gpu_rays, settled: true, timings: args.image.timings };
-        if let Some(tile) = crate::figure::tile_size(args, &gpu.device.limits(), &panel.settings) {
-            crate::figure::check_tiled(args, panel, dump)?;
+        if let Some(tile) = tile_size(args, &gpu.device.limits(), &panel.settings) {
+            check_tiled(args, panel, dump)?;
             let (width, height) = (args.image.width, args.image.height);
             let mut image = Rgba8::filled(width, height, [0, 0, 0, 0]);
-            crate::figure::render_tiles(self, args, &mut chain, tile, options, |y, band| {
+            self.render_tiles(args, &mut chain, tile, options, |y, band| {
                 image.paste(&band, 0, y);
                 Ok(())
             })?;
@@ -813,7 +905,7 @@ pub fn camera(args: &RenderArgs, hint: &ViewHint) -> Result<Camera> {
     };
     validate_camera(&camera)?;
     match args.figure.orbit[..] {
-        [orbit] => Ok(crate::figure::orbit_camera(&camera, orbit)),
+        [orbit] => Ok(crate::cameras::orbit_camera(&camera, orbit)),
         _ => Ok(camera),
     }
 }

@@ -16,7 +16,7 @@
 //! and per 32-bit word, while a texel fetch of 16 bytes is one unrolled gather — and a BVH walk
 //! is little else but such loads. Moving the scene from storage buffers into textures, with
 //! the pass's specialized pipelines, made a one-ray frame 2.4–2.6× faster there
-//! (docs/measurements.md, session 17).
+//! (docs/measurements.md).
 //!
 //! **Layout**: four textures, one per region (texel i of a region is its i-th element):
 //!

@@ -22,8 +22,8 @@
 //! texture units (8 bytes a voxel); elsewhere in an `R32Float` one, and eight `textureLoad`s
 //! give both (exact, and what every device can do; 4 bytes a voxel). On lavapipe the filtered
 //! path draws the default frame's slices in about two thirds of the loads' time, and the packed
-//! texel in three quarters of two samples' (an `R32Float` value and an `R8Unorm` mask, until
-//! session 38; docs/measurements.md); on a GPU the texture units are what filtering is for. A
+//! texel in three quarters of two samples' (an `R32Float` value and an `R8Unorm` mask, before;
+//! docs/measurements.md); on a GPU the texture units are what filtering is for. A
 //! GPU filters with weights of 8 fractional bits or more: the sample is off by at most 1/512 of
 //! the difference between neighbouring voxels, below a colormap's step. `tests/slices.rs`
 //! checks both paths against the CPU's trilinear sample.

@@ -121,7 +121,7 @@ struct TraceUniform {
 /// sides of every branch of a SIMD group, uniform or not, so code a frame cannot need (triangles
 /// in a scene of lines, the first frame's point queries in the frames after it) is compiled out
 /// rather than branched around. With the scene in textures ([`crate::ray_scene`]) a one-ray
-/// frame became 2.4–2.6× faster on lavapipe (docs/measurements.md, session 17).
+/// frame became 2.4–2.6× faster on lavapipe (docs/measurements.md).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 struct Variant {
     /// Fixed-width lines (else tubes).
