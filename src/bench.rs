@@ -16,8 +16,10 @@
 //!   follow any method;
 //! - `lines-all`: every cluster drawn (the alternating strip); `lines-culled`: the default path,
 //!   culled on the GPU at levels of detail (both phases, tests and draws); `lines-culled-exact`:
-//!   culled without levels of detail (the full strip's G-buffer); `cull`: the cull's compute
-//!   alone;
+//!   culled without levels of detail (the full strip's G-buffer); `lines-compute`: the same
+//!   culled frame as `lines-culled` with its pieces rasterized in compute into a visibility
+//!   buffer and resolved ([`lineao::passes::raster`]; where the device lacks 64-bit atomics it
+//!   says so and draws in hardware); `cull`: the cull's compute alone;
 //! - `tubes`: the same streamlines as ray-cast tubes of radius 0.5 mm (against `lines`);
 //!   `tubes-culled`: the same tubes culled on the GPU at levels of detail, both phases (against
 //!   `lines-culled`); `tubes-culled-exact`: culled without levels of detail;
@@ -95,6 +97,8 @@ struct Passes {
     lines_culled: LineRenderer,
     /// The same without levels of detail (`lines-culled-exact`): the full strip's G-buffer.
     lines_culled_exact: LineRenderer,
+    /// `lines_culled` rasterized in compute (`lines-compute`).
+    lines_compute: LineRenderer,
     lines_native: LineRenderer,
     lines_full: LineRenderer,
     /// The strip of earlier versions and its renderer (`lines-strip`), when selected.
@@ -150,6 +154,7 @@ impl Passes {
             lines: lines(LineStyle::Quads),
             lines_culled: lines(LineStyle::Quads).culled(device, true),
             lines_culled_exact: lines(LineStyle::Quads).culled(device, false),
+            lines_compute: lines(LineStyle::Quads).culled(device, true).rasterized_in_compute(device),
             lines_native: lines(LineStyle::Native1px),
             lines_full: lines(LineStyle::FullStrip),
             strip: strip.map(|geometry| {
@@ -171,9 +176,15 @@ impl Passes {
             queue: queue.clone(),
             output: Target::output(device, "lineao::bench::output", (view.width, view.height), format),
         };
-        for renderer in
-            [&passes.lines, &passes.lines_culled, &passes.lines_culled_exact, &passes.lines_native, &passes.lines_full]
-        {
+        let line_passes = [
+            &passes.lines,
+            &passes.lines_culled,
+            &passes.lines_culled_exact,
+            &passes.lines_compute,
+            &passes.lines_native,
+            &passes.lines_full,
+        ];
+        for renderer in line_passes {
             renderer.prepare(queue, view, settings.line_width_px, settings.line_color, &settings.lighting, None);
         }
         for renderer in [&passes.tubes, &passes.tubes_culled] {
@@ -226,6 +237,7 @@ impl Passes {
             "lines-culled-exact" => {
                 self.lines_culled_exact.encode(encoder, targets, geometry, Load::Clear(background), span)
             }
+            "lines-compute" => self.lines_compute.encode(encoder, targets, geometry, Load::Clear(background), span),
             "cull" => self.lines_culled.encode_cull(encoder, targets, geometry, span),
             "lines-native-1px" => self.lines_native.encode(encoder, targets, geometry, Load::Clear(background), span),
             "lines-full-strip" => self.lines_full.encode(encoder, targets, geometry, Load::Clear(background), span),
@@ -352,6 +364,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         "lines-strip",
         "lines-all",
         "lines-culled-exact",
+        "lines-compute",
         "lines-culled",
         "cull",
     ];
@@ -386,6 +399,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         }
     }
 
+    if let Some(note) = passes.lines_compute.raster_note().filter(|_| selected("lines-compute")) {
+        eprintln!("lineao: lines-compute: {note}");
+    }
     // What the culled lines and tubes drew in their last frame (they ran last among their
     // passes).
     let mut visible = (None, None);
@@ -612,6 +628,7 @@ fn print_table(report: &serde_json::Value, passes: &[serde_json::Value]) {
         ("lines", "lines-native-1px"),
         ("lines-culled", "lines-all"),
         ("lines-culled", "lines-culled-exact"),
+        ("lines-compute", "lines-culled"),
         ("cull", "lines-all"),
         ("lines-full-strip", "lines-native-1px"),
         ("lines", "lines-strip"),

@@ -223,7 +223,7 @@ pub struct BenchLoadArgs {
 // The passes `lineao bench --passes` names (its vocabulary, so the CLI needs nothing of the
 // bench itself).
 /// The bench's own GPU passes: the geometry and what every method shares.
-const OWN_GPU_PASSES: [&str; 15] = [
+const OWN_GPU_PASSES: [&str; 16] = [
     "lines",
     "lines-native-1px",
     "lines-full-strip",
@@ -232,6 +232,7 @@ const OWN_GPU_PASSES: [&str; 15] = [
     "lines-all",
     "lines-culled",
     "lines-culled-exact",
+    "lines-compute",
     "cull",
     "composite",
     "bilateral",

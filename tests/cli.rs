@@ -331,6 +331,7 @@ fn bench_json_is_the_contract() {
         "lines-all",
         "lines-culled",
         "lines-culled-exact",
+        "lines-compute",
         "cull",
         "lineao",
         "lineao-tap-floor",

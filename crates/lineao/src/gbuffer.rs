@@ -145,8 +145,21 @@ pub(crate) struct PipelineSpec<'a> {
 /// A render pipeline writing the G-buffer (depth test `Less`, depth written), compiled for the
 /// lighting shape of `bindings`.
 pub(crate) fn pipeline(device: &wgpu::Device, bindings: &GeometryBindings, spec: PipelineSpec) -> wgpu::RenderPipeline {
+    pipeline_writing(device, bindings, spec, wgpu::CompareFunction::Less, wgpu::ColorWrites::ALL)
+}
+
+/// [`pipeline`] with the depth test `compare` and the G-buffer's channels `writes` (a pass that
+/// resolves a visibility buffer: every pixel's nearest fragment known, or its depth alone).
+pub(crate) fn pipeline_writing(
+    device: &wgpu::Device,
+    bindings: &GeometryBindings,
+    spec: PipelineSpec,
+    compare: wgpu::CompareFunction,
+    writes: wgpu::ColorWrites,
+) -> wgpu::RenderPipeline {
     let layout = &bindings.layout;
     let constants: Vec<_> = spec.constants.iter().copied().chain(bindings.shape.constants()).collect();
+    let color_target = |format| Some(wgpu::ColorTargetState { format, blend: None, write_mask: writes });
     let mut color_targets: Vec<_> = GBUFFER_FORMATS.iter().map(|&format| color_target(format)).collect();
     if spec.octants {
         color_targets.push(color_target(targets::OCTANTS_FORMAT));
@@ -177,7 +190,7 @@ pub(crate) fn pipeline(device: &wgpu::Device, bindings: &GeometryBindings, spec:
         depth_stencil: Some(wgpu::DepthStencilState {
             format: targets::DEPTH_FORMAT,
             depth_write_enabled: Some(true),
-            depth_compare: Some(wgpu::CompareFunction::Less),
+            depth_compare: Some(compare),
             stencil: Default::default(),
             bias: Default::default(),
         }),
@@ -191,10 +204,6 @@ pub(crate) fn pipeline(device: &wgpu::Device, bindings: &GeometryBindings, spec:
         multiview_mask: None,
         cache: None,
     })
-}
-
-fn color_target(format: wgpu::TextureFormat) -> Option<wgpu::ColorTargetState> {
-    Some(wgpu::ColorTargetState { format, blend: None, write_mask: wgpu::ColorWrites::ALL })
 }
 
 /// How a geometry pass starts on the G-buffer.

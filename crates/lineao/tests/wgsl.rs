@@ -2,10 +2,22 @@
 
 use std::path::Path;
 
+/// The capabilities a file's module is made with: the device's 64-bit atomics for the lines
+/// rasterized in compute (made only where the device has them), the defaults for every other.
+fn capabilities(path: &str) -> naga::valid::Capabilities {
+    use naga::valid::Capabilities;
+    match path {
+        "raster.wgsl" => {
+            Capabilities::default() | Capabilities::SHADER_INT64 | Capabilities::SHADER_INT64_ATOMIC_MIN_MAX
+        }
+        _ => Capabilities::default(),
+    }
+}
+
 fn validate(path: &str) -> Result<(), String> {
     let source = lineao::shader::compose(path);
     let module = naga::front::wgsl::parse_str(&source).map_err(|e| e.emit_to_string(&source))?;
-    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default())
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), capabilities(path))
         .validate(&module)
         .map_err(|e| e.emit_to_string(&source))?;
     Ok(())

@@ -27,6 +27,11 @@ fn visible_piece(slot: u32, coarse: bool) -> VisiblePiece {
     if slot < length {
         entry = visible_pieces[select(slot, length - 1u - slot, coarse)];
     }
+    return listed_piece(entry);
+}
+
+// The piece a list entry names (NO_PIECE: one that spans no point).
+fn listed_piece(entry: u32) -> VisiblePiece {
     if entry == NO_PIECE {
         return VisiblePiece(clusters[0], 0u, 0u, 1u, 0u);
     }

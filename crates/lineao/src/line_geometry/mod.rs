@@ -584,6 +584,11 @@ impl LineGeometry {
         Ok([octants, scalars, radii])
     }
 
+    /// `page`'s scalars as its bind group holds them (a placeholder where it has none).
+    pub(crate) fn scalars<'a>(&'a self, page: &'a Page) -> &'a wgpu::Buffer {
+        page.attributes[1].as_ref().unwrap_or(&self.placeholder)
+    }
+
     fn bind_group(
         &self,
         device: &wgpu::Device,

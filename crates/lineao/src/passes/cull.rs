@@ -232,7 +232,7 @@ pub struct PageCull {
     listing_group: wgpu::BindGroup,
     /// The page's arrays the tests read.
     geometry: wgpu::BindGroup,
-    pieces: wgpu::Buffer,
+    pub(crate) pieces: wgpu::Buffer,
     listing: wgpu::Buffer,
     /// What the capsule test adds, made where it first runs ([`LineCull::set_capsules`]).
     capsules: std::sync::OnceLock<PageCapsules>,
@@ -258,45 +258,14 @@ impl PageCull {
 fn geometry_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     let storage = wgpu::BufferBindingType::Storage { read_only: true };
     let entries = [(0, storage), (1, storage), (2, storage), (6, wgpu::BufferBindingType::Uniform), (7, storage)];
-    buffers_layout(device, "lineao::LineCull::geometry", &entries)
-}
-
-/// A bind group of whole buffers at their bindings.
-fn buffers_group(
-    device: &wgpu::Device,
-    label: &str,
-    layout: &wgpu::BindGroupLayout,
-    buffers: &[(u32, &wgpu::Buffer)],
-) -> wgpu::BindGroup {
-    let entries: Vec<_> = buffers
-        .iter()
-        .map(|&(binding, buffer)| wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() })
-        .collect();
-    device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries })
-}
-
-/// A compute layout of buffers at their bindings.
-fn buffers_layout(
-    device: &wgpu::Device,
-    label: &str,
-    entries: &[(u32, wgpu::BufferBindingType)],
-) -> wgpu::BindGroupLayout {
-    let entries: Vec<_> = entries
-        .iter()
-        .map(|&(binding, ty)| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
-            count: None,
-        })
-        .collect();
-    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &entries })
+    binding::buffers_layout(device, "lineao::LineCull::geometry", wgpu::ShaderStages::COMPUTE, &entries)
 }
 
 /// The layout of the visible pieces as the vertex shader reads them (group 2 of the culled
 /// line pipelines).
 pub(crate) fn pieces_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-    binding::layout(device, "lineao::LineCull::pieces", wgpu::ShaderStages::VERTEX, &[Slot::Storage])
+    let visibility = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::COMPUTE;
+    binding::layout(device, "lineao::LineCull::pieces", visibility, &[Slot::Storage])
 }
 
 /// The two-phase cull of [`LineGeometry`]'s pieces (see the module documentation).
@@ -355,7 +324,8 @@ impl LineCull {
         let state_layout = binding::layout(device, label, compute, &state[..2]);
         let listing_layout = binding::layout(device, label, compute, &state);
         let read_write = wgpu::BufferBindingType::Storage { read_only: false };
-        let bounds_layout = buffers_layout(device, label, &[(0, read_write), (1, read_write), (3, read_write)]);
+        let bounds = [(0, read_write), (1, read_write), (3, read_write)];
+        let bounds_layout = binding::buffers_layout(device, label, compute, &bounds);
         let page = geometry_layout(device);
         let module = crate::shader::module(device, "cull.wgsl");
         let constants = |lod: bool| [("TUBES", (shape == Shape::Tubes) as u32 as f64), ("LOD", lod as u32 as f64)];
@@ -487,7 +457,8 @@ impl LineCull {
                 binding::group(device, "lineao::LineCull::pieces", &self.pieces_layout, &[list])
             });
             let buffers = [(0, &page.xy), (1, &page.z), (2, &page.clusters), (6, &page.uniform), (7, &page.groups)];
-            let geometry = buffers_group(device, "lineao::LineCull::geometry", &self.geometry_layout, &buffers);
+            let geometry =
+                binding::buffers_group(device, "lineao::LineCull::geometry", &self.geometry_layout, &buffers);
             PageCull {
                 state,
                 draw_groups,
@@ -514,7 +485,7 @@ impl LineCull {
                 mapped_at_creation: false,
             });
             let buffers = [(0, &state.state), (1, &state.pieces), (3, &bounds)];
-            let group = buffers_group(device, "lineao::LineCull::bounds", &self.bounds_layout, &buffers);
+            let group = binding::buffers_group(device, "lineao::LineCull::bounds", &self.bounds_layout, &buffers);
             PageCapsules { bounds, group }
         })
     }

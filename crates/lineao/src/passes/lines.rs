@@ -25,6 +25,7 @@ use crate::line_geometry::{
     LineGeometry, MAX_ALTERNATING_WIDTH_PX, MAX_TOLERANCE_PX, Page, alternating_vertices, class_segments, full_vertices,
 };
 use crate::passes::cull::{Culled, Shape};
+use crate::passes::raster::ComputeRaster;
 use crate::settings::{LineColor, Slab};
 use crate::targets::FrameTargets;
 use crate::timing::Span;
@@ -74,6 +75,9 @@ pub struct LineRenderer {
     plain: Pipelines,
     /// Culling on the GPU ([`LineRenderer::culled`]): the visible pieces' full strips.
     culled: Option<Culled>,
+    /// The culled pieces rasterized in compute ([`LineRenderer::rasterized_in_compute`]), or
+    /// why they are not though asked.
+    compute: Option<Result<ComputeRaster, String>>,
     /// Writing `octants` too: the points' octant visibilities, fully visible where a page
     /// holds none.
     octants: Option<Pipelines>,
@@ -158,6 +162,7 @@ impl LineRenderer {
             plain,
             octants,
             culled: None,
+            compute: None,
             bindings,
             px_per_world: AtomicU32::new(f32::INFINITY.to_bits()),
         }
@@ -200,6 +205,29 @@ impl LineRenderer {
         let culled = Culled::new(device, &self.bindings.layout, Shape::Lines, lod, self.octants.is_some(), create);
         self.culled = Some(culled);
         self
+    }
+
+    /// This culled renderer drawing its visible pieces by compute shaders into a visibility
+    /// buffer ([`crate::passes::raster`]) where the device has 64-bit atomics and the frame
+    /// allows it, else by the hardware rasterizer ([`LineRenderer::raster_note`] says why).
+    pub fn rasterized_in_compute(mut self, device: &wgpu::Device) -> LineRenderer {
+        if self.culled.is_none() || self.octants.is_some() || self.slab {
+            let why = "only culled lines without a slab or octants are rasterized in compute";
+            self.compute = Some(Err(why.to_string()));
+            return self;
+        }
+        let page = crate::line_geometry::page_layout(device);
+        let pieces = crate::passes::cull::pieces_layout(device);
+        self.compute = Some(ComputeRaster::new(device, &self.bindings, &page, &pieces));
+        self
+    }
+
+    /// Why it draws in hardware though asked to rasterize in compute, if it does.
+    pub fn raster_note(&self) -> Option<&str> {
+        match &self.compute {
+            Some(Err(why)) => Some(why),
+            _ => None,
+        }
     }
 
     /// Its culling, where it culls.
@@ -306,6 +334,15 @@ impl LineRenderer {
         let label = "lineao::LineRenderer";
         let frame = &self.bindings.group;
         let culled = self.culled.as_ref();
+        if let (Some(culled), Some(Ok(raster))) = (culled, &self.compute) {
+            let cull = culled.cull();
+            if cull.unsupported(targets).or_else(|| raster.unsupported(targets, geometry, load)).is_none() {
+                let draw = |encoder: &mut wgpu::CommandEncoder, phase, span| {
+                    raster.encode(encoder, targets, geometry, cull, frame, phase, load, span);
+                };
+                return cull.encode(encoder, targets, geometry, frame, span, draw);
+            }
+        }
         if culled.is_some_and(|c| c.encode(encoder, targets, geometry, frame, label, load, octants.is_some(), span)) {
             return;
         }

@@ -15,6 +15,7 @@ pub mod lines;
 pub mod meshes;
 pub mod nd_from_depth;
 pub mod nd_pyramid;
+pub mod raster;
 pub mod seed_depth;
 pub mod slices;
 pub mod tubes;
