@@ -42,6 +42,10 @@
 override TUBES: bool = false;
 // Whether the pieces are drawn at a level of detail (`lineao::passes::cull::LineCull::new`'s `lod`).
 override LOD: bool = false;
+// A page's first culled frame knows nothing visible: `early` then also lists every piece of
+// every SEED-th cluster (0: none), spread over the page by the clusters' Morton order, whose
+// depth the late test culls against (`lineao::passes::cull::SEED_STRIDE`).
+override SEED: u32 = 0u;
 
 // Keep in sync with `lineao::passes::depth_pyramid::PyramidUniform`.
 struct Pyramid {
@@ -198,7 +202,12 @@ fn early(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_inde
     if i >= cluster_count() {
         return;
     }
-    let bits = atomicLoad(&state[VISIBLE + i]);
+    var bits = atomicLoad(&state[VISIBLE + i]);
+    if SEED > 0u && i % max(SEED, 1u) == 0u && is_selected(clusters[i]) {
+        // Whole, unmarked: the late test marks (and draws again) those that are visible.
+        let segments = drawn_points(clusters[i]) - 1u;
+        bits = select(1u, select(3u, 7u, segments > 2u * PIECE_SEGMENTS), segments > PIECE_SEGMENTS);
+    }
     for (var p = 0u; p < 3u; p++) {
         if (bits & (1u << p)) != 0u {
             append(0u, i, drawn_level(bits, p), p);

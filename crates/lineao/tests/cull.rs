@@ -247,6 +247,26 @@ fn culled_lines_draw_the_g_buffer_of_all_lines() {
     assert!((early + late) * 2 < pieces, "drew {early} + {late} of {pieces}");
 }
 
+/// A geometry's first culled frame knows nothing visible: it draws every piece of every
+/// `SEED_STRIDE`-th cluster first and culls the rest against their depth, so from outside the
+/// ball it draws well under half of the pieces — the G-buffer still every line's, bit for bit
+/// but at ties (the test above) — where against an empty pyramid it drew them all.
+#[test]
+fn a_first_frame_culls_against_a_seed_of_its_own_lines() {
+    let gpu = gpu();
+    let (geometry, all, culled) = ball_lines(&gpu, 8000);
+    let expected = draw(&gpu, &all, &geometry, &outside());
+    let got = draw(&gpu, &culled, &geometry, &outside());
+    let counts = culled.cull().unwrap().counts(&gpu.queue, &geometry).unwrap();
+    let (early, late, pieces) = (counts.early, counts.late, counts.pieces);
+    println!("first frame: drew {early} (the seed) + {late} of {pieces} pieces");
+    let stride = lineao::passes::cull::SEED_STRIDE as u64;
+    assert!(early * stride > pieces / 2 && early * stride < 2 * pieces, "the seed: {early} of {pieces}");
+    assert!((early + late) * 2 < pieces, "drew {early} + {late} of {pieces}");
+    let (covered, ties) = same_gbuffer(&expected, &got, "a seeded first frame");
+    assert!(ties * 2000 <= covered, "{ties} of {covered} pixels differ at equal depth");
+}
+
 /// Over a host's depth seeded into the G-buffer (`passes::seed_depth`, what `OverlayAo` does
 /// with a depth it can read: here a wall through the ball's centre), the culled lines draw the
 /// G-buffer every line's full strip draws over it, bit for bit, first frame and second, leave
