@@ -1,4 +1,4 @@
-//! `lineao bench`: GPU time per pass on a built-in scene, as CONTRACT.md's `lineao bench --json`.
+//! `lineao bench`: GPU time per pass on a built-in scene, as docs/reference.md's `lineao bench --json`.
 //!
 //! Every pass runs in its own submission, `--frames` times after `--warmup` frames, on the same
 //! G-buffer. With timestamp queries the time is the GPU's (`"on": "gpu"`); without, CPU wall time
@@ -129,7 +129,7 @@ struct Passes {
 /// Every stage reads the G-buffer `lines` wrote. On lavapipe a pass over one-level targets of
 /// its own (a copy of the G-buffer made once) measured 0.03–0.08 ms by its timestamps where on
 /// the chain's it took 1.7–5 ms; VO area there measured 40.6 ms by timestamps and 48.5 ms by
-/// the wall clock, 45.8–47.6 ms by timestamps on the chain's (docs/measurements.md).
+/// the wall clock, 45.8–47.6 ms by timestamps on the chain's.
 struct StagePass {
     method: AoMethod,
     pass: &'static BenchPass,

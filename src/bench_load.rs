@@ -6,7 +6,7 @@
 //! page faults included; the floor we are judged against) and into one reused 1 MiB buffer
 //! (the copy alone) — `lineao_tracts::load` in process, the whole
 //! `lineao info` process, its peak resident memory minus that of `lineao info` on an empty file
-//! (CONTRACT.md's memory measure), and — when Python has nibabel — nibabel's
+//! (docs/reference.md's memory measure), and — when Python has nibabel — nibabel's
 //! `nibabel.streamlines.load` timed in process on the same file. Medians of `--repeat` runs.
 
 use std::io::Read;

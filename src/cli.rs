@@ -21,13 +21,13 @@ pub struct Cli {
 pub enum Command {
     /// Render a tractography file or a built-in scene to a PNG.
     Render(Box<RenderArgs>),
-    /// Describe a tractography file (CONTRACT.md `lineao info --json`).
+    /// Describe a tractography file (docs/reference.md `lineao info --json`).
     Info(InfoArgs),
     /// Time loading .tck, .trk and .trx files against reading their bytes and against nibabel.
     BenchLoad(BenchLoadArgs),
     /// Convert between formats: reads any, writes .tck, .trk or .trx (by OUT's extension).
     Convert(ConvertArgs),
-    /// Time every pass on a built-in scene (CONTRACT.md `lineao bench --json`).
+    /// Time every pass on a built-in scene (docs/reference.md `lineao bench --json`).
     Bench(BenchArgs),
     /// Open a window: orbit a tractogram and compare LineAO with the other methods side by side.
     View(Box<ViewArgs>),
@@ -177,7 +177,7 @@ pub struct BenchArgs {
     /// `paper` for the papers' values). The other methods keep the papers' values.
     #[arg(long, default_value = "legible", value_parser = parse_preset)]
     pub preset: lineao::Preset,
-    /// Print CONTRACT.md's JSON instead of a table.
+    /// Print docs/reference.md's JSON instead of a table.
     #[arg(long)]
     pub json: bool,
     /// Time with CPU wall clocks around submit + wait even where timestamp queries exist.
@@ -216,6 +216,7 @@ pub struct BenchLoadArgs {
     /// Skip the nibabel comparison.
     #[arg(long)]
     pub no_nibabel: bool,
+    /// Print the measurements as JSON instead of a table.
     #[arg(long)]
     pub json: bool,
 }

@@ -10,7 +10,7 @@
 //! correlation with the bundle-scale truth.
 //!
 //! **Objective**: the mean of L over the three scales, averaged over the fit views.
-//! **Constraints** (CONTRACT.md "Presets", issue 33): on every view the near-black share is at
+//! **Constraints** (docs/reference.md "Presets"): on every view the near-black share is at
 //! most 2 % and the mean darkening at most 0.45; on every view where the bundle-scale truth's
 //! own picture darkens by 0.15 or more (dense data: where there is occlusion to show), the mean
 //! darkening is at least 0.15; and the mean correlation with the bundle-scale truth over the
@@ -56,8 +56,8 @@ fn families(line_width: f32) -> Vec<Family> {
     // The paper's first, then s_r × r0 (multiples of the line width) × the scale of δ(j) × s_h
     // × where the outer hemispheres are evaluated.
     let mut lineao = Vec::new();
-    // Outer hemispheres at every pixel: CONTRACT.md allows `outer = level` as a default only
-    // within 0.02 of `full`, and it differs by its noise (docs/measurements.md). s_h stays the
+    // Outer hemispheres at every pixel: docs/reference.md allows `outer = level` as a default only
+    // within 0.02 of `full`, and it differs by its noise. s_h stays the
     // paper's 32: it buys less noise, not another picture (s_h 16 against 32 changed no choice
     // in a trial on the built-in scenes and one real bundle).
     let paper = (3, 1.5f32, 1.0f32, 32, LineAoOuter::Full);

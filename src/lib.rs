@@ -10,6 +10,8 @@ pub mod bench_load;
 pub mod cli;
 pub mod fit;
 #[cfg(feature = "viewer")]
+pub mod options_doc;
+#[cfg(feature = "viewer")]
 pub mod view;
 
 pub use lineao_session::{args, cameras, dump, figure, info, kwargs, label, output, render, score, source, truth};

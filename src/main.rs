@@ -1,6 +1,6 @@
 //! `lineao`: render tractography and streamlines with LineAO.
 //!
-//! Exit codes (CONTRACT.md): 0 success, 1 bad input or a failed operation (message on stderr),
+//! Exit codes (docs/reference.md): 0 success, 1 bad input or a failed operation (message on stderr),
 //! 2 bad command line. A panic is a bug; it is reported and exits 1, never 101.
 
 use std::process::ExitCode;

@@ -157,7 +157,7 @@ fn render_with_dump(name: &str, extra: &[&str]) -> (PathBuf, PathBuf) {
 
 /// Renders with `--variant variant --dump` as `geometry` (lines or tubes), then recomputes LineAO
 /// from the dumped files and `params.json` alone, as an outside implementation would (for tubes
-/// with CONTRACT.md's r0(P) = 1.5 · z(P) · t_s / zoom_unit, t_s = 2 × `tube_radius_world`).
+/// with docs/reference.md's r0(P) = 1.5 · z(P) · t_s / zoom_unit, t_s = 2 × `tube_radius_world`).
 fn recompute_from_dump(variant: &str, outer: &str, geometry: &str) {
     let (png, dump) = render_with_dump(
         &format!("dump-{variant}-{outer}-{geometry}"),
@@ -293,7 +293,7 @@ fn recompute_from_dump(variant: &str, outer: &str, geometry: &str) {
     assert!(gpu_ao.data.iter().filter(|&&a| a > 0.1).count() > 1000);
 }
 
-/// The bench's passes timed on the CPU (CONTRACT.md's and `select`).
+/// The bench's passes timed on the CPU (docs/reference.md's and `select`).
 const CPU_PASSES: [&str; 7] =
     ["density-256", "sweep-256", "variance-volume-256", "bvh-build-1m", "raytraced-cpu-64", "bvh-upload", "select"];
 
@@ -318,7 +318,7 @@ fn bench_json_is_the_contract() {
     let on = if report["timestamps"] == true { "gpu" } else { "cpu" };
     let passes = report["passes"].as_array().unwrap();
     let names: Vec<&str> = passes.iter().map(|p| p["name"].as_str().unwrap()).collect();
-    // Every pass of CONTRACT.md, and the test build's `toy` (the registry's methods list
+    // Every pass of docs/reference.md, and the test build's `toy` (the registry's methods list
     // theirs); in the bench's order, its own passes first.
     let mut sorted = names.clone();
     sorted.sort_unstable();

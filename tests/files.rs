@@ -1,4 +1,4 @@
-//! `lineao info`, `convert` and `render FILE` on real files: CONTRACT.md's JSON and exit codes.
+//! `lineao info`, `convert` and `render FILE` on real files: docs/reference.md's JSON and exit codes.
 
 use std::path::Path;
 

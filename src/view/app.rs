@@ -21,12 +21,13 @@ use std::time::Duration;
 use web_time::Instant;
 
 use egui::emath::GuiRounding;
-use egui::{Align2, Color32, ColorImage, FontId, Key, PointerButton, Pos2, Rect, Sense, TextureHandle, Vec2};
+use egui::{Align2, Color32, ColorImage, FontId, PointerButton, Pos2, Rect, Sense, TextureHandle, Vec2};
 use egui_file_dialog::FileDialog;
 use lineao_tracts::SceneKind;
 
 use super::camera::OrbitCamera;
 use super::controls::{ColorMode, Controls, RegionRule, method_label};
+use super::keys::Action;
 use super::loading::PREVIEW_VERTICES;
 use super::worker::{self, Dataset, Frame, FromWorker, Output, Source, ToWorker, View, Worker};
 
@@ -885,41 +886,17 @@ impl App {
         let mut record_key = false;
         if !ui.ctx().egui_wants_keyboard_input() {
             let step = 5f32.to_radians();
-            ui.input(|i| {
-                let arrows = [
-                    (Key::ArrowLeft, -1.0, 0.0),
-                    (Key::ArrowRight, 1.0, 0.0),
-                    (Key::ArrowUp, 0.0, -1.0),
-                    (Key::ArrowDown, 0.0, 1.0),
-                ];
-                for (key, x, y) in arrows {
-                    if i.key_pressed(key) {
-                        if i.modifiers.shift {
-                            camera.pan(20.0 * x, 20.0 * y, rect.height())
-                        } else {
-                            camera.orbit(step * x, step * y)
-                        }
-                    }
+            for (action, (x, y)) in ui.input(super::keys::pressed) {
+                match action {
+                    Action::Orbit => camera.orbit(step * x, step * y),
+                    Action::Pan => camera.pan(20.0 * x, 20.0 * y, rect.height()),
+                    Action::Zoom(factor) => camera.zoom(factor),
+                    Action::Reset => camera.reset(),
+                    Action::Orthographic => camera.orthographic = !camera.orthographic,
+                    Action::Slab(steps) => self.controls.move_slab(steps),
+                    Action::Record => record_key = true,
                 }
-                if i.key_pressed(Key::Plus) || i.key_pressed(Key::Equals) {
-                    camera.zoom(0.9);
-                }
-                if i.key_pressed(Key::Minus) {
-                    camera.zoom(1.0 / 0.9);
-                }
-                if i.key_pressed(Key::R) {
-                    camera.reset();
-                }
-                if i.key_pressed(Key::O) {
-                    camera.orthographic = !camera.orthographic;
-                }
-                for (key, steps) in [(Key::OpenBracket, -1.0), (Key::CloseBracket, 1.0)] {
-                    if i.key_pressed(key) {
-                        self.controls.move_slab(steps);
-                    }
-                }
-                record_key = i.key_pressed(Key::M);
-            });
+            }
             self.orthographic = camera.orthographic;
         }
         if *camera != before {

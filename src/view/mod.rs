@@ -14,6 +14,7 @@ pub mod app;
 pub mod camera;
 pub mod controls;
 mod export;
+pub mod keys;
 mod loading;
 pub mod record;
 #[cfg(test)]

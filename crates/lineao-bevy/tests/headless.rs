@@ -259,7 +259,7 @@ fn pixel_of(p: Vec3) -> (usize, usize) {
 /// Lines and meshes in one Bevy frame: the meshes' AO is what lineao's `HostAo` makes of the
 /// same prepass, with the camera's matrices and the scene's bounds computed by the test; the
 /// lines' AO is what a standalone `AoChain` makes of the same polylines seen by the same camera;
-/// both within CONTRACT.md's agreement policy. On the open ground the default mesh settings
+/// both within docs/reference.md's agreement policy. On the open ground the default mesh settings
 /// leave the AO under 0.02 and darken the cube's contact with the ground.
 #[test]
 fn the_plugin_adds_no_error_to_lineaos_chains() {

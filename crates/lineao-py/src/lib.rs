@@ -169,7 +169,7 @@ fn sample_volume<'py>(
     Ok(values.into_pyarray(py))
 }
 
-/// `lineao info --json` of `path`, as its JSON text (CONTRACT.md's keys).
+/// `lineao info --json` of `path`, as its JSON text (docs/reference.md's keys).
 #[pyfunction]
 fn info(py: Python<'_>, path: PathBuf) -> PyResult<String> {
     let loaded = py.detach(|| lineao_tracts::load(&path)).map_err(|e| load_error(py, e))?;
@@ -509,7 +509,7 @@ impl Renderer {
     }
 
     /// `lineao score --json` on this session's view: each of `methods` (None: all) against
-    /// the ray-traced truth, as the JSON text of CONTRACT.md's `score --json`.
+    /// the ray-traced truth, as the JSON text of docs/reference.md's `score --json`.
     #[pyo3(signature = (settings, methods=None))]
     fn score(
         &mut self,

@@ -19,7 +19,7 @@ pub struct ScoreArgs {
     /// Methods to score, comma-separated [default: all of them].
     #[arg(long, value_delimiter = ',', value_parser = Listed { parse: parse_score_method, values: ScoreMethod::listed })]
     pub methods: Vec<ScoreMethod>,
-    /// Print JSON (CONTRACT.md `lineao score --json`) instead of a table.
+    /// Print JSON (docs/reference.md `lineao score --json`) instead of a table.
     #[arg(long)]
     pub json: bool,
     /// The bundle-scale truth's reach (obscurance with the linear falloff, the second truth
@@ -145,7 +145,7 @@ pub fn parse_ao_distance(s: &str) -> Result<AoDistance, String> {
     }
 }
 
-/// What `--method` and `--compare` name: a screen-space method (CONTRACT.md: none, lineao,
+/// What `--method` and `--compare` name: a screen-space method (docs/reference.md: none, lineao,
 /// ssao, vo-line, vo-area), object-space AO (sweep, variance-volume), or both (`lineao+sweep`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Method {
@@ -607,7 +607,7 @@ pub fn parse_region(s: &str) -> Result<lineao_tracts::Region, String> {
     }
 }
 
-/// `--slices`: three positions, each a number, or `none` (CONTRACT.md) or `-` for no slice.
+/// `--slices`: three positions, each a number, or `none` (docs/reference.md) or `-` for no slice.
 pub fn parse_slices(s: &str) -> Result<[Option<f32>; 3], String> {
     let parts: Vec<Option<f32>> = s
         .split(',')
@@ -964,7 +964,7 @@ pub struct InfoArgs {
     /// A .trk, .tck, .tsf, .trx (zip or directory), .vtk, .vtp, .tt.gz, .gltf/.glb or .obj file,
     /// optionally gzip-wrapped.
     pub file: PathBuf,
-    /// Print CONTRACT.md's JSON.
+    /// Print docs/reference.md's JSON.
     #[arg(long)]
     pub json: bool,
     /// With a selection, the count it keeps is reported (`"selected"`).

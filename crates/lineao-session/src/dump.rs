@@ -1,4 +1,4 @@
-//! `--dump DIR` (CONTRACT.md): the method's inputs and raw output at the guard-banded size, so an
+//! `--dump DIR` (docs/reference.md): the method's inputs and raw output at the guard-banded size, so an
 //! outside implementation can recompute the result: `nd_<j>.npy`, `zoom.npy`, `ao.npy`,
 //! `noise.npy`, `samples.npy` (LineAO), `ssao_kernel.npy`, `ssao_noise.npy` (SSAO) or
 //! `vo_samples.npy`, `vo_noise.npy` (VO; area sampling adds `moments_<l>.npy`, H_l × W_l × 2),
@@ -6,7 +6,7 @@
 //! bilateral blur; with the bilateral blur `ao_blurred.npy` (H × W) is what it made of it, our
 //! extension.
 //!
-//! Object-space AO (our extension of CONTRACT.md) adds `octants.npy` (H × W × 8: the lines'
+//! Object-space AO (our extension of docs/reference.md) adds `octants.npy` (H × W × 8: the lines'
 //! octant visibilities per pixel, as the `volume_ao` pass reads them), `geometry_term.npy`
 //! (T × T × 8: G_o over the octahedral map) and `volume_ao.npy` (H × W), and the keys `volume`
 //! (`sweep`, `variance-volume`), `volume_normal` (`pixel`, `tangent`, `none`), `sky` (eight
@@ -103,7 +103,7 @@ pub fn write(
     };
     write_npy(dir, "ao.npy", &[h, w], &read(&raw.texture)?.to_f32())?;
     if let (Some(blurred), true) = (&targets.ao_blurred, s.bilateral().is_some()) {
-        // Our extension of CONTRACT.md: what the bilateral blur (the denoiser) made of `ao.npy`.
+        // Our extension of docs/reference.md: what the bilateral blur (the denoiser) made of `ao.npy`.
         write_npy(dir, "ao_blurred.npy", &[h, w], &read(&blurred.texture)?.to_f32())?;
     }
 
@@ -163,7 +163,7 @@ pub fn write(
                 "ks": s.lighting.ks,
                 "shininess": s.lighting.shininess,
             }),
-            // Our extension of CONTRACT.md: what the authors' radius needs.
+            // Our extension of docs/reference.md: what the authors' radius needs.
             LineAoVariant::Reference => json!({
                 "reference_radius_px": ao.reference_radius_px,
                 "zoom_fit": view.zoom_fit(),
@@ -257,12 +257,12 @@ pub fn write(
         merge(&mut params, extra);
     }
     if let Some((blur, slices_only)) = s.bilateral() {
-        // Our extension of CONTRACT.md: the blur after `ao.npy` (what the image shows), over
+        // Our extension of docs/reference.md: the blur after `ao.npy` (what the image shows), over
         // every pixel or the anatomy slices' alone.
         let bilateral = json!({"radius_px": blur.radius_px, "depth_sigma_world": blur.depth_sigma_world, "slices_only": slices_only});
         merge(&mut params, json!({ "bilateral": bilateral }));
     }
-    // Our extension of CONTRACT.md: the method's described settings (`lineao::method::setting`)
+    // Our extension of docs/reference.md: the method's described settings (`lineao::method::setting`)
     // by their keywords, as `render` takes them (a switch: whether its flag is in force).
     let flags = s.method.info().settings.iter().map(|d| {
         let value = match ((d.get)(s), d.kind) {

@@ -20,7 +20,7 @@ pub fn load(path: &Path) -> Result<Loaded> {
     Ok(loaded?)
 }
 
-/// CONTRACT.md's `lineao info --json` object.
+/// docs/reference.md's `lineao info --json` object.
 pub fn describe(loaded: &Loaded) -> Value {
     let t = &loaded.tractogram;
     let point = |p: Option<&[f32; 3]>| p.map_or(Value::Null, |p| json!(p));

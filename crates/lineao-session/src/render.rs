@@ -940,7 +940,7 @@ pub fn validate_camera(camera: &Camera) -> Result<()> {
 
 #[cfg(test)]
 mod tests {
-    /// CONTRACT.md: the library's default settings are the front ends' default — what
+    /// docs/reference.md: the library's default settings are the front ends' default — what
     /// `lineao render` with no option gives each method is `ChainSettings::default()`'s preset.
     #[test]
     fn the_librarys_default_is_the_command_lines() {

@@ -41,7 +41,7 @@ pub struct Row {
 /// LineVis's default for its ray-traced AO of lines.
 pub const BUNDLE_DISTANCE: AoDistance = AoDistance::Share(0.2);
 
-/// The second truth: obscurance with the linear falloff at a bundle's reach (CONTRACT.md
+/// The second truth: obscurance with the linear falloff at a bundle's reach (docs/reference.md
 /// "Bundle-scale truth").
 ///
 /// It comes from the local truth's rays, each traced once to the larger reach
@@ -391,7 +391,7 @@ fn legibility_json(l: &Result<Legibility, Absent>) -> serde_json::Value {
     }
 }
 
-/// CONTRACT.md's `lineao score --json` object.
+/// docs/reference.md's `lineao score --json` object.
 pub fn to_json(session: &Session, args: &crate::args::RenderArgs, report: &Report) -> serde_json::Value {
     let errors = |e: &metrics::Errors| json!({"bias": e.bias, "mean_abs": e.mean_abs, "rmse": e.rmse, "ssim": e.ssim});
     let settings = crate::truth::settings(args, session.longest_side);

@@ -7,7 +7,9 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 #[error("{}: {kind}", path.display())]
 pub struct Error {
+    /// The file.
     pub path: PathBuf,
+    /// What went wrong, and where in it.
     pub kind: ErrorKind,
 }
 
@@ -16,10 +18,16 @@ pub struct Error {
 #[derive(Debug, thiserror::Error)]
 pub enum ErrorKind {
     #[error("{0}")]
+    /// Reading or writing failed.
     Io(#[from] io::Error),
     /// The bytes at `offset` are not what the format requires.
     #[error("at byte {offset}: expected {expected}")]
-    Format { offset: u64, expected: String },
+    Format {
+        /// The first byte that is wrong.
+        offset: u64,
+        /// What the format requires there.
+        expected: String,
+    },
     /// A valid file of a known kind that holds no streamlines: a polygon mesh, a point cloud.
     #[error("no lines: {0}")]
     NoLines(String),
@@ -29,7 +37,12 @@ pub enum ErrorKind {
     /// Decompressing would exceed the configured limit (a gzip or zip bomb, or a file that needs
     /// [`crate::LoadOptions::max_inflated_bytes`] raised).
     #[error("at byte {offset}: decompressed data would exceed the limit of {limit} bytes")]
-    TooLarge { offset: u64, limit: u64 },
+    TooLarge {
+        /// Where in the compressed input the limit was reached.
+        offset: u64,
+        /// The limit in bytes.
+        limit: u64,
+    },
     /// Valid input that asks for something we do not do (e.g. writing to a format we only read).
     #[error("unsupported: {0}")]
     Unsupported(String),

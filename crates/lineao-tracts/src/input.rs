@@ -13,7 +13,9 @@ use crate::error::{ErrorKind, Parse, bad};
 /// How far loading has got: bytes of the file read so far, of `total` when the size is known.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Progress {
+    /// Bytes read so far.
     pub bytes: u64,
+    /// The total, where known (a file's size; not a stream's).
     pub total: Option<u64>,
 }
 

@@ -26,6 +26,8 @@
 //! Context surfaces (a brain hull shown with the tracts) load as a [`TriangleMesh`] from OBJ and
 //! glTF ([`load_mesh`]).
 
+#![deny(missing_docs)]
+
 mod error;
 pub mod formats;
 mod input;

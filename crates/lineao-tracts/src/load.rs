@@ -13,18 +13,28 @@ use crate::tractogram::Tractogram;
 /// The file formats we read. [`Format::name`] is the `format` of `lineao info --json`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Format {
+    /// TrackVis `.trk`.
     Trk,
+    /// MRtrix `.tck`.
     Tck,
+    /// MRtrix track scalar file `.tsf` (values, no points).
     Tsf,
+    /// TRX (`.trx`, a zip of arrays).
     Trx,
+    /// Legacy VTK polydata `.vtk`.
     Vtk,
+    /// VTK XML polydata `.vtp`.
     Vtp,
+    /// DSI Studio `.tt.gz`.
     Tt,
+    /// glTF lines (`.gltf`, `.glb`).
     Gltf,
+    /// Wavefront OBJ `l` polylines.
     Obj,
 }
 
 impl Format {
+    /// The name `lineao info --json` writes (`trk`, `tck`, …).
     pub fn name(self) -> &'static str {
         match self {
             Format::Trk => "trk",
@@ -63,12 +73,16 @@ impl Format {
 /// What wrapped the format's bytes. [`Compression::name`] is `compression` in `info --json`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Compression {
+    /// Stored as is.
     None,
+    /// gzip-wrapped (`.gz`).
     Gzip,
+    /// A zip archive (TRX).
     Zip,
 }
 
 impl Compression {
+    /// The name `lineao info --json` writes (`none`, `gzip`, `zip`).
     pub fn name(self) -> &'static str {
         match self {
             Compression::None => "none",
@@ -96,8 +110,11 @@ impl LoadOptions {
 /// A loaded file: the streamlines and what the file was.
 #[derive(Clone, Debug)]
 pub struct Loaded {
+    /// The streamlines and their data.
     pub tractogram: Tractogram,
+    /// The format it was read as.
     pub format: Format,
+    /// How it was compressed.
     pub compression: Compression,
 }
 

@@ -19,6 +19,7 @@ use crate::input::{Limited, io_error};
 /// An indexed triangle mesh in world space.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TriangleMesh {
+    /// Vertex positions, world units.
     pub positions: Vec<[f32; 3]>,
     /// Unit normals, one per position.
     pub normals: Vec<[f32; 3]>,
@@ -27,6 +28,7 @@ pub struct TriangleMesh {
 }
 
 impl TriangleMesh {
+    /// The number of triangles.
     pub fn triangles(&self) -> usize {
         self.indices.len() / 3
     }

@@ -26,8 +26,20 @@ use crate::tractogram::{Group, Tractogram};
 /// A sphere or an axis-aligned box in world units.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Region {
-    Sphere { center: [f32; 3], radius: f32 },
-    Box { min: [f32; 3], max: [f32; 3] },
+    /// A ball: a segment meets it when its distance to `center` is at most `radius`.
+    Sphere {
+        /// The centre.
+        center: [f32; 3],
+        /// The radius.
+        radius: f32,
+    },
+    /// An axis-aligned box from `min` to `max`.
+    Box {
+        /// The corner with the smallest coordinates.
+        min: [f32; 3],
+        /// The corner with the largest coordinates.
+        max: [f32; 3],
+    },
 }
 
 impl Region {
@@ -84,7 +96,9 @@ pub struct Selection {
     pub field: Option<(String, [f32; 2])>,
     /// Groups a kept streamline belongs to one of (none: any streamline).
     pub groups: Vec<String>,
+    /// Regions each kept streamline passes through (all of them).
     pub include: Vec<Region>,
+    /// Regions no kept streamline passes through.
     pub exclude: Vec<Region>,
 }
 

@@ -34,9 +34,13 @@ use crate::tractogram::{Field, Group, Tractogram, VoxelSpace};
 /// What a file was, once all its chunks were handed over.
 #[derive(Clone, Debug, Default)]
 pub struct Streamed {
+    /// The format detected from the first bytes.
     pub format: Option<Format>,
+    /// The compression detected from the first bytes.
     pub compression: Option<Compression>,
+    /// Streamlines decoded.
     pub streamlines: u64,
+    /// Points decoded.
     pub vertices: u64,
     /// The voxel grid the streamlines were tracked in, where the format records one.
     pub space: Option<VoxelSpace>,

@@ -26,15 +26,20 @@ pub struct Tractogram {
 /// Named data with `columns` values per vertex or per streamline, row-major.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Field {
+    /// Its name in the file (trailing spaces and NULs trimmed).
     pub name: String,
+    /// Values per entry (1 for a scalar, 3 for a colour).
     pub columns: usize,
+    /// The values, `columns` per vertex or per streamline, row-major.
     pub values: Vec<f32>,
 }
 
 /// A named set of streamline indices, with optional data per group (TRX dpg).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Group {
+    /// Its name in the file.
     pub name: String,
+    /// The indices of its streamlines.
     pub streamlines: Vec<u32>,
     /// TRX `dpg/<group>/<name>`: `columns` values for the whole group.
     pub data: Vec<Field>,
@@ -45,6 +50,7 @@ pub struct Group {
 pub struct VoxelSpace {
     /// Voxel indices to RAS+ mm, row-major 4 × 4.
     pub affine: [[f64; 4]; 4],
+    /// The grid's size in voxels.
     pub dimensions: [u32; 3],
     /// Absent where the format records only the affine (TRX).
     pub voxel_sizes: Option<[f32; 3]>,
@@ -53,14 +59,18 @@ pub struct VoxelSpace {
 /// Axis-aligned bounds of all points.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bounds {
+    /// The smallest coordinate on each axis.
     pub min: [f32; 3],
+    /// The largest coordinate on each axis.
     pub max: [f32; 3],
 }
 
+/// The 4 × 4 identity: the affine of a file without one.
 pub const IDENTITY: [[f64; 4]; 4] =
     [[1.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 0.0, 1.0]];
 
 impl Tractogram {
+    /// An empty tractogram.
     pub fn new() -> Tractogram {
         Tractogram { offsets: vec![0], ..Tractogram::default() }
     }
@@ -74,6 +84,7 @@ impl Tractogram {
         self.offsets.push(self.positions.len() as u64);
     }
 
+    /// The number of streamlines.
     pub fn streamlines(&self) -> usize {
         self.offsets.len().saturating_sub(1)
     }

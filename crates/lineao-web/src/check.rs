@@ -2,7 +2,7 @@
 //! back what its chain's method read (the ND pyramid and the zoom map) and what it wrote (the
 //! raw AO, before any blur), with the frame's view and settings ([`Readback`]); the test saves
 //! them ([`Readback::write`]) and runs the reference natively on exactly those inputs
-//! ([`check`]), judged by CONTRACT.md's agreement policy ([`lineao::verify::check_policy`]).
+//! ([`check`]), judged by docs/reference.md's agreement policy ([`lineao::verify::check_policy`]).
 
 use std::path::Path;
 

@@ -127,6 +127,31 @@ pub fn link(
     format!("?{}", query.finish())
 }
 
+/// Every key the page's URL takes, with what it does: the page's own (`url`, `hold`), then
+/// `lineao view`'s options by their names, from the same definitions [`parse`] reads, less
+/// those a page cannot use. docs/options.md lists them (generated from this).
+pub fn url_keys() -> Vec<(String, String)> {
+    let mut keys = vec![
+        ("url".to_string(), "a tractogram's address, fetched (relative to the page), with a progress bar".to_string()),
+        (
+            "hold".to_string(),
+            format!("MiB of a file the page keeps to read it again (default {})", crate::HOLD_BYTES >> 20),
+        ),
+    ];
+    let command = <PageCli as clap::CommandFactory>::command();
+    for arg in command.get_arguments() {
+        let Some(long) = arg.get_long().filter(|long| !NOT_IN_A_PAGE.contains(long)) else { continue };
+        let help = arg.get_help().map(|h| h.to_string()).unwrap_or_default();
+        let what = match long {
+            "volume" => format!("a NIfTI volume's address, fetched and shown as slices (`--volume`: {help})"),
+            "color" => format!("as `--color`; `volume:` and `tsf:` take an address, fetched first ({help})"),
+            _ => format!("`--{long}`: {help}"),
+        };
+        keys.push((long.to_string(), what));
+    }
+    keys
+}
+
 /// What a link names as the data.
 #[derive(Clone, Debug, PartialEq)]
 pub enum LinkSource {

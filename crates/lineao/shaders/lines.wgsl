@@ -1,5 +1,5 @@
 // Line renderer: polylines at a fixed pixel width as triangle strips, writing the G-buffer of
-// CONTRACT.md (color, ND map, zoom map, specular, hardware depth).
+// docs/reference.md (color, ND map, zoom map, specular, hardware depth).
 //
 // The vertex shader pulls each strip vertex from the clusters (`shared/clusters.wgsl`):
 // instance = a cluster, vertex = a position along its strip, which takes every point twice

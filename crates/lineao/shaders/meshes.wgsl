@@ -1,4 +1,4 @@
-// Context surfaces: triangle meshes writing the G-buffer of CONTRACT.md (color with Phong
+// Context surfaces: triangle meshes writing the G-buffer of docs/reference.md (color with Phong
 // diffuse, the ND map with the interpolated normal turned toward the eye, zoom, specular and
 // hardware depth), so that a surface shown with the tracts occludes them and is occluded.
 // Two-sided: a hull seen from inside is lit like one seen from outside.

@@ -1,4 +1,4 @@
-// The G-buffer of CONTRACT.md from a host renderer's own buffers: its depth (any convention the
+// The G-buffer of docs/reference.md from a host renderer's own buffers: its depth (any convention the
 // inverse projection undoes: standard or reversed-Z, perspective or orthographic; MSAA samples
 // resolved to the nearest), its normals if it has them (view or world space, signed or packed
 // as unorm), else normals reconstructed from the depth; and its lit color. See

@@ -1,4 +1,4 @@
-// ND pyramid (paper §3.4, CONTRACT.md "Pyramid"): level j is the separable binomial
+// ND pyramid (paper §3.4, docs/reference.md "Pyramid"): level j is the separable binomial
 // [1 4 6 4 1]/16 of level j-1 centred at texel (2x, 2y), clamp-to-edge, over all four channels
 // (background included, so sparse lines fade and dense bundles merge at coarse levels). The
 // filtered normal is renormalized, or set to zero (background) when shorter than 1e-6.

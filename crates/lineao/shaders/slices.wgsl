@@ -2,7 +2,7 @@
 // voxel centres or (where voxels without data are transparent) an outline around the data
 // near the plane, drawn as a fan of triangles; each fragment
 // samples the volume trilinearly between voxel centres through the inverse affine and writes
-// the G-buffer of CONTRACT.md with the value through the window and colormap (`base_color`,
+// the G-buffer of docs/reference.md with the value through the window and colormap (`base_color`,
 // color mode 2), unlit, the plane's normal turned toward the eye. Transparent: no fragment
 // where the voxels without data (0 or NaN) weigh half the sample or more. The sample: one
 // filtered sample where the device filters f32 textures (`fs_slice_filtered`: an `Rg32Float`

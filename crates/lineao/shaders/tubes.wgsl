@@ -1,6 +1,6 @@
 // Tube renderer: every segment a ray-cast rounded cone (two spheres of the ends' radii and the
 // cone tangent to both; a capsule for one radius) on a billboard that bounds its projection,
-// writing true depth, the surface's normal and the G-buffer of CONTRACT.md. Overlapping
+// writing true depth, the surface's normal and the G-buffer of docs/reference.md. Overlapping
 // billboards at the joints each ray-cast their own segment and the depth test keeps the nearest
 // hit, so a polyline renders as the exact union of its segments' solids: seamless joints.
 // The vertex shader pulls the segments from the clusters (`shared/clusters.wgsl`): instance = a

@@ -1,4 +1,4 @@
-//! Camera, scene bounds and the per-frame view that every pass shares (CONTRACT.md
+//! Camera, scene bounds and the per-frame view that every pass shares (docs/reference.md
 //! "Coordinates and buffers").
 //!
 //! View space: camera at the origin looking down −z, +y up. The depth range that normalizes the
@@ -18,17 +18,27 @@ use glam::{Mat4, Vec3};
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Projection {
     /// Vertical field of view in degrees, (0, 180).
-    Perspective { fov_y_deg: f32 },
+    Perspective {
+        /// The vertical field of view in degrees.
+        fov_y_deg: f32,
+    },
     /// Height of the visible window in world units.
-    Orthographic { height: f32 },
+    Orthographic {
+        /// The visible height in world units.
+        height: f32,
+    },
 }
 
 /// A look-at camera in world units.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
+    /// Where the eye is, world units.
     pub eye: Vec3,
+    /// The point the eye looks at.
     pub target: Vec3,
+    /// Which way is up on screen.
     pub up: Vec3,
+    /// Perspective or orthographic.
     pub projection: Projection,
 }
 
@@ -42,7 +52,9 @@ impl Camera {
 /// The bounding sphere of all geometry in world units.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bounds {
+    /// The centre of the bounding sphere.
     pub center: Vec3,
+    /// Its radius, world units.
     pub radius: f32,
 }
 
@@ -89,20 +101,25 @@ impl Bounds {
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct FrameView {
+    /// World to view space.
     pub view: Mat4,
     /// Projection of the guard-banded G-buffer (wgpu clip space, depth in [0, 1]).
     pub proj: Mat4,
     /// Visible size in pixels (without the guard band).
     pub width: u32,
+    /// Visible height in pixels.
     pub height: u32,
     /// Guard band in pixels on each side.
     pub guard: u32,
     /// Normalized depth range, as −z_view.
     pub near: f32,
+    /// The far end of the normalized depth range, as −z_view.
     pub far: f32,
     /// Focal length in pixels.
     pub f_px: f32,
+    /// World units per zoom unit of z(P) (1 mm for tractograms).
     pub zoom_unit: f32,
+    /// Whether the projection is orthographic.
     pub orthographic: bool,
     /// Radius of the scene's bounding sphere, world units.
     pub scene_radius: f32,
@@ -118,11 +135,14 @@ pub struct FrameView {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 pub struct Tile {
+    /// The whole picture's size in pixels.
     pub picture: [u32; 2],
+    /// The tile's top-left pixel in the picture.
     pub origin: [u32; 2],
 }
 
 impl FrameView {
+    /// The view of `camera` on a `width` × `height` image with `guard` pixels of guard band on each side, its depth range from `bounds`.
     pub fn new(camera: &Camera, bounds: &Bounds, width: u32, height: u32, guard: u32, zoom_unit: f32) -> Self {
         let view = camera.view_matrix();
         let (near, far) = depth_range(&view, bounds);
@@ -273,7 +293,7 @@ impl FrameView {
         w.min(h).max(1) as f32 * self.zoom_unit / (2.0 * self.scene_radius)
     }
 
-    /// Normalized linear depth of a view-space z (CONTRACT.md).
+    /// Normalized linear depth of a view-space z (docs/reference.md).
     pub fn normalized_depth(&self, z_view: f32) -> f32 {
         ((-z_view - self.near) / (self.far - self.near)).clamp(0.0, 1.0)
     }
@@ -295,7 +315,7 @@ pub fn pyramid_reach(level: u32) -> f32 {
     3.0 * ((1u32 << level.min(16)) - 1) as f32
 }
 
-/// The guard band of CONTRACT.md: `radius_px` rounded up to a multiple of 2^(s_r−1), capped.
+/// The guard band of docs/reference.md: `radius_px` rounded up to a multiple of 2^(s_r−1), capped.
 pub fn guard_band(radius_px: f32, s_r: u32, cap: u32) -> u32 {
     let step = 1u32 << s_r.saturating_sub(1).min(16);
     let needed = radius_px.max(0.0).ceil().min(u32::MAX as f32 / 2.0) as u32;

@@ -27,8 +27,10 @@ pub enum Colormap {
 }
 
 impl Colormap {
+    /// Every colormap, the default first.
     pub const ALL: [Colormap; 4] = [Colormap::Viridis, Colormap::Gray, Colormap::CoolWarm, Colormap::Categories];
 
+    /// Its name on the command line.
     pub fn name(self) -> &'static str {
         match self {
             Colormap::Viridis => "viridis",

@@ -1,6 +1,6 @@
 //! What the geometry passes share — [`LineRenderer`](crate::passes::lines::LineRenderer),
 //! [`TubeRenderer`](crate::passes::tubes::TubeRenderer) and
-//! [`MeshRenderer`](crate::passes::meshes::MeshRenderer) all write the G-buffer of CONTRACT.md:
+//! [`MeshRenderer`](crate::passes::meshes::MeshRenderer) all write the G-buffer of docs/reference.md:
 //! the per-frame uniform (`shaders/shared/geometry.wgsl`), the attachments in their order, and
 //! a pipeline builder. The first writer of a frame clears the targets, the others draw over it.
 //!

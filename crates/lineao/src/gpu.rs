@@ -32,9 +32,17 @@ pub enum Lacking {
     /// Compute shaders (WebGL2's downlevel adapters).
     ComputeShaders,
     /// A G-buffer format without these usages.
-    Format { format: wgpu::TextureFormat, usages: wgpu::TextureUsages },
+    Format {
+        /// The format.
+        format: wgpu::TextureFormat,
+        /// The usages it lacks.
+        usages: wgpu::TextureUsages,
+    },
     /// Fewer color attachments than the G-buffer's four.
-    ColorAttachments { has: u32 },
+    ColorAttachments {
+        /// How many the adapter has.
+        has: u32,
+    },
 }
 
 impl std::fmt::Display for Lacking {
@@ -84,9 +92,13 @@ pub async fn validated_async<T>(device: &wgpu::Device, what: &str, create: impl 
 
 /// Instance, adapter, device and queue of one headless GPU.
 pub struct Gpu {
+    /// The wgpu instance.
     pub instance: wgpu::Instance,
+    /// The adapter the device came from.
     pub adapter: wgpu::Adapter,
+    /// The device, with the features lineao asks for where the adapter offers them.
     pub device: wgpu::Device,
+    /// Its queue.
     pub queue: wgpu::Queue,
     /// Why the device was lost, once it is: set by the device-lost callback [`Gpu::headless`]
     /// installs (wgpu keeps one callback per device; a host with its own device installs its own).

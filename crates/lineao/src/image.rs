@@ -5,8 +5,11 @@
 /// A row-major image, `data[y * width + x]`.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Image<T> {
+    /// Width in pixels.
     pub width: usize,
+    /// Height in pixels.
     pub height: usize,
+    /// The pixels, row-major, top row first.
     pub data: Vec<T>,
 }
 
@@ -14,10 +17,12 @@ pub struct Image<T> {
 pub type NdImage = Image<[f32; 4]>;
 
 impl<T: Copy> Image<T> {
+    /// An image of `value` everywhere.
     pub fn filled(width: usize, height: usize, value: T) -> Image<T> {
         Image { width, height, data: vec![value; width * height] }
     }
 
+    /// An image of `f(x, y)` at every pixel.
     pub fn from_fn(width: usize, height: usize, mut f: impl FnMut(usize, usize) -> T) -> Image<T> {
         let mut data = Vec::with_capacity(width * height);
         for y in 0..height {
@@ -28,6 +33,7 @@ impl<T: Copy> Image<T> {
         Image { width, height, data }
     }
 
+    /// The pixel at (x, y).
     pub fn get(&self, x: usize, y: usize) -> T {
         self.data[y * self.width + x]
     }

@@ -31,27 +31,48 @@
 //!
 //! An embedder's build (no feature) compiles the passes and the chain; the tools turn the
 //! features on. The G-buffer contract (the ND map, the zoom map, normalized depth) is in
-//! [`targets`] and [`FrameView`]; CONTRACT.md in the repository is the full specification.
+//! [`targets`] and [`FrameView`]; docs/reference.md in the repository is the full specification.
 //!
-//! ```no_run
+//! Embedding the chain in a host's frame: a headless device here, your own `Device`, `Queue`
+//! and target view in a renderer (docs/embedding.md has `HostAo`, over your own depth).
+//!
+//! ```
 //! use lineao::{AoChain, Camera, ChainSettings, Gpu, LineGeometry, Projection};
 //! # fn main() -> Result<(), lineao::Error> {
 //! let gpu = Gpu::headless()?;
-//! let positions = [[0.0, 0.0, 0.0], [10.0, 0.0, 0.0], [10.0, 10.0, 0.0]];
-//! let geometry = LineGeometry::new(&gpu.device, &gpu.queue, &positions, &[0, 3])?;
+//! // Two streamlines as one array of points and the offsets where each starts (CSR).
+//! let positions = [[0.0, 0.0, 0.0], [10.0, 0.0, 0.0], [10.0, 10.0, 0.0], [0.0, 5.0, -3.0], [12.0, 5.0, 3.0]];
+//! let geometry = LineGeometry::new(&gpu.device, &gpu.queue, &positions, &[0, 3, 5])?;
 //! let format = wgpu::TextureFormat::Rgba8UnormSrgb;
-//! let mut chain = AoChain::new(&gpu.device, format, ChainSettings::default())?;
-//! chain.resize(640, 480)?;
-//! let camera = Camera { eye: [5.0, 5.0, 40.0].into(), target: [5.0, 5.0, 0.0].into(), up: glam::Vec3::Y,
-//!                       projection: Projection::Perspective { fov_y_deg: 45.0 } };
+//! let mut chain = AoChain::new(&gpu.device, format, ChainSettings::default())?; // LineAO
+//! chain.resize(320, 240)?;
+//! let camera = Camera {
+//!     eye: [5.0, 5.0, 40.0].into(),
+//!     target: [5.0, 5.0, 0.0].into(),
+//!     up: glam::Vec3::Y,
+//!     projection: Projection::Perspective { fov_y_deg: 45.0 },
+//! };
+//! // The host's frame: the texture the composite writes.
+//! let target = gpu.device.create_texture(&wgpu::TextureDescriptor {
+//!     label: Some("frame"),
+//!     size: wgpu::Extent3d { width: 320, height: 240, depth_or_array_layers: 1 },
+//!     mip_level_count: 1,
+//!     sample_count: 1,
+//!     dimension: wgpu::TextureDimension::D2,
+//!     format,
+//!     usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+//!     view_formats: &[],
+//! });
+//! let view = target.create_view(&Default::default());
+//! // Each frame: the camera, then the passes recorded into the host's encoder.
 //! chain.prepare(&gpu.device, &gpu.queue, &camera, &geometry.bounds.unwrap());
-//! # let target: wgpu::TextureView = todo!();
 //! let mut encoder = gpu.device.create_command_encoder(&Default::default());
-//! chain.encode(&mut encoder, &geometry, &target)?;
+//! chain.encode(&mut encoder, &geometry, &view)?;
 //! gpu.queue.submit([encoder.finish()]);
 //! # Ok(()) }
 //! ```
 
+#![deny(missing_docs)]
 // The docs link the CPU reference, the truth and the volumes from the passes that they prove;
 // built without those features (an embedder's default) the links have no target and stay text.
 // docs.rs builds with every feature (Cargo.toml), where each link resolves.
@@ -160,32 +181,59 @@ pub enum Limit {
 #[derive(Debug, thiserror::Error)]
 pub enum Error {
     #[error("no GPU adapter found (install a Vulkan driver, e.g. mesa-vulkan-drivers): {0}")]
+    /// No adapter was found; the driver's message.
     NoAdapter(String),
     #[error("the GPU adapter refused a device: {0}")]
+    /// The adapter refused a device; the driver's message.
     RequestDevice(String),
     #[error("invalid settings: {0}")]
+    /// Settings that do not go together, said in words.
     InvalidSettings(String),
     /// A method's setting outside its range ([`method::setting::Setting`]): its flag (without
     /// the dashes), the value and what it takes, in its unit (`[0.25, 4] zoom units`, `> 0
     /// world units`, `5, 7 or 9`) — what a host matches on to say which setting to change.
     #[error("invalid settings: --{setting} must be {}{expected}, got {value}", if expected.starts_with(['[', '(']) || expected.contains("..=") { "in " } else { "" })]
-    OutOfRange { setting: &'static str, value: String, expected: String },
+    OutOfRange {
+        /// The setting's flag, without the dashes (`ssao-radius`).
+        setting: &'static str,
+        /// The value given.
+        value: String,
+        /// What it takes, in its unit.
+        expected: String,
+    },
     #[error("invalid line geometry: {0}")]
+    /// A line geometry that cannot be made (offsets out of order, points that are not finite).
     InvalidGeometry(String),
     /// More than the device allows: which limit, how much was asked and the most it takes (what
     /// a host matches on to shrink the frame or the data), and what was being made.
     #[error("too large for this adapter: {message}")]
-    TooLarge { limit: Limit, value: u64, max: u64, message: String },
+    TooLarge {
+        /// Which limit.
+        limit: Limit,
+        /// How much was asked.
+        value: u64,
+        /// The most the device takes.
+        max: u64,
+        /// What was being made, in words.
+        message: String,
+    },
     #[error("GPU operation failed: {0}")]
+    /// A GPU operation failed (mapping a buffer, a submission); the driver's message.
     Gpu(String),
     /// An adapter without what lineao's passes need ([`check_adapter`]): its name and backend,
     /// and each thing it lacks — what a host matches on to fall back or say which.
     #[error("the GPU cannot run lineao: {adapter} lacks {}", lacking.iter().map(|l| l.to_string()).collect::<Vec<_>>().join(", "))]
-    AdapterLacks { adapter: String, lacking: Vec<Lacking> },
+    AdapterLacks {
+        /// The adapter's name and backend.
+        adapter: String,
+        /// Each thing it lacks.
+        lacking: Vec<Lacking>,
+    },
     /// What the device refused to make (a validation error wgpu would panic with).
     #[error("the GPU cannot run lineao: {0}")]
     Unsupported(String),
     #[error("stopped before it finished")]
+    /// Cancelled by its caller before it finished.
     Cancelled,
     /// The device is gone (a driver reset, a removed GPU, `Device::destroy`): what was being
     /// rendered or accumulated stops; a new device starts again.

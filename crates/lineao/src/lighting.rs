@@ -64,7 +64,7 @@ pub struct Lighting {
 }
 
 impl Default for Lighting {
-    /// CONTRACT.md: one light toward normalize(−0.4, 0.6, 0.7), I = 1, kd 0.3, ks 0.4, α 32.
+    /// docs/reference.md: one light toward normalize(−0.4, 0.6, 0.7), I = 1, kd 0.3, ks 0.4, α 32.
     fn default() -> Self {
         Lighting {
             lights: vec![Light { dir: Vec3::new(-0.4, 0.6, 0.7).normalize(), intensity: 1.0 }],
@@ -150,13 +150,19 @@ const GAUSS_LEGENDRE_16: [(f32, f32); 8] = [
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct LightingUniform {
+    /// Each light: its view-space direction toward the light (xyz) and intensity (w).
     pub lights: [[f32; 4]; MAX_LIGHTS],
+    /// The lights in use.
     pub count: u32,
+    /// Diffuse coefficient kd.
     pub kd: f32,
+    /// Specular coefficient ks.
     pub ks: f32,
+    /// Specular exponent α.
     pub shininess: f32,
     /// 0: [`LineShading::Specular`], 1: [`LineShading::CylinderAveraged`].
     pub line_shading: u32,
+    /// Padding to WGSL's 16-byte alignment.
     pub _pad: [u32; 3],
 }
 
@@ -166,6 +172,7 @@ impl Lighting {
         self.lights.iter().map(|l| Light { dir: l.dir.normalize_or_zero(), intensity: l.intensity }).collect()
     }
 
+    /// The uniform the shaders read.
     pub fn uniform(&self) -> LightingUniform {
         let mut lights = [[0.0; 4]; MAX_LIGHTS];
         let normalized = self.normalized();

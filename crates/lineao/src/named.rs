@@ -1,18 +1,20 @@
 //! Settings with a fixed set of values ([`Named`]): each value's name — what the command line,
-//! `params.json`, Python and CONTRACT.md write — and a line of help, from which every front end
+//! `params.json`, Python and docs/reference.md write — and a line of help, from which every front end
 //! parses and lists them, and (with the `serde` feature) their (de)serialization by that name.
 //! The bottom floor of the settings: the methods' and the chain's settings name their values
 //! here, and nothing here knows of them.
 
 /// A setting with a fixed set of values, each with the name the command line, `params.json` and
-/// CONTRACT.md use and a line of help: what a CLI or a binding (Python, a host's UI) parses and
+/// docs/reference.md use and a line of help: what a CLI or a binding (Python, a host's UI) parses and
 /// lists, so that it mirrors no enum of its own.
 pub trait Named: Copy + Send + Sync + 'static {
     /// Every value, the default first.
     const VALUES: &'static [Self];
+    /// Its name.
     fn name(self) -> &'static str;
     /// What the value does, in one line.
     fn help(self) -> &'static str;
+    /// The value called `name`.
     fn from_name(name: &str) -> Option<Self> {
         Self::VALUES.iter().copied().find(|v| v.name() == name)
     }

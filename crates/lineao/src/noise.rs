@@ -1,4 +1,4 @@
-//! The random vectors of LineAO's Monte-Carlo sampling (paper §3.4, CONTRACT.md "Noise").
+//! The random vectors of LineAO's Monte-Carlo sampling (paper §3.4, docs/reference.md "Noise").
 //!
 //! R1 is a 64 × 64 tile of unit vectors repeated over the image (indexed by the pixel's position
 //! relative to the visible viewport's top-left corner), R2 a table `samples[j][i]` of unit vectors
@@ -43,7 +43,7 @@ pub fn noise_tile(seed: u32) -> Vec<[f32; 3]> {
 
 /// R2: `samples[j * s_h + i]` for j < s_r, i < s_h. Only i < `count(j)` is used (⌈s_h/(j+1)⌉ for
 /// the paper, s_h for the authors' code); the rest are zero so that the table reads the same as
-/// CONTRACT.md's zero-padded `samples.npy`.
+/// docs/reference.md's zero-padded `samples.npy`.
 pub fn sample_table(seed: u32, s_r: u32, s_h: u32, count: impl Fn(u32) -> u32) -> Vec<[f32; 3]> {
     let mut table = vec![[0.0; 3]; (s_r * s_h) as usize];
     for j in 0..s_r {

@@ -15,8 +15,7 @@
 //! (Mesa 22.3) loads a storage buffer one SIMD lane at a time, in a loop with a branch per lane
 //! and per 32-bit word, while a texel fetch of 16 bytes is one unrolled gather — and a BVH walk
 //! is little else but such loads. Moving the scene from storage buffers into textures, with
-//! the pass's specialized pipelines, made a one-ray frame 2.4–2.6× faster there
-//! (docs/measurements.md).
+//! the pass's specialized pipelines, made a one-ray frame 2.4–2.6× faster there.
 //!
 //! **Layout**: four textures, one per region (texel i of a region is its i-th element):
 //!
@@ -56,6 +55,7 @@ pub const GPU_LEAF: usize = 8;
 pub struct RayGeometry<'a> {
     /// Line vertices, streamline `s` being `positions[offsets[s] .. offsets[s + 1]]`.
     pub positions: &'a [[f32; 3]],
+    /// Each streamline's first point, and the end (CSR offsets).
     pub offsets: &'a [u64],
     /// Per-vertex tube radii (world units), where positive and finite; else the settings'.
     pub radii: Option<&'a [f32]>,

@@ -7,9 +7,13 @@ pub use images::{read_f32, read_image, read_rgba, write_target};
 
 /// A texture's texels, rows tightly packed.
 pub struct TextureData {
+    /// Width in texels.
     pub width: u32,
+    /// Height in texels.
     pub height: u32,
+    /// The texture's format.
     pub format: wgpu::TextureFormat,
+    /// The texels, row after row.
     pub bytes: Vec<u8>,
 }
 
@@ -147,6 +151,7 @@ const PENDING: u8 = 1;
 const MAPPED: u8 = 2;
 
 impl LateReadback {
+    /// A buffer of `bytes` to read back into.
     pub fn new(device: &wgpu::Device, label: &str, bytes: u64) -> LateReadback {
         LateReadback {
             buffer: device.create_buffer(&wgpu::BufferDescriptor {

@@ -73,6 +73,7 @@ impl BilateralSettings {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
+/// What the composite shows (`--debug-view`).
 pub enum DebugView {
     /// color · (1 − strength · ao) + specular.
     #[default]
@@ -131,7 +132,12 @@ pub enum LineColor {
     /// The geometry's per-vertex scalar ([`crate::passes::lines::VertexAttributes::scalar`]:
     /// FA, curvature, a bundle index …) through `colormap`, `range` mapped to its ends (values
     /// beyond clamp). Geometry without scalars shows the colormap's low end.
-    Scalar { colormap: Colormap, range: [f32; 2] },
+    Scalar {
+        /// The colormap.
+        colormap: Colormap,
+        /// The values at its two ends.
+        range: [f32; 2],
+    },
 }
 
 /// Streamlines as tubes (`lineao::passes::tubes`) instead of fixed-width lines.
@@ -192,9 +198,12 @@ impl Default for SliceSettings {
 /// The axis a [`Slab`] is thick along.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum SlabAxis {
+    /// Sagittal: along x.
     X,
+    /// Coronal: along y.
     Y,
     #[default]
+    /// Axial: along z.
     Z,
     /// The view direction, the slab's centre measured from the middle of the scene's depth
     /// range (the bounding sphere's centre, unless the eye is inside it).
@@ -209,6 +218,7 @@ named!(SlabAxis {
 });
 
 impl SlabAxis {
+    /// Its name on the command line.
     pub fn name(self) -> &'static str {
         match self {
             SlabAxis::X => "x",
@@ -225,6 +235,7 @@ impl SlabAxis {
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct Slab {
+    /// The axis it is thick along.
     pub axis: SlabAxis,
     /// The slab's middle along its axis, world units.
     pub center: f32,
@@ -272,6 +283,7 @@ macro_rules! chain_settings {
         #[cfg_attr(feature = "serde", serde(default))]
         #[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
         pub struct ChainSettings {
+            /// The method. Default LineAO.
             pub method: AoMethod,
             $( $(#[$attr])? #[doc = concat!("The settings of [`AoMethod::", stringify!($variant), "`] (its registry line's field).")] pub $field: $ty, )*
             /// The bilateral blur after the method, or none. Default none. After the ray tracer it is
@@ -279,6 +291,7 @@ macro_rules! chain_settings {
             pub blur: Option<BilateralSettings>,
             /// Object-space AO from the geometry's attributes, or none. Default none.
             pub volume: Option<VolumeAoSettings>,
+            /// The lights and the BRDF's coefficients (LineAO's g_light and the specular).
             pub lighting: Lighting,
             /// Line width in pixels, > 0. Default 2.
             pub line_width_px: f32,
@@ -292,11 +305,13 @@ macro_rules! chain_settings {
             pub slices: Option<SliceSettings>,
             /// Lines cut to a slab, or none. Default none.
             pub slab: Option<Slab>,
+            /// How lines are coloured. Default by tangent.
             pub line_color: LineColor,
             /// Linear RGB of the background.
             pub background: [f32; 3],
             /// AO strength in the composite, ≥ 0. Default 1.
             pub strength: f32,
+            /// What the composite shows. Default the final image.
             pub debug_view: DebugView,
             /// World units per zoom unit (1 mm for tractography). Default 1.
             pub zoom_unit: f32,
@@ -396,6 +411,7 @@ named!(Preset {
 });
 
 impl Preset {
+    /// Every preset, the default first.
     pub const ALL: [Preset; 4] = [Preset::Legible, Preset::Physical, Preset::Paper, Preset::Sparse];
 
     /// The name on the command line (`legible`, `physical`, `paper`, `sparse`).
@@ -439,7 +455,7 @@ impl ChainSettings {
     ///
     /// `cargo run --release --example embed_renderer -- --fit` scores every method on that
     /// example's meshes on a ground plane (binary AO to the same reach, 128 rays, each method at
-    /// its least-squares strength; docs/measurements.md has the table): this one has the least
+    /// its least-squares strength; docs/embedding.md has the table): this one has the least
     /// RMSE (0.053, correlation 0.95; LineAO's best 0.118, SSAO 0.162, VO area 0.155), leaves
     /// the open ground at 0.0007 and darkens the contacts by 0.50 where the truth says 0.53.
     /// Without the clamp VO darkens every open surface; without the thickness it darkens

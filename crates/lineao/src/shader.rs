@@ -41,7 +41,7 @@ const SHARED: &[(&str, &str)] = &[
 ];
 
 /// WGSL functions a host renderer can paste into (or concatenate with) its own shaders to write
-/// the ND map and zoom map of CONTRACT.md: `gbuffer_nd`, `gbuffer_zoom`, `gbuffer_depth`,
+/// the ND map and zoom map of docs/reference.md: `gbuffer_nd`, `gbuffer_zoom`, `gbuffer_depth`,
 /// `gbuffer_line_normal`, `gbuffer_eye_direction` (`shaders/shared/gbuffer.wgsl`; no bindings,
 /// no imports).
 pub const GBUFFER_WGSL: &str = include_str!("../shaders/shared/gbuffer.wgsl");
@@ -49,7 +49,9 @@ pub const GBUFFER_WGSL: &str = include_str!("../shaders/shared/gbuffer.wgsl");
 /// A number Rust and WGSL share, written into WGSL by Rust ([`CONSTANTS`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Constant {
+    /// A float constant.
     F32(f32),
+    /// An unsigned constant.
     U32(u32),
 }
 

@@ -14,7 +14,7 @@
 //! | octants   | Rg32Uint      | object-space AO: the lines' octant visibilities, unorm8 × 8 |
 //! | volume_ao | R32Float      | object-space AO with the pixel's normal (`volume_ao` pass) |
 //!
-//! All at the guard-banded size; level j is ⌈W_{j−1}/2⌉ × ⌈H_{j−1}/2⌉ (CONTRACT.md).
+//! All at the guard-banded size; level j is ⌈W_{j−1}/2⌉ × ⌈H_{j−1}/2⌉ (docs/reference.md).
 //! Object-space AO adds `octants` and `volume_ao` ([`FrameTargets::with_volume`]). What one
 //! method alone reads and writes on the way to `ao` is that method's own (SSAO's occlusion
 //! before its blur, VO area's moments pyramid, LineAO's `outer = level` targets: see
@@ -24,10 +24,15 @@
 /// per pixel, WebGPU's default `max_color_attachment_bytes_per_sample`, so the chain runs on a
 /// host's device opened with default limits (object-space AO's octants need 40).
 pub const COLOR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// The ND map's format: n.xyz, d.
 pub const ND_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba32Float;
+/// The zoom map's format.
 pub const ZOOM_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+/// The specular term's format.
 pub const SPECULAR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
+/// The hardware depth's format.
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// The occlusion's format.
 pub const AO_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
 /// The eight octant visibilities of object-space AO per pixel, `pack4x8unorm` of octants 0–3
 /// and 4–7.
@@ -35,11 +40,14 @@ pub const OCTANTS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Uint;
 
 /// A texture with its default view.
 pub struct Target {
+    /// The texture.
     pub texture: wgpu::Texture,
+    /// A view of all of it.
     pub view: wgpu::TextureView,
 }
 
 impl Target {
+    /// A texture of `size` and `format` with `usage`, and its view.
     pub fn new(
         device: &wgpu::Device,
         label: &str,
@@ -72,6 +80,7 @@ impl Target {
         Target::new(device, label, size, AO_FORMAT, AO_USAGE)
     }
 
+    /// Its size in texels.
     pub fn size(&self) -> (u32, u32) {
         (self.texture.width(), self.texture.height())
     }
@@ -88,7 +97,9 @@ pub fn level_sizes((width, height): (u32, u32), levels: u32) -> Vec<(u32, u32)> 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct LevelsUniform {
+    /// Per level: its size over level 0's (x, y).
     pub scale: [[f32; 4]; 5],
+    /// Per level: its size in texels (x, y).
     pub size: [[u32; 4]; 5],
 }
 
@@ -114,16 +125,21 @@ pub struct FrameTargets {
     pub size: (u32, u32),
     /// Guard band in pixels on each side.
     pub guard: u32,
+    /// The base colour.
     pub color: Target,
     /// The ND pyramid; `nd[0]` is the ND map the geometry writes.
     pub nd: Vec<Target>,
+    /// The zoom map.
     pub zoom: Target,
+    /// The specular term the composite adds.
     pub specular: Target,
+    /// The hardware depth.
     pub depth: Target,
     /// What the composite shows: the method's occlusion, after its blur if it has one.
     pub ao: Target,
     /// The bilateral blur's horizontal half, and its result.
     pub ao_blur_tmp: Option<Target>,
+    /// The bilateral blur's result.
     pub ao_blurred: Option<Target>,
     /// With the blur: a `u32` per 8 × 8 tile ([`SLICE_TILE`], row-major), not 0 where an anatomy
     /// slice's fragment fell (`passes::slices` writes it, `passes::bilateral` reads it).
@@ -131,6 +147,7 @@ pub struct FrameTargets {
     /// Object-space AO: the geometry's octant visibilities per pixel, and the occlusion the
     /// `volume_ao` pass makes of them.
     pub octants: Option<Target>,
+    /// Object-space AO's occlusion.
     pub volume_ao: Option<Target>,
 }
 

@@ -42,6 +42,7 @@ impl<'a> Span<'a> {
         (first, last)
     }
 
+    /// The timestamp writes of a compute pass.
     pub fn compute(&self) -> wgpu::ComputePassTimestampWrites<'a> {
         wgpu::ComputePassTimestampWrites {
             query_set: self.query_set,
@@ -50,6 +51,7 @@ impl<'a> Span<'a> {
         }
     }
 
+    /// The timestamp writes of a render pass.
     pub fn render(&self) -> wgpu::RenderPassTimestampWrites<'a> {
         wgpu::RenderPassTimestampWrites {
             query_set: self.query_set,
@@ -72,7 +74,9 @@ pub fn render_writes<'a>(span: Option<Span<'a>>) -> Option<wgpu::RenderPassTimes
 /// Duration of one named span, in milliseconds.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PassTime {
+    /// The span's name (`lineao bench`'s pass names).
     pub name: &'static str,
+    /// Its duration in ms.
     pub ms: f64,
 }
 

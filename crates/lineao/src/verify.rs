@@ -1,5 +1,5 @@
 //! Proving the GPU against the CPU reference (its targets read back by [`crate::readback`]): the
-//! agreement check of CONTRACT.md ("GPU vs CPU agreement"): ≥ 99.5 % of geometry pixels within
+//! agreement check of docs/reference.md ("GPU vs CPU agreement"): ≥ 99.5 % of geometry pixels within
 //! 1e-3, and every pixel within a bound of a few flipped samples.
 
 use crate::image::{Image, NdImage};
@@ -13,7 +13,9 @@ pub struct Agreement {
     pub fraction_within: f64,
     /// Largest absolute difference and where.
     pub worst: f32,
+    /// Where the largest difference is.
     pub worst_pixel: (usize, usize),
+    /// The mean absolute difference.
     pub mean_abs: f64,
 }
 
@@ -60,7 +62,7 @@ pub fn compare(a: &Image<f32>, b: &Image<f32>, tolerance: f32, mask: impl Fn(usi
     }
 }
 
-/// CONTRACT.md's bound for every pixel of LineAO: two flipped samples per hemisphere, Σ_j 2/n_j.
+/// docs/reference.md's bound for every pixel of LineAO: two flipped samples per hemisphere, Σ_j 2/n_j.
 pub fn line_ao_flip_bound(s_r: u32, s_h: u32) -> f32 {
     (0..s_r).map(|j| 2.0 / crate::noise::samples_on_hemisphere(s_h, j) as f32).sum()
 }

@@ -11,9 +11,11 @@ use crate::camera::FrameView;
 pub struct ViewParams {
     /// −z_view at normalized depth 0 and 1 (world units).
     pub near: f32,
+    /// −z_view at normalized depth 1.
     pub far: f32,
     /// Focal length in pixels (perspective) or pixels per world unit (orthographic).
     pub f_px: f32,
+    /// Whether the projection is orthographic.
     pub orthographic: bool,
     /// The optical axis in pixel coordinates of the guard-banded image: (W, H) / 2, or a
     /// tile's share of its picture's ([`FrameView::center`]).
@@ -21,6 +23,7 @@ pub struct ViewParams {
 }
 
 impl ViewParams {
+    /// The parameters of `view`.
     pub fn of(view: &FrameView) -> ViewParams {
         ViewParams {
             near: view.near,

@@ -1,4 +1,4 @@
-//! The guard band (CONTRACT.md, paper §3.4): AO at the viewport's edge must not fade. An edge
+//! The guard band (docs/reference.md, paper §3.4): AO at the viewport's edge must not fade. An edge
 //! pixel's AO with the guard band must equal the AO of the same pixel when it sits in the middle
 //! of a larger render of the same view (same focal length, pixel grid and noise phase).
 
@@ -106,7 +106,7 @@ fn edge_pixels_see_what_a_larger_render_sees() {
         assert!(occluded > 10, "{name}: the top edge must be occluded somewhere ({occluded} px)");
 
         // End to end: two rasterizations of the same view differ in the last bits of depth (and
-        // a rare pixel of coverage), which can flip a sample whose Δd sits at ε — CONTRACT.md's
+        // a rare pixel of coverage), which can flip a sample whose Δd sits at ε — docs/reference.md's
         // agreement policy.
         let e2e = edge_band(&small, &small.ao, &large, size, 8);
         println!(

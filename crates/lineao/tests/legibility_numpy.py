@@ -1,4 +1,4 @@
-"""An independent computation of lineao's legibility (CONTRACT.md "Legibility"), exact form.
+"""An independent computation of lineao's legibility (docs/reference.md "Legibility"), exact form.
 
 Every pair (p, p + o) with p a geometry pixel and o a non-zero integer offset with |o| <= r is
 enumerated by shifting whole arrays; pairs whose partner is off the image or background, or whose

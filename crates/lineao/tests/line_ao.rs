@@ -92,7 +92,7 @@ fn view_of(level0: &NdImage, guard: u32) -> FrameView {
 fn flat_region_is_unoccluded_even_with_rounding_noise() {
     let gpu = gpu();
     let s = settings(3, 6.0, true);
-    // Depth noise below ε = 1e-6 (f32 rounding of a flat surface) must not occlude (CONTRACT.md
+    // Depth noise below ε = 1e-6 (f32 rounding of a flat surface) must not occlude (docs/reference.md
     // departs from Eq. 8's Δd ≥ 0 for this reason).
     let nd0 = nd_map(64, 48, |x, y| 0.5 + if (x * 7 + y * 3) % 5 == 0 { 4e-7 } else { 0.0 });
     let zoom = Image::filled(64, 48, 4.0f32);

@@ -1,4 +1,4 @@
-//! The line renderer against the G-buffer contract (CONTRACT.md), with expected values worked
+//! The line renderer against the G-buffer contract (docs/reference.md), with expected values worked
 //! out here from the camera and the line: width in pixels, gap-free joins, separate streamlines,
 //! normals, normalized depth, zoom, hardware depth, colors, specular, chunked buffers.
 

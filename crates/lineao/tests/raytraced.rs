@@ -465,7 +465,7 @@ fn the_denoiser_brings_few_rays_closer_to_the_truth_and_fades_out() {
     assert_eq!(d.spatial(145, false), 0.0);
 }
 
-/// The bundle-scale truth's identity (CONTRACT.md): obscurance with the linear falloff over
+/// The bundle-scale truth's identity (docs/reference.md): obscurance with the linear falloff over
 /// [0, R] is binary AO averaged over radii R' uniform in [0, R] — a hit at t counts 1 − t/R,
 /// the share of those radii beyond t. Checked numerically with the same rays: the mean of
 /// binary truths at the midpoints of K bins of [0, R] against the linear truth at R.

@@ -1,5 +1,5 @@
 //! Crytek SSAO and its 4 × 4 blur: closed forms on CPU-written G-buffers, and the GPU against
-//! the CPU reference on rendered lines (CONTRACT.md's policy, bound 2/N).
+//! the CPU reference on rendered lines (docs/reference.md's policy, bound 2/N).
 
 mod common;
 

@@ -1,5 +1,5 @@
 //! Volumetric Obscurance, line and area sampling: the closed forms of the VO paper and
-//! CONTRACT.md (a plane facing the camera is half obscured without the normal clamp and not at
+//! docs/reference.md (a plane facing the camera is half obscured without the normal clamp and not at
 //! all with it; a 90° crease leaves a quarter of the sphere free; the box model's integral
 //! against a numeric one; two radii), the moments pyramid against its CPU reference, and both
 //! passes against the CPU reference on rendered lines.

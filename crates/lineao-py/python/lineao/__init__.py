@@ -422,7 +422,7 @@ def render(
 
 def score(streamlines: Any, methods: Optional[Iterable[str]] = None, **settings: Any) -> dict:
     """``lineao score --json`` of streamlines (any container ``render`` takes): each method's
-    AO against the ray-traced truth on one view, as a dict (CONTRACT.md's keys)."""
+    AO against the ray-traced truth on one view, as a dict (docs/reference.md's keys)."""
     camera = settings.pop("camera", None)
     return Renderer(streamlines, camera=camera, **settings).score(methods)
 

@@ -17,11 +17,14 @@ use crate::tractogram::{Field, Tractogram};
 /// The header: keys in file order, repeated keys joined by `\n`.
 #[derive(Clone, Debug, Default)]
 pub struct Header {
+    /// The header's `key: value` lines, in file order (a key may repeat).
     pub fields: Vec<(String, String)>,
+    /// Whether the file holds track scalars (`.tsf`) rather than tracks (`.tck`).
     pub scalars: bool,
 }
 
 impl Header {
+    /// The first value of `key`, if the header has it.
     pub fn get(&self, key: &str) -> Option<&str> {
         self.fields.iter().find(|(k, _)| k == key).map(|(_, v)| v.as_str())
     }

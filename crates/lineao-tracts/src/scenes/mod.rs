@@ -23,9 +23,13 @@ use crate::Tractogram;
 /// A camera suggestion in world units: a look-at and a vertical field of view.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ViewHint {
+    /// The eye, world units.
     pub eye: [f32; 3],
+    /// The point looked at.
     pub target: [f32; 3],
+    /// The camera's up vector.
     pub up: [f32; 3],
+    /// The vertical field of view in degrees.
     pub fov_y_deg: f32,
     /// World units per zoom unit (LineAO's z(P)); 1 = 1 mm.
     pub zoom_unit: f32,
@@ -34,22 +38,32 @@ pub struct ViewHint {
 /// A built-in scene.
 #[derive(Clone, Debug)]
 pub struct Scene {
+    /// Which scene it is.
     pub kind: SceneKind,
+    /// Its streamlines.
     pub tractogram: Tractogram,
+    /// The camera it is best seen from.
     pub view: ViewHint,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+/// The built-in scenes (`--scene`).
 pub enum SceneKind {
+    /// Dense bundles of parallel fibres crossing each other, like tractography.
     Bundles,
+    /// A bundle wound along a helix.
     Spiral,
+    /// Streamlines of two counter-rotating vortex tubes.
     Vortex,
+    /// A synthetic whole brain of any size (`--vertices`), made as it streams.
     WholeBrain,
 }
 
 impl SceneKind {
+    /// Every scene, in the order the help lists them.
     pub const ALL: [SceneKind; 4] = [SceneKind::Bundles, SceneKind::Spiral, SceneKind::Vortex, SceneKind::WholeBrain];
 
+    /// Its name on the command line.
     pub fn name(self) -> &'static str {
         match self {
             SceneKind::Bundles => "bundles",

@@ -189,6 +189,7 @@ impl WholeBrain {
         WholeBrain { seed, streamlines, templates }
     }
 
+    /// How many streamlines it makes.
     pub fn streamlines(&self) -> u64 {
         self.streamlines
     }

@@ -1,6 +1,6 @@
 //! `lineao-web-check DIR...`: each DIR a frame the web page read back (scripts/test-web.sh
 //! saves them), checked against lineao's CPU reference on exactly its inputs. Exits 1 when a
-//! frame breaks CONTRACT.md's agreement policy.
+//! frame breaks docs/reference.md's agreement policy.
 //!
 //! `lineao-web-check --load FILE`: the page's parse of FILE (its bytes in memory, as a drop or a
 //! fetch leaves them) natively, the median of five, for the page's load time to be compared.

@@ -1,4 +1,4 @@
-// Writing the G-buffer of CONTRACT.md from any shader: the functions lineao's own geometry
+// Writing the G-buffer of docs/reference.md from any shader: the functions lineao's own geometry
 // passes use, and that a host renderer can include to write the ND map and zoom map itself
 // (`lineao::shader::GBUFFER_WGSL`). All positions and normals are in view space (camera at the
 // origin looking down −z).
@@ -17,7 +17,7 @@ fn gbuffer_line_normal(t: vec3<f32>, c: vec3<f32>) -> vec3<f32> {
     return select(n, -n, dot(n, c) < 0.0);
 }
 
-// Normalized linear depth: (−z_view − near) / (far − near), clamped to [0, 1] (CONTRACT.md
+// Normalized linear depth: (−z_view − near) / (far − near), clamped to [0, 1] (docs/reference.md
 // "Scene depth range").
 fn gbuffer_depth(view_pos: vec3<f32>, near: f32, far: f32) -> f32 {
     return clamp((-view_pos.z - near) / (far - near), 0.0, 1.0);

@@ -1,4 +1,4 @@
-// The moments pyramid's layout (CONTRACT.md "VO area"; `lineao::method::vo_area::moments::Moments`): every level
+// The moments pyramid's layout (docs/reference.md "VO area"; `lineao::method::vo_area::moments::Moments`): every level
 // in one buffer of (E[z], E[z²]), level l at `levels[l].x` with `levels[l].yz` texels, row-major.
 // MAX_MOMENT_LEVELS: Rust's `lineao::method::vo_area::moments::MAX_MOMENT_LEVELS`.
 #import rust/constants.wgsl

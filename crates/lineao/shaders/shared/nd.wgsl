@@ -1,4 +1,4 @@
-// The ND map (CONTRACT.md): rgb = unit view-space normal facing the eye, a = normalized linear
+// The ND map (docs/reference.md): rgb = unit view-space normal facing the eye, a = normalized linear
 // depth in [0, 1]. Background: normal (0, 0, 0), depth 1.
 
 // Maximum number of ND pyramid levels a shader binds (`s_r` <= MAX_LEVELS).
@@ -18,7 +18,7 @@ struct Levels {
 }
 
 // Nearest texel of a pyramid level for full-resolution pixel `pixel` displaced by `offset` pixels:
-// floor((P + 0.5 + offset) * size_j / size_0), clamped to the level (CONTRACT.md "Addressing").
+// floor((P + 0.5 + offset) * size_j / size_0), clamped to the level (docs/reference.md "Addressing").
 // `scale` is size_j / size_0, computed once on the CPU so that both sides use the same f32.
 fn level_texel(pixel: vec2<u32>, offset: vec2<f32>, scale: vec2<f32>, size: vec2<u32>) -> vec2<i32> {
     let uv = (vec2<f32>(pixel) + 0.5 + offset) * scale;

@@ -1,4 +1,4 @@
-// From a pixel and its normalized depth to view space and back (CONTRACT.md "Coordinates").
+// From a pixel and its normalized depth to view space and back (docs/reference.md "Coordinates").
 // Keep in sync with `lineao::reference::ViewParams`.
 struct ViewParams {
     // −z_view at normalized depth 0 and 1.

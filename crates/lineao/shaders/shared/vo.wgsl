@@ -1,4 +1,4 @@
-// Volumetric Obscurance in the unit sphere's coordinates (Loos & Sloan §4, CONTRACT.md "VO"),
+// Volumetric Obscurance in the unit sphere's coordinates (Loos & Sloan §4, docs/reference.md "VO"),
 // shared by line and area sampling. x right, y up, z_d away from the camera, all over the
 // sphere's radius R; a disk point s is the vertical chord [−z_s, z_s], z_s = √(1 − |s|²).
 #import shared/view.wgsl
@@ -16,7 +16,7 @@ struct VoUniform {
     // Two radii: 0 = brightness multiplies, 1 = the darker one.
     combine: u32,
     // Area sampling: the deepest level of the moments pyramid, and σ (world units) below which
-    // the depth distribution counts as a step (CONTRACT.md: 1e-3 (far − near)).
+    // the depth distribution counts as a step (docs/reference.md: 1e-3 (far − near)).
     max_level: f32,
     sigma_floor: f32,
     // The number of samples in the tables. A uniform, not an override constant: with a constant

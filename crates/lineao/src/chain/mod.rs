@@ -36,7 +36,7 @@
 //!
 //! Every pass is labelled and the frame sits in a `lineao` debug group, so GPU debuggers show
 //! the chain by name. With [`AoChain::set_timing`] each pass also records timestamp queries under
-//! the names `lineao bench` uses (CONTRACT.md): `lines`, `nd-pyramid`, `lineao`, `raytraced`,
+//! the names `lineao bench` uses (docs/reference.md): `lines`, `nd-pyramid`, `lineao`, `raytraced`,
 //! `ray-denoise`, `ssao`, `ssao-blur`, `vo-line`, `moments`, `vo-area`, `blur`, `volume-ao`, `composite`.
 
 mod host;
@@ -71,6 +71,9 @@ use crate::{DebugView, LineColor};
 pub use host::HostAo;
 pub use overlay::OverlayAo;
 
+/// The pass chain of one method: the line geometry's G-buffer, the method's passes and the
+/// composite, with every size-dependent texture ([`FrameTargets`](crate::targets::FrameTargets)).
+/// `resize` to the image, `prepare` each frame with the camera, then `encode` into a command encoder.
 pub struct AoChain {
     settings: ChainSettings,
     lines: LineRenderer,
@@ -155,6 +158,7 @@ impl AoChain {
         .await
     }
 
+    /// The settings it runs with.
     pub fn settings(&self) -> &ChainSettings {
         &self.settings
     }
@@ -356,7 +360,7 @@ impl AoChain {
         Ok(())
     }
 
-    /// The guard band for this view: the largest sampling radius over the image (CONTRACT.md).
+    /// The guard band for this view: the largest sampling radius over the image (docs/reference.md).
     fn guard_for(&self, camera: &Camera, bounds: &Bounds) -> u32 {
         let s = &self.settings;
         // Plain lines read no neighbours on screen.

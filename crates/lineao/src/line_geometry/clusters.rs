@@ -90,6 +90,7 @@ pub struct ClusterRecord {
 }
 
 impl ClusterRecord {
+    /// Its points (at most [`CLUSTER_POINTS`](super::CLUSTER_POINTS)).
     pub fn count(&self) -> u32 {
         self.flags & flags::COUNT
     }

@@ -295,6 +295,7 @@ pub struct LineGeometry {
     corners: Option<(Vec3, Vec3)>,
     /// Input vertices appended so far.
     pub vertices: usize,
+    /// Streamlines appended so far.
     pub streamlines: usize,
     /// Of those, the ones drawn ([`LineGeometry::set_selection`]).
     selected: usize,

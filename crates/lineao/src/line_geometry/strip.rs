@@ -48,6 +48,7 @@ pub struct StripGeometry {
     alternating: wgpu::Buffer,
     indices: u32,
     tolerance: f32,
+    /// The box of its points.
     pub bounds: Option<Bounds>,
 }
 
@@ -168,6 +169,7 @@ impl StripRenderer {
         StripRenderer { pipeline, bindings, px_per_world: f32::INFINITY, full }
     }
 
+    /// Writes this frame's uniform.
     pub fn prepare(&mut self, queue: &wgpu::Queue, view: &FrameView, settings: &ChainSettings) {
         let uniform = GeometryUniform::new(view, settings.line_color, settings.line_width_px, 0.0);
         self.bindings.write(queue, &uniform, &settings.lighting);

@@ -39,7 +39,7 @@ pub(crate) type BuildStage = fn(&wgpu::Device, &ChainSettings) -> Box<dyn Stage>
 
 /// Everything the library and the front ends know of a method besides its settings.
 pub struct MethodInfo {
-    /// The name on the command line, in `params.json`, in Python and in CONTRACT.md.
+    /// The name on the command line, in `params.json`, in Python and in docs/reference.md.
     pub name: &'static str,
     /// What a method list in a user interface shows.
     pub label: &'static str,
@@ -48,7 +48,7 @@ pub struct MethodInfo {
     /// Whether the method is screen-space AO in the chain, shown by `--grid` and the viewer's
     /// list among the others (the ray-traced truth, progressive and scene-bound, is not).
     pub screen_space: bool,
-    /// The timing spans its stage can record, in chain order (CONTRACT.md's names).
+    /// The timing spans its stage can record, in chain order (docs/reference.md's names).
     pub spans: &'static [&'static str],
     /// Its WGSL files, by the name its passes compose them under.
     pub shaders: &'static [(&'static str, &'static str)],
@@ -80,14 +80,14 @@ pub struct MethodInfo {
     /// the settings stay valid (SSAO's sphere kernel takes only its sample counts). The command
     /// line calls nothing: what it is given is checked, not changed.
     pub conform: fn(&mut ChainSettings),
-    /// What `lineao bench` times of it, by CONTRACT.md's names.
+    /// What `lineao bench` times of it, by docs/reference.md's names.
     pub bench: &'static [BenchPass],
 }
 
 /// A pass of `lineao bench` that times a method: its stage, built and prepared with the bench's
 /// settings as [`BenchPass::settings`] changes them, on the bench's G-buffer.
 pub struct BenchPass {
-    /// The pass's name in `lineao bench` (CONTRACT.md's).
+    /// The pass's name in `lineao bench` (docs/reference.md's).
     pub name: &'static str,
     /// Changes the bench's settings (the papers', LineAO's preset, and this method) for frame
     /// `frame` of the run: a sample count, a variant, a new seed each frame for a new picture.
@@ -174,6 +174,10 @@ macro_rules! registry {
         impl AoMethod {
             /// Every method, in the registry's order.
             pub const REGISTRY: &'static [AoMethod] = &[$( $(#[cfg($cfg)])? AoMethod::$variant, )+];
+
+            /// The methods built for tests only (behind a feature), which a user's build lacks:
+            /// generated docs leave them out.
+            pub const FOR_TESTS: &'static [AoMethod] = &[$( $( #[cfg($cfg)] AoMethod::$variant, )? )+];
 
             /// What the registry holds for the method.
             pub fn info(self) -> &'static MethodInfo {
@@ -265,7 +269,7 @@ impl std::str::FromStr for AoMethod {
     }
 }
 
-/// The spans of a timed frame, in chain order (CONTRACT.md): the geometry, every method's, the
+/// The spans of a timed frame, in chain order (docs/reference.md): the geometry, every method's, the
 /// blur, object-space AO and the composite.
 pub fn pass_names() -> Vec<&'static str> {
     let methods = AoMethod::REGISTRY.iter().flat_map(|m| m.info().spans.iter().copied());
@@ -275,12 +279,17 @@ pub fn pass_names() -> Vec<&'static str> {
     names
 }
 
-/// How far from a pixel a stage reads, for the guard band (CONTRACT.md).
+/// How far from a pixel a stage reads, for the guard band (docs/reference.md).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Reach {
     /// At most `radius_px` pixels (before any blur), on a pyramid of `levels` levels (the band
     /// is rounded to the deepest level's texel).
-    Pixels { radius_px: f32, levels: u32 },
+    Pixels {
+        /// The reach in pixels.
+        radius_px: f32,
+        /// The pyramid's levels.
+        levels: u32,
+    },
     /// Without bound (it grows toward the far plane): the largest band allowed.
     Unbounded,
 }
@@ -325,7 +334,7 @@ pub(crate) fn one_level(_: &ChainSettings) -> u32 {
 }
 
 /// What a method does in the chain: it reads the G-buffer in [`FrameTargets`] and writes `ao`,
-/// between the geometry and the composite. The timing span names are CONTRACT.md's.
+/// between the geometry and the composite. The timing span names are docs/reference.md's.
 ///
 /// Why a trait object and not an enum of stage types: a stage is called a handful of times per
 /// frame (not per pixel), so dynamic dispatch costs nothing measurable, and the chain, the

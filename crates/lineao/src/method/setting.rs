@@ -46,6 +46,7 @@ pub struct Setting {
 /// What a [`Setting`] is counted in.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Unit {
+    /// No unit (a count, a share, a choice).
     None,
     /// Pixels.
     Px,
@@ -73,23 +74,52 @@ impl Unit {
 pub enum Kind {
     /// A number in `[min, max]`, or `(min, max]` where `open`; `log`: a slider moves it by
     /// factors.
-    Number { min: f32, max: f32, open: bool, log: bool },
+    Number {
+        /// The least value.
+        min: f32,
+        /// The greatest value.
+        max: f32,
+        /// Whether `min` itself is left out.
+        open: bool,
+        /// Whether a slider moves it by factors.
+        log: bool,
+    },
     /// Any finite number above `min` (`> min` where `open`, else `≥ min`); a panel's slider
     /// spans `slider` (by factors where `log`).
-    Above { min: f32, open: bool, slider: [f32; 2], log: bool },
+    Above {
+        /// The bound below.
+        min: f32,
+        /// Whether `min` itself is left out.
+        open: bool,
+        /// What a panel's slider spans.
+        slider: [f32; 2],
+        /// Whether a slider moves it by factors.
+        log: bool,
+    },
     /// A whole number in `min..=max`.
-    Count { min: u32, max: u32 },
+    Count {
+        /// The least value.
+        min: u32,
+        /// The greatest value.
+        max: u32,
+    },
     /// One of these whole numbers (VO's sample sets).
     Counts(&'static [u32]),
     /// One of these names ([`crate::Named`] values').
     Choice(&'static [&'static str]),
     /// On or off. The flag sets it to `given` (`--no-normal-clamp` gives `false`), so its
     /// default is the other.
-    Switch { given: bool },
+    Switch {
+        /// What the flag sets it to.
+        given: bool,
+    },
     /// A length > 0 ([`Value::Number`], in its unit), or a share in (0 %, 100 %] of the longest
     /// side of the scene's axis-aligned bounds written with `%` ([`Value::Share`]: the ray
     /// tracer's reach, LineVis's 20 %); a panel's slider spans `slider` by factors.
-    Reach { slider: [f32; 2] },
+    Reach {
+        /// What a panel's slider spans.
+        slider: [f32; 2],
+    },
 }
 
 /// The shorthands of the command line that give a setting of the method shown.
@@ -104,9 +134,13 @@ pub enum Role {
 /// A [`Setting`]'s value.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Value {
+    /// A number, in the setting's unit.
     Number(f32),
+    /// A whole number.
     Count(u32),
+    /// One of the setting's names.
     Choice(&'static str),
+    /// On or off.
     Switch(bool),
     /// A share of the scene's longest side ([`Kind::Reach`]), as a fraction (`20%`: 0.2).
     Share(f32),

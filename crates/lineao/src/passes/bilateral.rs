@@ -39,7 +39,9 @@ use crate::view_params::ViewUniform;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct BilateralUniform {
+    /// The view's parameters.
     pub view: ViewUniform,
+    /// Taps on each side.
     pub radius: i32,
     /// 1/(2σ_s²), σ_s = radius/2.
     pub spatial: f32,
@@ -52,6 +54,7 @@ pub struct BilateralUniform {
 }
 
 impl BilateralUniform {
+    /// The uniform for `view`, `settings` and the region the blur covers.
     pub fn new(view: &FrameView, settings: &BilateralSettings, region: Region) -> BilateralUniform {
         let sigma_s = settings.radius_px as f32 * 0.5;
         let (x, y) = tile_grid(view.banded_size());
@@ -83,6 +86,7 @@ struct Tiles {
     dispatches: wgpu::Buffer,
 }
 
+/// The separable, depth-aware blur after a method: a horizontal and a vertical pass.
 pub struct Bilateral {
     /// Along x, then along y: over every pixel, and over the listed tiles.
     pipelines: [wgpu::ComputePipeline; 2],
@@ -100,6 +104,7 @@ pub struct Bilateral {
 }
 
 impl Bilateral {
+    /// Its pipelines and layout.
     pub fn new(device: &wgpu::Device) -> Bilateral {
         let label = "lineao::Bilateral";
         use Slot::*;

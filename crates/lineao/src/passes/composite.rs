@@ -36,20 +36,30 @@ use crate::timing::{self, Span};
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct CompositeUniform {
+    /// The pyramid's levels (for the level debug view).
     pub levels: LevelsUniform,
+    /// The guard band on each side, x and y.
     pub guard: [u32; 2],
+    /// The AO's strength.
     pub strength: f32,
+    /// The debug view shown ([`crate::DebugView`]'s index).
     pub debug_view: u32,
+    /// The pyramid level of the level debug view.
     pub debug_level: u32,
+    /// The largest zoom, which the zoom debug view maps to white.
     pub zoom_max: f32,
     /// 0: the screen-space AO, 1: object-space AO alone, 2: both, brightness multiplied,
     /// 3: both, the darker.
     pub combine: u32,
+    /// Padding to WGSL's 16-byte alignment.
     pub _pad: u32,
     /// The overlay depth's projection rows: depth = (x z + y) / (z z + w).
     pub host_depth_rows: [f32; 4],
+    /// The near end of the depth range, as −z_view.
     pub near: f32,
+    /// The far end of the depth range, as −z_view.
     pub far: f32,
+    /// Padding to WGSL's 16-byte alignment.
     pub _pad1: [u32; 2],
 }
 
@@ -58,7 +68,9 @@ pub struct CompositeUniform {
 /// far plane; perspective or orthographic).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct OverlayDepth {
+    /// The host's depth format.
     pub format: wgpu::TextureFormat,
+    /// The projection the host draws with.
     pub proj: Mat4,
 }
 
@@ -85,8 +97,11 @@ struct Overlay {
 /// Which occlusion the composite shows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Shown {
+    /// The screen-space method's occlusion.
     Screen,
+    /// Object-space AO alone.
     Volume,
+    /// Both, combined so.
     Both(crate::VoCombine),
 }
 
@@ -101,6 +116,7 @@ impl Shown {
     }
 }
 
+/// The last pass: the colour darkened by the occlusion, the specular added, written to the target.
 pub struct Composite {
     pipeline: wgpu::RenderPipeline,
     /// Made by [`Composite::set_overlay`].
@@ -183,6 +199,7 @@ impl Composite {
         self.group = Some(binding::group(device, "lineao::Composite::group", &self.layout, &resources));
     }
 
+    /// Writes this frame's uniform.
     pub fn prepare(
         &self,
         queue: &wgpu::Queue,

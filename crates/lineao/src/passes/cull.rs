@@ -198,6 +198,7 @@ pub struct LevelsView {
 }
 
 impl LevelsView {
+    /// The levels of the depth pyramid for `view`.
     pub fn of(view: &crate::FrameView) -> LevelsView {
         LevelsView { view: view.view, proj: view.proj, near: view.near, orthographic: view.orthographic }
     }
@@ -865,17 +866,24 @@ impl Culled {
 /// found visible.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct CullCounts {
+    /// Pieces drawn in the early phase.
     pub early: u64,
+    /// Pieces drawn in the late phase.
     pub late: u64,
+    /// Of the drawn pieces, those drawn at a coarser level of detail.
     pub coarse: u64,
     /// Groups of 16 clusters whose pieces the late test tested, of all.
     pub listed_groups: u64,
     /// Pieces of the listed groups whose bounding capsule passed, tested segment by segment
     /// (`None` where the cull tests no capsules: [`LineCull::set_capsules`]).
     pub segment_tested: Option<u64>,
+    /// Groups of 16 clusters in all.
     pub groups: u64,
+    /// Pieces in all.
     pub pieces: u64,
+    /// Clusters with a piece found visible.
     pub visible_clusters: u64,
+    /// Clusters in all.
     pub clusters: u64,
 }
 

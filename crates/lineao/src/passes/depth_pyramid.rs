@@ -26,7 +26,9 @@ pub const MAX_LEVELS: usize = 16;
 pub struct PyramidUniform {
     /// Level 0's size (the targets' guard-banded size).
     pub size: [u32; 2],
+    /// How many levels it has.
     pub levels: u32,
+    /// Padding to WGSL's 16-byte alignment.
     pub _pad: u32,
     /// Per level: its first texel in the buffer, its width and height.
     pub level: [[u32; 4]; MAX_LEVELS],
@@ -51,6 +53,7 @@ pub struct Built {
     pub texels: wgpu::Buffer,
     /// [`PyramidUniform`] of this pyramid.
     pub uniform: wgpu::Buffer,
+    /// Its levels' layout.
     pub description: PyramidUniform,
     steps: Vec<(wgpu::BindGroup, (u32, u32))>,
 }
@@ -65,6 +68,7 @@ pub struct DepthPyramid {
 }
 
 impl DepthPyramid {
+    /// Its pipeline and layout.
     pub fn new(device: &wgpu::Device) -> DepthPyramid {
         let label = "lineao::DepthPyramid";
         let layout = binding::layout(

@@ -3,7 +3,7 @@
 //! triangle strip whose vertices the vertex shader pushes half a line width to either side of
 //! the curve (see `shaders/lines.wgsl`).
 //!
-//! Per pixel it writes the G-buffer of CONTRACT.md: base color, the ND map (n = (T × C) × T
+//! Per pixel it writes the G-buffer of docs/reference.md: base color, the ND map (n = (T × C) × T
 //! normalized, facing the eye; normalized linear depth), the zoom map, the illuminated-lines
 //! specular and hardware depth.
 //!
@@ -93,6 +93,7 @@ impl LineRenderer {
         Self::with_style(device, LineStyle::Quads)
     }
 
+    /// A line renderer drawing in `style`.
     pub fn with_style(device: &wgpu::Device, style: LineStyle) -> LineRenderer {
         Self::with_outputs(device, style, false)
     }
@@ -280,6 +281,7 @@ impl LineRenderer {
         self.bindings.shape
     }
 
+    /// Writes this frame's uniform.
     pub fn prepare(
         &self,
         queue: &wgpu::Queue,

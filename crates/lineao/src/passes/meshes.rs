@@ -15,7 +15,9 @@ use crate::timing::Span;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct MeshVertex {
+    /// Position, world units.
     pub position: [f32; 3],
+    /// Unit normal.
     pub normal: [f32; 3],
 }
 

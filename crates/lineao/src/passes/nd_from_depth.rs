@@ -164,18 +164,30 @@ fn check_texture(name: &str, texture: &wgpu::Texture, (width, height): (u32, u32
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct HostUniform {
+    /// The host's inverse projection.
     pub inv_proj: [[f32; 4]; 4],
+    /// The host's world-to-view rotation (for world-space normals).
     pub view_rotation: [[f32; 4]; 4],
+    /// The target's size in pixels.
     pub size: [f32; 2],
+    /// The near end of the depth range, as −z_view.
     pub near: f32,
+    /// The far end of the depth range, as −z_view.
     pub far: f32,
+    /// The focal length in pixels.
     pub f_px: f32,
+    /// World units per zoom unit.
     pub zoom_unit: f32,
+    /// 1 for an orthographic projection.
     pub orthographic: u32,
+    /// The depth value of the far plane (background).
     pub far_depth: f32,
+    /// Padding to WGSL's 16-byte alignment.
     pub _pad: [u32; 4],
 }
 
+/// The G-buffer from a host's depth (and normals, colour): the ND map and zoom map that the
+/// methods read.
 pub struct NdFromDepth {
     config: HostConfig,
     pipeline: wgpu::ComputePipeline,
@@ -192,6 +204,7 @@ pub struct NdFromDepth {
 }
 
 impl NdFromDepth {
+    /// The pass for a host configured by `config`.
     pub fn new(device: &wgpu::Device, config: HostConfig) -> NdFromDepth {
         let multisampled = config.depth_samples > 1;
         let layout = binding::layout(
@@ -261,6 +274,7 @@ impl NdFromDepth {
         Ok(self.outside_readback.try_take(device)?.map(|bytes| bytemuck::pod_read_unaligned(&bytes[..4])))
     }
 
+    /// How it is configured.
     pub fn config(&self) -> HostConfig {
         self.config
     }

@@ -12,6 +12,7 @@ use crate::passes::dispatch_size;
 use crate::targets::{FrameTargets, ND_FORMAT};
 use crate::timing::{self, Span};
 
+/// The Gaussian pyramid of normals and depth (reference.md "Pyramid").
 pub struct NdPyramid {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
@@ -20,6 +21,7 @@ pub struct NdPyramid {
 }
 
 impl NdPyramid {
+    /// Its pipeline and layout.
     pub fn new(device: &wgpu::Device) -> NdPyramid {
         let layout = binding::layout(
             device,
@@ -38,6 +40,7 @@ impl NdPyramid {
         NdPyramid { pipeline, layout, groups: Vec::new() }
     }
 
+    /// Binds the levels of `targets`.
     pub fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets) {
         self.groups = targets
             .nd

@@ -19,7 +19,7 @@
 //!
 //! The visibility buffer is a storage buffer of `u64` words (wgpu's
 //! `SHADER_INT64_ATOMIC_MIN_MAX`; no R64 texture needed); a device without the feature draws
-//! in hardware ([`ComputeRaster::new`] says why). It is a prototype measured against the
+//! in hardware (`ComputeRaster::new` says why). It is a prototype measured against the
 //! hardware draw (`lineao bench`'s `lines-compute` beside `lines-culled`): it leaves out
 //! triangles with a corner behind the eye (the hardware clips them), the slab and the octant
 //! outputs (object-space AO), and draws over nothing but a cleared frame.

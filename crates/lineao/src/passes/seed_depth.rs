@@ -54,6 +54,7 @@ pub struct SeedDepth {
 }
 
 impl SeedDepth {
+    /// Its pipelines and layout.
     pub fn new(device: &wgpu::Device) -> SeedDepth {
         let label = "lineao::SeedDepth";
         let layout = binding::layout(

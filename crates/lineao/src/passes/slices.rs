@@ -22,8 +22,8 @@
 //! texture units (8 bytes a voxel); elsewhere in an `R32Float` one, and eight `textureLoad`s
 //! give both (exact, and what every device can do; 4 bytes a voxel). On lavapipe the filtered
 //! path draws the default frame's slices in about two thirds of the loads' time, and the packed
-//! texel in three quarters of two samples' (an `R32Float` value and an `R8Unorm` mask, before;
-//! docs/measurements.md); on a GPU the texture units are what filtering is for. A
+//! texel in three quarters of two samples' (an `R32Float` value and an `R8Unorm` mask, before);
+//! on a GPU the texture units are what filtering is for. A
 //! GPU filters with weights of 8 fractional bits or more: the sample is off by at most 1/512 of
 //! the difference between neighbouring voxels, below a colormap's step. `tests/slices.rs`
 //! checks both paths against the CPU's trilinear sample.
@@ -246,6 +246,7 @@ impl SliceVolume {
         self.percentiles
     }
 
+    /// The volume's size in voxels.
     pub fn dims(&self) -> [u32; 3] {
         self.dims
     }
@@ -478,6 +479,7 @@ impl SliceRenderer {
         self.volume.is_some()
     }
 
+    /// Writes this frame's uniform.
     pub fn prepare(&self, queue: &wgpu::Queue, view: &FrameView, slices: &SliceSettings, lighting: &Lighting) {
         let Some((volume, _)) = &self.volume else { return };
         let range = slices.window.unwrap_or(volume.percentiles);

@@ -37,11 +37,14 @@ pub struct VolumeAoUniform {
     pub view_to_world: [[f32; 4]; 3],
     /// w_o for octants 0–3 and 4–7.
     pub weights: [[f32; 4]; 2],
+    /// Texels a side of the geometry term's table.
     pub table_size: u32,
+    /// Padding to WGSL's 16-byte alignment.
     pub _pad: [u32; 3],
 }
 
 impl VolumeAoUniform {
+    /// The uniform for `view` and the sky's eight weights.
     pub fn new(view: &FrameView, sky: [f32; 8]) -> VolumeAoUniform {
         let r = view_to_world(view);
         let column = |v: glam::Vec3| [v.x, v.y, v.z, 0.0];
@@ -59,6 +62,7 @@ pub fn view_to_world(view: &FrameView) -> Mat3 {
     Mat3::from_mat4(view.view).inverse()
 }
 
+/// Object-space AO per pixel: the octant visibilities against the geometry term.
 pub struct VolumeAo {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
@@ -69,6 +73,7 @@ pub struct VolumeAo {
 }
 
 impl VolumeAo {
+    /// Its pipeline and layout.
     pub fn new(device: &wgpu::Device) -> VolumeAo {
         let layout = binding::layout(
             device,

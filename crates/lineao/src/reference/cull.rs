@@ -23,6 +23,7 @@ use crate::line_geometry::{ClusterRecord, GROUP_CLUSTERS, PIECE_SEGMENTS};
 
 /// One page as the GPU holds it ([`crate::LineGeometry::page_contents`]).
 pub struct PageContents {
+    /// Its clusters' records.
     pub records: Vec<ClusterRecord>,
     /// Every point decoded on its cluster's grid, in page order.
     pub points: Vec<[f32; 3]>,
@@ -32,10 +33,13 @@ pub struct PageContents {
 
 /// The frame the cull tested against.
 pub struct CullView {
+    /// World to view space.
     pub view: Mat4,
+    /// The guard-banded projection.
     pub proj: Mat4,
     /// The targets' guard-banded size.
     pub size: (u32, u32),
+    /// The lines' width in pixels.
     pub line_width_px: f32,
     /// Tubes of this radius (world units; the pages' largest or the frame's, as the GPU bounds
     /// them) instead of lines, for the levels of detail.
@@ -45,15 +49,20 @@ pub struct CullView {
 /// What a test says once the GPU's rounding is allowed for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Verdict {
+    /// Certainly seen.
     Visible,
+    /// Certainly hidden.
     Hidden,
+    /// Within the GPU's rounding of the bound: either is right.
     Unsure,
 }
 
 /// How far the GPU may round: pixels of a rectangle's edges, and depth.
 #[derive(Clone, Copy, Debug)]
 pub struct Slack {
+    /// In pixels.
     pub px: f32,
+    /// In depth.
     pub depth: f32,
 }
 

@@ -2,7 +2,7 @@
 //!
 //! Each method's reference lives in its folder (`method/<name>/reference.rs`) and is
 //! re-exported here, beside the shared passes'. It exists to prove the shaders. Tests read the GPU's inputs back, run these functions on
-//! exactly those inputs (same noise) and compare pixel by pixel (CONTRACT.md "GPU vs CPU
+//! exactly those inputs (same noise) and compare pixel by pixel (docs/reference.md "GPU vs CPU
 //! agreement"). The arithmetic follows the WGSL line by line, in f32 and in the same order, so
 //! the two differ only by rounding inside the GPU (fused multiply-adds, `pow`, `sqrt`).
 
@@ -69,7 +69,7 @@ pub fn nd_pyramid(level0: NdImage, levels: u32) -> Vec<NdImage> {
 }
 
 /// The nearest texel of a level of size `size` for full-resolution pixel `pixel` displaced by
-/// `offset` pixels (CONTRACT.md "Addressing"; `shared/nd.wgsl::level_texel`).
+/// `offset` pixels (docs/reference.md "Addressing"; `shared/nd.wgsl::level_texel`).
 pub fn level_texel(pixel: [u32; 2], offset: [f32; 2], scale: [f32; 2], size: [usize; 2]) -> [i64; 2] {
     let t = |k: usize| {
         let uv = (pixel[k] as f32 + 0.5 + offset[k]) * scale[k];

@@ -16,7 +16,7 @@
 //! Weight A_i = V_i / (2 z_s,i): the volume V_i of sample i's Voronoi column divided by its own
 //! chord length, so that A_i · |free ∩ allowed|_i estimates the free volume of that column and
 //! Σ A_i · 2 z_s,i = 4π/3 exactly (the weights are normalized to it). For evenly sized regions
-//! A_i is about the region's area, CONTRACT.md's "Voronoi area".
+//! A_i is about the region's area, the Voronoi area of docs/reference.md "VO".
 //!
 //! [`VO_DISK_SAMPLES`] holds the disk tables for N ∈ {5, 7, 9, 12, 13, 16},
 //! [`VO_SPHERE_SAMPLES`] the sphere tables for N ∈ {8, 12, 16, 24, 32}, written by
@@ -66,7 +66,7 @@ pub fn vo_sphere_samples(n: u32) -> Option<&'static [[f32; 3]]> {
     VO_SPHERE_SAMPLES.iter().find(|(count, _)| *count == n).map(|(_, table)| *table)
 }
 
-/// σ below which VO area sampling treats depth as a step (CONTRACT.md): 1e-3 (far − near).
+/// σ below which VO area sampling treats depth as a step (docs/reference.md): 1e-3 (far − near).
 pub fn vo_sigma_floor(near: f32, far: f32) -> f32 {
     1e-3 * (far - near)
 }

@@ -45,7 +45,9 @@ pub struct Node {
 /// A primitive the tree points at.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Prim {
+    /// A rounded cone, by index.
     Cone(u32),
+    /// A triangle, by index.
     Triangle(u32),
 }
 
@@ -63,9 +65,13 @@ enum Visit {
 
 /// The tree with the primitives it holds.
 pub struct Bvh {
+    /// The nodes, the root first.
     pub nodes: Vec<Node>,
+    /// The leaves' primitives, as [`Prim`]s packed in a `u32` each.
     pub refs: Vec<u32>,
+    /// The rounded cones.
     pub cones: Vec<RoundedCone>,
+    /// The triangles.
     pub triangles: Vec<Triangle>,
 }
 
@@ -148,6 +154,7 @@ impl Bvh {
         cones * size_of::<RoundedCone>() + triangles * size_of::<Triangle>() + n * (4 + 40 + size_of::<Node>())
     }
 
+    /// Whether it holds no primitive.
     pub fn is_empty(&self) -> bool {
         self.nodes.is_empty()
     }

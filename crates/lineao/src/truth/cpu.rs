@@ -27,9 +27,17 @@ impl Reach {
 #[derive(Clone, Copy, Debug)]
 pub enum LineShape<'a> {
     /// Fixed-width lines of this many pixels.
-    Lines { width_px: f32 },
+    Lines {
+        /// The width in pixels.
+        width_px: f32,
+    },
     /// Tubes of this radius, per vertex from `radii` where it has a positive value.
-    Tubes { radius_world: f32, radii: Option<&'a [f32]> },
+    Tubes {
+        /// The radius, world units.
+        radius_world: f32,
+        /// Per vertex, where positive.
+        radii: Option<&'a [f32]>,
+    },
 }
 
 /// The sphere-swept segments of fixed-width lines in `view`: radius (w/2)·(−z_view)/f_px at
@@ -97,6 +105,7 @@ pub struct Truth {
     pub second: Option<Image<f32>>,
     /// Geometry pixels, and those whose origin was buried in another primitive.
     pub geometry_pixels: usize,
+    /// Geometry pixels whose origin was buried in another primitive.
     pub buried: usize,
     /// Rays traced (and VO points tested).
     pub rays: u64,
@@ -113,6 +122,7 @@ impl Truth {
 pub struct Frame<'a> {
     /// The ND map (level 0, guard-banded).
     pub nd: &'a NdImage,
+    /// The view it was drawn with.
     pub view: &'a FrameView,
     /// Whether the streamlines are fixed-width lines (their pixels lie inside their volume).
     pub lines: bool,

@@ -4,7 +4,7 @@
 //! depiction of local and global line structures"). Under diffuse light the eye reads *darker as
 //! deeper* (Langer & Bülthoff 2000; Scaccia & Langer 2018 for cluttered scenes), so a picture
 //! conveys depth order where its darkening agrees with depth. This module measures that
-//! agreement (CONTRACT.md "Legibility"):
+//! agreement (docs/reference.md "Legibility"):
 //!
 //! - **Darkening** D = 1 − Y/Y_none per geometry pixel, Y the linear-light luminance of the
 //!   composite and Y_none that of the same frame without AO ([`Shading::darkening`]).
@@ -71,9 +71,14 @@ impl Legibility {
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum Absent {
     #[error("{0} geometry pixels, fewer than the {MIN_PIXELS} legibility needs")]
+    /// Fewer geometry pixels than legibility needs.
     TooFewPixels(usize),
+    /// No pair of pixels far enough apart in depth.
     #[error("no two geometry pixels within {radius_px:.1} px lie apart in depth by more than {DEPTH_SEPARATION}")]
-    NoPairs { radius_px: f64 },
+    NoPairs {
+        /// The pairs' radius in pixels.
+        radius_px: f64,
+    },
 }
 
 /// What AO darkens in a frame, per pixel in linear light: the luminance of the lines' colour,

@@ -17,16 +17,23 @@ use crate::image::Image;
 
 /// Half the SSIM window's side: ⌊3.5 σ + 0.5⌋ for σ = 1.5.
 pub const SSIM_RADIUS: usize = 5;
+/// SSIM's Gaussian window's σ (Wang et al. 2004).
 pub const SSIM_SIGMA: f64 = 1.5;
+/// SSIM's C1 = (0.01 L)², L = 1.
 pub const SSIM_C1: f64 = 0.01 * 0.01;
+/// SSIM's C2 = (0.03 L)², L = 1.
 pub const SSIM_C2: f64 = 0.03 * 0.03;
 
 /// The error measures of one map.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Errors {
+    /// The mean of method − truth.
     pub bias: f64,
+    /// The mean of |method − truth|.
     pub mean_abs: f64,
+    /// The root of the mean squared error.
     pub rmse: f64,
+    /// SSIM, averaged over the compared pixels.
     pub ssim: f64,
 }
 
@@ -35,7 +42,9 @@ pub struct Errors {
 pub struct Scores {
     /// Pixels compared.
     pub pixels: usize,
+    /// The method's mean.
     pub mean_method: f64,
+    /// The truth's mean.
     pub mean_truth: f64,
     /// Pearson's correlation (0 when either map is constant).
     pub correlation: f64,
@@ -43,6 +52,7 @@ pub struct Scores {
     pub raw: Errors,
     /// The best single scale s, and the errors of s · ao.
     pub scale: f64,
+    /// The errors of s · ao.
     pub scaled: Errors,
 }
 
@@ -50,12 +60,19 @@ pub struct Scores {
 /// windows (what `lineao score` reports against its second truth).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Agreement {
+    /// Pixels compared.
     pub pixels: usize,
+    /// The method's mean.
     pub mean_method: f64,
+    /// The truth's mean.
     pub mean_truth: f64,
+    /// The mean of method − truth.
     pub bias: f64,
+    /// The mean of |method − truth|.
     pub mean_abs: f64,
+    /// The root of the mean squared error.
     pub rmse: f64,
+    /// Pearson's correlation (0 when either map is constant).
     pub correlation: f64,
 }
 

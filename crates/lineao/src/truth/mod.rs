@@ -85,6 +85,7 @@ pub enum Falloff {
 }
 
 impl Falloff {
+    /// Every falloff, the default first.
     pub const ALL: [Falloff; 2] = [Falloff::None, Falloff::Linear];
 
     /// The name on the command line and in `params.json` (`none`, `linear`).
@@ -95,6 +96,7 @@ impl Falloff {
         }
     }
 
+    /// The falloff called `name`.
     pub fn from_name(name: &str) -> Option<Falloff> {
         Falloff::ALL.into_iter().find(|f| f.name() == name)
     }
@@ -121,6 +123,7 @@ pub struct TruthSettings {
     pub rays: u32,
     /// The rays' reach R in world units (> 0, finite).
     pub distance_world: f32,
+    /// Binary AO or obscurance with a linear falloff.
     pub falloff: Falloff,
     /// Seed of the per-pixel scramble.
     pub seed: u32,
@@ -156,10 +159,12 @@ impl Default for TruthSettings {
 pub struct Reach {
     /// R in world units (> 0, finite).
     pub distance_world: f32,
+    /// Binary AO or obscurance with a linear falloff.
     pub falloff: Falloff,
 }
 
 impl TruthSettings {
+    /// Its ranges, as [`Error::OutOfRange`].
     pub fn validate(&self) -> Result<(), Error> {
         if self.rays == 0 {
             return Err(Error::InvalidSettings("rays must be at least 1".into()));

@@ -18,19 +18,25 @@ use glam::{DVec3, Vec3};
 /// A segment's rounded cone, with where it came from.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RoundedCone {
+    /// One end.
     pub a: Vec3,
+    /// The other end.
     pub b: Vec3,
+    /// The radius at `a`.
     pub ra: f32,
+    /// The radius at `b`.
     pub rb: f32,
     /// The streamline it belongs to, and its segment index within it (segment k joins points
     /// k and k + 1): what tells a line pixel's own segment and its neighbours.
     pub streamline: u32,
+    /// Its segment within the streamline.
     pub segment: u32,
 }
 
 /// A triangle of a context surface.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Triangle {
+    /// The corners.
     pub v: [Vec3; 3],
 }
 
@@ -77,10 +83,12 @@ impl RoundedCone {
 }
 
 impl Triangle {
+    /// Its axis-aligned box.
     pub fn bounds(&self) -> (Vec3, Vec3) {
         (self.v[0].min(self.v[1]).min(self.v[2]), self.v[0].max(self.v[1]).max(self.v[2]))
     }
 
+    /// The nearest hit along the ray ro + t rd in (t_min, t_max), if any.
     pub fn intersect(&self, ro: DVec3, rd: DVec3, t_min: f64, t_max: f64) -> Option<f64> {
         intersect_triangle(ro, rd, self.v.map(Vec3::as_dvec3), t_min, t_max)
     }

@@ -8,6 +8,7 @@ use super::{OctantVisibility, ScalarForm, Sky, VolumeMethod, density, geometry_t
 /// A cubic-voxel grid: `dims` voxels of edge `voxel` from the corner `origin`, x fastest.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct VolumeGrid {
+    /// Voxels along x, y and z.
     pub dims: [usize; 3],
     /// World position of the corner of voxel (0, 0, 0).
     pub origin: Vec3,
@@ -16,10 +17,12 @@ pub struct VolumeGrid {
 }
 
 impl VolumeGrid {
+    /// The number of voxels.
     pub fn len(&self) -> usize {
         self.dims.iter().product()
     }
 
+    /// Whether it has no voxel.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
     }
@@ -77,8 +80,11 @@ impl VolumeGrid {
 /// fractions toward them.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Trilinear {
+    /// The index of the voxel at the lower corner.
     pub base: usize,
+    /// The index step to the neighbour along each axis.
     pub step: [usize; 3],
+    /// The fractions toward the neighbours.
     pub f: Vec3,
 }
 
@@ -88,6 +94,7 @@ impl<T: Copy + std::ops::Mul<f32, Output = T> + std::ops::Add<Output = T>> Inter
 
 impl Trilinear {
     #[inline]
+    /// The value of `field` at the point.
     pub fn sample<T: Interpolate>(&self, field: &[T]) -> T {
         let ([sx, sy, sz], f, i) = (self.step, self.f, self.base);
         let (gx, gy, gz) = (1.0 - f.x, 1.0 - f.y, 1.0 - f.z);
@@ -130,13 +137,18 @@ pub fn probe(volume: &density::DensityVolume, p: Vec3, t: Vec3, o: usize) -> Vec
 /// Everything [`vertex_visibility`] needs.
 #[derive(Clone, Debug, PartialEq)]
 pub struct VolumeAoOptions {
+    /// Occlusion sweeping or variance occlusion maps.
     pub method: VolumeMethod,
+    /// How the density volume is made.
     pub density: density::DensityOptions,
+    /// Occlusion sweeping's settings.
     pub sweep: sweep::SweepSettings,
+    /// Variance occlusion maps' settings.
     pub variance: variance::VarianceSettings,
     /// `None`: the eight octants stay apart, for the geometry term with each pixel's normal
     /// (the paper's way); `Some`: one view-independent value per vertex.
     pub form: Option<ScalarForm>,
+    /// Where the light comes from.
     pub sky: Sky,
 }
 
@@ -157,6 +169,7 @@ impl Default for VolumeAoOptions {
 /// the chain then applies per pixel ([`crate::VolumeAoSettings::sky`]).
 #[derive(Clone, Debug, PartialEq)]
 pub struct VertexVisibility {
+    /// Each vertex's eight octant visibilities.
     pub octants: Vec<OctantVisibility>,
     /// The options' sky for the per-pixel form; all ones for a view-independent value, which
     /// holds the sky already (and is stored in all eight octants).

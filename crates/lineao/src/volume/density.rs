@@ -26,6 +26,7 @@ const SUB: usize = 4;
 /// A density volume: occupancy over a grid of cubic voxels.
 #[derive(Clone, Debug, PartialEq)]
 pub struct DensityVolume {
+    /// The grid.
     pub grid: VolumeGrid,
     /// Occupancy in [0, 1] (multiples of 1/64 when voxelized), indexed by [`VolumeGrid::index`].
     pub occupancy: Vec<f32>,

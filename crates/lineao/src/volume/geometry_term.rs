@@ -103,7 +103,9 @@ fn sign_not_zero(p: Vec2) -> Vec2 {
 /// code ((i + ½)/size, (j + ½)/size)·2 − 1), row-major, j slowest.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GeometryTable {
+    /// Texels a side.
     pub size: usize,
+    /// Eight values per texel, row-major.
     pub values: Vec<[f32; 8]>,
 }
 

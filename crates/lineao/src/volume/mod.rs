@@ -93,6 +93,7 @@ impl Sky {
         Sky::Above(direction)
     }
 
+    /// The eight octants' weights.
     pub fn weights(&self) -> [f32; 8] {
         match self {
             Sky::Uniform => [1.0; 8],
@@ -115,6 +116,7 @@ pub enum VolumeMethod {
 }
 
 impl VolumeMethod {
+    /// Every method, the default first.
     pub const ALL: [VolumeMethod; 2] = [VolumeMethod::Sweep, VolumeMethod::VarianceVolume];
 
     /// The CLI and `params.json` name: `sweep` or `variance-volume`.
@@ -125,6 +127,7 @@ impl VolumeMethod {
         }
     }
 
+    /// The method called `name`.
     pub fn from_name(name: &str) -> Option<VolumeMethod> {
         VolumeMethod::ALL.into_iter().find(|m| m.name() == name)
     }

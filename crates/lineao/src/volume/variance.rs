@@ -52,6 +52,7 @@ impl Default for VarianceSettings {
 }
 
 impl VarianceSettings {
+    /// Its ranges, as [`Error::OutOfRange`].
     pub fn validate(&self) -> Result<(), Error> {
         if !(1..=8).contains(&self.levels) {
             return Err(Error::InvalidSettings(format!("variance maps need 1..=8 levels, got {}", self.levels)));
@@ -69,17 +70,22 @@ impl VarianceSettings {
 /// One level: moments over a grid, and the world σ of the Gaussian region each texel covers.
 #[derive(Clone, Debug, PartialEq)]
 pub struct MomentLevel {
+    /// The level's grid.
     pub grid: VolumeGrid,
     /// (M₁, M₂) per texel, side by side so that a lookup reads both from one place.
     pub moments: Vec<Vec2>,
+    /// The world σ of the Gaussian region a texel covers.
     pub sigma: f32,
 }
 
 /// The moment pyramid.
 #[derive(Clone, Debug, PartialEq)]
 pub struct VarianceMaps {
+    /// The levels, finest first.
     pub levels: Vec<MomentLevel>,
+    /// The density taken as the surface.
     pub iso: f32,
+    /// The offset along the normal before sampling, world units.
     pub offset: f32,
 }
 

@@ -8,7 +8,7 @@
 //   n_j = ceil(s_h / (j + 1)),  r_j = r0 + j · z(P) pixels  (tubes: r0 = 1.5 · z(P) · t_s, Eq. 16)
 //   ω_i = reflect(R1(P), R2[j][i]), flipped into n_j(P)'s hemisphere
 //
-// The occlusion test departs from Eq. 8 on purpose (Δd > ε, not Δd >= 0): see CONTRACT.md.
+// The occlusion test departs from Eq. 8 on purpose (Δd > ε, not Δd >= 0): see docs/reference.md.
 //
 // With REFERENCE the pass computes variant `reference` instead, the authors' own shader
 // (`lineao::method::line_ao` documents it): `reference_ao` below.

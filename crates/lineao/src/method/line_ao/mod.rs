@@ -14,7 +14,7 @@
 //! ```
 //!
 //! ω_i = reflect(R1(P), `R2[j][i]`) flipped into the hemisphere of n_j(P) (§3.4, `noise.rs`).
-//! Where we depart from the paper (the ε test, the third case of Eq. 12) is in CONTRACT.md.
+//! Where we depart from the paper (the ε test, the third case of Eq. 12) is in docs/reference.md.
 //! The CPU reference is [`crate::reference::line_ao`]; `line_ao.wgsl` is the shader.
 //!
 //! # Variant `reference`: what the authors' code does
@@ -41,7 +41,7 @@
 //! scene's. 1 − d is kept above 1e−6. The radius grows without bound as d → 1, so the guard
 //! band of this variant is the cap.
 
-//! # `outer = level` (CONTRACT.md's optional speed-up)
+//! # `outer = level` (docs/reference.md's optional speed-up)
 //!
 //! Hemispheres j ≥ 1 read level j of the pyramid, which is blurred and 2^j times smaller, so
 //! their AO varies slowly. With [`LineAoOuter::Level`] a pass per j evaluates AO_j once per
@@ -53,7 +53,7 @@
 //! t_P the texel `full` reads its centre from. At the defaults this replaces 27 of 59 taps per
 //! pixel by 8 (plus 16/4 + 11/16 per pixel in the level passes). It is not the default: its
 //! per-pixel difference from `full` is below the noise (`full` against itself with another
-//! seed differs more) but above CONTRACT.md's 0.02 (README, "Measured").
+//! seed differs more) but above docs/reference.md's 0.02 (README, "Measured").
 
 use crate::binding::{self, Slot};
 use crate::camera::FrameView;
@@ -106,17 +106,23 @@ use crate::timing::Span;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct LineAoUniform {
+    /// The pyramid's levels: their sizes and UV scales.
     pub levels: LevelsUniform,
+    /// The visible image's top-left pixel, where R1's tile starts.
     pub noise_origin: [i32; 2],
+    /// r0 in pixels.
     pub r0_px: f32,
+    /// δ0 in normalized depth.
     pub delta0: f32,
     /// Variant `reference`: radius_px / z_fit · (W, H) / max(W, H).
     pub reference_scale: [f32; 2],
+    /// ε: occluded iff Δd > ε.
     pub epsilon: f32,
     /// r0's part per unit of zoom (tubes, Eq. 16): r0(P) = r0_px + r0_zoom · z(P).
     pub r0_zoom: f32,
     /// δ(j) = delta_scale · (1 − j/s_r)².
     pub delta_scale: f32,
+    /// Padding to WGSL's 16-byte alignment.
     pub _pad: [f32; 3],
 }
 
@@ -177,6 +183,7 @@ pub fn sample_table(settings: &LineAoSettings) -> Vec<[f32; 3]> {
     }
 }
 
+/// LineAO's compute pass: every hemisphere's samples over the ND pyramid, into the AO target.
 pub struct LineAo {
     shape: Shape,
     pipeline: wgpu::ComputePipeline,
@@ -207,6 +214,8 @@ impl LineAo {
         Self::with_evaluation(device, settings, lighting, Evaluation::Occlusion)
     }
 
+    /// The pass evaluating `evaluation`: the occlusion, or (for the bench's tap floor) only the sum
+    /// of the same fetches.
     pub fn with_evaluation(
         device: &wgpu::Device,
         settings: &LineAoSettings,
@@ -325,6 +334,7 @@ impl LineAo {
             .collect();
     }
 
+    /// Writes this frame's uniform, lighting, noise and sample tables.
     pub fn prepare(
         &self,
         queue: &wgpu::Queue,
@@ -378,6 +388,7 @@ pub struct LineAoStage {
 }
 
 impl LineAoStage {
+    /// LineAO as a stage of the chain, with the ND pyramid it reads.
     pub fn new(device: &wgpu::Device, settings: &ChainSettings) -> LineAoStage {
         LineAoStage {
             pyramid: crate::passes::nd_pyramid::NdPyramid::new(device),

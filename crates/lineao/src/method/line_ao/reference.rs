@@ -1,4 +1,4 @@
-//! CPU reference of LineAO, variants `paper` (CONTRACT.md "LineAO") and `reference` (the
+//! CPU reference of LineAO, variants `paper` (docs/reference.md "LineAO") and `reference` (the
 //! authors' shader, [`crate::method::line_ao`]), written plainly from the equations: the shader
 //! `line_ao.wgsl` is optimized differently and the tests compare the two.
 
@@ -14,23 +14,33 @@ use crate::settings::ChainSettings;
 /// Every number LineAO reads besides the images and the noise.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LineAoParams {
+    /// `paper` or `reference`.
     pub variant: LineAoVariant,
-    /// Hemispheres j ≥ 1 at full resolution or at their level's (CONTRACT.md `outer`).
+    /// Hemispheres j ≥ 1 at full resolution or at their level's (docs/reference.md `outer`).
     pub outer: LineAoOuter,
+    /// s_r: hemispheres and pyramid levels.
     pub s_r: u32,
+    /// s_h: samples on the first hemisphere.
     pub s_h: u32,
+    /// r0 in pixels.
     pub r0_px: f32,
     /// Tubes (Eq. 16): r0(P) = r0_px + r0_zoom · z(P).
     pub r0_zoom: f32,
+    /// δ0 in normalized depth.
     pub delta0: f32,
     /// δ(j) = delta_scale · (1 − j/s_r)².
     pub delta_scale: f32,
+    /// ε: occluded iff Δd > ε.
     pub epsilon: f32,
+    /// Whether g_light weighs the samples.
     pub light_attenuation: bool,
     /// Unit view-space directions toward the lights, with intensities.
     pub lights: Vec<Light>,
+    /// Diffuse coefficient kd.
     pub kd: f32,
+    /// Specular coefficient ks.
     pub ks: f32,
+    /// Specular exponent α.
     pub shininess: f32,
     /// Pixel coordinate of the visible viewport's top-left corner (the guard band).
     pub noise_origin: [i32; 2],

@@ -5,7 +5,7 @@ use crate::method::setting::{Kind, Setting, Unit, Value};
 use crate::named::{Named, named};
 use crate::settings::{ChainSettings, Preset};
 
-/// LineAO's settings as the front ends show them (CONTRACT.md's flags). The variant first: a
+/// LineAO's settings as the front ends show them (docs/reference.md's flags). The variant first: a
 /// preset's values depend on it.
 pub(crate) const SETTINGS: &[Setting] = &[
     Setting {
@@ -124,7 +124,7 @@ pub(crate) fn conform(settings: &mut ChainSettings) {
 /// Which LineAO: the paper's equations, or what the authors' own code does.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum LineAoVariant {
-    /// Eq. 4–15 with CONTRACT.md's conventions.
+    /// Eq. 4–15 with docs/reference.md's conventions.
     #[default]
     Paper,
     /// The authors' OpenWalnut shader (DESIGN.md): no pyramid, radii growing 1.5, 4, 7.5 times a
@@ -134,7 +134,7 @@ pub enum LineAoVariant {
 }
 
 named!(LineAoVariant {
-    Paper => "The paper's equations with CONTRACT.md's conventions",
+    Paper => "The paper's equations with docs/reference.md's conventions",
     Reference => "What the authors' OpenWalnut shader does (no pyramid, growing radii, `1.5 − …` weights)",
 });
 named!(LineAoOuter {
@@ -152,12 +152,13 @@ impl LineAoVariant {
     }
 }
 
-/// The LineAO parameters of Eq. 7–15 (CONTRACT.md "LineAO").
+/// The LineAO parameters of Eq. 7–15 (docs/reference.md "LineAO").
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(default))]
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct LineAoSettings {
+    /// `paper` (the paper's equations) or `reference` (the authors' shader).
     pub variant: LineAoVariant,
     /// s_r: number of hemispheres and pyramid levels, 1..=5; the paper uses 3 (and needs > 1
     /// for δ(l) to fall off).
@@ -176,20 +177,20 @@ pub struct LineAoSettings {
     /// paper's 1 lets anything in front count, however far; smaller values keep occlusion local
     /// in depth. Default 1 (paper).
     pub delta_scale: f32,
-    /// ε: occluded iff Δd > ε. Default 1e-6 (CONTRACT.md departs from Eq. 8's Δd ≥ 0).
+    /// ε: occluded iff Δd > ε. Default 1e-6 (docs/reference.md departs from Eq. 8's Δd ≥ 0).
     pub epsilon: f32,
     /// Light attenuation g_light of Eq. 15; off means g_light = 1.
     pub light_attenuation: bool,
-    /// Seed of the R1/R2 noise (CONTRACT.md "Noise"). Default 1.
+    /// Seed of the R1/R2 noise (docs/reference.md "Noise"). Default 1.
     pub noise_seed: u32,
     /// Variant `reference`: the base radius in pixels at the home zoom (the authors'
     /// `u_lineAORadius`). Default 2.
     pub reference_radius_px: f32,
-    /// Variant `paper`: hemispheres j ≥ 1 at full resolution or at their level's (CONTRACT.md).
+    /// Variant `paper`: hemispheres j ≥ 1 at full resolution or at their level's (docs/reference.md).
     pub outer: LineAoOuter,
 }
 
-/// Where LineAO evaluates its outer hemispheres (j ≥ 1; CONTRACT.md `outer`).
+/// Where LineAO evaluates its outer hemispheres (j ≥ 1; docs/reference.md `outer`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum LineAoOuter {
     /// At every pixel, as the paper does.
@@ -279,7 +280,9 @@ impl LineAoSettings {
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
 pub struct R0 {
+    /// The part in pixels.
     pub px: f32,
+    /// The part per unit of zoom z(P).
     pub per_zoom: f32,
 }
 

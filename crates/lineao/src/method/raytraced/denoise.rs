@@ -47,6 +47,8 @@ struct DenoiseUniform {
 
 const LABEL: &str = "lineao::RayDenoise";
 
+/// The edge-aware denoiser after the rays: a window over the same line or surface that narrows
+/// as 1/√rays.
 pub struct RayDenoise {
     layout: wgpu::BindGroupLayout,
     pipeline: wgpu::ComputePipeline,
@@ -55,6 +57,7 @@ pub struct RayDenoise {
 }
 
 impl RayDenoise {
+    /// Its pipeline and layout.
     pub fn new(device: &wgpu::Device) -> RayDenoise {
         let slots = [Slot::Uniform, Slot::Texture, Slot::StorageTexture(AO_FORMAT), Slot::Storage];
         let layout = binding::layout(device, LABEL, wgpu::ShaderStages::COMPUTE, &slots);

@@ -121,7 +121,7 @@ struct TraceUniform {
 /// sides of every branch of a SIMD group, uniform or not, so code a frame cannot need (triangles
 /// in a scene of lines, the first frame's point queries in the frames after it) is compiled out
 /// rather than branched around. With the scene in textures ([`crate::ray_scene`]) a one-ray
-/// frame became 2.4–2.6× faster on lavapipe (docs/measurements.md).
+/// frame became 2.4–2.6× faster on lavapipe.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 struct Variant {
     /// Fixed-width lines (else tubes).
@@ -165,6 +165,7 @@ pub struct RayProgress {
 }
 
 impl RayProgress {
+    /// Whether every pixel has traced all its rays.
     pub fn converged(&self) -> bool {
         self.rays_per_pixel >= self.max_rays
     }
@@ -213,6 +214,8 @@ struct Progress {
     pipeline: Option<wgpu::ComputePipeline>,
 }
 
+/// Ray-traced AO on the GPU, progressive: a BVH over the scene's rounded cones and triangles,
+/// rays accumulated frame by frame while the view rests.
 pub struct RayTracedAo {
     device: wgpu::Device,
     layout: wgpu::BindGroupLayout,
@@ -242,6 +245,7 @@ fn fits(size: (u32, u32), limits: &wgpu::Limits) -> Result<(), crate::Error> {
 }
 
 impl RayTracedAo {
+    /// The pass and its denoiser; the scene is given with [`RayTracedAo::set_scene`].
     pub fn new(device: &wgpu::Device) -> RayTracedAo {
         let mut slots = vec![Slot::Uniform, Slot::Texture, Slot::StorageTexture(AO_FORMAT), Slot::StorageReadWrite];
         // The scene: nodes, vertices, words, triangles.

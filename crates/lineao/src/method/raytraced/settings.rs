@@ -2,7 +2,7 @@
 
 use crate::method::setting::{Kind, Setting, Unit, Value};
 
-/// The ray tracer's settings as the front ends show them (CONTRACT.md's flags, which the CPU
+/// The ray tracer's settings as the front ends show them (docs/reference.md's flags, which the CPU
 /// truth of `lineao score` and `render --cpu` reads too).
 pub(crate) const SETTINGS: &[Setting] = &[
     Setting {
@@ -89,6 +89,7 @@ pub struct RayTracedSettings {
     /// axis-aligned bounds instead ([`RayTracedSettings::resolve`]; LineVis's 0.2).
     #[cfg_attr(feature = "serde", serde(skip_serializing_if = "Option::is_none"))]
     pub distance_share: Option<f32>,
+    /// Binary AO or obscurance with a linear falloff.
     pub falloff: crate::truth::Falloff,
     /// Seed of the per-pixel scramble (the CPU truth's `seed`).
     pub seed: u32,
@@ -136,6 +137,7 @@ impl RayDenoiseSettings {
         if sigma < 0.25 { 0.0 } else { 1.0 / (2.0 * sigma * sigma) }
     }
 
+    /// Its ranges, as [`crate::Error::OutOfRange`].
     pub fn validate(&self) -> Result<(), crate::Error> {
         let ok = (1..=8).contains(&self.radius_px)
             && self.sigma_px.is_finite()
@@ -194,6 +196,7 @@ impl RayTracedSettings {
         }
     }
 
+    /// Its ranges, as [`crate::Error::OutOfRange`].
     pub fn validate(&self) -> Result<(), crate::Error> {
         if self.rays_per_frame == 0 || self.max_rays == 0 {
             return Err(crate::Error::InvalidSettings(format!(

@@ -9,6 +9,7 @@ use crate::passes::dispatch_full_screen;
 use crate::targets::{AO_FORMAT, FrameTargets, Target};
 use crate::timing::Span;
 
+/// Crytek SSAO's 4 × 4 box blur over its occlusion.
 pub struct SsaoBlur {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
@@ -16,6 +17,7 @@ pub struct SsaoBlur {
 }
 
 impl SsaoBlur {
+    /// Its pipeline and layout.
     pub fn new(device: &wgpu::Device) -> SsaoBlur {
         let layout = binding::layout(
             device,

@@ -65,12 +65,17 @@ use crate::view_params::{ViewParams, ViewUniform};
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct SsaoUniform {
+    /// The view's parameters.
     pub view: ViewUniform,
+    /// The visible image's top-left pixel, where the noise tile starts.
     pub noise_origin: [i32; 2],
+    /// The sphere's radius, world units.
     pub radius: f32,
+    /// The range check's distance, world units.
     pub range: f32,
 }
 
+/// Crytek SSAO's compute pass (its blur is [`SsaoBlur`](blur::SsaoBlur)).
 pub struct Ssao {
     samples: u32,
     noise_seed: u32,
@@ -83,6 +88,7 @@ pub struct Ssao {
 }
 
 impl Ssao {
+    /// The pass for `settings` (the sample count is compiled in).
     pub fn new(device: &wgpu::Device, settings: &SsaoSettings) -> Ssao {
         let layout = binding::layout(
             device,
@@ -138,6 +144,7 @@ impl Ssao {
         ));
     }
 
+    /// Writes this frame's uniform.
     pub fn prepare(&self, queue: &wgpu::Queue, targets: &FrameTargets, view: &FrameView, settings: &SsaoSettings) {
         debug_assert_eq!(targets.guard, view.guard);
         let uniform = SsaoUniform {
@@ -166,11 +173,12 @@ pub struct SsaoStage {
 }
 
 impl SsaoStage {
+    /// SSAO and its blur as a stage of the chain.
     pub fn new(device: &wgpu::Device, settings: &ChainSettings) -> SsaoStage {
         SsaoStage { ssao: Ssao::new(device, &settings.ssao), blur: blur::SsaoBlur::new(device), raw: None }
     }
 
-    /// The occlusion before the blur of the last frame (what CONTRACT.md's `ao.npy` holds for
+    /// The occlusion before the blur of the last frame (what docs/reference.md's `ao.npy` holds for
     /// SSAO).
     pub fn raw(&self) -> Option<&Target> {
         self.raw.as_ref()

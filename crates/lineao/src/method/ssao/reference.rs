@@ -7,10 +7,13 @@ pub use crate::view_params::ViewParams;
 pub use super::SSAO_EPSILON;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
+/// Every number SSAO reads besides the images, the kernel and the noise.
 pub struct SsaoParams {
+    /// The view's depth range and projection.
     pub view: ViewParams,
     /// Sphere radius and range check, world units.
     pub radius: f32,
+    /// The range check's distance, world units.
     pub range: f32,
     /// Pixel of the visible viewport's top-left corner: the rotation tile starts there.
     pub noise_origin: [i32; 2],
@@ -21,6 +24,7 @@ pub fn ssao(nd: &NdImage, kernel: &[[f32; 3]], noise: &[[f32; 3]], params: &Ssao
     Image::from_fn(nd.width, nd.height, |x, y| ssao_pixel(nd, kernel, noise, params, x as u32, y as u32))
 }
 
+/// The occluded fraction of the kernel at pixel (x, y).
 pub fn ssao_pixel(nd: &NdImage, kernel: &[[f32; 3]], noise: &[[f32; 3]], p: &SsaoParams, x: u32, y: u32) -> f32 {
     let here = nd.get(x as usize, y as usize);
     if here[0] == 0.0 && here[1] == 0.0 && here[2] == 0.0 {

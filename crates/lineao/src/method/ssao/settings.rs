@@ -4,7 +4,7 @@ use crate::method::setting::{Kind, Role, Setting, Unit, Value};
 use crate::named::{Named, named};
 use crate::settings::{ChainSettings, Preset};
 
-/// SSAO's settings as the front ends show them (CONTRACT.md's flags).
+/// SSAO's settings as the front ends show them (docs/reference.md's flags).
 pub(crate) const SETTINGS: &[Setting] = &[
     Setting {
         flag: "ssao-kernel",

@@ -19,7 +19,7 @@
 //! detail (`sample_sets::vo_area_lod_offsets`); reads are trilinear. One sample — the
 //! whole sphere — already darkens creases and contacts without any noise; more samples keep
 //! finer structure. σ below 1e-3 · (far − near) is f32 cancellation and counts as 0
-//! (CONTRACT.md). The CPU reference is [`crate::reference::vo_area`].
+//! (docs/reference.md). The CPU reference is [`crate::reference::vo_area`].
 
 use crate::camera::FrameView;
 use crate::method::vo_line::VoSettings;
@@ -54,6 +54,7 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
 use crate::targets::FrameTargets;
 use crate::timing::Span;
 
+/// VO with area samples: the moments pyramid and the pass that reads it.
 pub struct VoArea {
     moments: MomentsPyramid,
     core: VoCore,
@@ -92,6 +93,7 @@ impl VoArea {
         self.moments.moments()
     }
 
+    /// Writes this frame's uniforms.
     pub fn prepare(&self, queue: &wgpu::Queue, targets: &FrameTargets, view: &FrameView, settings: &VoSettings) {
         self.moments.prepare(queue, view);
         self.core.prepare(queue, &VoUniform::new(targets, view, settings, self.max_level));

@@ -1,4 +1,4 @@
-//! The moments pyramid of VO area sampling (Loos & Sloan §4.2; CONTRACT.md "VO area").
+//! The moments pyramid of VO area sampling (Loos & Sloan §4.2; docs/reference.md "VO area").
 //!
 //! Area sampling needs the distribution of depth over a sample's footprint, at any footprint
 //! size. As in variance shadow maps, the first two moments M₁ = E\[z\] and M₂ = E\[z²\] of depth
@@ -25,8 +25,11 @@ pub const MAX_MOMENT_LEVELS: usize = 16;
 /// One level of [`Moments`]: `width` × `height` texels from element `offset`, row-major.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct MomentsLevel {
+    /// Its first element in the buffer.
     pub offset: u32,
+    /// Its width in texels.
     pub width: u32,
+    /// Its height in texels.
     pub height: u32,
 }
 
@@ -34,8 +37,11 @@ pub struct MomentsLevel {
 /// storage buffer of `vec2<f32>` (E\[z\], E\[z²\]), and the layout as a uniform
 /// (`array<vec4<u32>, 16>` of (offset, width, height, 0)).
 pub struct Moments {
+    /// Every level's (E[z], E[z²]).
     pub buffer: wgpu::Buffer,
+    /// Where each level lies in `buffer`.
     pub levels: Vec<MomentsLevel>,
+    /// The layout as a uniform.
     pub layout: wgpu::Buffer,
 }
 
@@ -75,6 +81,7 @@ impl Moments {
         (last.offset as u64 + (last.width * last.height) as u64) * 8
     }
 
+    /// The buffers for a guard-banded `size`.
     pub fn new(device: &wgpu::Device, size: (u32, u32)) -> Moments {
         use wgpu::util::DeviceExt;
         let levels = Moments::levels(size);
@@ -117,6 +124,7 @@ pub struct MomentsPyramid {
 }
 
 impl MomentsPyramid {
+    /// The passes that build the pyramid.
     pub fn new(device: &wgpu::Device) -> MomentsPyramid {
         let label = "lineao::MomentsPyramid";
         let layout = binding::layout(
@@ -178,6 +186,7 @@ impl MomentsPyramid {
         (group, (moments.levels[l].width, moments.levels[l].height))
     }
 
+    /// Writes this frame's view.
     pub fn prepare(&self, queue: &wgpu::Queue, view: &FrameView) {
         let uniform: ViewUniform = ViewParams::of(view).into();
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));

@@ -1,4 +1,4 @@
-// The moments pyramid of VO area sampling (Loos & Sloan §4.2, CONTRACT.md "VO area"): level 0
+// The moments pyramid of VO area sampling (Loos & Sloan §4.2, docs/reference.md "VO area"): level 0
 // holds (E[z], E[z²]) of one pixel, z = −z_view in world units (the background at the far
 // plane); level l is the binomial 5 x 5 of level l−1 at half resolution, centred at (2x, 2y) —
 // the Gaussian the paper puts on its mip-map so that trilinear reads of a large footprint stay

@@ -69,17 +69,27 @@ use crate::view_params::ViewUniform;
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct VoUniform {
+    /// The view's parameters.
     pub view: ViewUniform,
+    /// The visible image's top-left pixel, where the noise tile starts.
     pub noise_origin: [i32; 2],
+    /// The two radii, world units (the second 0 where there is none).
     pub radius: [f32; 2],
+    /// World units per zoom unit.
     pub zoom_unit: f32,
+    /// The thickness model's depth, world units (0: off).
     pub thickness: f32,
+    /// 1 with the normal clamp.
     pub normal_clamp: u32,
+    /// How two radii combine: 0 product, 1 the darker.
     pub combine: u32,
+    /// The moments pyramid's last level (area samples).
     pub max_level: f32,
+    /// σ below which depth counts as a step (area samples).
     pub sigma_floor: f32,
     /// The number of samples in the tables (set by the pass that owns them).
     pub samples: u32,
+    /// Padding to WGSL's 16-byte alignment.
     pub _pad: u32,
 }
 
@@ -182,6 +192,7 @@ impl VoCore {
     }
 }
 
+/// VO with line samples' compute pass.
 pub struct VoLine {
     core: VoCore,
 }
@@ -207,6 +218,7 @@ impl VoLine {
         self.core.resize(device, targets, None);
     }
 
+    /// Writes this frame's uniform.
     pub fn prepare(&self, queue: &wgpu::Queue, targets: &FrameTargets, view: &FrameView, settings: &VoSettings) {
         self.core.prepare(queue, &VoUniform::new(targets, view, settings, 0));
     }

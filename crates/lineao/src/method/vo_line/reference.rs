@@ -8,14 +8,19 @@ use crate::image::{Image, NdImage};
 use crate::view_params::ViewParams;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
+/// Every number VO with line samples reads besides the images, the samples and the noise.
 pub struct VoParams {
+    /// The view's depth range and projection.
     pub view: ViewParams,
     /// Sphere radius, world units; world units per zoom unit.
     pub radius: f32,
     /// A second radius, combined with the first by `combine`.
     pub radius2: Option<f32>,
+    /// How two radii combine.
     pub combine: VoCombine,
+    /// World units per zoom unit.
     pub zoom_unit: f32,
+    /// Whether the normal clamp cuts the chords.
     pub normal_clamp: bool,
     /// Thickness in world units, 0 = off.
     pub thickness: f32,
@@ -171,6 +176,7 @@ pub fn vo_line(nd: &NdImage, zoom: &Image<f32>, samples: &[[f32; 3]], noise: &[[
     Image::from_fn(nd.width, nd.height, |x, y| vo_line_pixel(nd, zoom, samples, noise, p, x as u32, y as u32))
 }
 
+/// VO's occlusion at pixel (x, y).
 pub fn vo_line_pixel(
     nd: &NdImage,
     zoom: &Image<f32>,

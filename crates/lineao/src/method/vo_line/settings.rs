@@ -6,7 +6,7 @@ use crate::named::{Named, named};
 use crate::sample_sets::{VO_AREA_SAMPLE_COUNTS, VO_SAMPLE_COUNTS};
 use crate::settings::{ChainSettings, Preset};
 
-/// VO line's settings as the front ends show them (CONTRACT.md's flags): its samples, and the
+/// VO line's settings as the front ends show them (docs/reference.md's flags): its samples, and the
 /// sphere that area sampling shares ([`AREA_SETTINGS`]).
 pub(crate) const SETTINGS: &[Setting] = &[SAMPLES, RADIUS, RADIUS2, COMBINE, NORMAL_CLAMP, THICKNESS];
 
@@ -135,6 +135,7 @@ pub struct VoSettings {
     /// A second radius: VO is evaluated at both and combined by `combine`, so fine features
     /// (the small one) and wide contact shadows (the large one) both show.
     pub radius2_world: Option<f32>,
+    /// How two radii combine.
     pub combine: VoCombine,
     /// Restrict the sphere to the half above the surface's tangent plane (§4.4).
     pub normal_clamp: bool,
