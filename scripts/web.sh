@@ -28,7 +28,7 @@ done
 target=wasm32-unknown-unknown
 export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$PWD/target}/wasm32"
 # WebAssembly's 128-bit SIMD, which every browser with WebGPU runs. Measured: a .wasm 0.2 MB
-# smaller, stroke.trk.gz's parse no faster (docs/measurements.md).
+# smaller, stroke.trk.gz's parse no faster.
 export CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUSTFLAGS="${CARGO_TARGET_WASM32_UNKNOWN_UNKNOWN_RUSTFLAGS:--C target-feature=+simd128}"
 start=$(date +%s)
 if rustup target list --installed 2>/dev/null | grep -qx "$target"; then
