@@ -504,6 +504,35 @@ pub struct ContextArgs {
     #[arg(long, value_name = "AXIS,CENTRE,THICKNESS", value_parser = parse_slab, allow_hyphen_values = true)]
     #[serde(deserialize_with = "crate::kwargs::opt_slab")]
     pub slab: Option<lineao::Slab>,
+    /// Opacity of the streamlines shown (the selected ones), in (0, 1]: below 1 they are seen
+    /// through one another, composited in depth order, each darkened by its object-space AO
+    /// (with `--method sweep`, `lineao+sweep`, …; lit but unoccluded without) [default: 1,
+    /// opaque with the method's AO].
+    #[arg(long, value_parser = parse_alpha)]
+    pub alpha: Option<f32>,
+    /// Opacity of the streamlines the selection leaves out, in [0, 1]: above 0 they stay as a
+    /// transparent context around the selected ones (focus + context) [default: 0, hidden].
+    #[arg(long, value_parser = parse_unit)]
+    pub context_alpha: Option<f32>,
+    /// Transparent fragments per pixel composited exactly, nearest first (the K-buffer's K,
+    /// 1–16; those behind are blended into an approximate tail; 12 bytes a pixel each).
+    #[arg(long, default_value_t = lineao::TransparencySettings::default().layers)]
+    pub layers: u32,
+}
+
+impl ContextArgs {
+    /// The transparency these flags ask for, or none where every line is opaque.
+    pub fn transparency(&self) -> Option<lineao::TransparencySettings> {
+        if self.alpha.is_none() && self.context_alpha.is_none() {
+            return None;
+        }
+        let defaults = lineao::TransparencySettings::default();
+        Some(lineao::TransparencySettings {
+            alpha: self.alpha.unwrap_or(defaults.alpha),
+            context_alpha: self.context_alpha.unwrap_or(defaults.context_alpha),
+            layers: self.layers,
+        })
+    }
 }
 
 /// Which streamlines are shown (`lineao_tracts::selection`): each rule keeps fewer.
@@ -631,6 +660,22 @@ pub fn parse_window(s: &str) -> Result<[f32; 2], String> {
         [lo, hi] if lo.is_finite() && hi.is_finite() && lo < hi => Ok([lo, hi]),
         [_, _] => Err(format!("expected finite MIN < MAX, got '{s}'")),
         _ => Err(format!("expected MIN,MAX, got '{s}'")),
+    }
+}
+
+/// `--alpha`: an opacity in (0, 1].
+pub fn parse_alpha(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(a) if a > 0.0 && a <= 1.0 => Ok(a),
+        _ => Err(format!("'{s}' is not an opacity in (0, 1]")),
+    }
+}
+
+/// `--context-alpha`: a number in [0, 1].
+pub fn parse_unit(s: &str) -> Result<f32, String> {
+    match s.parse::<f32>() {
+        Ok(a) if (0.0..=1.0).contains(&a) => Ok(a),
+        _ => Err(format!("'{s}' is not a number in [0, 1]")),
     }
 }
 

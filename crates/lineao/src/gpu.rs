@@ -143,12 +143,14 @@ impl Gpu {
 
     /// What lineao asks of an adapter: its own limits, plus timestamp queries, early depth
     /// tests before a shader that writes its depth (the tubes'), filtered f32 textures (the
-    /// anatomy slices' volume) and 64-bit atomics (the lines rasterized in compute) when offered.
+    /// anatomy slices' volume), blended f32 targets (transparent lines over an Rgba32Float
+    /// picture) and 64-bit atomics (the lines rasterized in compute) when offered.
     pub fn device_descriptor(adapter: &wgpu::Adapter) -> wgpu::DeviceDescriptor<'static> {
         let wanted = wgpu::Features::TIMESTAMP_QUERY
             | wgpu::Features::TIMESTAMP_QUERY_INSIDE_ENCODERS
             | wgpu::Features::SHADER_EARLY_DEPTH_TEST
             | wgpu::Features::FLOAT32_FILTERABLE
+            | wgpu::Features::FLOAT32_BLENDABLE
             | wgpu::Features::SHADER_INT64
             | wgpu::Features::SHADER_INT64_ATOMIC_MIN_MAX;
         wgpu::DeviceDescriptor {

@@ -145,7 +145,7 @@ pub use passes::slices::SliceVolume;
 pub use ray_scene::{RayGeometry, RayScene};
 pub use settings::{
     BilateralSettings, ChainSettings, DebugView, LineColor, Preset, Slab, SlabAxis, SliceSettings, SurfaceSettings,
-    TubeSettings, VolumeAoSettings,
+    TransparencySettings, TubeSettings, VolumeAoSettings,
 };
 
 // docs/embedding.md's code compiles as it stands: `cargo test --doc` checks it.

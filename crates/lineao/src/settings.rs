@@ -150,6 +150,62 @@ pub struct TubeSettings {
     pub radius_world: f32,
 }
 
+/// Lines seen through one another ([`crate::passes::transparency`]): the selected streamlines
+/// at opacity `alpha`, the others (the context) at `context_alpha`, composited in depth order —
+/// the `layers` nearest fragments of each pixel exactly, those beyond blended into a tail.
+/// A line of opacity 1 is drawn as without it, into the G-buffer and its screen-space AO.
+#[derive(Clone, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(feature = "serde", serde(default))]
+#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
+pub struct TransparencySettings {
+    /// Opacity of the selected streamlines (every one without a selection), in (0, 1]. Default 1.
+    pub alpha: f32,
+    /// Opacity of the streamlines the selection leaves out, in [0, 1]: 0 hides them (as
+    /// without transparency). Default 0.
+    pub context_alpha: f32,
+    /// Fragments per pixel composited exactly (the K-buffer's K), in
+    /// [`TransparencySettings::LAYERS`]. Default 8.
+    pub layers: u32,
+}
+
+impl TransparencySettings {
+    /// The layers a K-buffer may hold.
+    pub const LAYERS: std::ops::RangeInclusive<u32> = 1..=16;
+
+    /// Whether any line is drawn transparent (else the chain draws as without these settings).
+    pub fn any(&self) -> bool {
+        self.alpha < 1.0 || self.context_alpha > 0.0
+    }
+
+    /// Whether the selected lines are drawn transparent (else into the G-buffer).
+    pub fn focus_transparent(&self) -> bool {
+        self.alpha < 1.0
+    }
+
+    /// Checks the ranges above, naming each setting.
+    pub fn validate(&self) -> Result<(), crate::Error> {
+        let bad = |what: String| Err(crate::Error::InvalidSettings(what));
+        if !(self.alpha > 0.0 && self.alpha <= 1.0) {
+            return bad(format!("alpha must be in (0, 1], got {}", self.alpha));
+        }
+        if !(0.0..=1.0).contains(&self.context_alpha) {
+            return bad(format!("context alpha must be in [0, 1], got {}", self.context_alpha));
+        }
+        if !Self::LAYERS.contains(&self.layers) {
+            let (lo, hi) = (Self::LAYERS.start(), Self::LAYERS.end());
+            return bad(format!("layers must be in {lo}..={hi}, got {}", self.layers));
+        }
+        Ok(())
+    }
+}
+
+impl Default for TransparencySettings {
+    fn default() -> Self {
+        TransparencySettings { alpha: 1.0, context_alpha: 0.0, layers: 8 }
+    }
+}
+
 /// Context surfaces (`lineao::passes::meshes`) drawn with the lines.
 #[derive(Clone, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
@@ -305,6 +361,8 @@ macro_rules! chain_settings {
             pub slices: Option<SliceSettings>,
             /// Lines cut to a slab, or none. Default none.
             pub slab: Option<Slab>,
+            /// Lines seen through one another, or none (every line opaque). Default none.
+            pub transparency: Option<TransparencySettings>,
             /// How lines are coloured. Default by tangent.
             pub line_color: LineColor,
             /// Linear RGB of the background.
@@ -348,6 +406,7 @@ macro_rules! chain_settings {
                     surfaces: None,
                     slices: None,
                     slab: None,
+                    transparency: None,
                     line_color: LineColor::Tangent,
                     background: [1.0, 1.0, 1.0],
                     strength: 1.0,
@@ -373,6 +432,11 @@ impl Default for ChainSettings {
 }
 
 impl ChainSettings {
+    /// The transparency the frame draws, where any line is transparent.
+    pub fn transparent(&self) -> Option<&TransparencySettings> {
+        self.transparency.as_ref().filter(|t| t.any())
+    }
+
     /// Whether the culled lines and tubes are drawn at levels of detail: [`ChainSettings::lod`], but never
     /// for the GPU ray tracer, whose rays start on the G-buffer's lines and must find them
     /// where the scene it traces has them.
@@ -550,6 +614,12 @@ impl ChainSettings {
                 "a slab needs a finite centre and a thickness > 0, got centre {} and thickness {}",
                 slab.center, slab.thickness
             ));
+        }
+        if let Some(transparency) = &self.transparency {
+            transparency.validate()?;
+            if transparency.any() && self.tubes.is_some() {
+                return bad("transparency draws lines: tubes are opaque only".into());
+            }
         }
         if let Some(slices) = &self.slices {
             if let Some(p) = slices.positions.iter().flatten().find(|p| !p.is_finite()) {

@@ -19,6 +19,7 @@ const SHARED: &[(&str, &str)] = &[
     ("shared/moments.wgsl", include_str!("../shaders/shared/moments.wgsl")),
     ("shared/line_strip.wgsl", include_str!("../shaders/shared/line_strip.wgsl")),
     ("shared/nd.wgsl", include_str!("../shaders/shared/nd.wgsl")),
+    ("shared/object_ao.wgsl", include_str!("../shaders/shared/object_ao.wgsl")),
     ("shared/pieces.wgsl", include_str!("../shaders/shared/pieces.wgsl")),
     ("shared/view.wgsl", include_str!("../shaders/shared/view.wgsl")),
     ("shared/vo.wgsl", include_str!("../shaders/shared/vo.wgsl")),
@@ -36,6 +37,7 @@ const SHARED: &[(&str, &str)] = &[
     ("seed_depth.wgsl", include_str!("../shaders/seed_depth.wgsl")),
     ("slices.wgsl", include_str!("../shaders/slices.wgsl")),
     ("strip.wgsl", include_str!("../shaders/strip.wgsl")),
+    ("transparency.wgsl", include_str!("../shaders/transparency.wgsl")),
     ("tubes.wgsl", include_str!("../shaders/tubes.wgsl")),
     ("volume_ao.wgsl", include_str!("../shaders/volume_ao.wgsl")),
 ];
@@ -81,8 +83,9 @@ pub fn constants() -> String {
 }
 
 /// Files that are a pass's body rather than a module: they use what their importer defines (VO's
-/// entry point calls its method's `obscurance`), so they validate within their importers only.
-pub const FRAGMENTS: &[&str] = &["shared/vo_pass.wgsl"];
+/// entry point calls its method's `obscurance`; object-space AO reads its importer's table), so
+/// they validate within their importers only.
+pub const FRAGMENTS: &[&str] = &["shared/vo_pass.wgsl", "shared/object_ao.wgsl"];
 
 /// Every embedded WGSL file, (name, source): the shared ones, then each method's.
 pub fn files() -> impl Iterator<Item = (&'static str, &'static str)> {

@@ -3,13 +3,16 @@
 use std::path::Path;
 
 /// The capabilities a file's module is made with: the device's 64-bit atomics for the lines
-/// rasterized in compute (made only where the device has them), the defaults for every other.
+/// rasterized in compute (made only where the device has them), WebGPU's `pack2x16float` for
+/// the transparent lines' K-buffer (which wgpu grants every device but the oldest GL), the
+/// defaults for every other.
 fn capabilities(path: &str) -> naga::valid::Capabilities {
     use naga::valid::Capabilities;
     match path {
         "raster.wgsl" => {
             Capabilities::default() | Capabilities::SHADER_INT64 | Capabilities::SHADER_INT64_ATOMIC_MIN_MAX
         }
+        "transparency.wgsl" => Capabilities::default() | Capabilities::SHADER_FLOAT16_IN_FLOAT32,
         _ => Capabilities::default(),
     }
 }

@@ -155,7 +155,7 @@ impl HostAo {
             |encoder, targets, span| self.pass.encode(device, encoder, targets, inputs, span),
             |composite, encoder, span| {
                 if let Some(target) = target {
-                    composite.encode(encoder, target, span);
+                    composite.encode(encoder, target, span("composite"));
                 }
             },
         );

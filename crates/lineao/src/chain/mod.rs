@@ -25,6 +25,10 @@
 //! pixel's normal (`volume_ao`), and the composite shows it alone (method `None`) or combined
 //! with the method's occlusion.
 //!
+//! With `ChainSettings::transparency` the lines of opacity below 1 are left out of the G-buffer
+//! and composited over the composite's picture in depth order, each darkened by its own
+//! object-space AO ([`crate::passes::transparency`]).
+//!
 //! Two wrappers embed the chain in a host renderer: [`HostAo`] runs it over the host's own depth
 //! (and normals, color) instead of lineao's lines, and [`OverlayAo`] draws lineao's lines with
 //! their occlusion into the host's frame.
@@ -37,7 +41,8 @@
 //! Every pass is labelled and the frame sits in a `lineao` debug group, so GPU debuggers show
 //! the chain by name. With [`AoChain::set_timing`] each pass also records timestamp queries under
 //! the names `lineao bench` uses (docs/reference.md): `lines`, `nd-pyramid`, `lineao`, `raytraced`,
-//! `ray-denoise`, `ssao`, `ssao-blur`, `vo-line`, `moments`, `vo-area`, `blur`, `volume-ao`, `composite`.
+//! `ray-denoise`, `ssao`, `ssao-blur`, `vo-line`, `moments`, `vo-area`, `blur`, `volume-ao`, `composite`,
+//! `transparency`.
 
 mod host;
 mod overlay;
@@ -47,7 +52,7 @@ use std::sync::Arc;
 use crate::Error;
 use crate::LineGeometry;
 use crate::camera::{self, Bounds, Camera, FrameView, Tile};
-use crate::gbuffer::Load;
+use crate::gbuffer::{self, Load};
 use crate::lighting::LightingShape;
 use crate::method::raytraced::RayProgress;
 use crate::method::{self, Reach};
@@ -59,6 +64,7 @@ use crate::passes::lines::LineStyle;
 use crate::passes::meshes::{MeshGeometry, MeshRenderer};
 use crate::passes::seed_depth::SeedDepth;
 use crate::passes::slices::{SliceRenderer, SliceVolume};
+use crate::passes::transparency::{self, Transparency};
 use crate::passes::tubes::TubeRenderer;
 use crate::passes::volume_ao::VolumeAo;
 use crate::ray_scene::RayScene;
@@ -90,6 +96,8 @@ pub struct AoChain {
     bilateral: Bilateral,
     /// Made when the settings ask for object-space AO.
     volume_ao: Option<VolumeAo>,
+    /// Made when the settings draw lines transparent.
+    transparency: Option<Transparency>,
     composite: Composite,
     /// An overlay's seeding of the G-buffer's depth from the host's ([`OverlayAo::set_depth`]).
     seed: Option<SeedDepth>,
@@ -128,32 +136,39 @@ impl AoChain {
                 "AoChain::new takes the color format the composite writes, not the depth's ({format:?})"
             )));
         }
-        crate::gpu::validated_async(device, "creating the pass chain's pipelines", || AoChain {
-            stages: {
-                let mut stages = Stages::default();
-                stages.select(&settings, None, device, || method::build(device, &settings));
-                stages
-            },
-            lines: line_renderer(device, &settings),
-            tubes: tube_renderer(device, &settings),
-            meshes: settings
-                .surfaces
-                .as_ref()
-                .map(|_| MeshRenderer::new(device, settings.volume.is_some(), lit(&settings))),
-            slices: settings.slices.as_ref().map(|_| SliceRenderer::new(device, settings.volume.is_some())),
-            slice_volume: None,
-            bilateral: Bilateral::new(device),
-            volume_ao: settings.volume.as_ref().map(|_| VolumeAo::new(device)),
-            composite: Composite::new(device, format),
-            seed: None,
-            format,
-            settings,
-            size: (0, 0),
-            tile: None,
-            limits: device.limits(),
-            targets: None,
-            view: None,
-            timer: None,
+        if settings.transparent().is_some() {
+            transparency::check_format(device, format)?;
+        }
+        crate::gpu::validated_async(device, "creating the pass chain's pipelines", || {
+            let lines = line_renderer(device, &settings);
+            AoChain {
+                stages: {
+                    let mut stages = Stages::default();
+                    stages.select(&settings, None, device, || method::build(device, &settings));
+                    stages
+                },
+                transparency: transparency_passes(device, &settings, &lines, format),
+                lines,
+                tubes: tube_renderer(device, &settings),
+                meshes: settings
+                    .surfaces
+                    .as_ref()
+                    .map(|_| MeshRenderer::new(device, settings.volume.is_some(), lit(&settings))),
+                slices: settings.slices.as_ref().map(|_| SliceRenderer::new(device, settings.volume.is_some())),
+                slice_volume: None,
+                bilateral: Bilateral::new(device),
+                volume_ao: settings.volume.as_ref().map(|_| VolumeAo::new(device)),
+                composite: Composite::new(device, format),
+                seed: None,
+                format,
+                settings,
+                size: (0, 0),
+                tile: None,
+                limits: device.limits(),
+                targets: None,
+                view: None,
+                timer: None,
+            }
         })
         .await
     }
@@ -173,6 +188,9 @@ impl AoChain {
     pub async fn set_settings_async(&mut self, device: &wgpu::Device, settings: ChainSettings) -> Result<(), Error> {
         settings.validate()?;
         self.check_size(&settings, self.size.0, self.size.1)?;
+        if settings.transparent().is_some() {
+            transparency::check_format(device, self.format)?;
+        }
         // The method's pipelines: kept when they still compute the settings, else a kept or a
         // new stage (the targets stay; a new stage binds them).
         let (stages, targets) = (&mut self.stages, self.targets.as_ref());
@@ -182,12 +200,12 @@ impl AoChain {
         .await?;
         let octants = settings.volume.is_some();
         let shape = lit(&settings);
-        if octants != self.lines.writes_octants()
+        let lines_stale = octants != self.lines.writes_octants()
             || shape != self.lines.lighting_shape()
             || settings.slab.is_some() != self.lines.cuts()
             || settings.cull != self.lines.culls()
-            || (settings.cull && settings.levels_of_detail() != self.lines.lods())
-        {
+            || (settings.cull && settings.levels_of_detail() != self.lines.lods());
+        if lines_stale {
             // Writing octants or not, testing a slab or not, culling (at levels of detail) or not,
             // the lighting's shape, are matters of the geometry pipelines.
             self.lines = line_renderer(device, &settings);
@@ -205,6 +223,16 @@ impl AoChain {
         };
         if !tubes_match {
             self.tubes = tube_renderer(device, &settings);
+        }
+        // The transparent lines' pipelines bind the line renderer's group 0.
+        let slab = settings.slab.is_some();
+        let transparency_stale = match (&self.transparency, settings.transparent()) {
+            (Some(pass), Some(t)) => lines_stale || !pass.made_for(t.layers, octants, slab, shape),
+            (None, None) => false,
+            _ => true,
+        };
+        if transparency_stale {
+            self.transparency = transparency_passes(device, &settings, &self.lines, self.format);
         }
         // Surfaces and slices: there when asked for, writing the octants where object-space AO is on.
         let meshes = |m: &MeshRenderer| (m.writes_octants(), m.lighting_shape());
@@ -310,7 +338,8 @@ impl AoChain {
         let method = self.stages.active().map_or(&[][..], |stage| stage.spans(&self.settings));
         let blur: &[&str] = if self.settings.bilateral().is_some() { &["blur"] } else { &[] };
         let volume: &[&str] = if self.settings.volume.is_some() { &["volume-ao"] } else { &[] };
-        [&["lines"], method, blur, volume, &["composite"]].concat()
+        let transparency: &[&str] = if self.transparency.is_some() { &["transparency"] } else { &[] };
+        [&["lines"], method, blur, volume, &["composite"], transparency].concat()
     }
 
     /// Sets the visible size. 0 × 0 (a minimized window) is allowed: nothing is rendered until a
@@ -357,6 +386,9 @@ impl AoChain {
         }
         let banded = (width + 2 * guard, height + 2 * guard);
         (settings.method.info().fits)(banded, &self.limits)?;
+        if let Some(t) = settings.transparent() {
+            transparency::fits(t, banded, &self.limits)?;
+        }
         Ok(())
     }
 
@@ -491,6 +523,11 @@ impl AoChain {
             (_, Some(volume)) => Shown::Both(volume.combine),
         };
         let strength = if s.method == AoMethod::None && s.volume.is_none() { 0.0 } else { s.strength };
+        if let (Some(pass), Some(t)) = (&mut self.transparency, s.transparent()) {
+            pass.resize(device, targets);
+            let sky = s.volume.as_ref().map_or([1.0; 8], |v| v.sky);
+            pass.prepare(queue, &view, t, strength, sky);
+        }
         self.composite.prepare(queue, targets, &view, strength, s.debug_view, shown);
         if let (Some(seed), Some(Some(host))) = (&self.seed, self.composite.overlay_depth()) {
             seed.prepare(queue, targets, &view, &host);
@@ -577,7 +614,10 @@ impl AoChain {
             |encoder, targets, span| {
                 self.draw_geometry(encoder, targets, geometry, meshes, Load::Clear(self.settings.background), span)
             },
-            |composite, encoder, span| composite.encode(encoder, target, span),
+            |composite, encoder, span| {
+                composite.encode(encoder, target, span("composite"));
+                self.encode_transparency(encoder, geometry, target, span("transparency"));
+            },
         );
         Ok(())
     }
@@ -590,14 +630,14 @@ impl AoChain {
         &'s self,
         encoder: &mut wgpu::CommandEncoder,
         gbuffer: impl FnOnce(&mut wgpu::CommandEncoder, &'s FrameTargets, Option<Span<'s>>),
-        composite: impl FnOnce(&'s Composite, &mut wgpu::CommandEncoder, Option<Span<'s>>),
+        composite: impl FnOnce(&'s Composite, &mut wgpu::CommandEncoder, &dyn Fn(&'static str) -> Option<Span<'s>>),
     ) {
         let (Some(targets), Some(_)) = (&self.targets, &self.view) else { return };
         let span = |name| self.timer.as_ref().and_then(|t| t.span(name));
         encoder.push_debug_group("lineao");
         gbuffer(encoder, targets, span("lines"));
         self.encode_method(encoder, targets, &span);
-        composite(&self.composite, encoder, span("composite"));
+        composite(&self.composite, encoder, &span);
         if let Some(timer) = &self.timer {
             timer.resolve(encoder);
         }
@@ -635,10 +675,35 @@ impl AoChain {
         };
         match &self.tubes {
             Some(tubes) => tubes.encode(encoder, targets, geometry, load, lines_span),
+            // The selected lines are the transparency's: the G-buffer is only cleared.
+            None if self.settings.transparent().is_some_and(|t| t.focus_transparent()) => {
+                drop(gbuffer::begin(
+                    encoder,
+                    "lineao::LineRenderer",
+                    targets,
+                    load,
+                    targets.octants.is_some(),
+                    lines_span,
+                ));
+            }
             None => self.lines.encode(encoder, targets, geometry, load, lines_span),
         }
         if let Some((renderer, meshes)) = meshes {
             renderer.encode(encoder, targets, meshes, Load::Keep, last_span);
+        }
+    }
+
+    /// The transparent lines of `geometry` over the opaque picture in `target`, where the
+    /// settings draw any.
+    fn encode_transparency(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        geometry: &LineGeometry,
+        target: &wgpu::TextureView,
+        span: Option<Span<'_>>,
+    ) {
+        if let Some(pass) = &self.transparency {
+            pass.encode(encoder, geometry, &self.lines.bindings().group, target, span);
         }
     }
 
@@ -704,4 +769,23 @@ fn tube_renderer(device: &wgpu::Device, settings: &ChainSettings) -> Option<Tube
     settings.tubes.as_ref()?;
     let renderer = TubeRenderer::new(device, settings.volume.is_some(), lit(settings));
     Some(if settings.cull { renderer.culled(device, settings.levels_of_detail()) } else { renderer })
+}
+
+/// The transparent lines' passes where `settings` draw any, for the line renderer `lines`
+/// compositing into `format`.
+fn transparency_passes(
+    device: &wgpu::Device,
+    settings: &ChainSettings,
+    lines: &LineRenderer,
+    format: wgpu::TextureFormat,
+) -> Option<Transparency> {
+    let t = settings.transparent()?;
+    Some(Transparency::new(
+        device,
+        lines.bindings(),
+        t.layers,
+        settings.volume.is_some(),
+        settings.slab.is_some(),
+        format,
+    ))
 }

@@ -117,7 +117,10 @@ impl OverlayAo {
                 };
                 chain.draw_geometry(encoder, targets, geometry, meshes, load, span)
             },
-            |composite, encoder, span| composite.encode_overlay(encoder, target, depth, span),
+            |composite, encoder, span| {
+                composite.encode_overlay(encoder, target, depth, span("composite"));
+                chain.encode_transparency(encoder, geometry, target, span("transparency"));
+            },
         );
         Ok(())
     }

@@ -643,7 +643,8 @@ impl LineGeometry {
     }
 
     /// Draws only the polylines `selected` marks (one entry per polyline appended; `None`:
-    /// all of them): the others are neither drawn, culled nor occlude, in every pass. Nothing
+    /// all of them): the others are neither drawn, culled nor occlude, in every pass — but the
+    /// transparent context's ([`crate::TransparencySettings::context_alpha`]). Nothing
     /// is uploaded again but a bit per cluster, which a compute pass writes into the cluster
     /// records; polylines appended later are selected. Flushes first.
     pub fn set_selection(

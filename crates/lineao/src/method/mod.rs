@@ -275,7 +275,7 @@ pub fn pass_names() -> Vec<&'static str> {
     let methods = AoMethod::REGISTRY.iter().flat_map(|m| m.info().spans.iter().copied());
     let mut names: Vec<&'static str> = std::iter::once("lines").chain(methods).collect();
     names.dedup();
-    names.extend(["blur", "volume-ao", "composite"]);
+    names.extend(["blur", "volume-ao", "composite", "transparency"]);
     names
 }
 

@@ -281,6 +281,11 @@ impl LineRenderer {
         self.bindings.shape
     }
 
+    /// Its group 0 (the frame's uniform and lighting), which the transparent lines' passes bind.
+    pub(crate) fn bindings(&self) -> &GeometryBindings {
+        &self.bindings
+    }
+
     /// Writes this frame's uniform.
     pub fn prepare(
         &self,

@@ -18,6 +18,7 @@ pub mod nd_pyramid;
 pub mod raster;
 pub mod seed_depth;
 pub mod slices;
+pub mod transparency;
 pub mod tubes;
 pub mod volume_ao;
 

@@ -29,7 +29,7 @@ use crate::targets::{AO_FORMAT, FrameTargets};
 use crate::timing::Span;
 use crate::volume::geometry_term::{GeometryTable, TABLE_SIZE};
 
-/// Keep in sync with `VolumeAoUniform` in `shaders/volume_ao.wgsl`.
+/// Keep in sync with `VolumeAoUniform` in `shaders/shared/object_ao.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
 pub struct VolumeAoUniform {
@@ -62,6 +62,17 @@ pub fn view_to_world(view: &FrameView) -> Mat3 {
     Mat3::from_mat4(view.view).inverse()
 }
 
+/// [`GeometryTable::normals`] as the shaders read it (`volume_table` of
+/// `shaders/shared/object_ao.wgsl`): two vec4 per texel, octants 0–3 and 4–7, row-major.
+pub(crate) fn table_buffer(device: &wgpu::Device, label: &str) -> wgpu::Buffer {
+    let table: Vec<[f32; 8]> = GeometryTable::normals(TABLE_SIZE).values;
+    device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some(label),
+        contents: bytemuck::cast_slice(&table),
+        usage: wgpu::BufferUsages::STORAGE,
+    })
+}
+
 /// Object-space AO per pixel: the octant visibilities against the geometry term.
 pub struct VolumeAo {
     pipeline: wgpu::ComputePipeline,
@@ -89,16 +100,11 @@ impl VolumeAo {
             "volume_ao",
             &[],
         );
-        let table: Vec<[f32; 8]> = GeometryTable::normals(TABLE_SIZE).values;
         VolumeAo {
             pipeline,
             layout,
             uniform: binding::uniform_buffer::<VolumeAoUniform>(device, "lineao::VolumeAo::uniform"),
-            table: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("lineao::VolumeAo::table"),
-                contents: bytemuck::cast_slice(&table),
-                usage: wgpu::BufferUsages::STORAGE,
-            }),
+            table: table_buffer(device, "lineao::VolumeAo::table"),
             group: None,
         }
     }
@@ -139,7 +145,7 @@ impl VolumeAo {
 fn uniform_matches_its_wgsl_struct() {
     crate::shader::assert_wgsl_layout!(
         VolumeAoUniform,
-        "volume_ao.wgsl",
+        "shared/object_ao.wgsl",
         "VolumeAoUniform",
         [view_to_world, weights, table_size]
     );
