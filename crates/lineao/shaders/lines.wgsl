@@ -25,43 +25,6 @@ struct VsOutOctants {
     @location(4) octants_hi: vec4<f32>,
 }
 
-// The first vertex of point k in the alternating strip of a cluster whose bent inner points are
-// `bent` (point j at bit j − 1): one vertex a point, two for the first point and each bent one.
-fn alternating_start(k: u32, bent: u32) -> u32 {
-    if k == 0u {
-        return 0u;
-    }
-    return k + 1u + countOneBits(bent & ((1u << (k - 1u)) - 1u));
-}
-
-// The alternating strip: both sides of the first point, then one side per point by turns, both
-// sides of bent points and of the last (L0 R0 L1 R2 L3 … for sides L, R, where nothing bends).
-// The point of vertex v is the last whose first vertex is at most v: a binary search over the
-// mask's prefix counts (a cluster draws at most 25 points: five steps).
-fn alternating_strip(v: u32, drawn: u32, bent: u32) -> StripPosition {
-    let side = select(1.0, -1.0, (v & 1u) != 0u);
-    let vertices = alternating_start(drawn - 1u, bent) + 2u;
-    if v < vertices && bent == 0u {
-        return StripPosition(i32(clamp(v, 1u, drawn) - 1u), side);
-    }
-    if v < vertices {
-        var lo = 0u;
-        var hi = drawn - 1u;
-        while lo < hi {
-            let mid = (lo + hi + 1u) >> 1u;
-            if alternating_start(mid, bent) <= v {
-                lo = mid;
-            } else {
-                hi = mid - 1u;
-            }
-        }
-        return StripPosition(i32(lo), side);
-    }
-    // The repeat of the last vertex, then the collapsed ones.
-    let last = select(1.0, -1.0, ((vertices - 1u) & 1u) != 0u);
-    return StripPosition(select(-1, i32(drawn) - 1, v == vertices), last);
-}
-
 // A vertex that collapses with every other past its strip's end.
 fn collapsed() -> VsOut {
     var out: VsOut;

@@ -79,11 +79,8 @@ fn layer_alpha(c: Cluster) -> f32 {
     return select(layer.context_alpha, layer.alpha, is_selected(c));
 }
 
-// The full strip of every cluster whose opacity is not 0 (`lines.wgsl`'s `vs_full`).
-@vertex
-fn vs_layer(@builtin(vertex_index) v: u32, @builtin(instance_index) cluster: u32) -> LayerOut {
-    let c = clusters[cluster];
-    let at = full_strip(v, drawn_points(c));
+// A strip vertex of a cluster whose opacity is not 0 (the others' collapse).
+fn layer_vertex(c: Cluster, at: StripPosition) -> LayerOut {
     let alpha = layer_alpha(c);
     var out: LayerOut;
     if at.point < 0 || alpha <= 0.0 {
@@ -108,6 +105,19 @@ fn vs_layer(@builtin(vertex_index) v: u32, @builtin(instance_index) cluster: u32
     return out;
 }
 
+// The strips `lines.wgsl` draws: the full one (`vs_full`), and the alternating one from afar.
+@vertex
+fn vs_layer(@builtin(vertex_index) v: u32, @builtin(instance_index) cluster: u32) -> LayerOut {
+    let c = clusters[cluster];
+    return layer_vertex(c, full_strip(v, drawn_points(c)));
+}
+
+@vertex
+fn vs_layer_alternating(@builtin(vertex_index) v: u32, @builtin(instance_index) cluster: u32) -> LayerOut {
+    let c = clusters[cluster];
+    return layer_vertex(c, alternating_strip(v, drawn_points(c), c.flags >> BENT_SHIFT));
+}
+
 // Slot `k` of the guard-banded pixel `pixel`.
 fn slot(pixel: vec2<u32>, k: u32) -> u32 {
     return (pixel.y * layer.size.x + pixel.x) * LAYERS + k;
@@ -115,9 +125,9 @@ fn slot(pixel: vec2<u32>, k: u32) -> u32 {
 
 // The fragment's key: its depth, inverted so that the nearest is the largest and 0 is nothing,
 // above its nearest point (what tells a line's own overlapping pieces from another line).
-fn key(in: LayerOut) -> u32 {
-    let depth = clamp(u32(in.clip.z * f32(DEPTH_STEPS)), 1u, DEPTH_STEPS - 1u);
-    return ((DEPTH_STEPS - depth) << POINT_BITS) | (u32(round(in.point)) & POINT_MASK);
+fn key(clip: vec4<f32>, point: f32) -> u32 {
+    let depth = clamp(u32(clip.z * f32(DEPTH_STEPS)), 1u, DEPTH_STEPS - 1u);
+    return ((DEPTH_STEPS - depth) << POINT_BITS) | (u32(round(point)) & POINT_MASK);
 }
 
 // Whether two keys' points are close on the page (modulo 2¹²): one line's pieces.
@@ -126,18 +136,29 @@ fn same_line(a: u32, b: u32) -> bool {
     return min(d, POINT_MASK + 1u - d) <= SAME_LINE;
 }
 
-// Whether the fragment is cut by the slab or lies behind the opaque picture.
-fn hidden(in: LayerOut) -> bool {
-    return (SLAB && outside_slab(in.view_pos)) || in.clip.z >= textureLoad(opaque_depth, vec2<u32>(in.clip.xy), 0);
+// Whether the fragment at `clip`, `view_pos` is cut by the slab or lies behind the opaque picture.
+fn hidden(clip: vec4<f32>, view_pos: vec3<f32>) -> bool {
+    return (SLAB && outside_slab(view_pos)) || clip.z >= textureLoad(opaque_depth, vec2<u32>(clip.xy), 0);
+}
+
+// What the depths pass reads of `LayerOut` (a device may then interpolate nothing else).
+struct DepthIn {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) view_pos: vec3<f32>,
+    @location(6) point: f32,
 }
 
 @fragment
-fn fs_depths(in: LayerOut) {
-    if hidden(in) {
+fn fs_depths(in: DepthIn) {
+    if hidden(in.clip, in.view_pos) {
         discard;
     }
     let pixel = vec2<u32>(in.clip.xy);
-    var d = key(in);
+    var d = key(in.clip, in.point);
+    // The K nearer fragments are kept already (a slot's key only grows): the tail's, at once.
+    if d < atomicLoad(&depths[slot(pixel, LAYERS - 1u)]) {
+        return;
+    }
     for (var k = 0u; k < LAYERS; k++) {
         let kept = atomicMax(&depths[slot(pixel, k)], d);
         if kept == 0u {
@@ -154,7 +175,7 @@ struct TailOut {
 
 @fragment
 fn fs_colors(in: LayerOut) -> TailOut {
-    if hidden(in) {
+    if hidden(in.clip, in.view_pos) {
         discard;
     }
     // The line's G-buffer texel, composited as the composite does it: color · (1 − strength · ao)
@@ -166,7 +187,12 @@ fn fs_colors(in: LayerOut) -> TailOut {
     }
     let rgb = g.color.rgb * (1.0 - clamp(layer.strength * ao, 0.0, 1.0)) + g.specular;
     let pixel = vec2<u32>(in.clip.xy);
-    let d = key(in);
+    let d = key(in.clip, in.point);
+    let tail = TailOut(vec4<f32>(rgb * in.alpha, in.alpha), in.alpha);
+    // Behind the K-th (the slots are sorted, nearest first): the tail's, without a search.
+    if d < atomicLoad(&depths[slot(pixel, LAYERS - 1u)]) {
+        return tail;
+    }
     for (var k = 0u; k < LAYERS; k++) {
         let s = slot(pixel, k);
         if atomicLoad(&depths[s]) == d {
@@ -174,7 +200,7 @@ fn fs_colors(in: LayerOut) -> TailOut {
             return TailOut(vec4<f32>(0.0), 0.0);
         }
     }
-    return TailOut(vec4<f32>(rgb * in.alpha, in.alpha), in.alpha);
+    return tail;
 }
 
 @vertex

@@ -8,6 +8,7 @@
 mod common;
 
 use common::gpu;
+use lineao::passes::lines::GeometryOptions;
 use lineao::readback::{read_f32, read_rgba};
 use lineao::reference::{Image, NdImage};
 use lineao::targets::Target;
@@ -76,7 +77,10 @@ fn geometry(gpu: &Gpu, lines: &[Line]) -> LineGeometry {
             Some(*end)
         }))
         .collect();
-    let mut geometry = LineGeometry::new(&gpu.device, &gpu.queue, &positions, &offsets).unwrap();
+    // One tolerance for the alternating strip whatever the lines' bounds: a line's strip is
+    // then the same drawn alone or with the others.
+    let options = GeometryOptions { tolerance: Some(0.002), ..Default::default() };
+    let mut geometry = LineGeometry::with_options(&gpu.device, &gpu.queue, &positions, &offsets, options).unwrap();
     let visibility = |p: &[f32; 3], o: usize| 0.5 + 0.45 * (3.0 * p[0] + 2.0 * p[1] + p[2] + o as f32).sin();
     let octants: Vec<[f32; 8]> = positions.iter().map(|p| std::array::from_fn(|o| visibility(p, o))).collect();
     let attributes = lineao::passes::lines::VertexAttributes { octants: Some(&octants), ..Default::default() };

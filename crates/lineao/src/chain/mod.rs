@@ -703,7 +703,7 @@ impl AoChain {
         span: Option<Span<'_>>,
     ) {
         if let Some(pass) = &self.transparency {
-            pass.encode(encoder, geometry, &self.lines.bindings().group, target, span);
+            pass.encode(encoder, geometry, &self.lines, target, span);
         }
     }
 

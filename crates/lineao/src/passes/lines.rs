@@ -307,7 +307,7 @@ impl LineRenderer {
 
     /// Whether `page` is drawn as the alternating strip in the frame of the last
     /// [`LineRenderer::prepare`].
-    fn page_alternates(&self, page: &Page) -> bool {
+    pub(crate) fn page_alternates(&self, page: &Page) -> bool {
         let scale = f32::from_bits(self.px_per_world.load(Ordering::Relaxed));
         self.style == LineStyle::Quads && page.tolerance * scale <= MAX_TOLERANCE_PX
     }

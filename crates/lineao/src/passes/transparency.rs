@@ -54,7 +54,8 @@ use crate::binding::{self, Slot};
 use crate::camera::FrameView;
 use crate::gbuffer::GeometryBindings;
 use crate::lighting::LightingShape;
-use crate::line_geometry::{LineGeometry, full_vertices};
+use crate::line_geometry::{LineGeometry, alternating_vertices, full_vertices};
+use crate::passes::lines::LineRenderer;
 use crate::passes::volume_ao::{VolumeAoUniform, table_buffer};
 use crate::settings::TransparencySettings;
 use crate::targets::FrameTargets;
@@ -131,8 +132,9 @@ pub struct Transparency {
     octants: bool,
     slab: bool,
     shape: LightingShape,
-    depths: wgpu::RenderPipeline,
-    colors: wgpu::RenderPipeline,
+    /// The depths and colours passes, over the full strip and over the alternating one.
+    depths: [wgpu::RenderPipeline; 2],
+    colors: [wgpu::RenderPipeline; 2],
     resolve: wgpu::RenderPipeline,
     buffers_layout: wgpu::BindGroupLayout,
     tail_layout: wgpu::BindGroupLayout,
@@ -209,13 +211,13 @@ impl Transparency {
             ]
         };
         let options = wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
-        let geometry = |label, fragment, writes| {
+        let geometry = |label, fragment, writes, alternating| {
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some(label),
                 layout: Some(&geometry_layout),
                 vertex: wgpu::VertexState {
                     module: &module,
-                    entry_point: Some("vs_layer"),
+                    entry_point: Some(if alternating { "vs_layer_alternating" } else { "vs_layer" }),
                     compilation_options: options.clone(),
                     buffers: &[],
                 },
@@ -237,8 +239,13 @@ impl Transparency {
         };
         // The depths pass writes no target: the tail's are its attachments (a render pass needs
         // one), cleared there for the colours pass.
-        let depths = geometry("lineao::Transparency::depths", "fs_depths", wgpu::ColorWrites::empty());
-        let colors = geometry("lineao::Transparency::colors", "fs_colors", wgpu::ColorWrites::ALL);
+        let [depths, colors] = [
+            ("lineao::Transparency::depths", "fs_depths", wgpu::ColorWrites::empty()),
+            ("lineao::Transparency::colors", "fs_colors", wgpu::ColorWrites::ALL),
+        ]
+        .map(|(label, fragment, writes)| {
+            [false, true].map(|alternating| geometry(label, fragment, writes, alternating))
+        });
         let resolve_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("lineao::Transparency::resolve"),
             bind_group_layouts: &[Some(&tail_layout), None, Some(&uniforms_layout), Some(&buffers_layout)],
@@ -377,14 +384,14 @@ impl Transparency {
         queue.write_buffer(&self.volume, 0, bytemuck::bytes_of(&VolumeAoUniform::new(view, sky)));
     }
 
-    /// Records the three passes for `geometry` (drawn with the line renderer's group 0,
-    /// `frame`, prepared for this frame), the resolve blending over `target`, which holds the
-    /// opaque picture of `targets`. Timed into `span` when given.
+    /// Records the three passes for `geometry` as `lines` draws it (its group 0 and strips,
+    /// prepared for this frame), the resolve blending over `target`, which holds the opaque
+    /// picture. Timed into `span` when given.
     pub(crate) fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         geometry: &LineGeometry,
-        frame: &wgpu::BindGroup,
+        lines: &LineRenderer,
         target: &wgpu::TextureView,
         span: Option<Span>,
     ) {
@@ -392,7 +399,7 @@ impl Transparency {
         let (first, last) = Span::split(span);
         encoder.clear_buffer(&slots.depths, 0, None);
         encoder.clear_buffer(&slots.colors, 0, None);
-        for (label, pipeline, clear) in [
+        for (label, pipelines, clear) in [
             ("lineao::Transparency::depths", &self.depths, true),
             ("lineao::Transparency::colors", &self.colors, false),
         ] {
@@ -417,15 +424,21 @@ impl Transparency {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(pipeline);
-            pass.set_bind_group(0, frame, &[]);
+            pass.set_bind_group(0, &lines.bindings().group, &[]);
             pass.set_bind_group(2, &self.uniforms, &[]);
             pass.set_bind_group(3, &slots.buffers, &[]);
             for page in geometry.pages() {
+                // The strip the opaque lines take for this page, from afar the alternating one —
+                // but the full one under object-space AO: over the alternating strip's triangles
+                // (three points each) the octants interpolate otherwise than the opaque lines'
+                // object-space AO does, measured 0.02 of a channel apart.
+                let alternating = lines.page_alternates(page) && !self.octants;
+                pass.set_pipeline(&pipelines[alternating as usize]);
                 pass.set_bind_group(1, &page.group, &[]);
                 for (class, range) in page.classes.iter().enumerate().filter(|(_, range)| !range.is_empty()) {
+                    let vertices = if alternating { alternating_vertices(class) } else { full_vertices(class) };
                     for batch in geometry.draw_batches(range.clone()) {
-                        pass.draw(0..full_vertices(class), batch);
+                        pass.draw(0..vertices, batch);
                     }
                 }
             }
