@@ -12,6 +12,9 @@
 //!   against which `lines` shows what its alternating strip saves; `lines-strip`: the same
 //!   lines from the strip of earlier versions (a vertex buffer of 40 bytes a point and an index
 //!   buffer: what the clusters replaced, timed in the same run);
+//! - `lines-transparent`: the same lines seen through one another at α = 0.3, K = 8
+//!   ([`lineao::passes::transparency`]: the depths and colours passes and the resolve, over a
+//!   G-buffer without opaque lines), against `lines`;
 //! - `nd-pyramid`, `composite`; `bilateral`: the separable bilateral blur (radius 4), which can
 //!   follow any method;
 //! - `lines-all`: every cluster drawn (the alternating strip); `lines-culled`: the default path,
@@ -73,6 +76,7 @@ use lineao::passes::composite::Composite;
 use lineao::passes::lines::{LineRenderer, LineStyle};
 use lineao::passes::nd_from_depth::{HostConfig, HostInputs, NdFromDepth};
 use lineao::passes::nd_pyramid::NdPyramid;
+use lineao::passes::transparency::Transparency;
 use lineao::passes::tubes::TubeRenderer;
 use lineao::targets::{FrameTargets, Target};
 use lineao::timing::{PassTimer, Span};
@@ -80,11 +84,14 @@ use lineao::volume::density::{DensityOptions, voxelize};
 use lineao::volume::sweep::{self, SweepSettings};
 use lineao::volume::variance::{VarianceMaps, VarianceSettings};
 use lineao::volume::vertex_tangents;
-use lineao::{AoChain, AoMethod, BilateralSettings, ChainSettings, Gpu, LineAoSettings};
+use lineao::{AoChain, AoMethod, BilateralSettings, ChainSettings, Gpu, LineAoSettings, TransparencySettings};
 use lineao::{FrameView, Projection};
 use serde_json::json;
 
 use crate::cli::{BenchArgs, gpu_passes};
+
+/// The opacity of pass `lines-transparent`.
+const TRANSPARENT_ALPHA: f32 = 0.3;
 
 /// The radius of pass `tubes` in zoom units (0.5 mm for tractograms).
 const TUBE_RADIUS: f32 = 0.5;
@@ -101,6 +108,8 @@ struct Passes {
     lines_compute: LineRenderer,
     lines_native: LineRenderer,
     lines_full: LineRenderer,
+    /// `lines` seen through one another (`lines-transparent`).
+    transparency: Transparency,
     /// The strip of earlier versions and its renderer (`lines-strip`), when selected.
     strip: Option<(lineao::passes::lines::StripGeometry, lineao::passes::lines::StripRenderer)>,
     pyramid: NdPyramid,
@@ -150,8 +159,15 @@ impl Passes {
         // Compiled for the bench's lighting, as the chain's are.
         let shape = LightingShape::of(&settings.lighting);
         let lines = |style| LineRenderer::with_slab(device, style, false, false, shape);
+        let plain = lines(LineStyle::Quads);
+        let layers = TransparencySettings::default().layers;
+        let mut transparency = Transparency::new(device, &plain, layers, false, false, format);
+        transparency.resize(device, targets);
+        let opacity = TransparencySettings { alpha: TRANSPARENT_ALPHA, ..TransparencySettings::default() };
+        transparency.prepare(queue, view, &opacity, settings.strength, [1.0; 8]);
         let mut passes = Passes {
-            lines: lines(LineStyle::Quads),
+            lines: plain,
+            transparency,
             lines_culled: lines(LineStyle::Quads).culled(device, true),
             lines_culled_exact: lines(LineStyle::Quads).culled(device, false),
             lines_compute: lines(LineStyle::Quads).culled(device, true).rasterized_in_compute(device),
@@ -233,6 +249,11 @@ impl Passes {
         let background = self.settings.background;
         match name {
             "lines" | "lines-all" => self.lines.encode(encoder, targets, geometry, Load::Clear(background), span),
+            "lines-transparent" => {
+                // No opaque line hides them.
+                lineao::passes::clear(encoder, targets, background);
+                self.transparency.encode(encoder, geometry, &self.lines, &self.output.view, span);
+            }
             "lines-culled" => self.lines_culled.encode(encoder, targets, geometry, Load::Clear(background), span),
             "lines-culled-exact" => {
                 self.lines_culled_exact.encode(encoder, targets, geometry, Load::Clear(background), span)
@@ -359,6 +380,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     let mut times: Vec<Vec<f64>> = vec![Vec::new(); all.len()];
     // `lines` last among the line passes, so the G-buffer the later passes read is the chain's.
     let first = [
+        "lines-transparent",
         "lines-native-1px",
         "lines-full-strip",
         "lines-strip",
@@ -626,6 +648,7 @@ fn print_table(report: &serde_json::Value, passes: &[serde_json::Value]) {
     for (a, b) in [
         ("lineao", "lineao-tap-floor"),
         ("lines", "lines-native-1px"),
+        ("lines-transparent", "lines"),
         ("lines-culled", "lines-all"),
         ("lines-culled", "lines-culled-exact"),
         ("lines-compute", "lines-culled"),

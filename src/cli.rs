@@ -75,6 +75,9 @@ pub struct ViewArgs {
     /// (`z,0,8`); `[` and `]` move it (see `render --slab`).
     #[arg(long, value_name = "AXIS,CENTRE,THICKNESS", value_parser = lineao_session::args::parse_slab, allow_hyphen_values = true)]
     pub slab: Option<lineao::Slab>,
+    /// Lines seen through one another (see `render --alpha`; `t` turns it on and off).
+    #[command(flatten)]
+    pub transparency: lineao_session::args::TransparencyArgs,
     /// Anatomy: a NIfTI-1 or NIfTI-2 volume shown as slices with each dataset opened (see `render
     /// --volume`); the side panel moves them.
     #[arg(long, value_name = "NIFTI")]
@@ -224,7 +227,7 @@ pub struct BenchLoadArgs {
 // The passes `lineao bench --passes` names (its vocabulary, so the CLI needs nothing of the
 // bench itself).
 /// The bench's own GPU passes: the geometry and what every method shares.
-const OWN_GPU_PASSES: [&str; 16] = [
+const OWN_GPU_PASSES: [&str; 17] = [
     "lines",
     "lines-native-1px",
     "lines-full-strip",
@@ -241,6 +244,7 @@ const OWN_GPU_PASSES: [&str; 16] = [
     "tubes-culled",
     "tubes-culled-exact",
     "nd-from-depth",
+    "lines-transparent",
 ];
 
 /// The GPU passes of one run: the bench's own, then every method's from the registry

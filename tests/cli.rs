@@ -348,6 +348,7 @@ fn bench_json_is_the_contract() {
         "tubes-culled",
         "tubes-culled-exact",
         "nd-from-depth",
+        "lines-transparent",
         "raytraced-1spp",
         "raytraced-start-1spp",
         "ray-denoise",

@@ -894,6 +894,7 @@ impl App {
                     Action::Reset => camera.reset(),
                     Action::Orthographic => camera.orthographic = !camera.orthographic,
                     Action::Slab(steps) => self.controls.move_slab(steps),
+                    Action::Transparency => self.controls.toggle_transparency(),
                     Action::Record => record_key = true,
                 }
             }

@@ -12,7 +12,7 @@ use lineao::method::setting::{Kind, Unit, Value};
 use lineao::volume::{ScalarForm, Sky, VolumeAoOptions, VolumeMethod};
 use lineao::{
     AoMethod, BilateralSettings, ChainSettings, Colormap, DebugView, LineAoVariant, LineColor, Named, Preset, Slab,
-    SlabAxis, SliceSettings, TubeSettings, VoCombine, VolumeAoSettings,
+    SlabAxis, SliceSettings, TransparencySettings, TubeSettings, VoCombine, VolumeAoSettings,
 };
 
 use super::worker::Panel;
@@ -149,6 +149,8 @@ pub struct Controls {
     pub moving_method: Method,
     /// The last slab the lines were cut to (`params.chain.slab`), kept while it is off.
     pub slab: Slab,
+    /// The last transparency (`params.chain.transparency`), kept while it is off.
+    pub transparency: TransparencySettings,
     /// How far the slab's centre slider reaches either way (world units): half the dataset's
     /// viewing distance.
     pub slab_reach: f32,
@@ -216,6 +218,7 @@ impl Controls {
             preset,
             moving_method: MOVING_DEFAULT,
             slab: Slab { axis: SlabAxis::Z, center: 0.0, thickness: 10.0 },
+            transparency: TransparencySettings { alpha: 0.3, ..TransparencySettings::default() },
             slab_reach: 100.0,
             slice_box: None,
             anatomy_field: None,
@@ -301,6 +304,15 @@ impl Controls {
         self.slice_box = Some(world_box);
     }
 
+    /// Turns transparency on (as it was last) or off: the `t` key.
+    pub fn toggle_transparency(&mut self) {
+        let chain = &mut self.params.chain;
+        chain.transparency = match chain.transparency.take() {
+            Some(_) => None,
+            None => Some(self.transparency.clone()),
+        };
+    }
+
     /// Moves the slab (when it is on) by `steps` quarters of its thickness: the `[` and `]` keys.
     pub fn move_slab(&mut self, steps: f32) {
         if let Some(slab) = &mut self.params.chain.slab {
@@ -312,10 +324,15 @@ impl Controls {
     /// The data's zoom unit changed (a new file): the parameters take the preset's values in it,
     /// except the ray counts (`view --rays`) and the denoiser's switch, which are no lengths.
     pub fn set_zoom_unit(&mut self, zoom_unit: f32) {
-        let (rays, slab, slices) =
-            (self.params.chain.raytraced.clone(), self.params.chain.slab, self.params.chain.slices.take());
+        let (rays, slab, slices, transparency) = (
+            self.params.chain.raytraced.clone(),
+            self.params.chain.slab,
+            self.params.chain.slices.take(),
+            self.params.chain.transparency.take(),
+        );
         self.params = Params::preset(self.preset, zoom_unit);
         (self.params.chain.slab, self.params.chain.slices) = (slab, slices);
+        self.params.chain.transparency = transparency;
         let r = &mut self.params.chain.raytraced;
         (r.rays_per_frame, r.max_rays, r.denoise) = (rays.rays_per_frame, rays.max_rays, rays.denoise);
         self.given.apply(&mut self.params.chain);
@@ -363,6 +380,11 @@ impl Controls {
         }
         if let Some(Slab { axis, center, thickness }) = self.params.chain.slab {
             flags.push(("slab".into(), format!("{},{center},{thickness}", axis.name())));
+        }
+        if let Some(t) = &self.params.chain.transparency {
+            flags.push(("alpha".into(), t.alpha.to_string()));
+            flags.push(("context-alpha".into(), t.context_alpha.to_string()));
+            flags.push(("layers".into(), t.layers.to_string()));
         }
         let selection = self.selection();
         let pair = |[a, b]: [f32; 2]| format!("{a},{b}");
@@ -417,6 +439,10 @@ impl Controls {
             combine: p.volume_combine,
         });
         settings.tubes = (self.geometry == Geometry::Tubes).then_some(TubeSettings { radius_world: p.tube_radius });
+        // Tubes are opaque only.
+        if settings.tubes.is_some() {
+            settings.transparency = None;
+        }
         settings.line_color = match (&self.color, range) {
             (ColorMode::Field(_), Some(range)) => LineColor::Scalar { colormap: self.colormap, range },
             (ColorMode::Groups, Some(range)) => LineColor::Scalar { colormap: Colormap::Categories, range },
@@ -482,6 +508,7 @@ impl Controls {
         self.color_ui(ui, fields);
         ui.add(egui::Slider::new(&mut self.light_azimuth, -180.0..=180.0).text("light azimuth (°)"));
         ui.add(egui::Slider::new(&mut self.light_elevation, -89.0..=89.0).text("light elevation (°)"));
+        self.transparency_ui(ui);
         self.slab_ui(ui);
         self.slices_ui(ui);
         self.selection_ui(ui);
@@ -560,6 +587,28 @@ impl Controls {
             }
         });
         ui.checkbox(&mut self.timings, "GPU time per pass");
+    }
+
+    /// Transparency: on or off, the selection's opacity and the context's, the K-buffer's K.
+    fn transparency_ui(&mut self, ui: &mut Ui) {
+        let lines = self.geometry == Geometry::Lines;
+        let mut on = self.params.chain.transparency.is_some();
+        ui.add_enabled(lines, egui::Checkbox::new(&mut on, "see through (t)")).on_hover_text(
+            "lines composited in depth order, each darkened by its object-space AO (a method with sweep); tubes are opaque",
+        );
+        let chain = &mut self.params.chain;
+        let Some(t) = on.then(|| chain.transparency.get_or_insert_with(|| self.transparency.clone())) else {
+            chain.transparency = None;
+            return;
+        };
+        ui.add(egui::Slider::new(&mut t.alpha, 0.02..=1.0).text("opacity"))
+            .on_hover_text("of the lines shown: 1 draws them opaque, with the method's AO");
+        ui.add(egui::Slider::new(&mut t.context_alpha, 0.0..=1.0).text("context opacity"))
+            .on_hover_text("of the lines the selection leaves out: 0 hides them");
+        let (lo, hi) = (*TransparencySettings::LAYERS.start(), *TransparencySettings::LAYERS.end());
+        ui.add(egui::Slider::new(&mut t.layers, lo..=hi).text("exact layers"))
+            .on_hover_text("the nearest fragments of each pixel composited exactly; those behind are blended");
+        self.transparency = t.clone();
     }
 
     /// The slab: on or off, its axis, centre and thickness.

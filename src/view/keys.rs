@@ -18,6 +18,8 @@ pub enum Action {
     Orthographic,
     /// Move the slab by its thickness, backward (−1) or forward (+1).
     Slab(f32),
+    /// Turn transparency on or off.
+    Transparency,
     /// Start or stop recording a movie.
     Record,
 }
@@ -46,6 +48,7 @@ pub const KEYS: &[Binding] = &[
     Binding { keys: &[Key::O], shift: false, action: Action::Orthographic, help: "perspective ↔ orthographic" },
     Binding { keys: &[Key::OpenBracket], shift: false, action: Action::Slab(-1.0), help: "move the slab back" },
     Binding { keys: &[Key::CloseBracket], shift: false, action: Action::Slab(1.0), help: "move the slab forward" },
+    Binding { keys: &[Key::T], shift: false, action: Action::Transparency, help: "lines seen through ↔ opaque" },
     Binding {
         keys: &[Key::M],
         shift: false,

@@ -87,6 +87,10 @@ pub fn options(args: &ViewArgs) -> app::Options {
     if let Some(slab) = args.slab {
         (controls.slab, controls.params.chain.slab) = (slab, Some(slab));
     }
+    if let Some(transparency) = args.transparency.settings() {
+        controls.transparency = transparency.clone();
+        controls.params.chain.transparency = Some(transparency);
+    }
     controls.opaque_slices = args.opaque_slices;
     if let Some((name, volume)) = &anatomy {
         controls.set_anatomy(name, volume.world_box(), args.slices);

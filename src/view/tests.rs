@@ -593,6 +593,29 @@ fn the_ray_traced_method_accumulates_while_the_camera_rests_and_shows_lineao_whi
 }
 
 #[test]
+fn the_t_key_sees_through_the_lines_and_back() {
+    let mut harness = harness(options(scene(SceneKind::Vortex, 20_000), [methods()[0], methods()[4]], false));
+    settle(&mut harness);
+    let opaque = harness.state().shown.as_ref().unwrap().images[0].clone();
+    harness.key_press(egui::Key::T);
+    settle(&mut harness);
+    let app = harness.state();
+    assert!(app.error.is_none(), "{:?}", app.error);
+    let frame = app.shown.as_ref().unwrap();
+    let transparency = frame.view.panels[0].settings.transparency.clone();
+    assert_eq!(transparency.map(|t| t.alpha), Some(0.3));
+    // Lines over the white background are lighter seen through: less darkening of the white.
+    let darkening = |image: &[u8]| {
+        image.chunks_exact(4).map(|p| p[..3].iter().map(|&c| 255.0 - c as f64).sum::<f64>()).sum::<f64>()
+    };
+    let (seen, solid) = (darkening(&frame.images[0]), darkening(&opaque));
+    assert!(seen < 0.8 * solid, "{seen} against {solid}");
+    harness.key_press(egui::Key::T);
+    settle(&mut harness);
+    assert_eq!(harness.state().shown.as_ref().unwrap().view.panels[0].settings.transparency, None);
+}
+
+#[test]
 fn a_slab_cuts_the_lines_and_the_brackets_move_it() {
     let path = data("niivue+niivue/packages/niivue/demos/images/stroke.trk.gz");
     let mut harness = harness(options(Source::File(path), [methods()[1], methods()[4]], false));

@@ -137,6 +137,24 @@ def test_slices_and_a_slab_are_keywords():
     assert background(slab) > background(alone) + 0.1
 
 
+def test_transparency_and_context_are_keywords():
+    t = lineao.load(STROKE)
+    frame = {"width": 200, "height": 160, "method": "none"}
+    opaque = np.asarray(lineao.render(t, **frame)).astype(int)
+    seen_through = np.asarray(lineao.render(t, **frame, alpha=0.3, layers=4)).astype(int)
+    drawn = (opaque[..., :3] != 255).any(axis=-1)
+    # Over a white background, lines at opacity 0.3 are lighter where they are drawn.
+    assert seen_through[drawn][:, :3].mean() > opaque[drawn][:, :3].mean() + 20
+    # The context: what a selection leaves out, faint, where it alone would leave background.
+    sphere = "sphere:0,-20,10,25"
+    focus = np.asarray(lineao.render(t, **frame, include=sphere)).astype(int)
+    context = np.asarray(lineao.render(t, **frame, include=sphere, context_alpha=0.1)).astype(int)
+    empty = (focus[..., :3] == 255).all(axis=-1)
+    assert (context[empty][:, :3] != 255).any(axis=-1).mean() > 0.05
+    with pytest.raises(ValueError, match="alpha"):
+        lineao.render(t, **frame, alpha=1.5)
+
+
 def test_streamlines_in_memory_keep_their_groups_and_fields():
     # pyAFQ's arcuate fasciculi, loaded into numpy and rendered from memory: coloured and
     # selected by their groups as the file itself is.

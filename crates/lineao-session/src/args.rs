@@ -504,6 +504,17 @@ pub struct ContextArgs {
     #[arg(long, value_name = "AXIS,CENTRE,THICKNESS", value_parser = parse_slab, allow_hyphen_values = true)]
     #[serde(deserialize_with = "crate::kwargs::opt_slab")]
     pub slab: Option<lineao::Slab>,
+    /// Lines seen through one another.
+    #[command(flatten)]
+    #[serde(flatten)]
+    pub transparency: TransparencyArgs,
+}
+
+/// Lines seen through one another (`render`, `view`, the page, Python): their opacities and
+/// the K of the K-buffer.
+#[derive(Args, Clone, Debug, Default, serde::Deserialize)]
+#[serde(default)]
+pub struct TransparencyArgs {
     /// Opacity of the streamlines shown (the selected ones), in (0, 1]: below 1 they are seen
     /// through one another, composited in depth order, each darkened by its object-space AO
     /// (with `--method sweep`, `lineao+sweep`, …; lit but unoccluded without) [default: 1,
@@ -515,14 +526,15 @@ pub struct ContextArgs {
     #[arg(long, value_parser = parse_unit)]
     pub context_alpha: Option<f32>,
     /// Transparent fragments per pixel composited exactly, nearest first (the K-buffer's K,
-    /// 1–16; those behind are blended into an approximate tail; 12 bytes a pixel each).
-    #[arg(long, default_value_t = lineao::TransparencySettings::default().layers)]
-    pub layers: u32,
+    /// 1–16; those behind are blended into an approximate tail; 12 bytes a pixel each)
+    /// [default: 8].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=16))]
+    pub layers: Option<u32>,
 }
 
-impl ContextArgs {
+impl TransparencyArgs {
     /// The transparency these flags ask for, or none where every line is opaque.
-    pub fn transparency(&self) -> Option<lineao::TransparencySettings> {
+    pub fn settings(&self) -> Option<lineao::TransparencySettings> {
         if self.alpha.is_none() && self.context_alpha.is_none() {
             return None;
         }
@@ -530,7 +542,7 @@ impl ContextArgs {
         Some(lineao::TransparencySettings {
             alpha: self.alpha.unwrap_or(defaults.alpha),
             context_alpha: self.context_alpha.unwrap_or(defaults.context_alpha),
-            layers: self.layers,
+            layers: self.layers.unwrap_or(defaults.layers),
         })
     }
 }

@@ -134,6 +134,11 @@ pub fn srgb(v: f32) -> f32 {
     if v <= 0.003_130_8 { 12.92 * v } else { 1.055 * v.powf(1.0 / 2.4) - 0.055 }
 }
 
+/// The linear value of an sRGB-encoded one in [0, 1] (the inverse of [`srgb`]).
+pub fn linear(v: f32) -> f32 {
+    if v <= 0.040_45 { v / 12.92 } else { ((v + 0.055) / 1.055).powf(2.4) }
+}
+
 /// A linear RGB channel (clamped to [0, 1]) as an sRGB byte.
 pub fn srgb8(c: f32) -> u8 {
     (srgb(c) * 255.0).round() as u8

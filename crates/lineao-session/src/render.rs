@@ -87,7 +87,7 @@ pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky, lon
         surfaces: (!args.style.surfaces.is_empty()).then_some(SurfaceSettings { color: args.style.surface_color }),
         slices: slice_settings(args),
         slab: args.context.slab,
-        transparency: args.context.transparency(),
+        transparency: args.context.transparency.settings(),
         line_color: match &args.style.color {
             ColorArg::Tangent => LineColor::Tangent,
             ColorArg::Constant(rgb) => LineColor::Constant(*rgb),

@@ -255,11 +255,92 @@ pub fn read_frame(session: &Session, chain: &lineao::AoChain) -> Result<(NdImage
     Ok((nd, Shading::new(&color, &specular.data)))
 }
 
+/// The methods whose darkening reaches a transparent line's every layer: object-space AO at
+/// each fragment's own point (screen-space AO darkens only the opaque G-buffer).
+pub const THROUGH_THE_LAYERS: [&str; 3] = ["sweep", "variance-volume", "lineao+sweep"];
+
+/// Legibility through the layers (`score --alpha …`): each method's transparent picture
+/// darkened against the same transparent picture without AO (D = 1 − Y/Y_none, Y the
+/// pictures' linear luminance), its depth order that of the nearest line at each pixel (the
+/// opaque picture's G-buffer), over the pixels that show a line. Rows: `none` (0 by
+/// definition) and [`THROUGH_THE_LAYERS`].
+pub fn transparent_legibility(
+    session: &mut Session,
+    args: &crate::args::RenderArgs,
+) -> Result<Vec<(String, Result<Legibility, Absent>)>> {
+    let (w, h) = (args.image.width as usize, args.image.height as usize);
+    let none = Method { screen: AoMethod::None, volume: None };
+    let with = |method: Method, transparency: bool| {
+        let mut a = args.clone();
+        (a.image.timings, a.image.dump, a.shown.compare, a.shown.grid) = (false, None, None, false);
+        a.shown.method = method;
+        if !transparency {
+            a.context.transparency = Default::default();
+        }
+        a
+    };
+    // The nearest line's depth: the opaque picture's G-buffer (no method: no guard band).
+    let mut chains = Vec::new();
+    session.compose_panels(&with(none, false), &mut chains)?;
+    let (nd, _) = read_frame(session, &chains[0])?;
+    anyhow::ensure!(chains[0].targets().is_some_and(|t| t.guard == 0), "the opaque picture has a guard band");
+    let mask: Vec<bool> = nd.data.iter().map(|t| t[..3] != [0.0; 3]).collect();
+    let depth = Image { data: nd.data.iter().map(|t| t[3]).collect(), width: w, height: h };
+    let luminance = |image: &Rgba8| -> Vec<f32> {
+        let linear = |c: u8| crate::label::linear(c as f32 / 255.0);
+        image
+            .data
+            .chunks_exact(4)
+            .map(|p| 0.2126 * linear(p[0]) + 0.7152 * linear(p[1]) + 0.0722 * linear(p[2]))
+            .collect()
+    };
+    let (plain, _) = session.compose_panels(&with(none, true), &mut Vec::new())?;
+    let y_none = luminance(&plain);
+    let pairs = legibility::Pairs::sample(&depth, &mask);
+    let mut rows =
+        vec![("none".to_string(), pairs.as_ref().map(|p| p.measure(&vec![0.0; w * h], &mask)).map_err(Clone::clone))];
+    for name in THROUGH_THE_LAYERS {
+        let method = crate::args::parse_method(name).map_err(anyhow::Error::msg)?;
+        let (image, _) = session.compose_panels(&with(method, true), &mut Vec::new())?;
+        let d: Vec<f32> = luminance(&image)
+            .iter()
+            .zip(&y_none)
+            .map(|(&y, &none)| if none > 0.0 { 1.0 - y / none } else { 0.0 })
+            .collect();
+        rows.push((name.to_string(), pairs.as_ref().map(|p| p.measure(&d, &mask)).map_err(Clone::clone)));
+    }
+    Ok(rows)
+}
+
 pub fn run(args: &ScoreArgs) -> Result<()> {
     let render = &args.render;
     crate::figure::refuse_in_score(&render.figure)?;
     let methods = if args.methods.is_empty() { ScoreMethod::all() } else { args.methods.clone() };
-    let session = Session::open_with_points(render)?;
+    let mut session = Session::open_with_points(render)?;
+    if let Some(t) = render.context.transparency.settings() {
+        // The truths start on the opaque G-buffer's lines: through the layers, legibility alone.
+        let rows = transparent_legibility(&mut session, render)?;
+        println!(
+            "{}: {} x {}, alpha {}, context alpha {}, {} layers: legibility through the layers (darkening against the \
+             same transparent picture without AO, depth order of the nearest line)",
+            session.lines.name, render.image.width, render.image.height, t.alpha, t.context_alpha, t.layers
+        );
+        println!("{:<17} {:>7} {:>7} {:>7} {:>7} {:>7}", "method", "L 1%", "L 4%", "L 15%", "mean D", "black");
+        for (name, l) in rows {
+            match l {
+                Ok(l) => println!(
+                    "{name:<17} {:>+7.3} {:>+7.3} {:>+7.3} {:>7.3} {:>6.1}%",
+                    l.scales[0],
+                    l.scales[1],
+                    l.scales[2],
+                    l.mean_darkening,
+                    100.0 * l.near_black
+                ),
+                Err(absent) => println!("{name:<17} {absent}"),
+            }
+        }
+        return Ok(());
+    }
     let report = score(&session, render, &methods, args.bundle_distance)?;
     let truth = &report.truth;
     let local = crate::truth::settings(render, session.longest_side);

@@ -219,6 +219,13 @@ pub enum Load {
     Keep,
 }
 
+/// Clears the G-buffer of `targets` to `background` ([`Load::Clear`]'s values): what a frame
+/// without opaque geometry starts from.
+pub fn clear(encoder: &mut wgpu::CommandEncoder, targets: &FrameTargets, background: [f32; 3]) {
+    let load = Load::Clear(background);
+    drop(begin(encoder, "lineao::gbuffer::clear", targets, load, targets.octants.is_some(), None));
+}
+
 /// Begins a render pass over the G-buffer of `targets` (with `octants` when asked and present).
 pub(crate) fn begin<'e>(
     encoder: &'e mut wgpu::CommandEncoder,

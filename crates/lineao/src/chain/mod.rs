@@ -780,12 +780,5 @@ fn transparency_passes(
     format: wgpu::TextureFormat,
 ) -> Option<Transparency> {
     let t = settings.transparent()?;
-    Some(Transparency::new(
-        device,
-        lines.bindings(),
-        t.layers,
-        settings.volume.is_some(),
-        settings.slab.is_some(),
-        format,
-    ))
+    Some(Transparency::new(device, lines, t.layers, settings.volume.is_some(), settings.slab.is_some(), format))
 }

@@ -5,7 +5,7 @@
 //! layouts, rebuilds its bind groups on `resize`, writes its uniforms in `prepare` and records
 //! itself in `encode`, so a host with its own render graph can use any of them alone.
 
-pub use crate::gbuffer::Load;
+pub use crate::gbuffer::{Load, clear};
 
 pub mod bilateral;
 pub mod composite;

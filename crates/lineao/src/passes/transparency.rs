@@ -52,7 +52,6 @@
 
 use crate::binding::{self, Slot};
 use crate::camera::FrameView;
-use crate::gbuffer::GeometryBindings;
 use crate::lighting::LightingShape;
 use crate::line_geometry::{LineGeometry, alternating_vertices, full_vertices};
 use crate::passes::lines::LineRenderer;
@@ -147,17 +146,19 @@ pub struct Transparency {
 }
 
 impl Transparency {
-    /// The passes for lines drawn with `bindings` (the line renderer's group 0) into targets
-    /// whose opaque picture is composited into `format`: K = `layers`, each fragment darkened by
-    /// its object-space AO with `octants`, cut by the frame's slab with `slab`.
-    pub(crate) fn new(
+    /// The passes for the lines `lines` draws (its group 0: the frame's uniform and lighting),
+    /// blending over a picture of `format`: K = `layers` (in [`TransparencySettings::LAYERS`]),
+    /// each fragment darkened by its object-space AO with `octants`, cut by the frame's slab with
+    /// `slab`.
+    pub fn new(
         device: &wgpu::Device,
-        bindings: &GeometryBindings,
+        lines: &LineRenderer,
         layers: u32,
         octants: bool,
         slab: bool,
         format: wgpu::TextureFormat,
     ) -> Transparency {
+        let bindings = lines.bindings();
         let stages = wgpu::ShaderStages::VERTEX_FRAGMENT;
         let uniforms_layout = binding::layout(device, "lineao::Transparency::uniforms", stages, &[Slot::Uniform; 2]);
         let buffers_layout = binding::layout(
@@ -309,7 +310,7 @@ impl Transparency {
 
     /// (Re)allocates the K-buffer and the tail for `targets` (checked against the device by
     /// [`fits`] before).
-    pub(crate) fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets) {
+    pub fn resize(&mut self, device: &wgpu::Device, targets: &FrameTargets) {
         if self.slots.as_ref().is_some_and(|s| s.size == targets.size) {
             return;
         }
@@ -363,7 +364,7 @@ impl Transparency {
 
     /// Writes the frame's uniforms: the opacities of `settings`, the composite's AO `strength`
     /// and the sky of object-space AO.
-    pub(crate) fn prepare(
+    pub fn prepare(
         &self,
         queue: &wgpu::Queue,
         view: &FrameView,
@@ -387,7 +388,7 @@ impl Transparency {
     /// Records the three passes for `geometry` as `lines` draws it (its group 0 and strips,
     /// prepared for this frame), the resolve blending over `target`, which holds the opaque
     /// picture. Timed into `span` when given.
-    pub(crate) fn encode(
+    pub fn encode(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         geometry: &LineGeometry,
