@@ -270,13 +270,27 @@ mod tests {
         (controls.subset, controls.length) = (0.3, Some([20.0, 80.5]));
         (controls.color, controls.colormap) = (ColorMode::Field("fa".into()), lineao::Colormap::CoolWarm);
         controls.params.chain.slab = Some(lineao::Slab { axis: lineao::SlabAxis::Y, center: -12.5, thickness: 8.0 });
+        let transparency = lineao::TransparencySettings { alpha: 0.35, context_alpha: 0.05, layers: 6 };
+        controls.params.chain.transparency = Some(transparency);
         controls.regions = vec![
             RegionRule { include: true, region: Region::Sphere { center: [1.5, -2.0, 0.1], radius: 7.25 } },
             RegionRule { include: false, region: Region::Box { min: [-1.0, -2.0, -3.0], max: [4.0, 5.0, 6.5] } },
         ];
         let flags = controls.link_flags();
         let keys: Vec<&str> = flags.iter().map(|(flag, _)| flag.as_str()).collect();
-        let kept = ["ssao-samples", "ssao-radius", "ssao-range", "colormap", "color", "slab", "subset", "length"];
+        let kept = [
+            "ssao-samples",
+            "ssao-radius",
+            "ssao-range",
+            "colormap",
+            "color",
+            "slab",
+            "alpha",
+            "context-alpha",
+            "layers",
+            "subset",
+            "length",
+        ];
         assert_eq!(keys, [&kept[..], &["include", "exclude"]].concat());
         let query = link(
             (&LinkSource::Scene("bundles".into()), None),
@@ -290,6 +304,7 @@ mod tests {
         assert_eq!(opened.selection(), controls.selection());
         assert_eq!((&opened.color, opened.colormap), (&controls.color, controls.colormap));
         assert_eq!(opened.params.chain.slab, controls.params.chain.slab);
+        assert_eq!(opened.params.chain.transparency, controls.params.chain.transparency);
         assert_eq!(opened.params.chain.ssao, controls.params.chain.ssao);
         assert_eq!(opened.link_flags(), flags, "the link of the page it opens is the same");
     }
