@@ -393,6 +393,7 @@ mod tests {
             }
         }
         assert_eq!(names.first(), Some(&"lines"));
-        assert_eq!(names.last(), Some(&"composite"));
+        // The transparent lines blend over the composite's picture: after it.
+        assert_eq!(names[names.len() - 2..], ["composite", "transparency"]);
     }
 }

@@ -145,7 +145,7 @@ impl VolumeAo {
 fn uniform_matches_its_wgsl_struct() {
     crate::shader::assert_wgsl_layout!(
         VolumeAoUniform,
-        "shared/object_ao.wgsl",
+        "volume_ao.wgsl",
         "VolumeAoUniform",
         [view_to_world, weights, table_size]
     );
