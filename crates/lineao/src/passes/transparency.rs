@@ -57,7 +57,7 @@ use crate::line_geometry::{LineGeometry, alternating_vertices, full_vertices};
 use crate::passes::lines::LineRenderer;
 use crate::passes::volume_ao::{VolumeAoUniform, table_buffer};
 use crate::settings::TransparencySettings;
-use crate::targets::FrameTargets;
+use crate::targets::{FrameTargets, Target};
 use crate::timing::Span;
 
 /// Bytes a slot of the K-buffer takes: the depth key (4) and the colour with its opacity (8).
@@ -314,7 +314,6 @@ impl Transparency {
         if self.slots.as_ref().is_some_and(|s| s.size == targets.size) {
             return;
         }
-        let (width, height) = targets.size;
         let storage = |label, bytes| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -326,20 +325,8 @@ impl Transparency {
         let colour = colour_bytes(targets.size, self.layers);
         let depths = storage("lineao::Transparency::depths", colour / 2);
         let colors = storage("lineao::Transparency::colors", colour);
-        let texture = |label, format| {
-            device
-                .create_texture(&wgpu::TextureDescriptor {
-                    label: Some(label),
-                    size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-                    mip_level_count: 1,
-                    sample_count: 1,
-                    dimension: wgpu::TextureDimension::D2,
-                    format,
-                    usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-                    view_formats: &[],
-                })
-                .create_view(&Default::default())
-        };
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+        let texture = |label, format| Target::new(device, label, targets.size, format, usage).view;
         let accum = texture("lineao::Transparency::accum", ACCUM_FORMAT);
         let reveal = texture("lineao::Transparency::reveal", REVEAL_FORMAT);
         let buffers = binding::group(
