@@ -119,11 +119,11 @@ pub fn uniform_buffer<T: bytemuck::Pod>(device: &wgpu::Device, label: &str) -> w
 }
 
 /// A compute pipeline over one bind group, with WGSL `override` constants.
-pub fn compute_pipeline(
+pub fn compute_pipeline<'a>(
     device: &wgpu::Device,
     label: &str,
     group: &wgpu::BindGroupLayout,
-    shader: &str,
+    shader: impl Into<crate::shader::Source<'a>>,
     entry_point: &str,
     constants: &[(&str, f64)],
 ) -> wgpu::ComputePipeline {

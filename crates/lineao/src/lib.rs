@@ -138,9 +138,9 @@ pub use method::raytraced::settings::{RayDenoiseSettings, RayTracedSettings};
 pub use method::ssao::settings::{SsaoKernel, SsaoSettings};
 pub use method::vo_line::settings::{VoCombine, VoSettings};
 pub use named::Named;
-pub use passes::composite::OverlayDepth;
 pub use passes::meshes::MeshGeometry;
 pub use passes::nd_from_depth::{HostConfig, HostInputs};
+pub use passes::seed_depth::OverlayDepth;
 pub use passes::slices::SliceVolume;
 pub use ray_scene::{RayGeometry, RayScene};
 pub use settings::{

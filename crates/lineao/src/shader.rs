@@ -7,7 +7,7 @@
 use std::borrow::Cow;
 
 /// The WGSL files of the shared passes (under `shaders/`), by path relative to that folder;
-/// each method's are in its folder and its registry entry ([`crate::method::MethodInfo::shaders`]).
+/// each method's are in its folder and its [`Library`].
 const SHARED: &[(&str, &str)] = &[
     ("shared/billboard.wgsl", include_str!("../shaders/shared/billboard.wgsl")),
     ("shared/clusters.wgsl", include_str!("../shaders/shared/clusters.wgsl")),
@@ -16,7 +16,6 @@ const SHARED: &[(&str, &str)] = &[
     ("shared/gbuffer.wgsl", include_str!("../shaders/shared/gbuffer.wgsl")),
     ("shared/geometry.wgsl", include_str!("../shaders/shared/geometry.wgsl")),
     ("shared/lighting.wgsl", include_str!("../shaders/shared/lighting.wgsl")),
-    ("shared/moments.wgsl", include_str!("../shaders/shared/moments.wgsl")),
     ("shared/line_strip.wgsl", include_str!("../shaders/shared/line_strip.wgsl")),
     ("shared/nd.wgsl", include_str!("../shaders/shared/nd.wgsl")),
     ("shared/object_ao.wgsl", include_str!("../shaders/shared/object_ao.wgsl")),
@@ -58,23 +57,60 @@ pub enum Constant {
 }
 
 /// The file, made by Rust, of the constants that the CPU reference and the shaders share: a
-/// shader that says `#import rust/constants.wgsl` gets every method's
-/// ([`crate::method::MethodInfo::constants`]) and the passes' ([`PASS_CONSTANTS`]) as WGSL
-/// `const`s, so no number is written twice.
+/// shader that says `#import rust/constants.wgsl` gets the passes' ([`PASS_CONSTANTS`]) and its
+/// method's ([`Library::constants`]) as WGSL `const`s, so no number is written twice.
 pub const CONSTANTS: &str = "rust/constants.wgsl";
 
-/// The passes' shared numbers: the side of the tiles in which the slices mark their pixels for
-/// the bilateral blur.
-pub const PASS_CONSTANTS: &[(&str, Constant)] = &[
-    ("SLICE_TILE", Constant::U32(crate::targets::SLICE_TILE)),
-    ("OUTLINE_SIDES", Constant::U32(crate::passes::slices::OUTLINE_SIDES as u32)),
-];
+/// The side of the tiles in which the slices mark their pixels for the bilateral blur.
+pub const SLICE_TILE: u32 = 8;
 
-/// [`CONSTANTS`]' text: `const NAME: f32 = …;` per constant, each f32 written with as many
-/// digits as give it back exactly.
-pub fn constants() -> String {
-    let methods = crate::AoMethod::REGISTRY.iter().flat_map(|m| m.info().constants.iter());
-    let all = methods.chain(PASS_CONSTANTS);
+/// The corners of the polygon a transparent slice is drawn as.
+pub const OUTLINE_SIDES: usize = 32;
+
+/// The passes' shared numbers.
+pub const PASS_CONSTANTS: &[(&str, Constant)] =
+    &[("SLICE_TILE", Constant::U32(SLICE_TILE)), ("OUTLINE_SIDES", Constant::U32(OUTLINE_SIDES as u32))];
+
+/// What a composed shader draws on besides the shared files: a method's own WGSL files and the
+/// numbers its WGSL shares with its CPU reference (each method's registry entry holds its own).
+#[derive(Clone, Copy, Debug)]
+pub struct Library {
+    /// Its WGSL files, by the name its shaders import them under.
+    pub files: &'static [(&'static str, &'static str)],
+    /// The numbers Rust writes into its WGSL ([`CONSTANTS`]).
+    pub constants: &'static [(&'static str, Constant)],
+}
+
+impl Library {
+    /// The shared files alone.
+    pub const SHARED: Library = Library { files: &[], constants: &[] };
+
+    /// Its file `path` (or a shared one), to compose.
+    pub fn source(self, path: &str) -> Source<'_> {
+        Source { path, library: self }
+    }
+}
+
+/// A WGSL file to compose, and the library its imports are found in: a shared pass's file is
+/// its path (`"cull.wgsl".into()`), a method's is [`Library::source`].
+#[derive(Clone, Copy, Debug)]
+pub struct Source<'a> {
+    /// The path relative to `shaders/`, or a method's file name.
+    pub path: &'a str,
+    /// The library beyond the shared files.
+    pub library: Library,
+}
+
+impl<'a> From<&'a str> for Source<'a> {
+    fn from(path: &'a str) -> Source<'a> {
+        Source { path, library: Library::SHARED }
+    }
+}
+
+/// [`CONSTANTS`]' text for `library`: `const NAME: f32 = …;` per constant, each f32 written
+/// with as many digits as give it back exactly.
+pub fn constants(library: &Library) -> String {
+    let all = library.constants.iter().chain(PASS_CONSTANTS);
     all.map(|(name, value)| match value {
         Constant::F32(v) => format!("const {name}: f32 = {v:?};\n"),
         Constant::U32(v) => format!("const {name}: u32 = {v}u;\n"),
@@ -87,39 +123,39 @@ pub fn constants() -> String {
 /// they validate within their importers only.
 pub const FRAGMENTS: &[&str] = &["shared/vo_pass.wgsl", "shared/object_ao.wgsl"];
 
-/// Every embedded WGSL file, (name, source): the shared ones, then each method's.
-pub fn files() -> impl Iterator<Item = (&'static str, &'static str)> {
-    let methods = crate::AoMethod::REGISTRY.iter().flat_map(|m| m.info().shaders.iter());
-    SHARED.iter().chain(methods).copied()
+/// The embedded WGSL files `library` composes from, (name, source): the shared ones, then its own.
+pub fn files(library: &Library) -> impl Iterator<Item = (&'static str, &'static str)> {
+    SHARED.iter().chain(library.files).copied()
 }
 
-/// The embedded source of `path` (relative to `shaders/`, or a method's file name), without
+/// The embedded source of `path` (relative to `shaders/`, or a file of `library`), without
 /// imports resolved.
-pub fn raw(path: &str) -> Option<&'static str> {
-    files().find(|(p, _)| *p == path).map(|(_, s)| s)
+pub fn raw(path: &str, library: &Library) -> Option<&'static str> {
+    files(library).find(|(p, _)| *p == path).map(|(_, s)| s)
 }
 
-/// `path` with every `#import` resolved. Panics only on a missing import, which the naga test
+/// `source` with every `#import` resolved. Panics only on a missing import, which the naga test
 /// catches for every embedded file.
-pub fn compose(path: &str) -> String {
+pub fn compose<'a>(source: impl Into<Source<'a>>) -> String {
+    let source = source.into();
     let mut out = String::new();
     let mut seen = Vec::new();
-    append(path, &mut out, &mut seen);
+    append(source.path, &source.library, &mut out, &mut seen);
     out
 }
 
-fn append(path: &str, out: &mut String, seen: &mut Vec<String>) {
+fn append(path: &str, library: &Library, out: &mut String, seen: &mut Vec<String>) {
     if seen.iter().any(|p| p == path) {
         return;
     }
     seen.push(path.to_owned());
     if path == CONSTANTS {
-        return out.push_str(&constants());
+        return out.push_str(&constants(library));
     }
-    let source = raw(path).unwrap_or_else(|| panic!("WGSL file {path} is not embedded"));
+    let source = raw(path, library).unwrap_or_else(|| panic!("WGSL file {path} is not embedded"));
     for line in source.lines() {
         match line.trim().strip_prefix("#import ") {
-            Some(import) => append(import.trim(), out, seen),
+            Some(import) => append(import.trim(), library, out, seen),
             None => {
                 out.push_str(line);
                 out.push('\n');
@@ -128,18 +164,23 @@ fn append(path: &str, out: &mut String, seen: &mut Vec<String>) {
     }
 }
 
-/// A shader module from the composed `path`, labelled `lineao::<path>`.
-pub fn module(device: &wgpu::Device, path: &str) -> wgpu::ShaderModule {
-    module_with(device, path, &[])
+/// A shader module from the composed `source`, labelled `lineao::<path>`.
+pub fn module<'a>(device: &wgpu::Device, source: impl Into<Source<'a>>) -> wgpu::ShaderModule {
+    module_with(device, source, &[])
 }
 
 /// [`module`] with textual `replacements` (from, to) applied: a binding's type that override
 /// constants cannot change (e.g. `texture_depth_2d` → `texture_depth_multisampled_2d`).
-pub fn module_with(device: &wgpu::Device, path: &str, replacements: &[(&str, &str)]) -> wgpu::ShaderModule {
-    let source = replacements.iter().fold(compose(path), |s, (from, to)| s.replace(from, to));
+pub fn module_with<'a>(
+    device: &wgpu::Device,
+    source: impl Into<Source<'a>>,
+    replacements: &[(&str, &str)],
+) -> wgpu::ShaderModule {
+    let source = source.into();
+    let composed = replacements.iter().fold(compose(source), |s, (from, to)| s.replace(from, to));
     device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some(&format!("lineao::{path}")),
-        source: wgpu::ShaderSource::Wgsl(Cow::Owned(source)),
+        label: Some(&format!("lineao::{}", source.path)),
+        source: wgpu::ShaderSource::Wgsl(Cow::Owned(composed)),
     })
 }
 
@@ -150,7 +191,7 @@ pub fn module_with(device: &wgpu::Device, path: &str, replacements: &[(&str, &st
 /// one side only, renamed or reordered fails it.
 #[cfg(test)]
 macro_rules! assert_wgsl_layout {
-    ($rust:ty, $file:literal, $wgsl:literal, [$($field:ident),+ $(,)?]) => {
+    ($rust:ty, $file:expr, $wgsl:literal, [$($field:ident),+ $(,)?]) => {
         $crate::shader::check_layout(
             $file,
             $wgsl,
@@ -165,8 +206,10 @@ pub(crate) use assert_wgsl_layout;
 /// [`assert_wgsl_layout`]'s check: `fields` (name, offset) and `size` against naga's layout of
 /// `wgsl` in the composed `file`.
 #[cfg(test)]
-pub(crate) fn check_layout(file: &str, wgsl: &str, size: usize, fields: &[(&str, usize)]) {
+pub(crate) fn check_layout<'a>(file: impl Into<Source<'a>>, wgsl: &str, size: usize, fields: &[(&str, usize)]) {
+    let file = file.into();
     let source = compose(file);
+    let file = file.path;
     let module =
         naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| panic!("{file}: {}", e.emit_to_string(&source)));
     let (members, span) = module
@@ -194,7 +237,7 @@ pub(crate) fn check_layout(file: &str, wgsl: &str, size: usize, fields: &[(&str,
 /// List the fields in location order.
 #[cfg(test)]
 macro_rules! assert_vertex_layout {
-    ($rust:ty, $file:literal, $wgsl:literal, $attributes:expr, [$($field:ident),+ $(,)?]) => {{
+    ($rust:ty, $file:expr, $wgsl:literal, $attributes:expr, [$($field:ident),+ $(,)?]) => {{
         fn width<T, F>(_: fn(&T) -> &F) -> usize {
             std::mem::size_of::<F>()
         }
@@ -213,8 +256,8 @@ pub(crate) use assert_vertex_layout;
 /// [`assert_vertex_layout`]'s check: `fields` (offset, size) against `attributes`, and those
 /// against the locations of `wgsl` in the composed `file`.
 #[cfg(test)]
-pub(crate) fn check_vertex_layout(
-    file: &str,
+pub(crate) fn check_vertex_layout<'a>(
+    file: impl Into<Source<'a>>,
     wgsl: &str,
     size: usize,
     attributes: &[wgpu::VertexAttribute],
@@ -232,7 +275,9 @@ pub(crate) fn check_vertex_layout(
     assert_eq!(declared, rust, "{wgsl}'s attributes (offset, size), then the Rust fields'");
     let end = attributes.iter().map(|a| a.offset + a.format.size()).max().unwrap_or(0);
     assert!(end as usize <= size, "{wgsl}: the attributes end at {end}, past the struct's {size} bytes");
+    let file = file.into();
     let source = compose(file);
+    let file = file.path;
     let module =
         naga::front::wgsl::parse_str(&source).unwrap_or_else(|e| panic!("{file}: {}", e.emit_to_string(&source)));
     let members = module

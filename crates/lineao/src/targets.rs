@@ -111,8 +111,8 @@ const AO_USAGE: wgpu::TextureUsages = wgpu::TextureUsages::STORAGE_BINDING
     .union(wgpu::TextureUsages::COPY_DST);
 
 /// The side in pixels of the tiles in which [`FrameTargets::slice_tiles`] marks the slices:
-/// the bilateral blur's workgroup.
-pub const SLICE_TILE: u32 = 8;
+/// the bilateral blur's workgroup (a number the WGSL shares: [`crate::shader::PASS_CONSTANTS`]).
+pub use crate::shader::SLICE_TILE;
 
 /// Tiles of [`SLICE_TILE`] pixels a side across and down a target of `size`.
 pub fn tile_grid(size: (u32, u32)) -> (u32, u32) {

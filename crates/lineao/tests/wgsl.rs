@@ -2,6 +2,8 @@
 
 use std::path::Path;
 
+use lineao::shader::Library;
+
 /// The capabilities a file's module is made with: the device's 64-bit atomics for the lines
 /// rasterized in compute (made only where the device has them), WebGPU's `pack2x16float` for
 /// the transparent lines' K-buffer (which wgpu grants every device but the oldest GL), the
@@ -17,8 +19,15 @@ fn capabilities(path: &str) -> naga::valid::Capabilities {
     }
 }
 
-fn validate(path: &str) -> Result<(), String> {
-    let source = lineao::shader::compose(path);
+/// The shared files, then each method's with the library it composes them in.
+fn libraries() -> impl Iterator<Item = (Library, Vec<(&'static str, &'static str)>)> {
+    let shared = std::iter::once((Library::SHARED, lineao::shader::files(&Library::SHARED).collect()));
+    let methods = lineao::AoMethod::REGISTRY.iter().map(|m| m.info().library).map(|l| (l, l.files.to_vec()));
+    shared.chain(methods)
+}
+
+fn validate(path: &str, library: Library) -> Result<(), String> {
+    let source = lineao::shader::compose(library.source(path));
     let module = naga::front::wgsl::parse_str(&source).map_err(|e| e.emit_to_string(&source))?;
     naga::valid::Validator::new(naga::valid::ValidationFlags::all(), capabilities(path))
         .validate(&module)
@@ -28,14 +37,17 @@ fn validate(path: &str) -> Result<(), String> {
 
 #[test]
 fn every_wgsl_file_validates() {
-    let modules = lineao::shader::files().filter(|(path, _)| !lineao::shader::FRAGMENTS.contains(path));
-    let failures: Vec<String> =
-        modules.filter_map(|(path, _)| validate(path).err().map(|e| format!("{path}:\n{e}"))).collect();
+    let modules = libraries().flat_map(|(library, files)| files.into_iter().map(move |(path, _)| (library, path)));
+    let failures: Vec<String> = modules
+        .filter(|(_, path)| !lineao::shader::FRAGMENTS.contains(path))
+        .filter_map(|(library, path)| validate(path, library).err().map(|e| format!("{path}:\n{e}")))
+        .collect();
     assert!(failures.is_empty(), "{}", failures.join("\n"));
     // A fragment validates within the modules that import it: at least one does.
     for fragment in lineao::shader::FRAGMENTS {
         let import = format!("#import {fragment}");
-        let importers = lineao::shader::files().filter(|(_, source)| source.lines().any(|l| l.trim() == import));
+        let importers =
+            libraries().flat_map(|(_, files)| files).filter(|(_, source)| source.lines().any(|l| l.trim() == import));
         assert!(importers.count() > 0, "{fragment} is imported by no module");
     }
 }
@@ -67,7 +79,7 @@ fn every_wgsl_file_on_disk_is_embedded() {
     }
     on_disk.sort();
     let mut embedded: Vec<(String, String)> =
-        lineao::shader::files().map(|(p, s)| (p.to_string(), s.to_string())).collect();
+        libraries().flat_map(|(_, files)| files).map(|(p, s)| (p.to_string(), s.to_string())).collect();
     embedded.sort();
     let names = |files: &[(String, String)]| files.iter().map(|(p, _)| p.clone()).collect::<Vec<_>>();
     assert_eq!(names(&on_disk), names(&embedded));

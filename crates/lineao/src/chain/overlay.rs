@@ -13,8 +13,8 @@
 use super::AoChain;
 use crate::Error;
 use crate::LineGeometry;
-use crate::passes::composite::OverlayDepth;
 use crate::passes::meshes::MeshGeometry;
+use crate::passes::seed_depth::OverlayDepth;
 use crate::passes::seed_depth::{SeedDepth, can_read};
 
 /// An [`AoChain`] that draws its geometry into a host's frame.

@@ -250,7 +250,7 @@ pub(crate) struct Page {
     pub pieces: u64,
     /// Its culling state for lines and tubes, each at levels of detail or not (each marks what
     /// it found visible, and at which level), made on its first culled frame.
-    pub cull: [std::sync::OnceLock<crate::passes::cull::PageCull>; 4],
+    pub cull: [std::sync::OnceLock<crate::passes::cull::page::PageCull>; 4],
     points: u32,
     runs: Vec<RunMap>,
     /// Per record, its polyline (for [`LineGeometry::set_selection`]).
@@ -268,7 +268,7 @@ impl Page {
     /// Bytes of its buffers.
     fn bytes(&self) -> u64 {
         let attributes: u64 = self.attributes.iter().flatten().map(wgpu::Buffer::size).sum();
-        let cull: u64 = self.cull.iter().filter_map(|c| c.get()).map(crate::passes::cull::PageCull::bytes).sum();
+        let cull: u64 = self.cull.iter().filter_map(|c| c.get()).map(crate::passes::cull::page::PageCull::bytes).sum();
         let own = self.xy.size() + self.z.size() + self.clusters.size() + self.groups.size();
         // (`streamlines` is on the CPU.)
         own + attributes + self.uniform.size() + cull
@@ -736,11 +736,7 @@ impl LineGeometry {
     /// Each page's cluster records, points (page order) and group boxes (min, max) as the GPU
     /// holds them, read back: what the cull's CPU reference tests ([`crate::reference::cull`]).
     #[cfg(feature = "reference")]
-    pub fn page_contents(
-        &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-    ) -> Result<Vec<crate::reference::cull::PageContents>, Error> {
+    pub fn page_contents(&self, device: &wgpu::Device, queue: &wgpu::Queue) -> Result<Vec<PageContents>, Error> {
         let read = |buffer| pollster::block_on(crate::readback::read_buffer_async(device, queue, buffer));
         self.pages
             .iter()
@@ -751,14 +747,22 @@ impl LineGeometry {
                     .iter()
                     .map(|g| (Vec3::new(g[0], g[1], g[2]), Vec3::new(g[4], g[5], g[6])))
                     .collect();
-                Ok(crate::reference::cull::PageContents {
-                    records,
-                    points: compute::decode(device, queue, page)?,
-                    groups,
-                })
+                Ok(PageContents { records, points: compute::decode(device, queue, page)?, groups })
             })
             .collect()
     }
+}
+
+/// One page as the GPU holds it ([`LineGeometry::page_contents`]), what the cull's CPU
+/// reference tests ([`crate::reference::cull`]).
+#[cfg(feature = "reference")]
+pub struct PageContents {
+    /// Its clusters' records.
+    pub records: Vec<ClusterRecord>,
+    /// Every point decoded on its cluster's grid, in page order.
+    pub points: Vec<[f32; 3]>,
+    /// Per group of GROUP_CLUSTERS (16) consecutive records, its box (min, max).
+    pub groups: Vec<(Vec3, Vec3)>,
 }
 
 /// A storage buffer holding `bytes` (words; at least one), written through the queue; an allocation

@@ -50,11 +50,10 @@ pub struct MethodInfo {
     pub screen_space: bool,
     /// The timing spans its stage can record, in chain order (docs/reference.md's names).
     pub spans: &'static [&'static str],
-    /// Its WGSL files, by the name its passes compose them under.
-    pub shaders: &'static [(&'static str, &'static str)],
-    /// The numbers its WGSL shares with its CPU reference, which Rust writes into the WGSL
+    /// Its WGSL files, by the name its passes compose them under, and the numbers its WGSL
+    /// shares with its CPU reference, which Rust writes into the WGSL
     /// ([`crate::shader::CONSTANTS`]).
-    pub constants: &'static [(&'static str, crate::shader::Constant)],
+    pub library: crate::shader::Library,
     /// Its stage; `None` for a method that runs no pass (`none`).
     pub(crate) build: Option<BuildStage>,
     /// Whether what its stage allocates for a guard-banded frame of this size fits the device's
@@ -205,8 +204,7 @@ const NONE: MethodInfo = MethodInfo {
     help: "Plain lines (with the illuminated-lines specular), no occlusion",
     screen_space: true,
     spans: &[],
-    shaders: &[],
-    constants: &[],
+    library: crate::shader::Library::SHARED,
     build: None,
     fits: fits_always,
     preset: |_, settings| settings.strength = 1.0,

@@ -24,10 +24,9 @@
 //!   z = −(near + nd.w · (far − near)),   depth = (P₂₂ z + P₂₃) / (P₃₂ z + P₃₃)
 //! ```
 
-use glam::Mat4;
-
 use crate::binding::{self, Slot};
 use crate::camera::FrameView;
+use crate::passes::seed_depth::OverlayDepth;
 use crate::settings::DebugView;
 use crate::targets::{FrameTargets, LevelsUniform, Target};
 use crate::timing::{self, Span};
@@ -61,31 +60,6 @@ pub struct CompositeUniform {
     pub far: f32,
     /// Padding to WGSL's 16-byte alignment.
     pub _pad1: [u32; 2],
-}
-
-/// The depth of a host's frame that an overlay writes and tests against: its format and the
-/// projection the host draws with (any convention: standard or reversed-Z, finite or infinite
-/// far plane; perspective or orthographic).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct OverlayDepth {
-    /// The host's depth format.
-    pub format: wgpu::TextureFormat,
-    /// The projection the host draws with.
-    pub proj: Mat4,
-}
-
-impl OverlayDepth {
-    /// The z and w rows of the projection: depth = (x z + y) / (z z + w) of a view-space z.
-    fn rows(&self) -> [f32; 4] {
-        super::seed_depth::depth_rows(&self.proj)
-    }
-
-    /// Whether depth grows toward the eye (reversed-Z), so the test keeps the greater.
-    pub(crate) fn reversed(&self) -> bool {
-        let [a, b, c, d] = self.rows();
-        let depth = |z: f32| (a * z + b) / (c * z + d);
-        depth(-1.0) > depth(-2.0)
-    }
 }
 
 /// The overlay pipeline and the depth it was made for.

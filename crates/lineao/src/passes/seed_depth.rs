@@ -17,13 +17,37 @@ use glam::Mat4;
 
 use crate::binding::{self, Slot};
 use crate::camera::FrameView;
-use crate::passes::composite::OverlayDepth;
 use crate::targets::{self, FrameTargets};
 
 /// The z and w rows of `proj`: depth = (x z + y) / (z z + w) of a view-space z.
 pub(crate) fn depth_rows(proj: &Mat4) -> [f32; 4] {
     let (z, w) = (proj.row(2), proj.row(3));
     [z.z, z.w, w.z, w.w]
+}
+
+/// The depth of a host's frame that an overlay writes and tests against: its format and the
+/// projection the host draws with (any convention: standard or reversed-Z, finite or infinite
+/// far plane; perspective or orthographic).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OverlayDepth {
+    /// The host's depth format.
+    pub format: wgpu::TextureFormat,
+    /// The projection the host draws with.
+    pub proj: Mat4,
+}
+
+impl OverlayDepth {
+    /// The z and w rows of the projection: depth = (x z + y) / (z z + w) of a view-space z.
+    pub(crate) fn rows(&self) -> [f32; 4] {
+        depth_rows(&self.proj)
+    }
+
+    /// Whether depth grows toward the eye (reversed-Z), so the test keeps the greater.
+    pub(crate) fn reversed(&self) -> bool {
+        let [a, b, c, d] = self.rows();
+        let depth = |z: f32| (a * z + b) / (c * z + d);
+        depth(-1.0) > depth(-2.0)
+    }
 }
 
 /// Whether the chain can read `depth` (a host's depth texture) to seed its own: it needs

@@ -340,8 +340,9 @@ fn percentiles(values: &[f32], quantiles: [f32; 2]) -> [f32; 2] {
     if hi > lo { [lo, hi] } else { [lo, lo + 1.0] }
 }
 
-/// The corners of a slice's polygon ([`SliceVolume::outline`]; `OUTLINE_SIDES` in WGSL).
-pub const OUTLINE_SIDES: usize = 32;
+/// The corners of a slice's polygon ([`SliceVolume::outline`]; a number the WGSL shares:
+/// [`crate::shader::PASS_CONSTANTS`]).
+pub use crate::shader::OUTLINE_SIDES;
 /// The `vec4`s of the three axes' polygons in [`SliceUniform`].
 const OUTLINE_WORDS: usize = 3 * OUTLINE_SIDES / 2;
 

@@ -19,17 +19,8 @@
 use glam::{Mat4, Vec3, Vec4Swizzles};
 
 use super::Image;
-use crate::line_geometry::{ClusterRecord, GROUP_CLUSTERS, PIECE_SEGMENTS};
-
-/// One page as the GPU holds it ([`crate::LineGeometry::page_contents`]).
-pub struct PageContents {
-    /// Its clusters' records.
-    pub records: Vec<ClusterRecord>,
-    /// Every point decoded on its cluster's grid, in page order.
-    pub points: Vec<[f32; 3]>,
-    /// Per group of GROUP_CLUSTERS (16) consecutive records, its box (min, max).
-    pub groups: Vec<(Vec3, Vec3)>,
-}
+pub use crate::line_geometry::PageContents;
+use crate::line_geometry::{GROUP_CLUSTERS, PIECE_SEGMENTS};
 
 /// The frame the cull tested against.
 pub struct CullView {

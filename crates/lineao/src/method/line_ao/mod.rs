@@ -79,8 +79,10 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     help: "LineAO (Eichelbaum et al. 2013): hemispheres of growing radius on a Gaussian pyramid of normals and depth",
     screen_space: true,
     spans: &["nd-pyramid", "lineao"],
-    shaders: &[("line_ao.wgsl", include_str!("line_ao.wgsl"))],
-    constants: &[("OUTER_DEPTH_TOLERANCE", crate::shader::Constant::F32(OUTER_DEPTH_TOLERANCE))],
+    library: crate::shader::Library {
+        files: &[("line_ao.wgsl", include_str!("line_ao.wgsl"))],
+        constants: &[("OUTER_DEPTH_TOLERANCE", crate::shader::Constant::F32(OUTER_DEPTH_TOLERANCE))],
+    },
     build: Some(|device, settings| Box::new(LineAoStage::new(device, settings))),
     fits: super::fits_always,
     preset: settings::preset,
@@ -250,7 +252,7 @@ impl LineAo {
             device,
             "lineao::LineAo::pipeline",
             &layout,
-            "line_ao.wgsl",
+            METHOD.library.source("line_ao.wgsl"),
             "line_ao",
             &constants,
         );
@@ -259,7 +261,14 @@ impl LineAo {
                 let mut constants = constants.to_vec();
                 constants.push(("LEVEL", j as f64));
                 let label = format!("lineao::LineAo::outer[{j}]");
-                binding::compute_pipeline(device, &label, &outer_layout, "line_ao.wgsl", "line_ao_outer", &constants)
+                binding::compute_pipeline(
+                    device,
+                    &label,
+                    &outer_layout,
+                    METHOD.library.source("line_ao.wgsl"),
+                    "line_ao_outer",
+                    &constants,
+                )
             })
             .collect();
         LineAo {
@@ -465,7 +474,7 @@ impl crate::method::Stage for LineAoStage {
 fn uniform_matches_its_wgsl_struct() {
     crate::shader::assert_wgsl_layout!(
         LineAoUniform,
-        "line_ao.wgsl",
+        METHOD.library.source("line_ao.wgsl"),
         "LineAoUniform",
         [levels, noise_origin, r0_px, delta0, reference_scale, epsilon, r0_zoom, delta_scale]
     );

@@ -26,6 +26,7 @@ use super::settings::RayDenoiseSettings;
 use crate::binding::{self, Slot};
 use crate::camera::FrameView;
 use crate::passes::dispatch_full_screen;
+use crate::shader::Library;
 use crate::targets::{AO_FORMAT, FrameTargets};
 use crate::timing::Span;
 use crate::view_params::{ViewParams, ViewUniform};
@@ -47,6 +48,10 @@ struct DenoiseUniform {
 
 const LABEL: &str = "lineao::RayDenoise";
 
+/// Its WGSL file, one of the ray tracer's ([`super::METHOD`]'s library lists it).
+pub(crate) const WGSL: (&str, &str) = ("ray_denoise.wgsl", include_str!("ray_denoise.wgsl"));
+const LIBRARY: Library = Library { files: &[WGSL], constants: &[] };
+
 /// The edge-aware denoiser after the rays: a window over the same line or surface that narrows
 /// as 1/√rays.
 pub struct RayDenoise {
@@ -62,7 +67,7 @@ impl RayDenoise {
         let slots = [Slot::Uniform, Slot::Texture, Slot::StorageTexture(AO_FORMAT), Slot::Storage];
         let layout = binding::layout(device, LABEL, wgpu::ShaderStages::COMPUTE, &slots);
         RayDenoise {
-            pipeline: binding::compute_pipeline(device, LABEL, &layout, "ray_denoise.wgsl", "ray_denoise", &[]),
+            pipeline: binding::compute_pipeline(device, LABEL, &layout, LIBRARY.source(WGSL.0), "ray_denoise", &[]),
             uniform: binding::uniform_buffer::<DenoiseUniform>(device, LABEL),
             layout,
             group: None,
@@ -117,7 +122,7 @@ impl RayDenoise {
 fn uniform_matches_its_wgsl_struct() {
     crate::shader::assert_wgsl_layout!(
         DenoiseUniform,
-        "ray_denoise.wgsl",
+        LIBRARY.source(WGSL.0),
         "Denoise",
         [view, radius, spatial, normal_power, depth_tolerance, reach, width, height, rays]
     );

@@ -49,11 +49,10 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     help: "Ray-traced AO on the GPU, accumulated while the view rests: the ground truth",
     screen_space: false,
     spans: &["raytraced", "ray-denoise"],
-    shaders: &[
-        ("raytraced_ao.wgsl", include_str!("raytraced_ao.wgsl")),
-        ("ray_denoise.wgsl", include_str!("ray_denoise.wgsl")),
-    ],
-    constants: &[],
+    library: crate::shader::Library {
+        files: &[("raytraced_ao.wgsl", include_str!("raytraced_ao.wgsl")), denoise::WGSL],
+        constants: &[],
+    },
     build: Some(|device, _| Box::new(RayTracedAo::new(device))),
     fits,
     preset: |_, settings| settings.strength = 1.0,
@@ -273,7 +272,7 @@ impl RayTracedAo {
                 &self.device,
                 LABEL,
                 &self.layout,
-                "raytraced_ao.wgsl",
+                METHOD.library.source("raytraced_ao.wgsl"),
                 "raytraced_ao",
                 &constants,
             )
@@ -442,7 +441,7 @@ impl crate::method::Stage for RayTracedAo {
 fn uniform_matches_its_wgsl_struct() {
     crate::shader::assert_wgsl_layout!(
         TraceUniform,
-        "raytraced_ao.wgsl",
+        METHOD.library.source("raytraced_ao.wgsl"),
         "Trace",
         [
             view,

@@ -6,8 +6,13 @@
 
 use crate::binding::{self, Slot};
 use crate::passes::dispatch_full_screen;
+use crate::shader::Library;
 use crate::targets::{AO_FORMAT, FrameTargets, Target};
 use crate::timing::Span;
+
+/// Its WGSL file, one of SSAO's ([`super::METHOD`]'s library lists it).
+pub(crate) const WGSL: (&str, &str) = ("ssao_blur.wgsl", include_str!("ssao_blur.wgsl"));
+const LIBRARY: Library = Library { files: &[WGSL], constants: &[] };
 
 /// Crytek SSAO's 4 × 4 box blur over its occlusion.
 pub struct SsaoBlur {
@@ -25,8 +30,14 @@ impl SsaoBlur {
             wgpu::ShaderStages::COMPUTE,
             &[Slot::Texture, Slot::Texture, Slot::StorageTexture(AO_FORMAT)],
         );
-        let pipeline =
-            binding::compute_pipeline(device, "lineao::SsaoBlur::pipeline", &layout, "ssao_blur.wgsl", "blur", &[]);
+        let pipeline = binding::compute_pipeline(
+            device,
+            "lineao::SsaoBlur::pipeline",
+            &layout,
+            LIBRARY.source(WGSL.0),
+            "blur",
+            &[],
+        );
         SsaoBlur { pipeline, layout, group: None }
     }
 

@@ -43,8 +43,10 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     help: "Crytek SSAO (Mittring 2007), the LineAO paper's baseline, with its 4 × 4 blur",
     screen_space: true,
     spans: &["ssao", "ssao-blur"],
-    shaders: &[("ssao.wgsl", include_str!("ssao.wgsl")), ("ssao_blur.wgsl", include_str!("ssao_blur.wgsl"))],
-    constants: &[("SSAO_EPSILON", crate::shader::Constant::F32(SSAO_EPSILON))],
+    library: crate::shader::Library {
+        files: &[("ssao.wgsl", include_str!("ssao.wgsl")), blur::WGSL],
+        constants: &[("SSAO_EPSILON", crate::shader::Constant::F32(SSAO_EPSILON))],
+    },
     build: Some(|device, settings| Box::new(SsaoStage::new(device, settings))),
     fits: super::fits_always,
     preset: settings::preset,
@@ -100,7 +102,7 @@ impl Ssao {
             device,
             "lineao::Ssao::pipeline",
             &layout,
-            "ssao.wgsl",
+            METHOD.library.source("ssao.wgsl"),
             "ssao",
             &[("SAMPLES", settings.samples as f64)],
         );
@@ -226,5 +228,10 @@ impl crate::method::Stage for SsaoStage {
 #[cfg(test)]
 #[test]
 fn uniform_matches_its_wgsl_struct() {
-    crate::shader::assert_wgsl_layout!(SsaoUniform, "ssao.wgsl", "SsaoUniform", [view, noise_origin, radius, range]);
+    crate::shader::assert_wgsl_layout!(
+        SsaoUniform,
+        METHOD.library.source("ssao.wgsl"),
+        "SsaoUniform",
+        [view, noise_origin, radius, range]
+    );
 }

@@ -77,8 +77,7 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     // stay the papers' methods in a test build.
     screen_space: false,
     spans: &["toy"],
-    shaders: &[("toy.wgsl", include_str!("toy.wgsl"))],
-    constants: &[],
+    library: crate::shader::Library { files: &[("toy.wgsl", include_str!("toy.wgsl"))], constants: &[] },
     build: Some(|device, _| Box::new(Toy::new(device))),
     fits: super::fits_always,
     preset: |_, settings| settings.strength = 1.0,
@@ -100,7 +99,8 @@ impl Toy {
     fn new(device: &wgpu::Device) -> Toy {
         let slots = [Slot::Uniform, Slot::Texture, Slot::StorageTexture(AO_FORMAT)];
         let layout = binding::layout(device, "lineao::Toy", wgpu::ShaderStages::COMPUTE, &slots);
-        let pipeline = binding::compute_pipeline(device, "lineao::Toy", &layout, "toy.wgsl", "toy", &[]);
+        let pipeline =
+            binding::compute_pipeline(device, "lineao::Toy", &layout, METHOD.library.source("toy.wgsl"), "toy", &[]);
         let uniform = binding::uniform_buffer::<ToyUniform>(device, "lineao::Toy");
         Toy { pipeline, layout, uniform, group: None }
     }
@@ -155,7 +155,12 @@ mod tests {
 
     #[test]
     fn the_uniform_is_laid_out_as_the_wgsl_reads_it() {
-        crate::shader::assert_wgsl_layout!(super::ToyUniform, "toy.wgsl", "ToyUniform", [occlusion]);
+        crate::shader::assert_wgsl_layout!(
+            super::ToyUniform,
+            super::METHOD.library.source("toy.wgsl"),
+            "ToyUniform",
+            [occlusion]
+        );
     }
 
     #[test]
@@ -164,7 +169,7 @@ mod tests {
         assert!(AoMethod::REGISTRY.contains(&toy));
         assert!(crate::method::bench_passes().any(|(m, pass)| m == toy && pass.name == "toy"));
         assert!(crate::method::pass_names().contains(&"toy"));
-        assert!(crate::shader::raw("toy.wgsl").is_some());
+        assert!(crate::shader::raw("toy.wgsl", &super::METHOD.library).is_some());
         // Its preset and validation come through the registry too.
         let mut settings =
             ChainSettings { method: toy, ..ChainSettings::default() }.with_preset(crate::Preset::Legible);

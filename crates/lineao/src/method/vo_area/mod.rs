@@ -40,8 +40,10 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     help: "Volumetric Obscurance with area samples over a pyramid of depth moments (Loos & Sloan 2010, §4.2)",
     screen_space: true,
     spans: &["moments", "vo-area"],
-    shaders: &[("vo_area.wgsl", include_str!("vo_area.wgsl")), ("moments.wgsl", include_str!("moments.wgsl"))],
-    constants: &[("MAX_MOMENT_LEVELS", crate::shader::Constant::U32(moments::MAX_MOMENT_LEVELS as u32))],
+    library: crate::shader::Library {
+        files: &[("vo_area.wgsl", include_str!("vo_area.wgsl")), moments::LIBRARY.files[0], moments::LIBRARY.files[1]],
+        constants: moments::LIBRARY.constants,
+    },
     build: Some(|device, settings| Box::new(VoArea::new(device, &settings.vo))),
     fits: moments::fits,
     preset: |preset, settings| crate::method::vo_line::preset(preset, settings, 1.0, 1.0),
@@ -69,7 +71,7 @@ impl VoArea {
         let table: Vec<[f32; 4]> = samples.iter().zip(lod).map(|(s, w)| [s[0], s[1], s[2], w]).collect();
         VoArea {
             moments: MomentsPyramid::new(device),
-            core: VoCore::new(device, "lineao::VoArea", "vo_area.wgsl", &table, settings, true),
+            core: VoCore::new(device, "lineao::VoArea", METHOD.library.source("vo_area.wgsl"), &table, settings, true),
             max_level: 0,
         }
     }

@@ -14,13 +14,23 @@
 use crate::binding::{self, Slot};
 use crate::camera::FrameView;
 use crate::passes::dispatch_size;
+use crate::shader::{Constant, Library};
 use crate::targets::FrameTargets;
 use crate::timing::{self, Span};
 use crate::view_params::ViewParams;
 use crate::view_params::ViewUniform;
 
-/// Levels the moments pyramid can have (`shared/moments.wgsl`): enough for 32768² pixels.
+/// Levels the moments pyramid can have (`moments_layout.wgsl`): enough for 32768² pixels.
 pub const MAX_MOMENT_LEVELS: usize = 16;
+
+/// The pyramid's WGSL and the number it shares with Rust (`moments_layout.wgsl`, which `vo_area.wgsl` imports too, reads it).
+pub(crate) const LIBRARY: Library = Library {
+    files: &[
+        ("moments.wgsl", include_str!("moments.wgsl")),
+        ("moments_layout.wgsl", include_str!("moments_layout.wgsl")),
+    ],
+    constants: &[("MAX_MOMENT_LEVELS", Constant::U32(MAX_MOMENT_LEVELS as u32))],
+};
 
 /// One level of [`Moments`]: `width` × `height` texels from element `offset`, row-major.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -133,7 +143,8 @@ impl MomentsPyramid {
             wgpu::ShaderStages::COMPUTE,
             &[Slot::Uniform, Slot::Uniform, Slot::Uniform, Slot::Texture, Slot::StorageReadWrite],
         );
-        let pipeline = |entry| binding::compute_pipeline(device, label, &layout, "moments.wgsl", entry, &[]);
+        let pipeline =
+            |entry| binding::compute_pipeline(device, label, &layout, LIBRARY.source("moments.wgsl"), entry, &[]);
         MomentsPyramid {
             level0: pipeline("level0"),
             downsample: pipeline("downsample"),

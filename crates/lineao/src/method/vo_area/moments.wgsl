@@ -10,7 +10,7 @@
 // is per pixel), and a buffer lets every level be written and read in one binding.
 #import shared/nd.wgsl
 #import shared/view.wgsl
-#import shared/moments.wgsl
+#import moments_layout.wgsl
 
 @group(0) @binding(0) var<uniform> view: ViewParams;
 @group(0) @binding(1) var<uniform> levels: array<vec4<u32>, MAX_MOMENT_LEVELS>;

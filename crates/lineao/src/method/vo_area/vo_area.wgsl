@@ -14,7 +14,7 @@
 // on screen, crosses P's tangent plane (`tangent_plane_depth`), as line sampling does.
 #import shared/nd.wgsl
 #import shared/vo_pass.wgsl
-#import shared/moments.wgsl
+#import moments_layout.wgsl
 
 // The tables' w: ½ log2(π A_i/ΣA), each sample's footprint.
 // The moments pyramid (`moments.wgsl`): its layout and (E[z], E[z²]) of every level.

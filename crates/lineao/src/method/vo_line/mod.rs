@@ -48,8 +48,7 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     help: "Volumetric Obscurance with line samples (Loos & Sloan 2010, §4.1)",
     screen_space: true,
     spans: &["vo-line"],
-    shaders: &[("vo_line.wgsl", include_str!("vo_line.wgsl"))],
-    constants: &[],
+    library: crate::shader::Library { files: &[("vo_line.wgsl", include_str!("vo_line.wgsl"))], constants: &[] },
     build: Some(|device, settings| Box::new(VoLine::new(device, &settings.vo))),
     fits: super::fits_always,
     preset: |preset, settings| settings::preset(preset, settings, 2.0, 1.5),
@@ -133,7 +132,7 @@ impl VoCore {
     pub(crate) fn new(
         device: &wgpu::Device,
         label: &'static str,
-        shader: &str,
+        shader: crate::shader::Source<'_>,
         samples: &[[f32; 4]],
         settings: &VoSettings,
         reads_moments: bool,
@@ -205,7 +204,16 @@ impl VoLine {
             .iter()
             .map(|s| [s[0], s[1], s[2], crate::sample_sets::vo_chord_half(s[0], s[1])])
             .collect();
-        VoLine { core: VoCore::new(device, "lineao::VoLine", "vo_line.wgsl", &samples, settings, false) }
+        VoLine {
+            core: VoCore::new(
+                device,
+                "lineao::VoLine",
+                METHOD.library.source("vo_line.wgsl"),
+                &samples,
+                settings,
+                false,
+            ),
+        }
     }
 
     /// Whether `settings` can reuse this pipeline and its tables.

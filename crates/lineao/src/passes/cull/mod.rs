@@ -102,6 +102,10 @@ use crate::passes::depth_pyramid::{Built, DepthPyramid};
 use crate::targets::FrameTargets;
 use crate::timing::Span;
 
+pub(crate) mod page;
+use page::PageCapsules;
+pub use page::{LevelsView, PageCull};
+
 /// Workgroups per row of a dispatch, as `ROW` in `shaders/cull.wgsl`.
 const ROW: u32 = 32768;
 /// Invocations of a workgroup of `early` (one a cluster) and `test_groups` (one a group).
@@ -188,80 +192,10 @@ pub enum Frozen {
     All,
 }
 
-/// The view a page's levels of detail were found for.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct LevelsView {
-    view: glam::Mat4,
-    proj: glam::Mat4,
-    near: f32,
-    orthographic: bool,
-}
-
-impl LevelsView {
-    /// The levels of the depth pyramid for `view`.
-    pub fn of(view: &crate::FrameView) -> LevelsView {
-        LevelsView { view: view.view, proj: view.proj, near: view.near, orthographic: view.orthographic }
-    }
-
-    /// Whether levels found for this view keep a frame of `now` within about their bound: the
-    /// same projection, and (perspective) the eye moved by under 5 % of the near distance —
-    /// what the nearest line's depth, and so its pixels per unit, changes by at most — and the
-    /// view direction turned by under 0.05 rad.
-    pub fn holds(&self, now: &LevelsView) -> bool {
-        if self.proj != now.proj {
-            return false;
-        }
-        if self.orthographic {
-            // Orthographic: a unit spans the same pixels wherever it lies.
-            return true;
-        }
-        let (before, after) = (self.view.inverse(), now.view.inverse());
-        let moved = before.w_axis.truncate().distance(after.w_axis.truncate());
-        let turned = before.z_axis.truncate().angle_between(after.z_axis.truncate());
-        moved < 0.05 * self.near && turned < 0.05
-    }
-}
-
-/// A page's capsules: the pieces `late_bounds` lists for `late` and each piece's bounding
-/// radius (about 0.9 bytes a point), with the state and the pieces (`late_bounds`, `late`,
-/// `piece_radii`).
-struct PageCapsules {
-    bounds: wgpu::Buffer,
-    group: wgpu::BindGroup,
-}
-
-/// A page's culling state (see the module documentation).
-pub struct PageCull {
-    /// The indirect draws (and, in the same buffer, the marks and the listed groups).
-    pub(crate) state: wgpu::Buffer,
-    /// The early and the late list of visible pieces, read by the vertex shader (group 2 of
-    /// `lines.wgsl`, `tubes.wgsl`).
-    draw_groups: [wgpu::BindGroup; 2],
-    compute_group: wgpu::BindGroup,
-    /// With the listed groups' dispatch (`test_groups`, `size_dispatch`).
-    listing_group: wgpu::BindGroup,
-    /// The page's arrays the tests read.
-    geometry: wgpu::BindGroup,
-    pub(crate) pieces: wgpu::Buffer,
-    listing: wgpu::Buffer,
-    /// What the capsule test adds, made where it first runs ([`LineCull::set_capsules`]).
-    capsules: std::sync::OnceLock<PageCapsules>,
-    /// The view its marks' levels of detail were found for.
-    levels_of: std::sync::Mutex<Option<LevelsView>>,
-    /// Whether a frame culled it before (its first lists a seed: [`SEED_STRIDE`]).
-    culled_before: std::sync::atomic::AtomicBool,
-}
-
 impl PageCull {
     /// The pieces `phase` draws, as the vertex shader reads them.
     pub(crate) fn draw_group(&self, phase: Phase) -> &wgpu::BindGroup {
         &self.draw_groups[phase as usize]
-    }
-
-    /// Bytes of its buffers.
-    pub fn bytes(&self) -> u64 {
-        let capsules = self.capsules.get().map_or(0, |c| c.bounds.size());
-        self.state.size() + self.pieces.size() + self.listing.size() + capsules
     }
 }
 
