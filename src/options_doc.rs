@@ -110,7 +110,7 @@ fn url_table(out: &mut String, url_keys: &UrlKeys) {
 
 /// Whether `flag` is a setting of a method built for tests only, which users' builds lack.
 pub fn for_tests(flag: &str) -> bool {
-    lineao::AoMethod::FOR_TESTS.iter().any(|m| m.info().settings.iter().any(|s| s.flag == flag))
+    lineao::AoMethod::FOR_TESTS.iter().any(|m| m.info().settings().any(|s| s.flag == flag))
 }
 
 /// Text on one line.

@@ -1054,7 +1054,7 @@ fn only_its_folder_and_its_registry_line_name_the_toy() {
             let source_lines = text.lines().take_while(|l| l.trim() != "#[cfg(test)]");
             for (k, line) in source_lines.enumerate() {
                 // The registry's line and the module's declaration, each under the feature.
-                let registry = line.contains("Toy => crate::method::toy::METHOD")
+                let registry = line.contains("Toy => toy { toy: ToySettings }")
                     || line.trim() == "pub mod toy;"
                     || line.contains(r#"feature = "toy-method""#)
                     || line.contains("(feature `toy-method`");

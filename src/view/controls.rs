@@ -350,9 +350,8 @@ impl Controls {
         let shown = if self.compare { &self.methods[..] } else { &self.methods[..1] };
         for (method, setting) in lineao_session::method_args::described() {
             let chain = &self.params.chain;
-            let value = (setting.get)(chain);
-            if !shown.iter().any(|m| m.screen == method) || !(setting.applies)(chain) || value == (setting.get)(&opened)
-            {
+            let value = setting.get(chain);
+            if !shown.iter().any(|m| m.screen == method) || !setting.applies(chain) || value == setting.get(&opened) {
                 continue;
             }
             let text = match setting.kind {
@@ -362,7 +361,7 @@ impl Controls {
                 _ => value.to_string(),
             };
             flags.push((setting.flag.to_string(), text));
-            (setting.set)(&mut opened, value);
+            setting.set(&mut opened, value);
         }
         let color = match &self.color {
             ColorMode::Tangent => None,
@@ -539,7 +538,8 @@ impl Controls {
         ui.add(egui::Slider::new(&mut p.chain.strength, 0.0..=2.0).text("strength"));
         // Each method's panel: its settings' descriptions (object-space AO's, not a method of
         // the registry, below is written out).
-        for method in AoMethod::REGISTRY.iter().copied().filter(|&m| screen(m) && !m.info().settings.is_empty()) {
+        for method in AoMethod::REGISTRY.iter().copied().filter(|&m| screen(m) && m.info().settings().next().is_some())
+        {
             egui::CollapsingHeader::new(method.info().label)
                 .default_open(true)
                 .show(ui, |ui| described_ui(ui, method, &mut p.chain));
@@ -880,8 +880,8 @@ fn method_combo(ui: &mut Ui, id: &str, method: &mut Method) {
 pub fn described_ui(ui: &mut Ui, method: AoMethod, chain: &mut ChainSettings) {
     let info = method.info();
     let scale = chain.zoom_unit;
-    for setting in info.settings {
-        if !(setting.applies)(chain) {
+    for setting in info.settings() {
+        if !setting.applies(chain) {
             continue;
         }
         let label = match setting.unit {
@@ -889,7 +889,7 @@ pub fn described_ui(ui: &mut Ui, method: AoMethod, chain: &mut ChainSettings) {
             unit => format!("{} ({})", setting.label, unit.name()),
         };
         let world = if setting.unit == Unit::WorldUnits { scale } else { 1.0 };
-        let changed = match (setting.kind, (setting.get)(chain)) {
+        let changed = match (setting.kind, setting.get(chain)) {
             (Kind::Number { min, max, log, .. }, Value::Number(mut x)) => {
                 let slider = egui::Slider::new(&mut x, min * world..=max * world).logarithmic(log).text(label);
                 ui.add(slider).on_hover_text(setting.help).changed().then_some(Value::Number(x))
@@ -933,8 +933,8 @@ pub fn described_ui(ui: &mut Ui, method: AoMethod, chain: &mut ChainSettings) {
             }
         };
         if let Some(value) = changed {
-            (setting.set)(chain, value);
-            (info.conform)(chain);
+            setting.set(chain, value);
+            info.conform(chain);
         }
     }
 }

@@ -264,8 +264,8 @@ pub fn write(
     }
     // Our extension of docs/reference.md: the method's described settings (`lineao::method::setting`)
     // by their keywords, as `render` takes them (a switch: whether its flag is in force).
-    let flags = s.method.info().settings.iter().map(|d| {
-        let value = match ((d.get)(s), d.kind) {
+    let flags = s.method.info().settings().map(|d| {
+        let value = match (d.get(s), d.kind) {
             (Value::Number(x), _) => json!(x),
             (share @ Value::Share(_), _) => json!(share.to_string()),
             (Value::Count(n), _) => json!(n),

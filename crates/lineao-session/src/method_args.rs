@@ -12,7 +12,8 @@
 use clap::builder::TypedValueParser;
 use clap::parser::ValueSource;
 use clap::{Arg, ArgAction, ArgMatches, Command};
-use lineao::method::setting::{Kind, Role, Setting, Value};
+use lineao::method::ChainSetting;
+use lineao::method::setting::{Kind, Role, Value};
 use lineao::{AoMethod, ChainSettings};
 
 /// The described settings given explicitly, by flag, in the order of the registry.
@@ -23,9 +24,9 @@ pub struct MethodArgs {
 
 /// Every method's described settings, in the registry's order, each once (the first method
 /// that lists it: VO area lists VO line's sphere).
-pub fn described() -> impl Iterator<Item = (AoMethod, &'static Setting)> {
+pub fn described() -> impl Iterator<Item = (AoMethod, ChainSetting)> {
     let mut seen = std::collections::BTreeSet::new();
-    let all = AoMethod::REGISTRY.iter().flat_map(|&m| m.info().settings.iter().map(move |s| (m, s)));
+    let all = AoMethod::REGISTRY.iter().flat_map(|&m| m.info().settings().map(move |s| (m, s)));
     all.filter(move |(_, s)| seen.insert(s.flag))
 }
 
@@ -41,7 +42,7 @@ impl MethodArgs {
                 _ => None,
             };
             if let Some(value) = value.filter(|_| !self.given.iter().any(|(flag, _)| *flag == setting.flag)) {
-                (setting.set)(settings, value);
+                setting.set(settings, value);
             }
         }
         self.apply(settings);
@@ -62,7 +63,7 @@ impl MethodArgs {
     pub fn apply(&self, settings: &mut ChainSettings) {
         for (flag, value) in &self.given {
             if let Some((_, setting)) = described().find(|(_, s)| s.flag == *flag) {
-                (setting.set)(settings, *value);
+                setting.set(settings, *value);
             }
         }
     }
@@ -86,7 +87,7 @@ impl MethodArgs {
 
 /// The flag of `setting` (of `method`), its id Python's keyword: its help with the values it
 /// takes (`(> 0 world units)`) and its default.
-fn arg(method: AoMethod, setting: &'static Setting) -> Arg {
+fn arg(method: AoMethod, setting: ChainSetting) -> Arg {
     let mut arg = Arg::new(setting.keyword()).long(setting.flag);
     if let Some(flag) = setting.requires {
         arg = arg.requires(flag.replace('-', "_"));

@@ -41,7 +41,7 @@ pub fn gpu_settings(args: &RenderArgs, longest_side: f32) -> lineao::RayTracedSe
 /// `--ao-distance` as given (`2`, `20%`).
 pub fn reach_text(args: &RenderArgs) -> String {
     let (_, reach) = crate::method_args::described().find(|(_, s)| s.flag == "ao-distance").expect("described");
-    (reach.get)(&given(args)).to_string()
+    reach.get(&given(args)).to_string()
 }
 
 /// The papers' settings with the described settings the command line gave.

@@ -220,8 +220,8 @@ mod tests {
         page.view.methods.apply(&mut chain);
         let given: Vec<&str> = page.view.methods.given.iter().map(|(flag, _)| *flag).collect();
         assert_eq!(given, ["toy-radius", "toy-invert"]);
-        let described = AoMethod::from_name("toy").unwrap().info().settings;
-        let values: Vec<String> = described.iter().map(|s| (s.get)(&chain).to_string()).collect();
+        let described = AoMethod::from_name("toy").unwrap().info().settings();
+        let values: Vec<String> = described.map(|s| s.get(&chain).to_string()).collect();
         assert_eq!(values, ["1.5", "on"]);
         assert!(parse("toy-radius=9").unwrap_err().contains("--toy-radius must be in [0.25, 4] zoom units, got 9"));
     }
@@ -260,9 +260,9 @@ mod tests {
         let ssao = methods().into_iter().find(|m| m.screen == AoMethod::Ssao && m.volume.is_none()).unwrap();
         let mut controls = Controls::new([ssao, RAY_TRACED], true, lineao::Preset::Legible);
         // As the panel moves them: the radius sets the range check too, which then moves back.
-        let described = AoMethod::Ssao.info().settings;
         for (flag, value) in [("ssao-samples", Value::Count(8)), ("ssao-radius", Value::Number(3.3))] {
-            (described.iter().find(|s| s.flag == flag).unwrap().set)(&mut controls.params.chain, value);
+            let mut described = AoMethod::Ssao.info().settings();
+            described.find(|s| s.flag == flag).unwrap().set(&mut controls.params.chain, value);
         }
         controls.params.chain.ssao.range_world = 8.0;
         // A switch its flag cannot give (the denoiser off where the viewer turns it on) is left out.

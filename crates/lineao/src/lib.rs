@@ -102,6 +102,7 @@ pub mod noise;
 #[cfg(not(feature = "reference"))]
 pub(crate) mod noise;
 pub mod passes;
+mod preset;
 mod ray_scene;
 pub mod readback;
 #[cfg(feature = "reference")]
@@ -142,9 +143,10 @@ pub use passes::meshes::MeshGeometry;
 pub use passes::nd_from_depth::{HostConfig, HostInputs};
 pub use passes::seed_depth::OverlayDepth;
 pub use passes::slices::SliceVolume;
+pub use preset::Preset;
 pub use ray_scene::{RayGeometry, RayScene};
 pub use settings::{
-    BilateralSettings, ChainSettings, DebugView, LineColor, Preset, Slab, SlabAxis, SliceSettings, SurfaceSettings,
+    BilateralSettings, ChainSettings, DebugView, LineColor, Slab, SlabAxis, SliceSettings, SurfaceSettings,
     TransparencySettings, TubeSettings, VolumeAoSettings,
 };
 

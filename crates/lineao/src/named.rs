@@ -66,6 +66,24 @@ macro_rules! serde_by_name {
 }
 pub(crate) use serde_by_name;
 
+/// `impl FromStr` of a [`Named`] type by its names; an unknown one is an error naming `what` it
+/// should have been and listing the names (`unknown method 'gtao' (one of none, lineao, …)`).
+macro_rules! from_str_by_name {
+    ($ty:ty, $what:literal) => {
+        impl std::str::FromStr for $ty {
+            type Err = String;
+
+            fn from_str(name: &str) -> Result<$ty, String> {
+                <$ty as crate::named::Named>::from_name(name).ok_or_else(|| {
+                    let names: Vec<&str> = <$ty as crate::named::Named>::VALUES.iter().map(|v| v.name()).collect();
+                    format!("unknown {} '{name}' (one of {})", $what, names.join(", "))
+                })
+            }
+        }
+    };
+}
+pub(crate) use from_str_by_name;
+
 /// What an unknown name of a [`Named`] setting is told: the names it could have been.
 #[cfg(feature = "serde")]
 pub(crate) fn unknown<T: Named>(name: &str) -> String {

@@ -1,5 +1,5 @@
 //! User-facing settings of the LineAO pass chain. Each method's settings default to its paper's
-//! values; [`ChainSettings::default()`] is the default preset ([`Preset::Legible`]), which changes
+//! values; [`ChainSettings::default()`] is the default preset ([`crate::Preset::Legible`]), which changes
 //! LineAO's reach and every method's strength, as every front end does.
 
 use crate::lighting::Lighting;
@@ -7,9 +7,10 @@ use crate::named::{Named, named};
 
 // Each method's settings are its folder's (and the crate root's); named here for the crate.
 pub(crate) use crate::colormap::{COLORMAP_ENTRIES, Colormap};
-pub(crate) use crate::method::AoMethod;
-pub(crate) use crate::method::line_ao::R0;
-pub(crate) use crate::method::vo_line::VoCombine;
+use crate::method::line_ao::settings::R0;
+pub(crate) use crate::method::list::{AoMethod, for_each_method};
+use crate::method::setting::Context;
+use crate::method::vo_line::settings::VoCombine;
 
 /// Object-space AO in the chain ([`crate::volume`], [`crate::passes::volume_ao`]): the
 /// geometry's per-vertex octant visibilities ([`crate::passes::lines::VertexAttributes`])
@@ -317,14 +318,15 @@ impl Slab {
     }
 }
 
-/// Makes [`ChainSettings`] of the registry ([`crate::method`]'s `for_each_method!`): one field
-/// per method with settings of its own, which its registry line names (`LineAo => … { line_ao:
-/// LineAoSettings }`), so that a method's settings are in the chain's — and in its
-/// `--settings` JSON under that key — without this file naming them.
+/// Makes [`ChainSettings`] of the list of methods (`crate::method::list`'s
+/// `for_each_method!`): one field per method with settings of its own, which its line names
+/// (`LineAo => line_ao { line_ao: LineAoSettings }`, the type in its folder), so that a
+/// method's settings are in the chain's — and in its `--settings` JSON under that key —
+/// without this file naming them.
 macro_rules! chain_settings {
-    // The registry's lines: keep those with a field, with their `cfg`.
-    ($( $(#[doc = $doc:literal])* $(#[cfg($cfg:meta)])? $variant:ident => $info:path $({ $field:ident: $ty:ty })? ),+ $(,)?) => {
-        chain_settings!(@own [] $( [$(cfg($cfg))?] $variant [$($field: $ty)?] )+);
+    // The list's lines: keep those with a field, with their `cfg`.
+    ($( $(#[doc = $doc:literal])* $(#[cfg($cfg:meta)])? $variant:ident => $folder:ident $({ $field:ident: $ty:ident })? ),+ $(,)?) => {
+        chain_settings!(@own [] $( [$(cfg($cfg))?] $variant [$($field: crate::method::$folder::$ty)?] )+);
     };
     (@own [$($own:tt)*] [$($cfg:tt)*] $variant:ident [] $($rest:tt)*) => {
         chain_settings!(@own [$($own)*] $($rest)*);
@@ -393,7 +395,7 @@ macro_rules! chain_settings {
         impl ChainSettings {
             /// The papers' values for every setting (LineAO s_r 3, r0 1.5 × the line width, δ
             /// scale 1, strength 1; VO and SSAO spheres of 2 world units): `ChainSettings::default()`
-            /// before the default preset is applied, and what [`Preset::Paper`] restores.
+            /// before the default preset is applied, and what [`crate::Preset::Paper`] restores.
             pub fn papers() -> Self {
                 ChainSettings {
                     method: AoMethod::LineAo,
@@ -421,15 +423,7 @@ macro_rules! chain_settings {
     };
 }
 
-crate::method::for_each_method!(chain_settings);
-
-impl Default for ChainSettings {
-    /// The default preset's settings ([`Preset::Legible`], what every front end starts from):
-    /// the papers' values ([`ChainSettings::papers`]) with the preset's for LineAO.
-    fn default() -> Self {
-        ChainSettings::papers().with_preset(Preset::default())
-    }
-}
+for_each_method!(chain_settings);
 
 impl ChainSettings {
     /// The transparency the frame draws, where any line is transparent.
@@ -445,73 +439,7 @@ impl ChainSettings {
     }
 }
 
-/// A named set of parameters.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum Preset {
-    /// The papers' values ([`ChainSettings::papers`]).
-    Paper,
-    /// Each method's strength and reach fitted for *legibility* — visibly darker pixels lie
-    /// deeper ([`crate::truth::legibility`]) — with the picture kept readable (near-black ≤ 2 %,
-    /// mean darkening in [0.15, 0.45]): `lineao score --fit`, docs/ground-truth.md.
-    #[default]
-    Legible,
-    /// Each method's strength and reach fitted to the local ray-traced truth (binary AO within
-    /// 2 mm, least RMSE): physically close at that reach, but so faint on whole brains that it
-    /// looks like no AO at all. Was called `calibrated`, a name still accepted.
-    Physical,
-    /// For a few streamlines far apart (flow fields, a single bundle): the papers' values with
-    /// every method reaching farther, so that neighbours and not just a line's own body occlude
-    /// — LineAO's four hemispheres (the fourth reaches twice as far as the third), SSAO's and
-    /// VO's spheres of 6 zoom units — at a softer strength (0.8): the viewer's values for sparse
-    /// streamlines (`--scene vortex`), chosen by eye, not fitted.
-    Sparse,
-}
-
-named!(Preset {
-    Legible => "Each method's strength and reach chosen so that darker lines lie deeper (the default)",
-    Physical => "Fitted to binary AO within 2 mm (was `calibrated`; faint on whole brains)",
-    Paper => "The papers' values (`dense` too: whole-brain tractography)",
-    Sparse => "Few streamlines far apart: every method reaching farther, a softer strength",
-});
-
-impl Preset {
-    /// Every preset, the default first.
-    pub const ALL: [Preset; 4] = [Preset::Legible, Preset::Physical, Preset::Paper, Preset::Sparse];
-
-    /// The name on the command line (`legible`, `physical`, `paper`, `sparse`).
-    pub fn name(self) -> &'static str {
-        match self {
-            Preset::Paper => "paper",
-            Preset::Legible => "legible",
-            Preset::Physical => "physical",
-            Preset::Sparse => "sparse",
-        }
-    }
-
-    /// The preset called `name`; `calibrated`, the name `physical` had before, and `dense`, the
-    /// viewer's name for the papers' values, too.
-    pub fn from_name(name: &str) -> Option<Preset> {
-        match name {
-            "calibrated" => Some(Preset::Physical),
-            "dense" => Some(Preset::Paper),
-            _ => Preset::ALL.into_iter().find(|p| p.name() == name),
-        }
-    }
-}
-
 impl ChainSettings {
-    /// `self` with `preset`'s values for its method (and LineAO variant): the strength and the
-    /// method's own reach (each method's `preset` in its folder: LineAO's s_r, δ scale and r0,
-    /// VO's and SSAO's radius in zoom units). Every other method's values are the papers'.
-    /// [`Preset::Paper`] restores the papers' values of those ([`ChainSettings::papers`]).
-    pub fn with_preset(mut self, preset: Preset) -> ChainSettings {
-        for method in AoMethod::REGISTRY {
-            (method.info().preset)(Preset::Paper, &mut self);
-        }
-        (self.method.info().preset)(preset, &mut self);
-        self
-    }
-
     /// Settings for a host's triangle meshes ([`crate::HostAo`]) in a scene of bounding
     /// radius `scene_radius` (world units), chosen against the ray-traced truth: Volumetric
     /// Obscurance with line samples, the normal clamp and a thickness of one radius, reaching
@@ -538,11 +466,16 @@ impl ChainSettings {
         settings
     }
 
+    /// What a method's settings need of the chain around them: the line width, the tubes, the
+    /// zoom unit.
+    pub fn context(&self) -> Context {
+        Context { line_width_px: self.line_width_px, tubes: self.tubes.is_some(), zoom_unit: self.zoom_unit }
+    }
+
     /// r0's constant part in pixels: the explicit value, or `r0_per_width` × the line width
     /// (tubes: 0).
     pub fn r0_px(&self) -> f32 {
-        let default = if self.tubes.is_some() { 0.0 } else { self.line_ao.r0_per_width * self.line_width_px };
-        self.line_ao.r0_px.unwrap_or(default)
+        self.line_ao.r0_px(&self.context())
     }
 
     /// r0(P) of LineAO (paper §3.2.3, Eq. 16): for tubes 1.5 · z(P) · t_s, t_s = 2 × the radius
@@ -568,14 +501,9 @@ impl ChainSettings {
         }
     }
 
-    /// Pyramid levels the chain needs: what its method reads ([`crate::method::MethodInfo`]:
-    /// s_r for LineAO, one for the others and for LineAO's `reference` variant).
-    pub fn levels(&self) -> u32 {
-        (self.method.info().levels)(self)
-    }
-
-    /// Checks every range documented above.
-    pub fn validate(&self) -> Result<(), crate::Error> {
+    /// Checks every range documented above but the methods' own settings' (which
+    /// [`ChainSettings::validate`] checks after these).
+    pub(crate) fn validate_chain(&self) -> Result<(), crate::Error> {
         let bad = |what: String| Err(crate::Error::InvalidSettings(what));
         if let Some(blur) = &self.blur {
             blur.validate()?;
@@ -587,11 +515,6 @@ impl ChainSettings {
             && !(tubes.radius_world.is_finite() && tubes.radius_world > 0.0)
         {
             return bad(format!("the tube radius must be > 0 world units, got {}", tubes.radius_world));
-        }
-        // Each method's own settings (LineAO's r0 follows the width and the tubes checked above).
-        for method in AoMethod::REGISTRY {
-            crate::method::setting::check_all(method.info().settings, self)?;
-            (method.info().validate)(self)?;
         }
         if let Some(volume) = &self.volume
             && !volume.sky.iter().all(|w| (0.0..=1.0).contains(w))
@@ -631,11 +554,6 @@ impl ChainSettings {
                 return bad(format!("a slice window needs finite min < max, got {lo}, {hi}"));
             }
         }
-        if let DebugView::Level(k) = self.debug_view
-            && k >= self.levels()
-        {
-            return bad(format!("debug level {k} does not exist: the pyramid has {} levels", self.levels()));
-        }
         Ok(())
     }
 }
@@ -643,7 +561,8 @@ impl ChainSettings {
 #[cfg(test)]
 mod preset_tests {
     use super::*;
-    use crate::method::line_ao::LineAoVariant;
+    use crate::Preset;
+    use crate::method::line_ao::settings::LineAoVariant;
 
     /// The fitted table (docs/ground-truth.md), written out here apart from the methods' own
     /// `preset` functions: (strength, s_r, r0 per width, δ scale, reference radius, the method's
@@ -702,8 +621,8 @@ mod preset_tests {
 #[cfg(all(test, feature = "serde"))]
 mod serde_tests {
     use super::*;
-    use crate::method::line_ao::LineAoVariant;
-    use crate::method::ssao::SsaoSettings;
+    use crate::method::line_ao::settings::LineAoVariant;
+    use crate::method::ssao::settings::SsaoSettings;
 
     #[test]
     fn settings_round_trip_through_json_with_names_as_the_command_line_writes_them() {

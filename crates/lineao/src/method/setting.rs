@@ -1,21 +1,20 @@
 //! A method's settings as they describe themselves: for each, the flag it is given by, its
-//! help, unit, range and default, and how it is read from and written to a [`ChainSettings`].
+//! help, unit, range and default ([`About`]), and how it is read from and written to the
+//! method's own settings ([`Setting`]).
 //!
-//! A method lists its settings in its [`super::MethodInfo::settings`]; from that one table the
+//! A method lists its settings in its registry entry ([`super::Own`]); from that one table the
 //! front ends make what a user sees — the command line's flags (`lineao render --help` shows
 //! each with its unit and default), Python's keyword arguments (the flag with `_`), the
 //! viewer's sliders and checkboxes, the web page's URL keys (the flag) — and the chain checks
-//! each value against its range ([`ChainSettings::validate`]), naming the flag. The `--settings`
-//! JSON is the settings type's own serde: the method's field of [`ChainSettings`], which its
-//! registry line declares.
+//! each value against its range, naming the flag. The `--settings` JSON is the settings type's
+//! own serde: the method's field of the chain's settings, which its registry line declares.
 
-use crate::settings::ChainSettings;
-
-/// One setting of a method. [`Setting::BASE`] fills what most leave as it is:
-/// `Setting { flag: "…", …, ..Setting::BASE }`.
-pub struct Setting {
+/// What a setting is, for a user: its flag, help, unit, range and default.
+/// [`About::BASE`] fills what most leave as it is: `About { flag: "…", …, ..About::BASE }`.
+#[derive(Clone, Copy, Debug)]
+pub struct About {
     /// The command line's flag without its dashes (`ssao-samples`): the web page's URL key too;
-    /// Python's keyword is it with `_` ([`Setting::keyword`]).
+    /// Python's keyword is it with `_` ([`About::keyword`]).
     pub flag: &'static str,
     /// Its name in a method's panel of controls (`samples`).
     pub label: &'static str,
@@ -27,20 +26,47 @@ pub struct Setting {
     /// Its values.
     pub kind: Kind,
     /// What the help says of its default where that is not one value (`"the preset's; paper
-    /// 2"`, `"the radius"`); `None`: its value in [`ChainSettings::default`].
+    /// 2"`, `"the radius"`); `None`: its value in the default settings.
     pub default: Option<&'static str>,
     /// The command line's shorthand that gives it too where its method is shown.
     pub role: Option<Role>,
     /// The flag it means nothing without (VO's `combine` needs `radius2`): the command line
     /// refuses it alone.
     pub requires: Option<&'static str>,
+}
+
+/// One setting of a method whose own settings are `S`: what it is, and how it is read and
+/// written. [`Setting::BASE`] fills what most leave as it is.
+pub struct Setting<S> {
+    /// What it is, for a user.
+    pub about: About,
     /// Whether it means anything under these settings (LineAO's base radius only in its
     /// `reference` variant): a panel shows it only then.
-    pub applies: fn(&ChainSettings) -> bool,
-    /// Its value in `settings`.
-    pub get: fn(&ChainSettings) -> Value,
-    /// Puts `value` (of its [`Setting::kind`]) into `settings`.
-    pub set: fn(&mut ChainSettings, Value),
+    pub applies: fn(&S) -> bool,
+    /// Its value in `settings`, where the chain around them is `context`.
+    pub get: fn(&S, &Context) -> Value,
+    /// Puts `value` (of its [`About::kind`]) into `settings`.
+    pub set: fn(&mut S, Value),
+}
+
+impl<S> Setting<S> {
+    /// What most settings leave as it is: always applying. (`about`, `get` and `set` are each
+    /// setting's own.)
+    pub const BASE: Setting<S> =
+        Setting { about: About::BASE, applies: |_| true, get: |_, _| Value::Switch(false), set: |_, _| {} };
+}
+
+/// What a method's settings need of the chain around them: the line width (LineAO's r0 follows
+/// it), whether the lines are drawn as tubes (r0 then grows with depth instead), and the zoom
+/// unit (a preset's reach is in zoom units).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Context {
+    /// The lines' width in pixels.
+    pub line_width_px: f32,
+    /// Whether the lines are drawn as tubes.
+    pub tubes: bool,
+    /// World units per zoom unit.
+    pub zoom_unit: f32,
 }
 
 /// What a [`Setting`] is counted in.
@@ -131,7 +157,7 @@ pub enum Role {
     Radius,
 }
 
-/// A [`Setting`]'s value.
+/// A setting's value.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Value {
     /// A number, in the setting's unit.
@@ -194,10 +220,10 @@ impl Value {
     }
 }
 
-impl Setting {
-    /// What most settings leave as it is: no unit, their default value, no shorthand, always
-    /// applying. (`kind`, `get` and `set` are each setting's own.)
-    pub const BASE: Setting = Setting {
+impl About {
+    /// What most settings leave as it is: no unit, their default value, no shorthand. (`flag`,
+    /// `label`, `help` and `kind` are each setting's own.)
+    pub const BASE: About = About {
         flag: "",
         label: "",
         help: "",
@@ -206,20 +232,11 @@ impl Setting {
         default: None,
         role: None,
         requires: None,
-        applies: |_| true,
-        get: |_| Value::Switch(false),
-        set: |_, _| {},
     };
 
     /// Python's keyword argument: the flag with `_` (`ssao_samples`).
     pub fn keyword(&self) -> String {
         self.flag.replace('-', "_")
-    }
-
-    /// Its value where nothing changes it: in the default preset's settings with its method
-    /// shown ([`ChainSettings::default`]; a preset may change a method's own values).
-    pub fn default_value(&self, method: super::AoMethod) -> Value {
-        (self.get)(&ChainSettings { method, ..ChainSettings::papers() }.with_preset(crate::Preset::default()))
     }
 
     /// Its range in words (`[0.25, 4] zoom units`, `(0, 1]`, `1..=256`, `> 0 world units`, `≥ 0 px`, `5, 7 or 9`, `crytek or
@@ -299,73 +316,5 @@ impl Setting {
             value: value.to_string(),
             expected: self.range().unwrap_or_default(),
         })
-    }
-}
-
-/// Checks each of `settings`' values in `chain`: what the descriptions say of a method's
-/// validation (its own function checks how its values depend on each other).
-pub fn check_all(settings: &[Setting], chain: &ChainSettings) -> Result<(), crate::Error> {
-    settings.iter().try_for_each(|s| s.check((s.get)(chain)))
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::AoMethod;
-
-    /// Every described setting: a flag of lower-case words, help, a default in its range, a
-    /// value that round-trips through `set` and `get` and through the text the flag takes.
-    #[test]
-    fn every_description_holds_its_own_default_and_reads_back_what_it_writes() {
-        let mut flags = std::collections::BTreeMap::new();
-        for &method in AoMethod::REGISTRY {
-            for s in method.info().settings {
-                // Two methods may list one setting (VO's sphere): one flag, one description.
-                let help = *flags.entry(s.flag).or_insert(s.help);
-                assert_eq!(help, s.help, "{} describes two settings", s.flag);
-                assert!(
-                    s.flag.bytes().all(|b| b.is_ascii_lowercase() || b.is_ascii_digit() || b == b'-'),
-                    "{}",
-                    s.flag
-                );
-                assert!(!s.help.is_empty(), "{}", s.flag);
-                let default = s.default_value(method);
-                s.check(default).unwrap();
-                if let Kind::Switch { given } = s.kind {
-                    assert_eq!(default, Value::Switch(!given), "{}: the flag changes the default", s.flag);
-                }
-                // A value other than the default (where the kind has one), within range.
-                let other = match s.kind {
-                    Kind::Number { min, max, .. } => Value::Number(0.5 * (min + max)),
-                    Kind::Above { slider, .. } => Value::Number(slider[1]),
-                    Kind::Count { max, .. } => Value::Count(max),
-                    Kind::Counts(counts) => Value::Count(counts[counts.len() - 1]),
-                    Kind::Choice(names) => Value::Choice(names[names.len() - 1]),
-                    Kind::Switch { given } => Value::Switch(given),
-                    Kind::Reach { slider } => Value::Number(slider[1]),
-                };
-                let mut chain = ChainSettings { method, ..ChainSettings::default() };
-                (s.set)(&mut chain, other);
-                assert_eq!((s.get)(&chain), other, "{}", s.flag);
-                assert_eq!(s.parse(&other.to_string()).unwrap(), other, "{}", s.flag);
-                let outside = match s.kind {
-                    Kind::Number { max, .. } => Some(Value::Number(2.0 * max + 1.0)),
-                    Kind::Above { min, .. } => Some(Value::Number(min - 1.0)),
-                    Kind::Count { max, .. } => max.checked_add(1).map(Value::Count),
-                    Kind::Reach { .. } => Some(Value::Share(1.5)),
-                    _ => None,
-                };
-                if let Some(outside) = outside {
-                    (s.set)(&mut chain, outside);
-                    if (s.get)(&chain) != outside {
-                        // Taken as something valid (VO's `radius2` ≤ 0: none).
-                        continue;
-                    }
-                    let refused = chain.validate().unwrap_err().to_string();
-                    assert!(refused.contains(&format!("--{}", s.flag)), "{refused}");
-                    assert!(s.parse("x").is_err());
-                }
-            }
-        }
     }
 }

@@ -66,7 +66,7 @@ use crate::settings::ChainSettings;
 #[cfg(feature = "reference")]
 pub(crate) mod reference;
 pub(crate) mod settings;
-pub(crate) use settings::{LineAoOuter, LineAoSettings, LineAoVariant, R0};
+pub(crate) use settings::{LineAoOuter, LineAoSettings, LineAoVariant};
 
 /// LineAO in the registry ([`crate::method`]).
 /// Depth tolerance of the upsampling, in normalized depth: a level texel whose d_j differs from
@@ -85,11 +85,12 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     },
     build: Some(|device, settings| Box::new(LineAoStage::new(device, settings))),
     fits: super::fits_always,
-    preset: settings::preset,
-    validate: settings::validate,
-    levels: |s| if s.line_ao.variant == LineAoVariant::Paper { s.line_ao.s_r } else { 1 },
-    settings: settings::SETTINGS,
-    conform: settings::conform,
+    own: &super::Own {
+        validate: settings::validate,
+        levels: |s| if s.variant == LineAoVariant::Paper { s.s_r } else { 1 },
+        conform: settings::conform,
+        ..super::Own::at(settings::SETTINGS, |c| &c.line_ao, |c| &mut c.line_ao, settings::preset)
+    },
     bench: &[
         BenchPass::of("lineao", &["lineao"], |_, _| {}),
         BenchPass {

@@ -1,119 +1,144 @@
 //! LineAO's settings: the paper's parameters (Eq. 7–15), the authors' variant, and where the
 //! outer hemispheres are evaluated.
 
-use crate::method::setting::{Kind, Setting, Unit, Value};
+use crate::method::setting::{About, Context, Kind, Setting, Unit, Value};
 use crate::named::{Named, named};
-use crate::settings::{ChainSettings, Preset};
+use crate::preset::Preset;
 
 /// LineAO's settings as the front ends show them (docs/reference.md's flags). The variant first: a
 /// preset's values depend on it.
-pub(crate) const SETTINGS: &[Setting] = &[
+pub(crate) const SETTINGS: &[Setting<LineAoSettings>] = &[
     Setting {
-        flag: "variant",
-        label: "variant",
-        help: "LineAO: the paper's equations (paper) or what the authors' OpenWalnut shader does (reference)",
-        kind: Kind::Choice(&["paper", "reference"]),
-        get: |s| Value::Choice(s.line_ao.variant.name()),
-        set: |s, v| s.line_ao.variant = v.named(),
+        about: About {
+            flag: "variant",
+            label: "variant",
+            help: "LineAO: the paper's equations (paper) or what the authors' OpenWalnut shader does (reference)",
+            kind: Kind::Choice(&["paper", "reference"]),
+            ..About::BASE
+        },
+        get: |s, _| Value::Choice(s.variant.name()),
+        set: |s, v| s.variant = v.named(),
         ..Setting::BASE
     },
     Setting {
-        flag: "outer",
-        label: "outer hemispheres",
-        help: "LineAO (variant paper): hemispheres j ≥ 1 at every pixel (full) or at their pyramid level's resolution, upsampled depth-aware (level: faster)",
-        kind: Kind::Choice(&["full", "level"]),
-        applies: |s| s.line_ao.variant == LineAoVariant::Paper,
-        get: |s| Value::Choice(s.line_ao.outer.name()),
-        set: |s, v| s.line_ao.outer = v.named(),
+        about: About {
+            flag: "outer",
+            label: "outer hemispheres",
+            help: "LineAO (variant paper): hemispheres j ≥ 1 at every pixel (full) or at their pyramid level's resolution, upsampled depth-aware (level: faster)",
+            kind: Kind::Choice(&["full", "level"]),
+            ..About::BASE
+        },
+        applies: |s| s.variant == LineAoVariant::Paper,
+        get: |s, _| Value::Choice(s.outer.name()),
+        set: |s, v| s.outer = v.named(),
+    },
+    Setting {
+        about: About {
+            flag: "s-r",
+            label: "s_r hemispheres",
+            help: "LineAO s_r: hemispheres and pyramid levels",
+            kind: Kind::Count { min: 1, max: crate::MAX_LEVELS },
+            default: Some("the preset's; paper 3"),
+            ..About::BASE
+        },
+        applies: |s| s.variant == LineAoVariant::Paper,
+        get: |s, _| Value::Count(s.s_r),
+        set: |s, v| s.s_r = v.as_u32(),
+    },
+    Setting {
+        about: About {
+            flag: "s-h",
+            label: "s_h samples",
+            help: "LineAO s_h: samples on the first hemisphere",
+            kind: Kind::Count { min: 1, max: 256 },
+            ..About::BASE
+        },
+        get: |s, _| Value::Count(s.s_h),
+        set: |s, v| s.s_h = v.as_u32(),
         ..Setting::BASE
     },
     Setting {
-        flag: "s-r",
-        label: "s_r hemispheres",
-        help: "LineAO s_r: hemispheres and pyramid levels",
-        kind: Kind::Count { min: 1, max: crate::MAX_LEVELS },
-        default: Some("the preset's; paper 3"),
-        applies: |s| s.line_ao.variant == LineAoVariant::Paper,
-        get: |s| Value::Count(s.line_ao.s_r),
-        set: |s, v| s.line_ao.s_r = v.as_u32(),
+        about: About {
+            flag: "r0",
+            label: "r0",
+            help: "LineAO r0, the first hemisphere's radius",
+            unit: Unit::Px,
+            kind: Kind::Above { min: 0.0, open: false, slider: [0.5, 16.0], log: false },
+            default: Some("the preset's × the line width; paper 1.5 ×"),
+            ..About::BASE
+        },
+        applies: |s| s.variant == LineAoVariant::Paper,
+        get: |s, context| Value::Number(s.r0_px(context)),
+        set: |s, v| s.r0_px = Some(v.as_f32()),
+    },
+    Setting {
+        about: About {
+            flag: "reference-radius",
+            label: "base radius",
+            help: "LineAO (variant reference): the base radius at the home zoom (the authors' u_lineAORadius)",
+            unit: Unit::Px,
+            kind: Kind::Above { min: 0.0, open: false, slider: [0.5, 8.0], log: false },
+            default: Some("the preset's; paper 2"),
+            ..About::BASE
+        },
+        applies: |s| s.variant == LineAoVariant::Reference,
+        get: |s, _| Value::Number(s.reference_radius_px),
+        set: |s, v| s.reference_radius_px = v.as_f32(),
+    },
+    Setting {
+        about: About {
+            flag: "delta0",
+            label: "δ0",
+            help: "LineAO δ0: occluders nearer than this in normalized depth count fully; below δ scale · (1/s_r)²",
+            kind: Kind::Number { min: 0.0, max: 1.0, open: false, log: true },
+            ..About::BASE
+        },
+        get: |s, _| Value::Number(s.delta0),
+        set: |s, v| s.delta0 = v.as_f32(),
         ..Setting::BASE
     },
     Setting {
-        flag: "s-h",
-        label: "s_h samples",
-        help: "LineAO s_h: samples on the first hemisphere",
-        kind: Kind::Count { min: 1, max: 256 },
-        get: |s| Value::Count(s.line_ao.s_h),
-        set: |s, v| s.line_ao.s_h = v.as_u32(),
+        about: About {
+            flag: "delta-scale",
+            label: "δ scale",
+            help: "LineAO: scale of the falloff δ(j) = scale · (1 − j/s_r)²; below 1 occluders far in front (in normalized depth) stop counting",
+            kind: Kind::Number { min: 0.0, max: 1.0, open: true, log: true },
+            default: Some("the preset's; paper 1"),
+            ..About::BASE
+        },
+        get: |s, _| Value::Number(s.delta_scale),
+        set: |s, v| s.delta_scale = v.as_f32(),
         ..Setting::BASE
     },
     Setting {
-        flag: "r0",
-        label: "r0",
-        help: "LineAO r0, the first hemisphere's radius",
-        unit: Unit::Px,
-        kind: Kind::Above { min: 0.0, open: false, slider: [0.5, 16.0], log: false },
-        default: Some("the preset's × the line width; paper 1.5 ×"),
-        applies: |s| s.line_ao.variant == LineAoVariant::Paper,
-        get: |s| Value::Number(s.r0_px()),
-        set: |s, v| s.line_ao.r0_px = Some(v.as_f32()),
+        about: About {
+            flag: "epsilon",
+            label: "ε",
+            help: "LineAO ε: occluded iff Δd > ε",
+            kind: Kind::Above { min: 0.0, open: false, slider: [1e-8, 1e-3], log: true },
+            ..About::BASE
+        },
+        get: |s, _| Value::Number(s.epsilon),
+        set: |s, v| s.epsilon = v.as_f32(),
         ..Setting::BASE
     },
     Setting {
-        flag: "reference-radius",
-        label: "base radius",
-        help: "LineAO (variant reference): the base radius at the home zoom (the authors' u_lineAORadius)",
-        unit: Unit::Px,
-        kind: Kind::Above { min: 0.0, open: false, slider: [0.5, 8.0], log: false },
-        default: Some("the preset's; paper 2"),
-        applies: |s| s.line_ao.variant == LineAoVariant::Reference,
-        get: |s| Value::Number(s.line_ao.reference_radius_px),
-        set: |s, v| s.line_ao.reference_radius_px = v.as_f32(),
-        ..Setting::BASE
-    },
-    Setting {
-        flag: "delta0",
-        label: "δ0",
-        help: "LineAO δ0: occluders nearer than this in normalized depth count fully; below δ scale · (1/s_r)²",
-        kind: Kind::Number { min: 0.0, max: 1.0, open: false, log: true },
-        get: |s| Value::Number(s.line_ao.delta0),
-        set: |s, v| s.line_ao.delta0 = v.as_f32(),
-        ..Setting::BASE
-    },
-    Setting {
-        flag: "delta-scale",
-        label: "δ scale",
-        help: "LineAO: scale of the falloff δ(j) = scale · (1 − j/s_r)²; below 1 occluders far in front (in normalized depth) stop counting",
-        kind: Kind::Number { min: 0.0, max: 1.0, open: true, log: true },
-        default: Some("the preset's; paper 1"),
-        get: |s| Value::Number(s.line_ao.delta_scale),
-        set: |s, v| s.line_ao.delta_scale = v.as_f32(),
-        ..Setting::BASE
-    },
-    Setting {
-        flag: "epsilon",
-        label: "ε",
-        help: "LineAO ε: occluded iff Δd > ε",
-        kind: Kind::Above { min: 0.0, open: false, slider: [1e-8, 1e-3], log: true },
-        get: |s| Value::Number(s.line_ao.epsilon),
-        set: |s, v| s.line_ao.epsilon = v.as_f32(),
-        ..Setting::BASE
-    },
-    Setting {
-        flag: "no-light-attenuation",
-        label: "light attenuation g_light",
-        help: "Disable LineAO's light attenuation (g_light = 1)",
-        kind: Kind::Switch { given: false },
-        get: |s| Value::Switch(s.line_ao.light_attenuation),
-        set: |s, v| s.line_ao.light_attenuation = v.is_on(),
+        about: About {
+            flag: "no-light-attenuation",
+            label: "light attenuation g_light",
+            help: "Disable LineAO's light attenuation (g_light = 1)",
+            kind: Kind::Switch { given: false },
+            ..About::BASE
+        },
+        get: |s, _| Value::Switch(s.light_attenuation),
+        set: |s, v| s.light_attenuation = v.is_on(),
         ..Setting::BASE
     },
 ];
 
 /// What a panel's control leaves valid: δ0 below the last hemisphere's δ, the full-resolution
 /// outer hemispheres for the authors' variant.
-pub(crate) fn conform(settings: &mut ChainSettings) {
-    let ao = &mut settings.line_ao;
+pub(crate) fn conform(ao: &mut LineAoSettings) {
     let last_delta = ao.delta_scale / (ao.s_r * ao.s_r) as f32;
     ao.delta0 = ao.delta0.min(0.9 * last_delta);
     if ao.variant == LineAoVariant::Reference {
@@ -232,9 +257,9 @@ impl Default for LineAoSettings {
 }
 
 /// LineAO's settings in a chain's: its own, and r0 as the line width or the tubes make it.
-pub(crate) fn validate(settings: &crate::ChainSettings) -> Result<(), crate::Error> {
-    settings.line_ao.validate()?;
-    let r0 = settings.r0_px();
+pub(crate) fn validate(settings: &LineAoSettings, context: &Context) -> Result<(), crate::Error> {
+    settings.validate()?;
+    let r0 = settings.r0_px(context);
     if !(r0.is_finite() && r0 >= 0.0) {
         return Err(crate::Error::InvalidSettings(format!("r0 must be a finite number of pixels >= 0, got {r0}")));
     }
@@ -242,6 +267,13 @@ pub(crate) fn validate(settings: &crate::ChainSettings) -> Result<(), crate::Err
 }
 
 impl LineAoSettings {
+    /// r0's constant part in pixels: the explicit value, or `r0_per_width` × the line width
+    /// (tubes: 0).
+    pub fn r0_px(&self, context: &Context) -> f32 {
+        let default = if context.tubes { 0.0 } else { self.r0_per_width * context.line_width_px };
+        self.r0_px.unwrap_or(default)
+    }
+
     /// Checks every range documented above.
     pub fn validate(&self) -> Result<(), crate::Error> {
         let bad = |what: String| Err(crate::Error::InvalidSettings(what));
@@ -293,17 +325,15 @@ impl From<f32> for R0 {
 }
 
 /// LineAO's values in `preset` (`lineao score --fit`, docs/ground-truth.md): s_r, δ scale, r0
-/// (lines; tubes keep Eq. 16's) and the authors' base radius, and the strength it is shown with.
-pub(crate) fn preset(preset: Preset, settings: &mut ChainSettings) {
+/// (lines; tubes keep Eq. 16's) and the authors' base radius; the strength it is shown with.
+pub(crate) fn preset(preset: Preset, ao: &mut LineAoSettings, _: &Context) -> f32 {
     let paper = LineAoSettings::default();
-    let ao = &mut settings.line_ao;
     (ao.s_r, ao.delta_scale, ao.r0_per_width, ao.reference_radius_px) =
         (paper.s_r, paper.delta_scale, paper.r0_per_width, paper.reference_radius_px);
     // r0 follows the line width.
     ao.r0_px = None;
-    settings.strength = 1.0;
     match (preset, ao.variant) {
-        (Preset::Paper, _) => {}
+        (Preset::Paper, _) => 1.0,
         // The most legible settings that keep every view readable (`lineao score --fit --width
         // 640 --height 512 --fit-views 2 --rays 32`): two hemispheres, the first reaching past a
         // line's own width to its neighbours (r0 4.5 × the width), the paper's δ (occluders far
@@ -313,27 +343,27 @@ pub(crate) fn preset(preset: Preset, settings: &mut ChainSettings) {
         // `lineao` renders by default.
         (Preset::Legible, LineAoVariant::Paper) => {
             (ao.s_r, ao.r0_per_width) = (2, 4.5);
-            settings.strength = 0.6;
+            0.6
         }
-        (Preset::Legible, LineAoVariant::Reference) => settings.strength = 0.6,
+        (Preset::Legible, LineAoVariant::Reference) => 0.6,
         // Two hemispheres with δ a tenth of the paper's: the third hemisphere and occluders far
         // in front (in depth) darken dense and sparse data alike, where the truth tells them
         // apart; with them LineAO's mean stays within 0.1 of the truth's on every real
         // tractogram (within 0.09), and its held-out RMSE is 0.204 (paper: 0.450).
         (Preset::Physical, LineAoVariant::Paper) => {
             (ao.s_r, ao.delta_scale) = (2, 0.1);
-            settings.strength = 0.58;
+            0.58
         }
         (Preset::Physical, LineAoVariant::Reference) => {
             ao.reference_radius_px = 1.0;
-            settings.strength = 0.46;
+            0.46
         }
         // A fourth hemisphere on a fourth level: twice the third's reach, for neighbours far
         // apart. The authors' variant has one radius, which the sparse look leaves alone.
         (Preset::Sparse, LineAoVariant::Paper) => {
             ao.s_r = 4;
-            settings.strength = 0.8;
+            0.8
         }
-        (Preset::Sparse, LineAoVariant::Reference) => settings.strength = 0.8,
+        (Preset::Sparse, LineAoVariant::Reference) => 0.8,
     }
 }

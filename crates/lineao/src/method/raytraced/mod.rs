@@ -55,11 +55,10 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     },
     build: Some(|device, _| Box::new(RayTracedAo::new(device))),
     fits,
-    preset: |_, settings| settings.strength = 1.0,
-    validate: |s| s.raytraced.validate(),
-    levels: super::one_level,
-    settings: settings::SETTINGS,
-    conform: super::conform_always,
+    own: &super::Own {
+        validate: |s, _| RayTracedSettings::validate(s),
+        ..super::Own::at(settings::SETTINGS, |c| &c.raytraced, |c| &mut c.raytraced, |_, _, _| 1.0)
+    },
     bench: &[
         // One ray per pixel each frame, continuing one picture (started by the first warm-up
         // frame, over the G-buffer).

@@ -1,72 +1,89 @@
 //! The GPU ray tracer's settings: rays per frame, the cap, the reach, and the denoiser.
 
-use crate::method::setting::{Kind, Setting, Unit, Value};
+use crate::method::setting::{About, Kind, Setting, Unit, Value};
 
 /// The ray tracer's settings as the front ends show them (docs/reference.md's flags, which the CPU
 /// truth of `lineao score` and `render --cpu` reads too).
-pub(crate) const SETTINGS: &[Setting] = &[
+pub(crate) const SETTINGS: &[Setting<RayTracedSettings>] = &[
     Setting {
-        flag: "rays",
-        label: "rays per pixel",
-        help: "Ray-traced AO: rays per geometry pixel, after which the picture is complete. 256 is LineVis's reference count: a standard error of at most 0.03 per pixel",
-        kind: Kind::Count { min: 1, max: 1 << 20 },
-        default: Some("256; the viewer's 1024"),
-        get: |s| Value::Count(s.raytraced.max_rays),
+        about: About {
+            flag: "rays",
+            label: "rays per pixel",
+            help: "Ray-traced AO: rays per geometry pixel, after which the picture is complete. 256 is LineVis's reference count: a standard error of at most 0.03 per pixel",
+            kind: Kind::Count { min: 1, max: 1 << 20 },
+            default: Some("256; the viewer's 1024"),
+            ..About::BASE
+        },
+        get: |s, _| Value::Count(s.max_rays),
         set: |s, v| {
-            let r = &mut s.raytraced;
-            r.max_rays = v.as_u32();
-            r.rays_per_frame = r.rays_per_frame.min(r.max_rays);
+            s.max_rays = v.as_u32();
+            s.rays_per_frame = s.rays_per_frame.min(s.max_rays);
         },
         ..Setting::BASE
     },
     Setting {
-        flag: "rays-per-frame",
-        label: "rays per frame",
-        help: "Ray-traced AO: rays per pixel each frame adds; fewer keep a slow GPU responsive",
-        kind: Kind::Count { min: 1, max: 1024 },
-        default: Some("render: the rays, at most 64; the viewer's 4"),
-        get: |s| Value::Count(s.raytraced.rays_per_frame),
-        set: |s, v| s.raytraced.rays_per_frame = v.as_u32(),
+        about: About {
+            flag: "rays-per-frame",
+            label: "rays per frame",
+            help: "Ray-traced AO: rays per pixel each frame adds; fewer keep a slow GPU responsive",
+            kind: Kind::Count { min: 1, max: 1024 },
+            default: Some("render: the rays, at most 64; the viewer's 4"),
+            ..About::BASE
+        },
+        get: |s, _| Value::Count(s.rays_per_frame),
+        set: |s, v| s.rays_per_frame = v.as_u32(),
         ..Setting::BASE
     },
     Setting {
-        flag: "ao-distance",
-        label: "reach",
-        help: "Ray-traced AO: how far a ray looks for an occluder (the truth's R). 2 is the reach VO and SSAO sample by default and that of LineAO's widest hemisphere (r0 + 2 z(P) px); 20% is LineVis's default reach and score's bundle-scale truth",
-        unit: Unit::WorldUnits,
-        kind: Kind::Reach { slider: [0.1, 20.0] },
-        get: |s| s.raytraced.distance_share.map_or(Value::Number(s.raytraced.distance_world), Value::Share),
+        about: About {
+            flag: "ao-distance",
+            label: "reach",
+            help: "Ray-traced AO: how far a ray looks for an occluder (the truth's R). 2 is the reach VO and SSAO sample by default and that of LineAO's widest hemisphere (r0 + 2 z(P) px); 20% is LineVis's default reach and score's bundle-scale truth",
+            unit: Unit::WorldUnits,
+            kind: Kind::Reach { slider: [0.1, 20.0] },
+            ..About::BASE
+        },
+        get: |s, _| s.distance_share.map_or(Value::Number(s.distance_world), Value::Share),
         set: |s, v| match v {
-            Value::Share(share) => s.raytraced.distance_share = Some(share),
-            v => (s.raytraced.distance_world, s.raytraced.distance_share) = (v.as_f32(), None),
+            Value::Share(share) => s.distance_share = Some(share),
+            v => (s.distance_world, s.distance_share) = (v.as_f32(), None),
         },
         ..Setting::BASE
     },
     Setting {
-        flag: "ao-falloff",
-        label: "falloff",
-        help: "Ray-traced AO: binary (none) or obscurance with a linear falloff (linear)",
-        kind: Kind::Choice(&["none", "linear"]),
-        get: |s| Value::Choice(s.raytraced.falloff.name()),
-        set: |s, v| s.raytraced.falloff = v.named(),
+        about: About {
+            flag: "ao-falloff",
+            label: "falloff",
+            help: "Ray-traced AO: binary (none) or obscurance with a linear falloff (linear)",
+            kind: Kind::Choice(&["none", "linear"]),
+            ..About::BASE
+        },
+        get: |s, _| Value::Choice(s.falloff.name()),
+        set: |s, v| s.falloff = v.named(),
         ..Setting::BASE
     },
     Setting {
-        flag: "ray-seed",
-        label: "seed",
-        help: "Ray-traced AO: seed of the per-pixel scrambled ray sequence",
-        kind: Kind::Count { min: 0, max: u32::MAX },
-        get: |s| Value::Count(s.raytraced.seed),
-        set: |s, v| s.raytraced.seed = v.as_u32(),
+        about: About {
+            flag: "ray-seed",
+            label: "seed",
+            help: "Ray-traced AO: seed of the per-pixel scrambled ray sequence",
+            kind: Kind::Count { min: 0, max: u32::MAX },
+            ..About::BASE
+        },
+        get: |s, _| Value::Count(s.seed),
+        set: |s, v| s.seed = v.as_u32(),
         ..Setting::BASE
     },
     Setting {
-        flag: "denoise",
-        label: "denoise (edge-aware)",
-        help: "Ray-traced AO on the GPU: the edge-aware denoiser after the rays (same line or surface, a window narrowing as 1/√rays), for few rays",
-        kind: Kind::Switch { given: true },
-        get: |s| Value::Switch(s.raytraced.denoise.is_some()),
-        set: |s, v| s.raytraced.denoise = v.is_on().then(|| s.raytraced.denoise.clone().unwrap_or_default()),
+        about: About {
+            flag: "denoise",
+            label: "denoise (edge-aware)",
+            help: "Ray-traced AO on the GPU: the edge-aware denoiser after the rays (same line or surface, a window narrowing as 1/√rays), for few rays",
+            kind: Kind::Switch { given: true },
+            ..About::BASE
+        },
+        get: |s, _| Value::Switch(s.denoise.is_some()),
+        set: |s, v| s.denoise = v.is_on().then(|| s.denoise.clone().unwrap_or_default()),
         ..Setting::BASE
     },
 ];

@@ -49,11 +49,11 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     },
     build: Some(|device, settings| Box::new(SsaoStage::new(device, settings))),
     fits: super::fits_always,
-    preset: settings::preset,
-    validate: |s| s.ssao.validate(),
-    levels: super::one_level,
-    settings: settings::SETTINGS,
-    conform: settings::conform,
+    own: &super::Own {
+        validate: |s, _| SsaoSettings::validate(s),
+        conform: settings::conform,
+        ..super::Own::at(settings::SETTINGS, |c| &c.ssao, |c| &mut c.ssao, settings::preset)
+    },
     bench: &[
         BenchPass::of("ssao-12", &["ssao"], |s, _| s.ssao.samples = 12),
         BenchPass::of("ssao-16-chain", &["ssao", "ssao-blur"], |s, _| s.ssao.samples = 16),

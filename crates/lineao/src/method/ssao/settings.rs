@@ -1,58 +1,69 @@
 //! Crytek SSAO's settings: the kernel, its radius and range check in world units.
 
-use crate::method::setting::{Kind, Role, Setting, Unit, Value};
+use crate::method::setting::{About, Context, Kind, Role, Setting, Unit, Value};
 use crate::named::{Named, named};
-use crate::settings::{ChainSettings, Preset};
+use crate::preset::Preset;
 
 /// SSAO's settings as the front ends show them (docs/reference.md's flags).
-pub(crate) const SETTINGS: &[Setting] = &[
+pub(crate) const SETTINGS: &[Setting<SsaoSettings>] = &[
     Setting {
-        flag: "ssao-kernel",
-        label: "kernel",
-        help: "SSAO: the kernel's points: Mittring's random kernel, denser near the centre (crytek), or the VO paper's generated point set (sphere)",
-        kind: Kind::Choice(&["crytek", "sphere"]),
-        get: |s| Value::Choice(s.ssao.kernel.name()),
-        set: |s, v| s.ssao.kernel = v.named(),
+        about: About {
+            flag: "ssao-kernel",
+            label: "kernel",
+            help: "SSAO: the kernel's points: Mittring's random kernel, denser near the centre (crytek), or the VO paper's generated point set (sphere)",
+            kind: Kind::Choice(&["crytek", "sphere"]),
+            ..About::BASE
+        },
+        get: |s, _| Value::Choice(s.kernel.name()),
+        set: |s, v| s.kernel = v.named(),
         ..Setting::BASE
     },
     Setting {
-        flag: "ssao-samples",
-        label: "samples",
-        help: "SSAO: point samples in the sphere; the sphere kernel takes 8, 12, 16, 24 or 32",
-        kind: Kind::Count { min: 8, max: 32 },
-        role: Some(Role::Samples),
-        get: |s| Value::Count(s.ssao.samples),
-        set: |s, v| s.ssao.samples = v.as_u32(),
+        about: About {
+            flag: "ssao-samples",
+            label: "samples",
+            help: "SSAO: point samples in the sphere; the sphere kernel takes 8, 12, 16, 24 or 32",
+            kind: Kind::Count { min: 8, max: 32 },
+            role: Some(Role::Samples),
+            ..About::BASE
+        },
+        get: |s, _| Value::Count(s.samples),
+        set: |s, v| s.samples = v.as_u32(),
         ..Setting::BASE
     },
     Setting {
-        flag: "ssao-radius",
-        label: "radius",
-        help: "SSAO: sphere radius (the range check's too, unless --ssao-range gives it)",
-        unit: Unit::WorldUnits,
-        kind: Kind::Above { min: 0.0, open: true, slider: [0.1, 20.0], log: true },
-        default: Some("the preset's; paper 2"),
-        role: Some(Role::Radius),
-        get: |s| Value::Number(s.ssao.radius_world),
-        set: |s, v| (s.ssao.radius_world, s.ssao.range_world) = (v.as_f32(), v.as_f32()),
+        about: About {
+            flag: "ssao-radius",
+            label: "radius",
+            help: "SSAO: sphere radius (the range check's too, unless --ssao-range gives it)",
+            unit: Unit::WorldUnits,
+            kind: Kind::Above { min: 0.0, open: true, slider: [0.1, 20.0], log: true },
+            default: Some("the preset's; paper 2"),
+            role: Some(Role::Radius),
+            ..About::BASE
+        },
+        get: |s, _| Value::Number(s.radius_world),
+        set: |s, v| (s.radius_world, s.range_world) = (v.as_f32(), v.as_f32()),
         ..Setting::BASE
     },
     Setting {
-        flag: "ssao-range",
-        label: "range check",
-        help: "SSAO: a sample occludes only where the surface in front of it is nearer than this",
-        unit: Unit::WorldUnits,
-        kind: Kind::Above { min: 0.0, open: true, slider: [0.1, 20.0], log: true },
-        default: Some("the radius"),
-        get: |s| Value::Number(s.ssao.range_world),
-        set: |s, v| s.ssao.range_world = v.as_f32(),
+        about: About {
+            flag: "ssao-range",
+            label: "range check",
+            help: "SSAO: a sample occludes only where the surface in front of it is nearer than this",
+            unit: Unit::WorldUnits,
+            kind: Kind::Above { min: 0.0, open: true, slider: [0.1, 20.0], log: true },
+            default: Some("the radius"),
+            ..About::BASE
+        },
+        get: |s, _| Value::Number(s.range_world),
+        set: |s, v| s.range_world = v.as_f32(),
         ..Setting::BASE
     },
 ];
 
 /// What a panel's control leaves valid: the sphere kernel's sample counts only (the nearest).
-pub(crate) fn conform(settings: &mut ChainSettings) {
-    let ssao = &mut settings.ssao;
+pub(crate) fn conform(ssao: &mut SsaoSettings) {
     if ssao.kernel == SsaoKernel::Sphere {
         let counts = crate::sample_sets::VO_SPHERE_SAMPLE_COUNTS;
         ssao.samples = counts.iter().copied().min_by_key(|&n| n.abs_diff(ssao.samples)).unwrap_or(16);
@@ -144,15 +155,16 @@ impl SsaoKernel {
     }
 }
 
-/// SSAO's sphere (radius and range, zoom units) and strength in `preset` (docs/ground-truth.md).
-pub(crate) fn preset(preset: Preset, settings: &mut ChainSettings) {
+/// SSAO's sphere (radius and range, zoom units) in `preset` (docs/ground-truth.md); the strength
+/// it is shown with.
+pub(crate) fn preset(preset: Preset, ssao: &mut SsaoSettings, context: &Context) -> f32 {
     let (strength, radius) = match preset {
         Preset::Paper => (1.0, 2.0),
         Preset::Legible => (1.0, 8.0),
         Preset::Physical => (0.68, 3.0),
         Preset::Sparse => (0.8, 6.0),
     };
-    settings.strength = strength;
-    settings.ssao.radius_world = radius * settings.zoom_unit;
-    settings.ssao.range_world = radius * settings.zoom_unit;
+    ssao.radius_world = radius * context.zoom_unit;
+    ssao.range_world = radius * context.zoom_unit;
+    strength
 }

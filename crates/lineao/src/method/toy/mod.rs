@@ -11,33 +11,8 @@ use crate::settings::ChainSettings;
 use crate::targets::{AO_FORMAT, FrameTargets};
 use crate::timing::Span;
 
-use super::setting::{Kind, Setting, Unit, Value};
-
-/// The toy's settings: the `toy` field of [`ChainSettings`] (its registry line's).
-#[derive(Clone, Debug, PartialEq)]
-#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
-#[cfg_attr(feature = "serde", serde(default))]
-#[cfg_attr(feature = "serde", serde(deny_unknown_fields))]
-pub struct ToySettings {
-    /// A quarter of occlusion per zoom unit, 0.25..=4. Default 1.
-    pub radius_zoom: f32,
-    /// One minus that instead. Default off.
-    pub invert: bool,
-}
-
-impl Default for ToySettings {
-    fn default() -> Self {
-        ToySettings { radius_zoom: 1.0, invert: false }
-    }
-}
-
-impl ToySettings {
-    /// The occlusion of every geometry pixel.
-    pub fn occlusion(&self) -> f32 {
-        let quarter = (0.25 * self.radius_zoom).min(1.0);
-        if self.invert { 1.0 - quarter } else { quarter }
-    }
-}
+mod settings;
+pub use settings::ToySettings;
 
 /// `ToyUniform` in toy.wgsl.
 #[repr(C)]
@@ -46,28 +21,6 @@ struct ToyUniform {
     occlusion: f32,
     _pad: [f32; 3],
 }
-
-const SETTINGS: &[Setting] = &[
-    Setting {
-        flag: "toy-radius",
-        label: "radius",
-        help: "Toy: a quarter of occlusion per zoom unit",
-        unit: Unit::ZoomUnits,
-        kind: Kind::Number { min: 0.25, max: 4.0, open: false, log: true },
-        get: |s| Value::Number(s.toy.radius_zoom),
-        set: |s, v| s.toy.radius_zoom = v.as_f32(),
-        ..Setting::BASE
-    },
-    Setting {
-        flag: "toy-invert",
-        label: "invert",
-        help: "Toy: one minus that occlusion",
-        kind: Kind::Switch { given: true },
-        get: |s| Value::Switch(s.toy.invert),
-        set: |s, v| s.toy.invert = v.is_on(),
-        ..Setting::BASE
-    },
-];
 
 pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     name: "toy",
@@ -80,11 +33,7 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     library: crate::shader::Library { files: &[("toy.wgsl", include_str!("toy.wgsl"))], constants: &[] },
     build: Some(|device, _| Box::new(Toy::new(device))),
     fits: super::fits_always,
-    preset: |_, settings| settings.strength = 1.0,
-    validate: super::valid_always,
-    levels: super::one_level,
-    settings: SETTINGS,
-    conform: super::conform_always,
+    own: &super::Own::at(settings::SETTINGS, |c| &c.toy, |c| &mut c.toy, |_, _, _| 1.0),
     bench: &[super::BenchPass::of("toy", &["toy"], |_, _| {})],
 };
 

@@ -23,6 +23,7 @@
 
 use crate::camera::FrameView;
 use crate::method::vo_line::VoSettings;
+use crate::method::vo_line::settings::{AREA_SETTINGS, preset as vo_preset};
 use crate::method::vo_line::{VoCore, VoUniform};
 use crate::sample_sets;
 use crate::settings::ChainSettings;
@@ -46,11 +47,10 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     },
     build: Some(|device, settings| Box::new(VoArea::new(device, &settings.vo))),
     fits: moments::fits,
-    preset: |preset, settings| crate::method::vo_line::preset(preset, settings, 1.0, 1.0),
-    validate: |s| s.vo.validate(),
-    levels: super::one_level,
-    settings: crate::method::vo_line::settings::AREA_SETTINGS,
-    conform: super::conform_always,
+    own: &super::Own {
+        validate: |s, _| VoSettings::validate(s),
+        ..super::Own::at(AREA_SETTINGS, |c| &c.vo, |c| &mut c.vo, |preset, s, c| vo_preset(preset, s, c, 1.0, 1.0))
+    },
     bench: &[super::BenchPass::of("vo-area-1", &["moments", "vo-area"], |s, _| s.vo.area_samples = 1)],
 };
 use crate::targets::FrameTargets;

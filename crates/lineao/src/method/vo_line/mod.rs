@@ -38,7 +38,6 @@ use crate::settings::ChainSettings;
 #[cfg(feature = "reference")]
 pub(crate) mod reference;
 pub(crate) mod settings;
-pub(crate) use settings::preset;
 pub(crate) use settings::{VoCombine, VoSettings};
 
 /// VO with line samples in the registry ([`crate::method`]).
@@ -51,11 +50,15 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     library: crate::shader::Library { files: &[("vo_line.wgsl", include_str!("vo_line.wgsl"))], constants: &[] },
     build: Some(|device, settings| Box::new(VoLine::new(device, &settings.vo))),
     fits: super::fits_always,
-    preset: |preset, settings| settings::preset(preset, settings, 2.0, 1.5),
-    validate: |s| s.vo.validate(),
-    levels: super::one_level,
-    settings: settings::SETTINGS,
-    conform: super::conform_always,
+    own: &super::Own {
+        validate: |s, _| VoSettings::validate(s),
+        ..super::Own::at(
+            settings::SETTINGS,
+            |c| &c.vo,
+            |c| &mut c.vo,
+            |preset, s, c| settings::preset(preset, s, c, 2.0, 1.5),
+        )
+    },
     bench: &[super::BenchPass::of("vo-line-5", &["vo-line"], |s, _| s.vo.samples = 5)],
 };
 use crate::method::vo_area::moments::Moments;

@@ -1,95 +1,116 @@
 //! Volumetric Obscurance's settings, shared by line and area sampling (`vo_area` builds on
 //! `vo_line`): the sample sets, the radii, the normal clamp and the thickness.
 
-use crate::method::setting::{Kind, Role, Setting, Unit, Value};
+use crate::method::setting::{About, Context, Kind, Role, Setting, Unit, Value};
 use crate::named::{Named, named};
+use crate::preset::Preset;
 use crate::sample_sets::{VO_AREA_SAMPLE_COUNTS, VO_SAMPLE_COUNTS};
-use crate::settings::{ChainSettings, Preset};
 
 /// VO line's settings as the front ends show them (docs/reference.md's flags): its samples, and the
 /// sphere that area sampling shares ([`AREA_SETTINGS`]).
-pub(crate) const SETTINGS: &[Setting] = &[SAMPLES, RADIUS, RADIUS2, COMBINE, NORMAL_CLAMP, THICKNESS];
+pub(crate) const SETTINGS: &[Setting<VoSettings>] = &[SAMPLES, RADIUS, RADIUS2, COMBINE, NORMAL_CLAMP, THICKNESS];
 
 /// VO area's: its samples and VO line's sphere (a setting two methods list is one flag).
-pub(crate) const AREA_SETTINGS: &[Setting] = &[AREA_SAMPLES, RADIUS, RADIUS2, COMBINE, NORMAL_CLAMP, THICKNESS];
+pub(crate) const AREA_SETTINGS: &[Setting<VoSettings>] =
+    &[AREA_SAMPLES, RADIUS, RADIUS2, COMBINE, NORMAL_CLAMP, THICKNESS];
 
-const SAMPLES: Setting = Setting {
-    flag: "vo-samples",
-    label: "line samples",
-    help: "VO line sampling: line samples",
-    kind: Kind::Counts(&VO_SAMPLE_COUNTS),
-    role: Some(Role::Samples),
-    get: |s| Value::Count(s.vo.samples),
-    set: |s, v| s.vo.samples = v.as_u32(),
+const SAMPLES: Setting<VoSettings> = Setting {
+    about: About {
+        flag: "vo-samples",
+        label: "line samples",
+        help: "VO line sampling: line samples",
+        kind: Kind::Counts(&VO_SAMPLE_COUNTS),
+        role: Some(Role::Samples),
+        ..About::BASE
+    },
+    get: |s, _| Value::Count(s.samples),
+    set: |s, v| s.samples = v.as_u32(),
     ..Setting::BASE
 };
 
-const AREA_SAMPLES: Setting = Setting {
-    flag: "vo-area-samples",
-    label: "area samples",
-    help: "VO area sampling: area samples (1 or a line count)",
-    kind: Kind::Counts(&VO_AREA_SAMPLE_COUNTS),
-    role: Some(Role::Samples),
-    get: |s| Value::Count(s.vo.area_samples),
-    set: |s, v| s.vo.area_samples = v.as_u32(),
+const AREA_SAMPLES: Setting<VoSettings> = Setting {
+    about: About {
+        flag: "vo-area-samples",
+        label: "area samples",
+        help: "VO area sampling: area samples (1 or a line count)",
+        kind: Kind::Counts(&VO_AREA_SAMPLE_COUNTS),
+        role: Some(Role::Samples),
+        ..About::BASE
+    },
+    get: |s, _| Value::Count(s.area_samples),
+    set: |s, v| s.area_samples = v.as_u32(),
     ..Setting::BASE
 };
 
-const RADIUS: Setting = Setting {
-    flag: "vo-radius",
-    label: "radius",
-    help: "VO (line and area sampling): sphere radius",
-    unit: Unit::WorldUnits,
-    kind: Kind::Above { min: 0.0, open: true, slider: [0.1, 20.0], log: true },
-    default: Some("the preset's; paper 2"),
-    role: Some(Role::Radius),
-    get: |s| Value::Number(s.vo.radius_world),
-    set: |s, v| s.vo.radius_world = v.as_f32(),
+const RADIUS: Setting<VoSettings> = Setting {
+    about: About {
+        flag: "vo-radius",
+        label: "radius",
+        help: "VO (line and area sampling): sphere radius",
+        unit: Unit::WorldUnits,
+        kind: Kind::Above { min: 0.0, open: true, slider: [0.1, 20.0], log: true },
+        default: Some("the preset's; paper 2"),
+        role: Some(Role::Radius),
+        ..About::BASE
+    },
+    get: |s, _| Value::Number(s.radius_world),
+    set: |s, v| s.radius_world = v.as_f32(),
     ..Setting::BASE
 };
 
-const RADIUS2: Setting = Setting {
-    flag: "radius2",
-    label: "second radius",
-    help: "VO: a second sphere radius, combined with the first (VO paper, Fig. 8); 0: none",
-    unit: Unit::WorldUnits,
-    kind: Kind::Above { min: 0.0, open: false, slider: [0.0, 20.0], log: false },
-    default: Some("none"),
-    get: |s| Value::Number(s.vo.radius2_world.unwrap_or(0.0)),
-    set: |s, v| s.vo.radius2_world = Some(v.as_f32()).filter(|r| *r > 0.0),
+const RADIUS2: Setting<VoSettings> = Setting {
+    about: About {
+        flag: "radius2",
+        label: "second radius",
+        help: "VO: a second sphere radius, combined with the first (VO paper, Fig. 8); 0: none",
+        unit: Unit::WorldUnits,
+        kind: Kind::Above { min: 0.0, open: false, slider: [0.0, 20.0], log: false },
+        default: Some("none"),
+        ..About::BASE
+    },
+    get: |s, _| Value::Number(s.radius2_world.unwrap_or(0.0)),
+    set: |s, v| s.radius2_world = Some(v.as_f32()).filter(|r| *r > 0.0),
     ..Setting::BASE
 };
 
-const COMBINE: Setting = Setting {
-    flag: "combine",
-    label: "two radii combine",
-    help: "VO with two radii: brightness multiplied (product) or the darker of the two (min)",
-    kind: Kind::Choice(&["product", "min"]),
-    requires: Some("radius2"),
-    applies: |s| s.vo.radius2_world.is_some(),
-    get: |s| Value::Choice(s.vo.combine.name()),
-    set: |s, v| s.vo.combine = v.named(),
+const COMBINE: Setting<VoSettings> = Setting {
+    about: About {
+        flag: "combine",
+        label: "two radii combine",
+        help: "VO with two radii: brightness multiplied (product) or the darker of the two (min)",
+        kind: Kind::Choice(&["product", "min"]),
+        requires: Some("radius2"),
+        ..About::BASE
+    },
+    applies: |s| s.radius2_world.is_some(),
+    get: |s, _| Value::Choice(s.combine.name()),
+    set: |s, v| s.combine = v.named(),
+};
+
+const NORMAL_CLAMP: Setting<VoSettings> = Setting {
+    about: About {
+        flag: "no-normal-clamp",
+        label: "normal clamp (half sphere)",
+        help: "VO: no normal clamp (the whole sphere, not the half above the surface)",
+        kind: Kind::Switch { given: false },
+        ..About::BASE
+    },
+    get: |s, _| Value::Switch(s.normal_clamp),
+    set: |s, v| s.normal_clamp = v.is_on(),
     ..Setting::BASE
 };
 
-const NORMAL_CLAMP: Setting = Setting {
-    flag: "no-normal-clamp",
-    label: "normal clamp (half sphere)",
-    help: "VO: no normal clamp (the whole sphere, not the half above the surface)",
-    kind: Kind::Switch { given: false },
-    get: |s| Value::Switch(s.vo.normal_clamp),
-    set: |s, v| s.vo.normal_clamp = v.is_on(),
-    ..Setting::BASE
-};
-
-const THICKNESS: Setting = Setting {
-    flag: "thickness",
-    label: "thickness",
-    help: "VO: thickness model, occupied only this far behind the visible surface; 0: off",
-    unit: Unit::WorldUnits,
-    kind: Kind::Above { min: 0.0, open: false, slider: [0.0, 10.0], log: false },
-    get: |s| Value::Number(s.vo.thickness_world),
-    set: |s, v| s.vo.thickness_world = v.as_f32(),
+const THICKNESS: Setting<VoSettings> = Setting {
+    about: About {
+        flag: "thickness",
+        label: "thickness",
+        help: "VO: thickness model, occupied only this far behind the visible surface; 0: off",
+        unit: Unit::WorldUnits,
+        kind: Kind::Above { min: 0.0, open: false, slider: [0.0, 10.0], log: false },
+        ..About::BASE
+    },
+    get: |s, _| Value::Number(s.thickness_world),
+    set: |s, v| s.thickness_world = v.as_f32(),
     ..Setting::BASE
 };
 
@@ -198,15 +219,22 @@ impl VoSettings {
     }
 }
 
-/// VO's radius (zoom units) and strength in `preset` (docs/ground-truth.md), the radii being the
-/// sampling's own: line samples legible 2 and physical 1.5, area samples 1 and 1.
-pub(crate) fn preset(preset: Preset, settings: &mut ChainSettings, legible_radius: f32, physical_radius: f32) {
+/// VO's radius (zoom units) in `preset` (docs/ground-truth.md), the radii being the sampling's
+/// own: line samples legible 2 and physical 1.5, area samples 1 and 1; the strength it is shown
+/// with.
+pub(crate) fn preset(
+    preset: Preset,
+    vo: &mut VoSettings,
+    context: &Context,
+    legible_radius: f32,
+    physical_radius: f32,
+) -> f32 {
     let (strength, radius) = match preset {
         Preset::Paper => (1.0, 2.0),
         Preset::Legible => (0.8, legible_radius),
         Preset::Physical => (0.22, physical_radius),
         Preset::Sparse => (0.8, 6.0),
     };
-    settings.strength = strength;
-    settings.vo.radius_world = radius * settings.zoom_unit;
+    vo.radius_world = radius * context.zoom_unit;
+    strength
 }
