@@ -112,7 +112,7 @@ pub mod sample_sets;
 #[cfg(not(feature = "reference"))]
 pub(crate) mod sample_sets;
 mod settings;
-pub mod shader;
+pub(crate) mod shader;
 mod stage;
 pub mod targets;
 pub mod timing;
@@ -149,6 +149,7 @@ pub use settings::{
     BilateralSettings, ChainSettings, DebugView, LineColor, Slab, SlabAxis, SliceSettings, SurfaceSettings,
     TransparencySettings, TubeSettings, VolumeAoSettings,
 };
+pub use shader::GBUFFER_WGSL;
 
 // docs/embedding.md's code compiles as it stands: `cargo test --doc` checks it.
 #[cfg(doctest)]

@@ -111,7 +111,7 @@ const AO_USAGE: wgpu::TextureUsages = wgpu::TextureUsages::STORAGE_BINDING
     .union(wgpu::TextureUsages::COPY_DST);
 
 /// The side in pixels of the tiles in which [`FrameTargets::slice_tiles`] marks the slices:
-/// the bilateral blur's workgroup (a number the WGSL shares: [`crate::shader::PASS_CONSTANTS`]).
+/// the bilateral blur's workgroup (a number the WGSL shares: `rust/constants.wgsl`).
 pub use crate::shader::SLICE_TILE;
 
 /// Tiles of [`SLICE_TILE`] pixels a side across and down a target of `size`.

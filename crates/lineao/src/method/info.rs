@@ -30,7 +30,7 @@ pub struct MethodInfo {
     /// Its WGSL files, by the name its passes compose them under, and the numbers its WGSL
     /// shares with its CPU reference, which Rust writes into the WGSL
     /// ([`crate::shader::CONSTANTS`]).
-    pub library: crate::shader::Library,
+    pub(crate) library: crate::shader::Library,
     /// Its stage; `None` for a method that runs no pass (`none`).
     pub(crate) build: Option<BuildStage>,
     /// Whether what its stage allocates for a guard-banded frame of this size fits the device's

@@ -2,9 +2,9 @@
 //!
 //! A method's folder holds everything that is the method's own: its passes and their WGSL, the
 //! [`Stage`] that puts them in the chain, its settings (units, ranges, defaults, validation and
-//! its values in each [`Preset`], all on its own settings type: [`Own`]), and its CPU reference
+//! its values in each [`Preset`], all on its own settings type: `Own`), and its CPU reference
 //! (re-exported by [`crate::reference`]). The folder ends in one [`MethodInfo`], and the list
-//! ([`list`]'s `for_each_method!`) names every method by its folder. Everything that names methods derives from the registry:
+//! (`list.rs`'s `for_each_method!`) names every method by its folder. Everything that names methods derives from the registry:
 //! [`AoMethod`] itself, its names and help, the chain's timing spans ([`pass_names`]), the
 //! shaders the naga test validates, the presets, and — in the front ends — the command line's
 //! values, the bench's passes, `score`'s rows, the viewer's labels and Python's `methods()`.

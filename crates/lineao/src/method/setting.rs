@@ -2,7 +2,7 @@
 //! help, unit, range and default ([`About`]), and how it is read from and written to the
 //! method's own settings ([`Setting`]).
 //!
-//! A method lists its settings in its registry entry ([`super::Own`]); from that one table the
+//! A method lists its settings in its registry entry (its `Own`); from that one table the
 //! front ends make what a user sees — the command line's flags (`lineao render --help` shows
 //! each with its unit and default), Python's keyword arguments (the flag with `_`), the
 //! viewer's sliders and checkboxes, the web page's URL keys (the flag) — and the chain checks

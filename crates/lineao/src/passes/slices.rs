@@ -341,7 +341,7 @@ fn percentiles(values: &[f32], quantiles: [f32; 2]) -> [f32; 2] {
 }
 
 /// The corners of a slice's polygon ([`SliceVolume::outline`]; a number the WGSL shares:
-/// [`crate::shader::PASS_CONSTANTS`]).
+/// `rust/constants.wgsl`).
 pub use crate::shader::OUTLINE_SIDES;
 /// The `vec4`s of the three axes' polygons in [`SliceUniform`].
 const OUTLINE_WORDS: usize = 3 * OUTLINE_SIDES / 2;

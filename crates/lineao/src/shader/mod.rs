@@ -9,43 +9,43 @@ use std::borrow::Cow;
 /// The WGSL files of the shared passes (under `shaders/`), by path relative to that folder;
 /// each method's are in its folder and its [`Library`].
 const SHARED: &[(&str, &str)] = &[
-    ("shared/billboard.wgsl", include_str!("../shaders/shared/billboard.wgsl")),
-    ("shared/clusters.wgsl", include_str!("../shaders/shared/clusters.wgsl")),
-    ("shared/cone.wgsl", include_str!("../shaders/shared/cone.wgsl")),
-    ("shared/fullscreen.wgsl", include_str!("../shaders/shared/fullscreen.wgsl")),
-    ("shared/gbuffer.wgsl", include_str!("../shaders/shared/gbuffer.wgsl")),
-    ("shared/geometry.wgsl", include_str!("../shaders/shared/geometry.wgsl")),
-    ("shared/lighting.wgsl", include_str!("../shaders/shared/lighting.wgsl")),
-    ("shared/line_strip.wgsl", include_str!("../shaders/shared/line_strip.wgsl")),
-    ("shared/nd.wgsl", include_str!("../shaders/shared/nd.wgsl")),
-    ("shared/object_ao.wgsl", include_str!("../shaders/shared/object_ao.wgsl")),
-    ("shared/pieces.wgsl", include_str!("../shaders/shared/pieces.wgsl")),
-    ("shared/view.wgsl", include_str!("../shaders/shared/view.wgsl")),
-    ("shared/vo.wgsl", include_str!("../shaders/shared/vo.wgsl")),
-    ("shared/vo_pass.wgsl", include_str!("../shaders/shared/vo_pass.wgsl")),
-    ("bilateral.wgsl", include_str!("../shaders/bilateral.wgsl")),
-    ("composite.wgsl", include_str!("../shaders/composite.wgsl")),
-    ("cull.wgsl", include_str!("../shaders/cull.wgsl")),
-    ("depth_pyramid.wgsl", include_str!("../shaders/depth_pyramid.wgsl")),
-    ("line_geometry.wgsl", include_str!("../shaders/line_geometry.wgsl")),
-    ("lines.wgsl", include_str!("../shaders/lines.wgsl")),
-    ("meshes.wgsl", include_str!("../shaders/meshes.wgsl")),
-    ("nd_from_depth.wgsl", include_str!("../shaders/nd_from_depth.wgsl")),
-    ("nd_pyramid.wgsl", include_str!("../shaders/nd_pyramid.wgsl")),
-    ("raster.wgsl", include_str!("../shaders/raster.wgsl")),
-    ("seed_depth.wgsl", include_str!("../shaders/seed_depth.wgsl")),
-    ("slices.wgsl", include_str!("../shaders/slices.wgsl")),
-    ("strip.wgsl", include_str!("../shaders/strip.wgsl")),
-    ("transparency.wgsl", include_str!("../shaders/transparency.wgsl")),
-    ("tubes.wgsl", include_str!("../shaders/tubes.wgsl")),
-    ("volume_ao.wgsl", include_str!("../shaders/volume_ao.wgsl")),
+    ("shared/billboard.wgsl", include_str!("../../shaders/shared/billboard.wgsl")),
+    ("shared/clusters.wgsl", include_str!("../../shaders/shared/clusters.wgsl")),
+    ("shared/cone.wgsl", include_str!("../../shaders/shared/cone.wgsl")),
+    ("shared/fullscreen.wgsl", include_str!("../../shaders/shared/fullscreen.wgsl")),
+    ("shared/gbuffer.wgsl", include_str!("../../shaders/shared/gbuffer.wgsl")),
+    ("shared/geometry.wgsl", include_str!("../../shaders/shared/geometry.wgsl")),
+    ("shared/lighting.wgsl", include_str!("../../shaders/shared/lighting.wgsl")),
+    ("shared/line_strip.wgsl", include_str!("../../shaders/shared/line_strip.wgsl")),
+    ("shared/nd.wgsl", include_str!("../../shaders/shared/nd.wgsl")),
+    ("shared/object_ao.wgsl", include_str!("../../shaders/shared/object_ao.wgsl")),
+    ("shared/pieces.wgsl", include_str!("../../shaders/shared/pieces.wgsl")),
+    ("shared/view.wgsl", include_str!("../../shaders/shared/view.wgsl")),
+    ("shared/vo.wgsl", include_str!("../../shaders/shared/vo.wgsl")),
+    ("shared/vo_pass.wgsl", include_str!("../../shaders/shared/vo_pass.wgsl")),
+    ("bilateral.wgsl", include_str!("../../shaders/bilateral.wgsl")),
+    ("composite.wgsl", include_str!("../../shaders/composite.wgsl")),
+    ("cull.wgsl", include_str!("../../shaders/cull.wgsl")),
+    ("depth_pyramid.wgsl", include_str!("../../shaders/depth_pyramid.wgsl")),
+    ("line_geometry.wgsl", include_str!("../../shaders/line_geometry.wgsl")),
+    ("lines.wgsl", include_str!("../../shaders/lines.wgsl")),
+    ("meshes.wgsl", include_str!("../../shaders/meshes.wgsl")),
+    ("nd_from_depth.wgsl", include_str!("../../shaders/nd_from_depth.wgsl")),
+    ("nd_pyramid.wgsl", include_str!("../../shaders/nd_pyramid.wgsl")),
+    ("raster.wgsl", include_str!("../../shaders/raster.wgsl")),
+    ("seed_depth.wgsl", include_str!("../../shaders/seed_depth.wgsl")),
+    ("slices.wgsl", include_str!("../../shaders/slices.wgsl")),
+    ("strip.wgsl", include_str!("../../shaders/strip.wgsl")),
+    ("transparency.wgsl", include_str!("../../shaders/transparency.wgsl")),
+    ("tubes.wgsl", include_str!("../../shaders/tubes.wgsl")),
+    ("volume_ao.wgsl", include_str!("../../shaders/volume_ao.wgsl")),
 ];
 
 /// WGSL functions a host renderer can paste into (or concatenate with) its own shaders to write
 /// the ND map and zoom map of docs/reference.md: `gbuffer_nd`, `gbuffer_zoom`, `gbuffer_depth`,
 /// `gbuffer_line_normal`, `gbuffer_eye_direction` (`shaders/shared/gbuffer.wgsl`; no bindings,
 /// no imports).
-pub const GBUFFER_WGSL: &str = include_str!("../shaders/shared/gbuffer.wgsl");
+pub const GBUFFER_WGSL: &str = include_str!("../../shaders/shared/gbuffer.wgsl");
 
 /// A number Rust and WGSL share, written into WGSL by Rust ([`CONSTANTS`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -121,7 +121,8 @@ pub fn constants(library: &Library) -> String {
 /// Files that are a pass's body rather than a module: they use what their importer defines (VO's
 /// entry point calls its method's `obscurance`; object-space AO reads its importer's table), so
 /// they validate within their importers only.
-pub const FRAGMENTS: &[&str] = &["shared/vo_pass.wgsl", "shared/object_ao.wgsl"];
+#[cfg(test)]
+pub(crate) const FRAGMENTS: &[&str] = &["shared/vo_pass.wgsl", "shared/object_ao.wgsl"];
 
 /// The embedded WGSL files `library` composes from, (name, source): the shared ones, then its own.
 pub fn files(library: &Library) -> impl Iterator<Item = (&'static str, &'static str)> {
@@ -309,30 +310,4 @@ pub(crate) fn check_vertex_layout<'a>(
 }
 
 #[cfg(test)]
-mod tests {
-    /// The check fails on a reordered field: a Rust struct whose first two fields are swapped
-    /// against `Levels` (shared/nd.wgsl: scale, then size).
-    #[test]
-    #[should_panic(expected = "fields (name, offset)")]
-    fn a_reordered_field_fails_the_layout_check() {
-        #[repr(C)]
-        struct Swapped {
-            size: [[u32; 4]; 5],
-            scale: [[f32; 4]; 5],
-        }
-        assert_wgsl_layout!(Swapped, "shared/nd.wgsl", "Levels", [size, scale]);
-    }
-
-    /// The vertex check fails on an attribute at another field's offset.
-    #[test]
-    #[should_panic(expected = "attributes (offset, size)")]
-    fn a_vertex_attribute_at_the_wrong_offset_fails() {
-        #[repr(C)]
-        struct Vertex {
-            normal: [f32; 3],
-            position: [f32; 3],
-        }
-        let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3];
-        assert_vertex_layout!(Vertex, "meshes.wgsl", "MeshVertex", attributes, [position, normal]);
-    }
-}
+mod tests;

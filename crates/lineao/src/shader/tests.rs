@@ -1,8 +1,8 @@
-//! Every WGSL file parses and validates with naga, imports resolved — no GPU needed.
+//! The shader tests: every WGSL file parses and validates with naga, imports resolved — no GPU needed.
 
 use std::path::Path;
 
-use lineao::shader::Library;
+use super::Library;
 
 /// The capabilities a file's module is made with: the device's 64-bit atomics for the lines
 /// rasterized in compute (made only where the device has them), WebGPU's `pack2x16float` for
@@ -21,13 +21,13 @@ fn capabilities(path: &str) -> naga::valid::Capabilities {
 
 /// The shared files, then each method's with the library it composes them in.
 fn libraries() -> impl Iterator<Item = (Library, Vec<(&'static str, &'static str)>)> {
-    let shared = std::iter::once((Library::SHARED, lineao::shader::files(&Library::SHARED).collect()));
-    let methods = lineao::AoMethod::REGISTRY.iter().map(|m| m.info().library).map(|l| (l, l.files.to_vec()));
+    let shared = std::iter::once((Library::SHARED, super::files(&Library::SHARED).collect()));
+    let methods = crate::AoMethod::REGISTRY.iter().map(|m| m.info().library).map(|l| (l, l.files.to_vec()));
     shared.chain(methods)
 }
 
 fn validate(path: &str, library: Library) -> Result<(), String> {
-    let source = lineao::shader::compose(library.source(path));
+    let source = super::compose(library.source(path));
     let module = naga::front::wgsl::parse_str(&source).map_err(|e| e.emit_to_string(&source))?;
     naga::valid::Validator::new(naga::valid::ValidationFlags::all(), capabilities(path))
         .validate(&module)
@@ -39,12 +39,12 @@ fn validate(path: &str, library: Library) -> Result<(), String> {
 fn every_wgsl_file_validates() {
     let modules = libraries().flat_map(|(library, files)| files.into_iter().map(move |(path, _)| (library, path)));
     let failures: Vec<String> = modules
-        .filter(|(_, path)| !lineao::shader::FRAGMENTS.contains(path))
+        .filter(|(_, path)| !super::FRAGMENTS.contains(path))
         .filter_map(|(library, path)| validate(path, library).err().map(|e| format!("{path}:\n{e}")))
         .collect();
     assert!(failures.is_empty(), "{}", failures.join("\n"));
     // A fragment validates within the modules that import it: at least one does.
-    for fragment in lineao::shader::FRAGMENTS {
+    for fragment in super::FRAGMENTS {
         let import = format!("#import {fragment}");
         let importers =
             libraries().flat_map(|(_, files)| files).filter(|(_, source)| source.lines().any(|l| l.trim() == import));
@@ -62,7 +62,7 @@ fn every_wgsl_file_on_disk_is_embedded() {
     for entry in std::fs::read_dir(crate_root.join("src/method")).unwrap() {
         let dir = entry.unwrap().path();
         // The toy method (`method/toy/`) is registered with the feature `toy-method` only.
-        let registered = !dir.ends_with("toy") || lineao::AoMethod::from_name("toy").is_some();
+        let registered = !dir.ends_with("toy") || crate::AoMethod::from_name("toy").is_some();
         if dir.is_dir() && registered {
             folders.push((dir.clone(), dir));
         }
@@ -96,4 +96,30 @@ fn a_broken_shader_is_reported() {
     let result = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default())
         .validate(&module);
     assert!(result.is_err());
+}
+
+/// The check fails on a reordered field: a Rust struct whose first two fields are swapped
+/// against `Levels` (shared/nd.wgsl: scale, then size).
+#[test]
+#[should_panic(expected = "fields (name, offset)")]
+fn a_reordered_field_fails_the_layout_check() {
+    #[repr(C)]
+    struct Swapped {
+        size: [[u32; 4]; 5],
+        scale: [[f32; 4]; 5],
+    }
+    super::assert_wgsl_layout!(Swapped, "shared/nd.wgsl", "Levels", [size, scale]);
+}
+
+/// The vertex check fails on an attribute at another field's offset.
+#[test]
+#[should_panic(expected = "attributes (offset, size)")]
+fn a_vertex_attribute_at_the_wrong_offset_fails() {
+    #[repr(C)]
+    struct Vertex {
+        normal: [f32; 3],
+        position: [f32; 3],
+    }
+    let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3];
+    super::assert_vertex_layout!(Vertex, "meshes.wgsl", "MeshVertex", attributes, [position, normal]);
 }
