@@ -110,6 +110,33 @@ fn timings_over_frames_and_against_other_settings() {
     assert_eq!(lineao(&["render", "--timings-against", against]).status.code(), Some(2));
 }
 
+/// A single picture of a whole brain is culled where `--cull` is not given: its first frame
+/// seeds the cull (every 8th cluster drawn, the rest culled against their depth), and it is the
+/// picture drawing every line with the full strip makes (`--cull on --lod off`, settled), byte
+/// for byte; `--timings` says what was chosen. Below the threshold every line is drawn, as
+/// `--cull off` draws it.
+#[test]
+fn a_single_picture_of_a_whole_brain_is_culled_where_that_is_cheaper() {
+    let dir = scratch("cull-auto");
+    let picture = |vertices: &str, cull: &[&str], name: &str| {
+        let path = dir.join(name);
+        let size = ["--scene", "wholebrain", "--vertices", vertices, "--width", "128", "--height", "96"];
+        let args = [&["render"][..], &size, &["--method", "none", "-o", path.to_str().unwrap()], cull].concat();
+        let out = lineao(&args);
+        assert_eq!(out.status.code(), Some(0), "{}", stderr(&out));
+        (std::fs::read(&path).unwrap(), stderr(&out))
+    };
+    let whole_brain = "8100000";
+    let (chosen, said) = picture(whole_brain, &["--timings"], "chosen.png");
+    assert!(said.contains("cull on (8037714 points; culled from 8000000)"), "{said}");
+    assert!(said.contains("cull: drew"), "the culled frame reports what it drew: {said}");
+    let (full_strip, _) = picture(whole_brain, &["--cull", "on", "--lod", "off"], "full-strip.png");
+    assert!(chosen == full_strip, "the culled single picture differs from the full strip's");
+    let (small, said) = picture("400000", &["--timings"], "small.png");
+    assert!(said.contains("cull off (") && !said.contains("cull: drew"), "{said}");
+    assert!(small == picture("400000", &["--cull", "off"], "off.png").0, "below the threshold every line is drawn");
+}
+
 fn read_npy(path: &Path) -> (Vec<u64>, Vec<f32>) {
     let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let npy = npyz::NpyFile::new(&bytes[..]).unwrap();

@@ -458,10 +458,11 @@ pub struct StyleArgs {
     #[arg(long, default_value = "1,1,1", value_parser = parse_vec3)]
     #[serde(deserialize_with = "crate::kwargs::vec3")]
     pub background: [f32; 3],
-    /// Draw only the lines that can be seen, culled on the GPU against the frame before (`on`),
-    /// or every line (`off`) [default: off: one picture has no frame before it; culled, the
-    /// first frame culls against every 8th cluster drawn first and the picture is the second
-    /// frame, faster for whole brains (50 M points: 0.7 × the wall time); the viewer culls].
+    /// Draw only the lines that can be seen, culled on the GPU against the frame before (`on`:
+    /// the picture is the second frame, at the levels of detail the first found), or every
+    /// line (`off`) [default: culled from 8 M points (a whole brain), one frame that culls
+    /// against every 8th cluster drawn first, the picture every line draws with the full
+    /// strip; below, every line; `--timings` says which; the viewer culls].
     #[arg(long, value_parser = parse_on_off)]
     pub cull: Option<bool>,
     /// Where lines or tubes are culled, draw each visible piece at the coarsest level of detail

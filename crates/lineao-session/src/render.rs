@@ -59,6 +59,10 @@ fn tube_radius(args: &RenderArgs, zoom_unit: f32) -> f32 {
     args.style.tube_radius.unwrap_or(0.5 * zoom_unit)
 }
 
+/// The lines from which `render` culls a single picture where `--cull` is not given
+/// ([`Session::culls_one_picture`]).
+pub const CULL_POINTS: usize = 8_000_000;
+
 /// The chain's settings from the command line, for `method` (object-space AO lit by `sky`), in
 /// a scene whose bounds' longest side is `longest_side` world units.
 pub fn settings(args: &RenderArgs, method: Method, zoom_unit: f32, sky: Sky, longest_side: f32) -> ChainSettings {
@@ -635,16 +639,26 @@ impl Session {
     ) -> Result<Rendered> {
         let gpu = &self.gpu;
         let format = wgpu::TextureFormat::Rgba8UnormSrgb;
+        let tile = tile_size(args, &gpu.device.limits(), &panel.settings);
+        let mut settings = panel.settings.clone();
+        let culled = args.style.cull.is_none() && self.culls_one_picture(&settings, tile.is_some());
+        settings.cull |= culled;
+        if args.image.timings && args.style.cull.is_none() {
+            let (points, chosen) = (self.lines.geometry.points(), if culled { "on" } else { "off" });
+            eprintln!("lineao: {}: cull {chosen} ({points} points; culled from {CULL_POINTS})", panel.label);
+        }
         let mut chain = match kept {
             Some(mut chain) => {
-                chain.set_settings(&gpu.device, panel.settings.clone())?;
+                chain.set_settings(&gpu.device, settings)?;
                 chain
             }
-            None => AoChain::new(&gpu.device, format, panel.settings.clone())?,
+            None => AoChain::new(&gpu.device, format, settings)?,
         };
         let gpu_rays = panel.settings.method == AoMethod::RayTraced && !args.truth.cpu;
-        let options = FrameOptions { gpu_rays, settled: true, timings: args.image.timings };
-        if let Some(tile) = tile_size(args, &gpu.device.limits(), &panel.settings) {
+        // `--cull on` draws what a viewer shows of a still camera (its second frame, at the
+        // levels of detail the first found); the cull chosen for a single picture, its first.
+        let options = FrameOptions { gpu_rays, settled: !culled, timings: args.image.timings };
+        if let Some(tile) = tile {
             check_tiled(args, panel, dump)?;
             let (width, height) = (args.image.width, args.image.height);
             let mut image = Rgba8::filled(width, height, [0, 0, 0, 0]);
@@ -748,6 +762,16 @@ impl Session {
         }
         let image = Rgba8 { width: args.image.width, height: args.image.height, data: image.bytes };
         Ok(Rendered { image, chain })
+    }
+
+    /// Whether `render` culls a picture with `settings` where `--cull` is not given: where the
+    /// lines are many enough that the first frame's seeded cull (every 8th cluster drawn, the
+    /// rest culled against their depth: [`lineao::passes::cull`]) costs less than drawing every
+    /// line — whole brains — in an untiled, opaque frame of a screen-space method.
+    fn culls_one_picture(&self, settings: &ChainSettings, tiled: bool) -> bool {
+        let opaque_lines = settings.tubes.is_none() && settings.transparent().is_none();
+        let screen_space = settings.method != AoMethod::RayTraced;
+        opaque_lines && screen_space && !tiled && self.lines.geometry.points() >= CULL_POINTS
     }
 
     /// One frame of `chain` (sized, with its settings) over the session's lines, surfaces and
