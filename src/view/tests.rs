@@ -571,7 +571,10 @@ fn the_ray_traced_method_accumulates_while_the_camera_rests_and_shows_lineao_whi
         chain.encode(&mut encoder, &geometry, &target.view).unwrap();
         q.submit([encoder.finish()]);
     }
-    assert_eq!(chain.ray_progress().unwrap().rays_per_pixel, 12);
+    assert_eq!(
+        chain.stage::<lineao::method::raytraced::RayTracedAo>().map(|t| t.progress()).unwrap().rays_per_pixel,
+        12
+    );
     let direct = lineao::readback::read_texture(d, q, &target.texture).unwrap().bytes;
     let differing = direct.iter().zip(&frame.images[0]).filter(|(a, b)| a.abs_diff(**b) > 1).count();
     assert!(differing * 1000 < direct.len(), "{differing} of {} bytes differ", direct.len());

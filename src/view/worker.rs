@@ -279,7 +279,7 @@ impl Worker {
         timing.times.resize(timing.view.panels.len(), None);
         for (slot, panel) in timing.times.iter_mut().zip(&self.chains) {
             if slot.is_none() {
-                *slot = panel.chain.try_pass_times(&self.gpu.device).ok().flatten();
+                *slot = panel.chain.pass_times(&self.gpu.device, false).ok().flatten();
             }
         }
         timing.times.iter().all(Option::is_some)
@@ -767,14 +767,15 @@ async fn render_frame(
         };
         frame.submit(gpu, chain, &target.view).map_err(|e| e.to_string())?;
         if readback {
-            times.push(if view.timings { chain.pass_times(d).map_err(|e| e.to_string())? } else { None });
+            times.push(if view.timings { chain.pass_times(d, true).map_err(|e| e.to_string())? } else { None });
             images.push(lineao::readback::read_texture(d, q, &target.texture).map_err(|e| e.to_string())?.bytes);
         } else {
             // Without waiting: they follow once the GPU has finished ([`FromWorker::Times`]).
             times.push(None);
             views.push(target.view.clone());
         }
-        let progress = if traced { chain.ray_progress() } else { None };
+        let progress =
+            if traced { chain.stage::<lineao::method::raytraced::RayTracedAo>().map(|t| t.progress()) } else { None };
         rays.push(match progress {
             Some(progress) if !readback => Some(RayStatus { progress, rays_per_second: None }),
             Some(progress) => {

@@ -694,12 +694,12 @@ impl Session {
                     self.frame(&mut chain, &target.view, options)?;
                     gpu.wait()?;
                 }
-                let Some(times) = chain.pass_times(&gpu.device)? else { break };
+                let Some(times) = chain.pass_times(&gpu.device, true)? else { break };
                 frames.push(times);
                 if let Some((_, other, times)) = &mut against {
                     self.frame(other, &target.view, options)?;
                     gpu.wait()?;
-                    times.extend(other.pass_times(&gpu.device)?);
+                    times.extend(other.pass_times(&gpu.device, true)?);
                 }
             }
             match &frames[..] {
@@ -741,7 +741,7 @@ impl Session {
             let mut encoder = gpu
                 .device
                 .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::render::composite") });
-            chain.encode_composite(&mut encoder, &target.view);
+            chain.encode_composite(&mut encoder, &target.view)?;
             gpu.queue.submit([encoder.finish()]);
             Some(truth)
         } else if gpu_rays && dump.is_some() {

@@ -97,7 +97,12 @@ pub fn accumulate(
     mut frame: impl FnMut(&mut AoChain) -> std::result::Result<(), lineao::Error>,
 ) -> Result<()> {
     let start = std::time::Instant::now();
-    let progress = |chain: &AoChain| chain.ray_progress().context("the ray-traced method is not active");
+    let progress = |chain: &AoChain| {
+        chain
+            .stage::<lineao::method::raytraced::RayTracedAo>()
+            .map(|t| t.progress())
+            .context("the ray-traced method is not active")
+    };
     let first = progress(chain)?;
     let bar = std::io::stderr().is_terminal().then(|| {
         indicatif::ProgressBar::new(first.max_rays as u64).with_style(
@@ -143,7 +148,10 @@ pub fn accumulate(
 /// geometry and buried pixels. What `--dump` writes of a GPU-traced truth.
 pub fn from_gpu(gpu: &Gpu, chain: &AoChain) -> Result<Truth> {
     let (d, q) = (&gpu.device, &gpu.queue);
-    let progress = chain.ray_progress().context("the ray-traced method is not active")?;
+    let progress = chain
+        .stage::<lineao::method::raytraced::RayTracedAo>()
+        .map(|t| t.progress())
+        .context("the ray-traced method is not active")?;
     let accumulation =
         chain.stage::<RayTracedAo>().and_then(RayTracedAo::accumulation).context("nothing was traced")?;
     let targets = chain.targets().context("nothing was rendered")?;

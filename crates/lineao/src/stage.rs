@@ -86,12 +86,7 @@ impl Stages {
         stage.downcast_ref()
     }
 
-    /// The active stage if it is the ray tracer: the one stage whose progress the chain reports,
-    /// and that takes the scene.
-    pub fn ray_tracer(&self) -> Option<&RayTracedAo> {
-        self.active_as()
-    }
-
+    /// The active stage if it is the ray tracer: the one stage that takes the scene.
     fn ray_tracer_mut(&mut self) -> Option<&mut RayTracedAo> {
         let stage: &mut dyn std::any::Any = self.active.as_deref_mut()?;
         stage.downcast_mut()

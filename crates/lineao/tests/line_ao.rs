@@ -476,7 +476,7 @@ fn chain_reports_gpu_time_per_pass() {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         chain.encode(&mut encoder, &geometry, &output.view).unwrap();
         gpu.queue.submit([encoder.finish()]);
-        let Some(times) = chain.pass_times(&gpu.device).unwrap() else {
+        let Some(times) = chain.pass_times(&gpu.device, true).unwrap() else {
             assert!(!has_timestamps);
             continue;
         };
@@ -501,11 +501,11 @@ fn pass_times_can_be_polled_without_waiting() {
         // An adapter without timestamp queries (not lavapipe) has no timer: timing stays off and
         // polling says so at once.
         assert!(!timed);
-        assert_eq!(chain.try_pass_times(&gpu.device).unwrap(), None);
+        assert_eq!(chain.pass_times(&gpu.device, false).unwrap(), None);
         return;
     }
     assert!(timed);
-    assert_eq!(chain.try_pass_times(&gpu.device).unwrap(), None, "nothing was submitted yet");
+    assert_eq!(chain.pass_times(&gpu.device, false).unwrap(), None, "nothing was submitted yet");
     chain.resize(64, 48).unwrap();
     let output = lineao::targets::Target::output(&gpu.device, "test::output", (64, 48), common::OUTPUT_FORMAT);
     let mut polled = None;
@@ -514,7 +514,7 @@ fn pass_times_can_be_polled_without_waiting() {
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         chain.encode(&mut encoder, &geometry, &output.view).unwrap();
         gpu.queue.submit([encoder.finish()]);
-        if let Some(times) = chain.try_pass_times(&gpu.device).unwrap() {
+        if let Some(times) = chain.pass_times(&gpu.device, false).unwrap() {
             polled = Some(times);
             break;
         }
@@ -524,7 +524,7 @@ fn pass_times_can_be_polled_without_waiting() {
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
     chain.encode(&mut encoder, &geometry, &output.view).unwrap();
     gpu.queue.submit([encoder.finish()]);
-    let blocking = chain.pass_times(&gpu.device).unwrap().unwrap();
+    let blocking = chain.pass_times(&gpu.device, true).unwrap().unwrap();
     let names = |t: &[lineao::timing::PassTime]| t.iter().map(|t| t.name).collect::<Vec<_>>();
     assert_eq!(names(&polled), names(&blocking));
     assert_eq!(names(&polled), ["lines", "nd-pyramid", "lineao", "composite"]);

@@ -54,7 +54,6 @@ use crate::LineGeometry;
 use crate::camera::{self, Bounds, Camera, FrameView, Tile};
 use crate::gbuffer::{self, Load};
 use crate::lighting::LightingShape;
-use crate::method::raytraced::RayProgress;
 use crate::method::{self, Reach};
 use crate::passes::bilateral::{Bilateral, Region};
 use crate::passes::composite::{Composite, Shown};
@@ -278,16 +277,11 @@ impl AoChain {
         self.slice_volume = volume;
     }
 
-    /// How far the ray-traced method's picture has come (rays per pixel so far, the cap), or
-    /// `None` for the other methods.
-    pub fn ray_progress(&self) -> Option<RayProgress> {
-        self.stages.ray_tracer().map(|tracer| tracer.progress())
-    }
-
     /// The active method's stage if it is a `T` (its own targets, for readback: SSAO's
     /// occlusion before its blur, [`crate::method::ssao::SsaoStage::raw`]; VO area's moments,
-    /// [`crate::method::vo_area::VoArea::moments`]; the ray tracer's accumulation,
-    /// [`crate::method::raytraced::RayTracedAo::accumulation`]).
+    /// [`crate::method::vo_area::VoArea::moments`]; the ray tracer's accumulation and how far
+    /// its picture has come, [`crate::method::raytraced::RayTracedAo::accumulation`] and
+    /// [`crate::method::raytraced::RayTracedAo::progress`]).
     pub fn stage<T: method::Stage>(&self) -> Option<&T> {
         self.stages.active_as()
     }
@@ -317,20 +311,16 @@ impl AoChain {
         culled.filter(|c| c.note().is_none()).map(|c| c.counts(queue, geometry)).transpose()
     }
 
-    /// GPU time of each pass of the last submitted frame (waits for it), or `None` when timing
-    /// is off. Passes the method skips are left out.
-    pub fn pass_times(&self, device: &wgpu::Device) -> Result<Option<Vec<PassTime>>, Error> {
+    /// GPU time of each pass of a frame, or `None` when timing is off; passes the method skips
+    /// are left out. With `wait`, of the last submitted frame (it waits for the GPU); without,
+    /// for a host's render loop, of a finished earlier frame, or `None` while the GPU is still
+    /// at it (frames submitted while a readback is pending are not timed).
+    pub fn pass_times(&self, device: &wgpu::Device, wait: bool) -> Result<Option<Vec<PassTime>>, Error> {
         let Some(timer) = &self.timer else { return Ok(None) };
-        timer.read(device, &self.timed_spans()).map(Some)
-    }
-
-    /// [`AoChain::pass_times`] without waiting, for a host's render loop: call it after
-    /// submitting a frame; it returns the times of a finished earlier frame, or `None` while the
-    /// GPU is still at it (or timing is off). Frames submitted while a readback is pending are
-    /// not timed.
-    pub fn try_pass_times(&self, device: &wgpu::Device) -> Result<Option<Vec<PassTime>>, Error> {
-        let Some(timer) = &self.timer else { return Ok(None) };
-        timer.try_read(device, &self.timed_spans())
+        match wait {
+            true => timer.read(device, &self.timed_spans()).map(Some),
+            false => timer.try_read(device, &self.timed_spans()),
+        }
     }
 
     /// The spans a frame with the current settings records.
@@ -710,11 +700,24 @@ impl AoChain {
     /// Records only the composite of the last prepared frame over the targets as they are: for a
     /// caller that wrote its own occlusion into `targets().ao` after the frame's G-buffer was
     /// rendered (the CPU truth, `lineao render --method raytraced --cpu`). Does nothing before the first
-    /// `prepare` with a non-zero size.
-    pub fn encode_composite(&self, encoder: &mut wgpu::CommandEncoder, target: &wgpu::TextureView) {
-        if self.targets.is_some() && self.view.is_some() {
-            self.composite.encode(encoder, target, None);
+    /// `prepare` with a non-zero size; before it, and with a target `encode` would refuse, it is
+    /// the same [`Error::Usage`], with nothing recorded.
+    pub fn encode_composite(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+    ) -> Result<(), Error> {
+        if self.size.0 == 0 || self.size.1 == 0 {
+            return Ok(());
         }
+        if self.targets.is_none() || self.view.is_none() {
+            return Err(Error::Usage(
+                "AoChain::encode_composite before AoChain::prepare: prepare the frame first".into(),
+            ));
+        }
+        self.check_target(target)?;
+        self.composite.encode(encoder, target, None);
+        Ok(())
     }
 
     /// The method, its blur and object-space AO over a G-buffer already written.
