@@ -1,6 +1,6 @@
 //! What a method is to the chain and the front ends: its [`MethodInfo`] (names, spans, shaders,
 //! its [`Stage`] and its own settings, [`Own`]), the stage's trait and the bench's passes. Each
-//! method's folder ends in one `METHOD: MethodInfo`; the registry ([`super`]) lists them.
+//! method's folder ends in one `METHOD: MethodInfo`; the registry (`registry.rs`) lists them.
 
 use crate::Error;
 use crate::camera::FrameView;
@@ -14,7 +14,7 @@ use crate::timing::Span;
 /// How a method builds its stage for a device and settings.
 pub(crate) type BuildStage = fn(&wgpu::Device, &ChainSettings) -> Box<dyn Stage>;
 
-/// Everything the library and the front ends know of a method besides its settings.
+/// Everything the library and the front ends know of a method.
 pub struct MethodInfo {
     /// The name on the command line, in `params.json`, in Python and in docs/reference.md.
     pub name: &'static str,
