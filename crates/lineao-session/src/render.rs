@@ -642,7 +642,11 @@ impl Session {
         let tile = tile_size(args, &gpu.device.limits(), &panel.settings);
         let mut settings = panel.settings.clone();
         let culled = args.style.cull.is_none() && self.culls_one_picture(&settings, tile.is_some());
-        settings.cull |= culled;
+        if culled {
+            // Every piece at full detail: the first frame draws them so, and a frame timed after
+            // it (`--timed-frames`) draws the same picture.
+            (settings.cull, settings.lod) = (true, false);
+        }
         if args.image.timings && args.style.cull.is_none() {
             let (points, chosen) = (self.lines.geometry.points(), if culled { "on" } else { "off" });
             eprintln!("lineao: {}: cull {chosen} ({points} points; culled from {CULL_POINTS})", panel.label);
