@@ -441,8 +441,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 #[cfg(test)]
 mod tests {
     use lineao::readback::{read_f32, read_rgba};
+    use lineao::reference::line_ao_flip_bound;
     use lineao::reference::{self, LineAoParams};
-    use lineao::verify::{check_policy, line_ao_flip_bound};
+    use lineao::verify::check_policy;
 
     /// The example's AO against the CPU reference run on its own inputs (the G-buffer the chain
     /// derived from the host's buffers, read back).

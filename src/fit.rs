@@ -27,7 +27,7 @@ use glam::Quat;
 use lineao::reference::Image;
 use lineao::truth::legibility::{self, Pairs, Shading};
 use lineao::truth::{Falloff, TruthSettings};
-use lineao::{AoMethod, ChainSettings, LineAoOuter, LineAoVariant};
+use lineao::{AoMethod, ChainSettings, LineAoOuter};
 
 use crate::cli::{Method, RenderArgs, ScoreArgs, ScoreMethod};
 use crate::render::Session;
@@ -107,15 +107,15 @@ fn families(line_width: f32) -> Vec<Family> {
             ));
         }
     }
-    let family = |method, variant, candidates| Family { method: ScoreMethod { method, variant }, candidates };
-    let paper = LineAoVariant::Paper;
+    let family = |method, candidates| Family { method: ScoreMethod::main(method), candidates };
+    // LineAO without the Gaussian pyramid: the authors' shader.
+    let authors = ScoreMethod { method: AoMethod::LineAo, variant: AoMethod::LineAo.info().variant.as_ref() };
     vec![
-        family(AoMethod::LineAo, paper, lineao),
-        // LineAO without the Gaussian pyramid: the authors' shader.
-        family(AoMethod::LineAo, LineAoVariant::Reference, reference),
-        family(AoMethod::VoLine, paper, radii(2.0, &[1.0, 4.0], vo)),
-        family(AoMethod::VoArea, paper, radii(2.0, &[1.0, 4.0], vo)),
-        family(AoMethod::Ssao, paper, radii(2.0, &[4.0, 8.0], ssao)),
+        family(AoMethod::LineAo, lineao),
+        Family { method: authors, candidates: reference },
+        family(AoMethod::VoLine, radii(2.0, &[1.0, 4.0], vo)),
+        family(AoMethod::VoArea, radii(2.0, &[1.0, 4.0], vo)),
+        family(AoMethod::Ssao, radii(2.0, &[4.0, 8.0], ssao)),
     ]
 }
 

@@ -9,7 +9,8 @@ use common::{lineao, lineao_command, scratch};
 
 use lineao::lighting::Light;
 use lineao::reference::{self, Image, LineAoParams, SsaoParams, ViewParams, VoParams};
-use lineao::verify::{check_policy, line_ao_flip_bound, line_ao_reference_flip_bound};
+use lineao::reference::{line_ao_flip_bound, line_ao_reference_flip_bound};
+use lineao::verify::check_policy;
 use lineao::{LineAoOuter, LineAoVariant};
 use serde_json::Value;
 

@@ -1123,14 +1123,12 @@ impl App {
     }
 }
 
-/// What a panel's label says: its method, and LineAO's variant when it is the authors'.
+/// What a panel's label says: its method, and its variant's where it shows that form.
 fn panel_label(panel: &worker::Panel) -> String {
     let method = crate::cli::Method { screen: panel.settings.method, volume: panel.volume.as_ref().map(|v| v.method) };
     let mut label = method_label(method);
-    if panel.settings.method == lineao::AoMethod::LineAo
-        && panel.settings.line_ao.variant == lineao::LineAoVariant::Reference
-    {
-        label += " (authors' code)";
+    if let Some(variant) = panel.settings.method.info().variant_of(&panel.settings) {
+        label += &format!(" ({})", variant.label);
     }
     label
 }

@@ -11,8 +11,8 @@ use lineao::lighting::LineShading;
 use lineao::method::setting::{Kind, Unit, Value};
 use lineao::volume::{ScalarForm, Sky, VolumeAoOptions, VolumeMethod};
 use lineao::{
-    AoMethod, BilateralSettings, ChainSettings, Colormap, DebugView, LineAoVariant, LineColor, Named, Preset, Slab,
-    SlabAxis, SliceSettings, TransparencySettings, TubeSettings, VoCombine, VolumeAoSettings,
+    AoMethod, BilateralSettings, ChainSettings, Colormap, DebugView, LineColor, Named, Preset, Slab, SlabAxis,
+    SliceSettings, TransparencySettings, TubeSettings, VoCombine, VolumeAoSettings,
 };
 
 use super::worker::Panel;
@@ -106,14 +106,9 @@ impl Params {
         volume.density.occupancy_radius = 0.5 * zoom_unit;
         let mut params =
             Params { chain, tube_radius: 0.5 * zoom_unit, volume, cloudy: false, volume_combine: VoCombine::Product };
-        // Each method's own reach (the panels share one chain's settings): SSAO's and VO's from
-        // their presets (VO area shares VO line's sphere), LineAO's and the strength from
-        // LineAO's; `panel` scales the strength per method.
-        let of = |method| ChainSettings { method, ..params.chain.clone() }.with_preset(preset);
-        let (ssao, vo) = (of(AoMethod::Ssao).ssao, of(AoMethod::VoLine).vo);
-        params.chain = params.chain.with_preset(preset);
-        params.chain.ssao = ssao;
-        params.chain.vo = vo;
+        // Each method's own reach from its preset (the panels share one chain's settings), the
+        // strength from the chain's method's; `panel` scales the strength per method.
+        params.chain = params.chain.with_preset_for_every_method(preset);
         if preset == Preset::Sparse {
             // Lines far apart are drawn wider, with more samples on LineAO's wider hemispheres,
             // and their density volume smoothed as far.
@@ -428,10 +423,10 @@ impl Controls {
         let sky = if p.cloudy { Sky::above_nearest_axis(up.to_array()) } else { Sky::Uniform };
         let mut settings = p.chain.clone();
         settings.method = method.screen;
-        // The slider holds LineAO's strength of the preset; another method keeps its own
-        // strength of the preset relative to it.
+        // The slider holds the strength of the chain's method (LineAO) at the preset; another
+        // method keeps its own strength of the preset relative to it.
         let preset = |method| ChainSettings { method, ..ChainSettings::default() }.with_preset(self.preset).strength;
-        settings.strength *= preset(method.screen) / preset(AoMethod::LineAo);
+        settings.strength *= preset(method.screen) / preset(p.chain.method);
         settings.volume = method.volume.map(|_| VolumeAoSettings {
             // The view-independent forms hold the sky already.
             sky: if p.volume.form.is_none() { sky.weights() } else { [1.0; 8] },
@@ -547,7 +542,7 @@ impl Controls {
         if volume {
             egui::CollapsingHeader::new("Object-space AO").default_open(true).show(ui, |ui| volume_ui(ui, p));
         }
-        if screen(AoMethod::RayTraced) {
+        if shown.iter().any(|m| m.screen.info().traces_scene) {
             moving_ui(ui, &mut self.moving_method);
         }
         let mut blur = p.chain.blur.is_some();
@@ -563,11 +558,8 @@ impl Controls {
         ui.separator();
 
         ui.heading("Show");
-        let levels = if screen(AoMethod::LineAo) && p.chain.line_ao.variant == LineAoVariant::Paper {
-            p.chain.line_ao.s_r
-        } else {
-            1
-        };
+        let levels = shown.iter().map(|m| ChainSettings { method: m.screen, ..p.chain.clone() }.levels()).max();
+        let levels = levels.unwrap_or(1);
         let mut views = vec![
             (DebugView::Final, "final image".to_string()),
             (DebugView::Ao, "AO only".into()),

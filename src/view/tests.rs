@@ -572,7 +572,12 @@ fn the_ray_traced_method_accumulates_while_the_camera_rests_and_shows_lineao_whi
         q.submit([encoder.finish()]);
     }
     assert_eq!(
-        chain.stage::<lineao::method::raytraced::RayTracedAo>().map(|t| t.progress()).unwrap().rays_per_pixel,
+        chain
+            .stage()
+            .and_then(|s| s.downcast::<lineao::method::raytraced::RayTracedAo>())
+            .map(|t| t.progress())
+            .unwrap()
+            .rays_per_pixel,
         12
     );
     let direct = lineao::readback::read_texture(d, q, &target.texture).unwrap().bytes;

@@ -666,7 +666,7 @@ async fn render_frame(
         let mut settings = panel.settings.clone();
         // What works on the CPU needs every point there: read again once all has arrived (while
         // it arrives, such a panel shows the lines alone).
-        let cpu = panel.volume.is_some() || settings.method == AoMethod::RayTraced;
+        let cpu = panel.volume.is_some() || settings.method.info().traces_scene;
         let volume = match (cpu, scene.opening) {
             (true, true) => {
                 settings.method = AoMethod::None;
@@ -721,7 +721,7 @@ async fn render_frame(
         if view.scalar_field.is_none() && matches!(settings.line_color, LineColor::Scalar { .. }) {
             settings.line_color = LineColor::Tangent;
         }
-        let traced = settings.method == AoMethod::RayTraced;
+        let traced = settings.method.info().traces_scene;
         if chains.len() <= i {
             let chain = AoChain::new_async(d, format, settings.clone()).await.map_err(|e| e.to_string())?;
             chains.push(PanelChain { chain, geometry_pixels: 0 });
@@ -774,8 +774,11 @@ async fn render_frame(
             times.push(None);
             views.push(target.view.clone());
         }
-        let progress =
-            if traced { chain.stage::<lineao::method::raytraced::RayTracedAo>().map(|t| t.progress()) } else { None };
+        let progress = if traced {
+            chain.stage().and_then(|s| s.downcast::<lineao::method::raytraced::RayTracedAo>()).map(|t| t.progress())
+        } else {
+            None
+        };
         rays.push(match progress {
             Some(progress) if !readback => Some(RayStatus { progress, rays_per_second: None }),
             Some(progress) => {

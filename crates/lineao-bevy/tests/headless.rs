@@ -314,7 +314,7 @@ fn the_plugin_adds_no_error_to_lineaos_chains() {
 
     let (plugin, nd, standalone) = captured.lines.as_ref().expect("the lines were drawn");
     let settings = ChainSettings::default();
-    let bound = lineao::verify::line_ao_flip_bound(settings.line_ao.s_r, settings.line_ao.s_h);
+    let bound = lineao::reference::line_ao_flip_bound(settings.line_ao.s_r, settings.line_ao.s_h);
     let agreement = lineao::verify::check_policy(plugin, standalone, nd, bound).unwrap();
     println!("lines: {agreement:?}");
     let lines = nd.data.iter().filter(|p| p[..3] != [0.0; 3]).count();

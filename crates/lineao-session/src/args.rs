@@ -41,48 +41,45 @@ pub struct ScoreArgs {
     pub fit_views: u32,
 }
 
-/// A method `score` compares with the truth.
+/// A method `score` compares with the truth: a registry's method in its main form, or its
+/// [`lineao::method::Variant`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ScoreMethod {
     pub method: lineao::AoMethod,
-    pub variant: lineao::LineAoVariant,
+    pub variant: Option<&'static lineao::method::Variant>,
 }
 
 impl ScoreMethod {
     /// What `score` compares, in the registry's order: every method with a picture of its own
-    /// (not `none`), LineAO's authors' variant after LineAO.
+    /// (not `none`), each one's variant after it.
     pub fn all() -> Vec<ScoreMethod> {
         let mut all = Vec::new();
         for &method in lineao::AoMethod::REGISTRY.iter().filter(|&&m| m != lineao::AoMethod::None) {
-            all.push(ScoreMethod::paper(method));
-            if method == lineao::AoMethod::LineAo {
-                all.push(ScoreMethod { method, variant: lineao::LineAoVariant::Reference });
+            all.push(ScoreMethod::main(method));
+            if let Some(variant) = &method.info().variant {
+                all.push(ScoreMethod { method, variant: Some(variant) });
             }
         }
         all
     }
 
-    const fn paper(method: lineao::AoMethod) -> ScoreMethod {
-        ScoreMethod { method, variant: lineao::LineAoVariant::Paper }
+    /// `method` in its main form.
+    pub const fn main(method: lineao::AoMethod) -> ScoreMethod {
+        ScoreMethod { method, variant: None }
     }
 
     pub fn name(&self) -> &'static str {
-        match (self.method, self.variant) {
-            (lineao::AoMethod::LineAo, lineao::LineAoVariant::Reference) => "lineao-reference",
-            (method, _) => method.name(),
-        }
+        self.variant.map_or(self.method.name(), |v| v.name)
     }
 
     /// Every row's name and help, for `--help`.
     pub fn listed() -> Vec<(&'static str, &'static str)> {
-        let help = |m: ScoreMethod| match (m.method, m.variant) {
-            (lineao::AoMethod::LineAo, lineao::LineAoVariant::Reference) => {
-                "LineAO's `reference` variant (the authors' LineVis: radius in zoom units, no pyramid)"
-            }
-            (lineao::AoMethod::RayTraced, _) => {
+        let help = |m: ScoreMethod| match m.variant {
+            Some(variant) => variant.help,
+            None if m.method.info().traces_scene => {
                 "The truth again with the next --ray-seed, traced on the GPU (on the CPU with --cpu)"
             }
-            (method, _) => method.info().help,
+            None => m.method.info().help,
         };
         ScoreMethod::all().into_iter().map(|m| (m.name(), help(m))).collect()
     }

@@ -24,11 +24,9 @@ use std::path::Path;
 
 use anyhow::{Context, Result};
 use lineao::method::setting::{Kind, Value};
-use lineao::method::ssao::SsaoStage;
-use lineao::method::vo_area::VoArea;
 use lineao::readback::read_texture;
 use lineao::volume::{ScalarForm, VolumeAoOptions, VolumeMethod};
-use lineao::{AoChain, AoMethod, Gpu, LineAoVariant, noise};
+use lineao::{AoChain, AoMethod, Gpu};
 use lineao::{Camera, Projection};
 use npyz::WriterBuilder;
 use serde_json::json;
@@ -69,10 +67,6 @@ fn merge(params: &mut serde_json::Value, extra: serde_json::Value) {
     }
 }
 
-fn flat3(vectors: &[[f32; 3]]) -> Vec<f32> {
-    vectors.iter().flatten().copied().collect()
-}
-
 /// Writes the dump of the frame `chain` last prepared, for `method` (its name in `params.json`)
 /// with object-space AO computed by `volume` where the chain shows it.
 pub fn write(
@@ -94,11 +88,11 @@ pub fn write(
     }
     let (w, h) = (targets.size.0 as u64, targets.size.1 as u64);
     write_npy(dir, "zoom.npy", &[h, w], &read(&targets.zoom.texture)?.to_f32())?;
-    // SSAO's before its 4 × 4 blur.
-    let ssao_raw = chain.stage::<SsaoStage>().and_then(SsaoStage::raw);
-    let raw = match (s.method, &targets.volume_ao, ssao_raw) {
+    // A method's before its own blur (SSAO's 4 × 4 box).
+    let unblurred = chain.stage().and_then(|s| s.unblurred());
+    let raw = match (s.method, &targets.volume_ao, unblurred) {
         (AoMethod::None, Some(volume_ao), _) => volume_ao,
-        (AoMethod::Ssao, _, Some(raw)) => raw,
+        (_, _, Some(raw)) => raw,
         _ => &targets.ao,
     };
     write_npy(dir, "ao.npy", &[h, w], &read(&raw.texture)?.to_f32())?;
@@ -133,89 +127,12 @@ pub fn write(
             None => json!({"line_width_px": s.line_width_px, "line_shading": s.lighting.line_shading.name()}),
         },
     );
-    if s.method == AoMethod::LineAo {
-        let ao = &s.line_ao;
-        let lights: Vec<_> = s
-            .lighting
-            .normalized()
-            .iter()
-            .map(|l| json!({"dir": l.dir.to_array(), "intensity": l.intensity}))
-            .collect();
-        let mut extra = json!({
-            "variant": ao.variant.name(),
-            "s_r": ao.s_r,
-            "s_h": ao.s_h,
-            "light_attenuation": ao.light_attenuation,
-            "lights": lights,
-            "noise_seed": ao.noise_seed,
-            "outer": ao.outer.name(),
-        });
-        if ao.outer == lineao::LineAoOuter::Level {
-            merge(&mut extra, json!({"outer_depth_tolerance": lineao::reference::OUTER_DEPTH_TOLERANCE}));
-        }
-        let variant_keys = match ao.variant {
-            LineAoVariant::Paper => json!({
-                "r0_px": s.r0().px,
-                "delta0": ao.delta0,
-                "delta_scale": ao.delta_scale,
-                "epsilon": ao.epsilon,
-                "kd": s.lighting.kd,
-                "ks": s.lighting.ks,
-                "shininess": s.lighting.shininess,
-            }),
-            // Our extension of docs/reference.md: what the authors' radius needs.
-            LineAoVariant::Reference => json!({
-                "reference_radius_px": ao.reference_radius_px,
-                "zoom_fit": view.zoom_fit(),
-            }),
-        };
-        merge(&mut extra, variant_keys);
-        merge(&mut params, extra);
-        write_npy(dir, "noise.npy", &[64, 64, 3], &flat3(&noise::noise_tile(ao.noise_seed)))?;
-        let samples = lineao::method::line_ao::sample_table(ao);
-        write_npy(dir, "samples.npy", &[ao.s_r as u64, ao.s_h as u64, 3], &flat3(&samples))?;
-    }
-    if s.method == AoMethod::Ssao {
-        let ssao = &s.ssao;
-        let extra = json!({
-            "samples": ssao.samples,
-            "radius_world": ssao.radius_world,
-            "ssao_range": ssao.range_world,
-            "noise_seed": ssao.noise_seed,
-            "ssao_kernel": ssao.kernel.name(),
-        });
-        merge(&mut params, extra);
-        let kernel = ssao.kernel_points();
-        write_npy(dir, "ssao_kernel.npy", &[ssao.samples as u64, 3], &flat3(&kernel))?;
-        write_npy(dir, "ssao_noise.npy", &[4, 4, 3], &flat3(&noise::ssao_noise(ssao.noise_seed)))?;
-    }
-    if matches!(s.method, AoMethod::VoLine | AoMethod::VoArea) {
-        let vo = &s.vo;
-        let (count, samples) = if s.method == AoMethod::VoLine {
-            (vo.samples, lineao::sample_sets::vo_disk_samples(vo.samples).map(<[_]>::to_vec))
-        } else {
-            (vo.area_samples, lineao::sample_sets::vo_area_samples(vo.area_samples))
-        };
-        let mut extra = json!({
-            "samples": count,
-            "radius_world": vo.radius_world,
-            "normal_clamp": vo.normal_clamp,
-            "thickness": vo.thickness_world,
-            "noise_seed": vo.noise_seed,
-        });
-        if let Some(r2) = vo.radius2_world {
-            merge(&mut extra, json!({"radius2_world": r2, "combine": vo.combine.name()}));
-        }
-        merge(&mut params, extra);
-        let samples = samples.context("no VO sample set of that size")?;
-        write_npy(dir, "vo_samples.npy", &[count as u64, 3], &flat3(&samples))?;
-        let tile: Vec<f32> = noise::vo_noise(vo.noise_seed).into_iter().flatten().collect();
-        write_npy(dir, "vo_noise.npy", &[4, 4, 2], &tile)?;
-        if let Some(moments) = chain.stage::<VoArea>().and_then(VoArea::moments) {
-            for (l, level) in moments.read(&gpu.device, &gpu.queue)?.iter().enumerate() {
-                let shape = [level.height as u64, level.width as u64, 2];
-                write_npy(dir, &format!("moments_{l}.npy"), &shape, &level.data.concat())?;
-            }
+    if let Some(stage) = chain.stage() {
+        // The method's keys and tables, from its folder.
+        let dump = stage.dump(&gpu.device, &gpu.queue, s, view)?;
+        params.as_object_mut().context("params.json is an object")?.extend(dump.params);
+        for (name, shape, values) in &dump.arrays {
+            write_npy(dir, &format!("{name}.npy"), shape, values)?;
         }
     }
     if let (Some(options), Some(settings), Some(octants), Some(volume_ao)) =

@@ -13,8 +13,8 @@ use lineao::volume::density::DensityOptions;
 use lineao::volume::sweep::SweepSettings;
 use lineao::volume::{ScalarForm, Sky, VolumeAoOptions, VolumeMethod};
 use lineao::{
-    AoChain, AoMethod, BilateralSettings, ChainSettings, Gpu, LineAoVariant, LineColor, SliceSettings, SliceVolume,
-    SurfaceSettings, TubeSettings, VolumeAoSettings,
+    AoChain, BilateralSettings, ChainSettings, Gpu, LineColor, SliceSettings, SliceVolume, SurfaceSettings,
+    TubeSettings, VolumeAoSettings,
 };
 use lineao::{Bounds, Camera, Projection};
 use lineao_tracts::scenes::ViewHint;
@@ -147,8 +147,8 @@ impl Panel {
     pub fn new(method: Method, settings: ChainSettings) -> Panel {
         let name = method.name();
         let mut label = name.clone();
-        if method.screen == AoMethod::LineAo && settings.line_ao.variant == LineAoVariant::Reference {
-            label += " (reference)";
+        if let Some(variant) = method.screen.info().variant_of(&settings) {
+            label += &format!(" ({})", variant.value);
         }
         Panel { label, name, settings, volume: method.volume }
     }
@@ -170,15 +170,16 @@ fn panels(args: &RenderArgs, zoom_unit: f32, sky: Sky, longest_side: f32) -> Vec
     if !args.shown.grid {
         return vec![panel(args.shown.method)];
     }
-    let mut all: Vec<Panel> = grid_methods().into_iter().map(panel).collect();
-    // The third tile: LineAO as the authors' code computes it, next to the paper's.
-    let lineao = Method { screen: AoMethod::LineAo, volume: None };
-    let shown = settings(args, lineao, zoom_unit, sky, longest_side).line_ao.variant;
-    let variant = if shown == LineAoVariant::Reference { LineAoVariant::Paper } else { LineAoVariant::Reference };
-    let mut other = args.clone();
-    other.methods.give("variant", Value::Choice(variant.name()));
-    let reference = settings(&other, lineao, zoom_unit, sky, longest_side);
-    all.insert(2, Panel::new(lineao, reference));
+    let methods = grid_methods();
+    let mut all: Vec<Panel> = methods.iter().copied().map(panel).collect();
+    // The third tile: the first method's other form (LineAO as the authors' code computes it,
+    // next to the paper's).
+    if let Some((&first, variant)) = methods.first().and_then(|m| Some((m, m.screen.info().variant.as_ref()?))) {
+        let shown = first.screen.info().variant_of(&all[0].settings).is_some();
+        let mut other = args.clone();
+        other.methods.give(variant.setting, Value::Choice(if shown { variant.main } else { variant.value }));
+        all.insert(2, Panel::new(first, settings(&other, first, zoom_unit, sky, longest_side)));
+    }
     all
 }
 
@@ -495,7 +496,7 @@ pub fn check_tiled(args: &RenderArgs, panel: &Panel, dump: Option<&Path>) -> Res
         Some("--dump (one G-buffer a frame)")
     } else if args.image.timings {
         Some("--timings (time a frame of the device's size)")
-    } else if panel.settings.method == lineao::AoMethod::RayTraced {
+    } else if panel.settings.method.info().traces_scene {
         Some("the ray-traced method (its rays are seeded per frame)")
     } else {
         None
@@ -658,7 +659,7 @@ impl Session {
             }
             None => AoChain::new(&gpu.device, format, settings)?,
         };
-        let gpu_rays = panel.settings.method == AoMethod::RayTraced && !args.truth.cpu;
+        let gpu_rays = panel.settings.method.info().traces_scene && !args.truth.cpu;
         // `--cull on` draws what a viewer shows of a still camera (its second frame, at the
         // levels of detail the first found); the cull chosen for a single picture, its first.
         let options = FrameOptions { gpu_rays, settled: !culled, timings: args.image.timings };
@@ -738,7 +739,7 @@ impl Session {
             }
         }
         let truth_settings = crate::truth::settings(args, self.longest_side);
-        let truth = if panel.settings.method == AoMethod::RayTraced && args.truth.cpu {
+        let truth = if panel.settings.method.info().traces_scene && args.truth.cpu {
             let truth = self.trace(&chain, &truth_settings)?;
             let targets = chain.targets().context("nothing was rendered")?;
             lineao::readback::write_target(&gpu.queue, &targets.ao, &truth.ao);
@@ -774,7 +775,7 @@ impl Session {
     /// line — whole brains — in an untiled, opaque frame of a screen-space method.
     fn culls_one_picture(&self, settings: &ChainSettings, tiled: bool) -> bool {
         let opaque_lines = settings.tubes.is_none() && settings.transparent().is_none();
-        let screen_space = settings.method != AoMethod::RayTraced;
+        let screen_space = !settings.method.info().traces_scene;
         opaque_lines && screen_space && !tiled && self.lines.geometry.points() >= CULL_POINTS
     }
 
@@ -907,7 +908,7 @@ fn needs_points(args: &RenderArgs) -> bool {
         (None, true) => grid_methods(),
         (None, false) => vec![args.shown.method],
     };
-    methods.iter().any(|m| m.volume.is_some() || m.screen == AoMethod::RayTraced)
+    methods.iter().any(|m| m.volume.is_some() || m.screen.info().traces_scene)
 }
 
 /// The longest side of the axis-aligned box around the finite `points` (0 without any).

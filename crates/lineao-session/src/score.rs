@@ -9,6 +9,7 @@
 //! two truths are, the bar no method can pass.
 
 use anyhow::{Context, Result};
+use lineao::method::Estimate;
 use lineao::reference::Image;
 use lineao::reference::NdImage;
 use lineao::truth::legibility::{self, Absent, Legibility, Shading};
@@ -75,7 +76,10 @@ pub fn method_settings(session: &Session, args: &crate::args::RenderArgs, m: Sco
     // The variant first, so that the preset gives this variant's values and explicit options
     // still win.
     let mut args = args.clone();
-    args.methods.give("variant", lineao::method::setting::Value::Choice(m.variant.name()));
+    if let Some(variant) = &m.method.info().variant {
+        let value = if m.variant.is_some() { variant.value } else { variant.main };
+        args.methods.give(variant.setting, lineao::method::setting::Value::Choice(value));
+    }
     let mut settings = session.settings(&args, Method { screen: m.method, volume: None });
     settings.blur = None;
     settings.raytraced.denoise = None;
@@ -119,7 +123,7 @@ pub fn raw_ao(
         wgpu::TextureFormat::Rgba8UnormSrgb,
     );
     // One frame: the fit renders hundreds of settings, each exact after its first frame.
-    let gpu_rays = chain.settings().method == AoMethod::RayTraced;
+    let gpu_rays = chain.settings().method.info().traces_scene;
     session.frame(chain, &target.view, crate::render::FrameOptions { gpu_rays, ..Default::default() })?;
     let targets = chain.targets().context("nothing was rendered")?;
     let shown = targets.shown();
@@ -148,9 +152,10 @@ pub fn score(
     let (w, h) = (args.image.width as usize, args.image.height as usize);
     // VO's truth: the half ball where VO clamps to it (`--no-normal-clamp` or `--settings`
     // turn it off), as the settings VO's rows render with say.
-    let vo = ScoreMethod { method: AoMethod::VoLine, variant: Default::default() };
+    let obscurance = |m: &ScoreMethod| m.method.info().estimates == Estimate::Obscurance;
+    let vo = ScoreMethod::all().into_iter().find(obscurance).context("no method estimates obscurance")?;
     let vo_ball = if method_settings(session, args, vo).vo.normal_clamp { VoBall::Half } else { VoBall::Whole };
-    let wants_vo = methods.iter().any(|m| matches!(m.method, AoMethod::VoLine | AoMethod::VoArea));
+    let wants_vo = methods.iter().any(obscurance);
     let local = crate::truth::settings(args, session.longest_side);
     let bundle_settings = TruthSettings {
         distance_world: bundle_distance.world(session.longest_side),
@@ -165,7 +170,7 @@ pub fn score(
     // The truth's G-buffer: a chain without a method (and so without a guard band).
     let mut quiet = args.clone();
     (quiet.image.timings, quiet.image.dump) = (false, None);
-    let plain = ScoreMethod { method: AoMethod::None, variant: Default::default() };
+    let plain = ScoreMethod::main(AoMethod::None);
     let panel = Panel::new(Method { screen: AoMethod::None, volume: None }, method_settings(session, args, plain));
     let rendered = session.render(&quiet, &panel, None, None, None)?;
     let start = std::time::Instant::now();
@@ -193,14 +198,14 @@ pub fn score(
         }
     }
     for &m in methods {
-        let (target_truth, truth_name) = match m.method {
-            AoMethod::VoLine | AoMethod::VoArea => (
+        let (target_truth, truth_name) = match m.method.info().estimates {
+            Estimate::Obscurance => (
                 vo_truth.as_ref().context("the VO truth")?,
                 if vo_ball == VoBall::Half { "vo-half" } else { "vo-whole" },
             ),
             _ => (&ao_truth, "ao"),
         };
-        let ao = if m.method == AoMethod::RayTraced && args.truth.cpu {
+        let ao = if m.method.info().traces_scene && args.truth.cpu {
             let again = TruthSettings { seed: truth_settings.seed.wrapping_add(1), vo: None, ..truth_settings.clone() };
             session.trace(&rendered.chain, &again)?.ao
         } else {

@@ -371,7 +371,7 @@ impl FrameScene<'_> {
         chain.set_slice_volume(d, self.anatomy.clone());
         chain.prepare(d, q, self.camera, self.bounds);
         let mut encoder = d.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("lineao::frame") });
-        chain.encode_with_meshes(&mut encoder, self.geometry, self.meshes, target)?;
+        chain.encode(&mut encoder, (self.geometry, self.meshes), target)?;
         q.submit([encoder.finish()]);
         Ok(())
     }

@@ -99,7 +99,8 @@ pub fn accumulate(
     let start = std::time::Instant::now();
     let progress = |chain: &AoChain| {
         chain
-            .stage::<lineao::method::raytraced::RayTracedAo>()
+            .stage()
+            .and_then(|s| s.downcast::<lineao::method::raytraced::RayTracedAo>())
             .map(|t| t.progress())
             .context("the ray-traced method is not active")
     };
@@ -149,11 +150,15 @@ pub fn accumulate(
 pub fn from_gpu(gpu: &Gpu, chain: &AoChain) -> Result<Truth> {
     let (d, q) = (&gpu.device, &gpu.queue);
     let progress = chain
-        .stage::<lineao::method::raytraced::RayTracedAo>()
+        .stage()
+        .and_then(|s| s.downcast::<lineao::method::raytraced::RayTracedAo>())
         .map(|t| t.progress())
         .context("the ray-traced method is not active")?;
-    let accumulation =
-        chain.stage::<RayTracedAo>().and_then(RayTracedAo::accumulation).context("nothing was traced")?;
+    let accumulation = chain
+        .stage()
+        .and_then(|s| s.downcast::<RayTracedAo>())
+        .and_then(RayTracedAo::accumulation)
+        .context("nothing was traced")?;
     let targets = chain.targets().context("nothing was rendered")?;
     let nd = lineao::readback::read_rgba(d, q, &targets.nd[0])?;
     let words: Vec<[u32; 4]> = bytemuck::cast_slice(&lineao::readback::read_buffer(d, q, accumulation)?).to_vec();

@@ -7,9 +7,9 @@
 use std::path::Path;
 
 use anyhow::{Context, Result, bail};
-use lineao::reference::{self, Image, LineAoParams, NdImage, SsaoParams, ViewParams};
-use lineao::verify::{Agreement, check_policy, line_ao_flip_bound, line_ao_reference_flip_bound};
-use lineao::{AoMethod, ChainSettings, FrameView, LineAoVariant, SsaoKernel, noise};
+use lineao::reference::{Image, NdImage};
+use lineao::verify::{Agreement, FrameInputs, check_policy, reference_ao};
+use lineao::{ChainSettings, FrameView};
 use serde::{Deserialize, Serialize};
 
 /// What `meta.json` says of a read-back frame.
@@ -79,37 +79,11 @@ impl Readback {
 /// The CPU reference of the frame's method on its read-back inputs, against its AO.
 pub fn check(frame: &Readback) -> Result<Agreement, String> {
     let s = &frame.meta.settings;
-    let view = frame.meta.view;
-    let (cpu, bound) = match s.method {
-        AoMethod::LineAo => {
-            let ao = &s.line_ao;
-            let params = LineAoParams::new(s, &view);
-            let table = lineao::method::line_ao::sample_table(ao);
-            let cpu = reference::line_ao(&frame.nd, &frame.zoom, &noise::noise_tile(ao.noise_seed), &table, &params);
-            let bound = match ao.variant {
-                LineAoVariant::Paper => line_ao_flip_bound(ao.s_r, ao.s_h),
-                LineAoVariant::Reference => line_ao_reference_flip_bound(ao.s_h),
-            };
-            (cpu, bound)
-        }
-        AoMethod::Ssao => {
-            let ssao = &s.ssao;
-            let params = SsaoParams {
-                view: ViewParams::of(&view),
-                radius: ssao.radius_world,
-                range: ssao.range_world,
-                noise_origin: [view.guard as i32; 2],
-            };
-            let points = match ssao.kernel {
-                SsaoKernel::Crytek => noise::ssao_kernel(ssao.noise_seed, ssao.samples),
-                SsaoKernel::Sphere => lineao::sample_sets::vo_sphere_samples(ssao.samples)
-                    .ok_or_else(|| format!("no sphere set of {} samples", ssao.samples))?
-                    .to_vec(),
-            };
-            let cpu = reference::ssao(&frame.nd[0], &points, &noise::ssao_noise(ssao.noise_seed), &params);
-            (cpu, 2.0 / ssao.samples as f32)
-        }
-        other => return Err(format!("the page's check covers LineAO and Crytek SSAO, not {}", other.name())),
-    };
-    check_policy(&frame.ao, &cpu, &frame.nd[0], bound)
+    let inputs = FrameInputs { settings: s, view: &frame.meta.view, nd: &frame.nd, zoom: &frame.zoom };
+    let expected = reference_ao(&inputs)
+        .ok_or_else(|| {
+            format!("the page's check covers the methods with a CPU reference of their frame, not {}", s.method.name())
+        })?
+        .map_err(|e| e.to_string())?;
+    check_policy(&frame.ao, &expected.ao, &frame.nd[0], expected.every_pixel_bound)
 }

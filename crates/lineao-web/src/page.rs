@@ -11,7 +11,6 @@ use std::sync::{Arc, OnceLock};
 
 use eframe::egui_wgpu::{WgpuSetup, WgpuSetupCreateNew};
 use js_sys::{Array, Float32Array, Object, Promise, Reflect, Uint8Array};
-use lineao::method::ssao::SsaoStage;
 use lineao::readback::TextureData;
 use lineao_cli::args::ColorArg;
 use lineao_cli::source::{Sampled, SharedFeed, Source};
@@ -491,10 +490,7 @@ impl Page {
         let chain = worker.chain(panel).ok_or_else(|| format!("panel {panel} has rendered nothing"))?;
         let (targets, view) = chain.targets().zip(chain.frame_view()).ok_or("nothing was rendered")?;
         let settings = chain.settings().clone();
-        let raw = match settings.method {
-            lineao::AoMethod::Ssao => chain.stage::<SsaoStage>().and_then(SsaoStage::raw).unwrap_or(&targets.ao),
-            _ => &targets.ao,
-        };
+        let raw = chain.stage().and_then(|s| s.unblurred()).unwrap_or(&targets.ao);
         let textures: Vec<&wgpu::Texture> =
             targets.nd.iter().map(|t| &t.texture).chain([&targets.zoom.texture, &raw.texture]).collect();
         let (device, queue) = (&worker.gpu().device, &worker.gpu().queue);

@@ -30,7 +30,7 @@ fn frame(gpu: &Gpu, method: AoMethod) -> Readback {
     q.submit([encoder.finish()]);
     let targets = chain.targets().unwrap();
     let raw = match method {
-        AoMethod::Ssao => chain.stage::<lineao::method::ssao::SsaoStage>().and_then(|s| s.raw()).unwrap(),
+        AoMethod::Ssao => chain.stage().and_then(|s| s.unblurred()).unwrap(),
         _ => &targets.ao,
     };
     let nd: Vec<_> = targets.nd.iter().map(|t| read_rgba(d, q, t).unwrap()).collect();

@@ -129,7 +129,7 @@ pub use wgpu;
 
 // What an embedding needs first, at the root.
 pub use camera::{Bounds, Camera, FrameView, Projection, Tile};
-pub use chain::{AoChain, HostAo, OverlayAo};
+pub use chain::{AoChain, Drawn, HostAo, OverlayAo};
 pub use colormap::{COLORMAP_ENTRIES, Colormap};
 pub use gpu::{Gpu, Lacking, check_adapter};
 pub use line_geometry::LineGeometry;

@@ -355,7 +355,7 @@ macro_rules! chain_settings {
             pub line_width_px: f32,
             /// Tubes instead of lines, or none. Default none.
             pub tubes: Option<TubeSettings>,
-            /// Context surfaces drawn with the lines ([`crate::AoChain::encode_with_meshes`]), or none.
+            /// Context surfaces drawn with the lines ([`crate::AoChain::encode`]'s `meshes`), or none.
             /// Default none.
             pub surfaces: Option<SurfaceSettings>,
             /// Anatomy slices drawn with the lines ([`crate::AoChain::set_slice_volume`] gives their volume), or none.
@@ -429,13 +429,6 @@ impl ChainSettings {
     /// The transparency the frame draws, where any line is transparent.
     pub fn transparent(&self) -> Option<&TransparencySettings> {
         self.transparency.as_ref().filter(|t| t.any())
-    }
-
-    /// Whether the culled lines and tubes are drawn at levels of detail: [`ChainSettings::lod`], but never
-    /// for the GPU ray tracer, whose rays start on the G-buffer's lines and must find them
-    /// where the scene it traces has them.
-    pub fn levels_of_detail(&self) -> bool {
-        self.lod && self.method != AoMethod::RayTraced
     }
 }
 

@@ -80,12 +80,6 @@ impl Stages {
         }
     }
 
-    /// The active stage if it is a `T`.
-    pub fn active_as<T: Stage>(&self) -> Option<&T> {
-        let stage: &dyn std::any::Any = self.active.as_deref()?;
-        stage.downcast_ref()
-    }
-
     /// The active stage if it is the ray tracer: the one stage that takes the scene.
     fn ray_tracer_mut(&mut self) -> Option<&mut RayTracedAo> {
         let stage: &mut dyn std::any::Any = self.active.as_deref_mut()?;

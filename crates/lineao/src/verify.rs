@@ -2,7 +2,10 @@
 //! agreement check of docs/reference.md ("GPU vs CPU agreement"): ≥ 99.5 % of geometry pixels within
 //! 1e-3, and every pixel within a bound of a few flipped samples.
 
+use crate::Error;
+use crate::camera::FrameView;
 use crate::image::{Image, NdImage};
+use crate::settings::ChainSettings;
 
 /// How two images differ.
 #[derive(Clone, Debug, PartialEq)]
@@ -62,15 +65,32 @@ pub fn compare(a: &Image<f32>, b: &Image<f32>, tolerance: f32, mask: impl Fn(usi
     }
 }
 
-/// docs/reference.md's bound for every pixel of LineAO: two flipped samples per hemisphere, Σ_j 2/n_j.
-pub fn line_ao_flip_bound(s_r: u32, s_h: u32) -> f32 {
-    (0..s_r).map(|j| 2.0 / crate::noise::samples_on_hemisphere(s_h, j) as f32).sum()
+/// What a frame's method read, read back from the GPU: the inputs its CPU reference runs on.
+pub struct FrameInputs<'a> {
+    /// The chain's settings for the frame.
+    pub settings: &'a ChainSettings,
+    /// The view as the passes saw it (with its guard band).
+    pub view: &'a FrameView,
+    /// The ND pyramid; level 0 is the guard-banded frame.
+    pub nd: &'a [NdImage],
+    /// The zoom map z(P).
+    pub zoom: &'a Image<f32>,
 }
 
-/// The same bound for variant `reference`: two flipped samples per hemisphere, each weighing up
-/// to 1.5/s_h, averaged over the s_r hemispheres: 3/s_h.
-pub fn line_ao_reference_flip_bound(s_h: u32) -> f32 {
-    3.0 / s_h as f32
+/// The CPU reference's occlusion of a frame, before any blur, and docs/reference.md's bound on
+/// any one pixel's difference (a few samples that flip between inside and outside in f32).
+pub struct ReferenceAo {
+    /// The occlusion, at the frame's guard-banded size.
+    pub ao: Image<f32>,
+    /// The largest difference any pixel may have ([`check_policy`]'s `every_pixel_bound`).
+    pub every_pixel_bound: f32,
+}
+
+/// The CPU reference of `inputs`' method on exactly those inputs (each method's
+/// `reference.rs`, named by its registry entry); `None` for a method whose frame has no
+/// reference of its own here (`none`, VO, the ray tracer: their tests hold them to theirs).
+pub fn reference_ao(inputs: &FrameInputs) -> Option<Result<ReferenceAo, Error>> {
+    inputs.settings.method.info().reference.map(|reference| reference(inputs))
 }
 
 /// Checks the agreement policy on geometry pixels (non-background in `nd0`) and returns the

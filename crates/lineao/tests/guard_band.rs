@@ -8,7 +8,7 @@ use common::{Frame, gpu, line_ao_on, render_geometry};
 use glam::Vec3;
 use lineao::LineGeometry;
 use lineao::reference::Image;
-use lineao::verify::line_ao_flip_bound;
+use lineao::reference::line_ao_flip_bound;
 use lineao::{Camera, Projection};
 use lineao::{ChainSettings, Gpu, LineAoSettings};
 

@@ -259,10 +259,17 @@ fn the_chain_allocates_only_the_targets_its_method_uses() {
         let t = chain.targets().unwrap();
         // The method's own (its stage's), and the blur's (shared).
         let has = (
-            chain.stage::<lineao::method::ssao::SsaoStage>().and_then(|s| s.raw()).is_some(),
+            chain.stage().and_then(|s| s.unblurred()).is_some(),
             t.ao_blurred.is_some(),
-            chain.stage::<lineao::method::line_ao::LineAoStage>().is_some_and(|s| !s.outer().is_empty()),
-            chain.stage::<lineao::method::vo_area::VoArea>().and_then(|s| s.moments()).is_some(),
+            chain
+                .stage()
+                .and_then(|s| s.downcast::<lineao::method::line_ao::LineAoStage>())
+                .is_some_and(|s| !s.outer().is_empty()),
+            chain
+                .stage()
+                .and_then(|s| s.downcast::<lineao::method::vo_area::VoArea>())
+                .and_then(|s| s.moments())
+                .is_some(),
         );
         assert_eq!(has, (raw, blurred, outer, moments), "{:?}", settings.method);
     }

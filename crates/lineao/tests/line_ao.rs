@@ -10,7 +10,8 @@ use lineao::lighting::{Light, Lighting};
 use lineao::method::line_ao::sample_table;
 use lineao::noise::noise_tile;
 use lineao::reference::{self, Image, LineAoParams, NdImage};
-use lineao::verify::{check_policy, compare, line_ao_flip_bound, line_ao_reference_flip_bound};
+use lineao::reference::{line_ao_flip_bound, line_ao_reference_flip_bound};
+use lineao::verify::{check_policy, compare};
 use lineao::{Camera, Projection};
 use lineao::{ChainSettings, LineAoOuter, LineAoSettings, LineAoVariant};
 

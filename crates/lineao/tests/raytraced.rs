@@ -86,7 +86,7 @@ impl Tracer {
         self.chain.prepare(d, q, camera, &self.bounds).unwrap();
         let mut encoder = d.create_command_encoder(&Default::default());
         let meshes: Vec<&MeshGeometry> = self.mesh.iter().collect();
-        self.chain.encode_with_meshes(&mut encoder, &self.lines, &meshes, &self.output.view).unwrap();
+        self.chain.encode(&mut encoder, (&self.lines, &meshes[..]), &self.output.view).unwrap();
         q.submit([encoder.finish()]);
         let t = self.chain.targets().unwrap();
         (read_rgba(d, q, &t.nd[0]).unwrap(), read_f32(d, q, &t.ao).unwrap())
@@ -154,7 +154,13 @@ fn lines_accumulate_to_the_cpu_truth_with_the_same_rays_and_restart_when_the_cam
     let mut tracer = Tracer::new(&scene, settings(4), None);
     let (nd, first) = tracer.frame(&camera());
     assert_eq!(
-        tracer.chain.stage::<lineao::method::raytraced::RayTracedAo>().map(|t| t.progress()).unwrap().rays_per_pixel,
+        tracer
+            .chain
+            .stage()
+            .and_then(|s| s.downcast::<lineao::method::raytraced::RayTracedAo>())
+            .map(|t| t.progress())
+            .unwrap()
+            .rays_per_pixel,
         4
     );
     assert_same_hits(&nd, &first, &cpu_truth(&tracer, &scene, &nd, 4), 4, "lines, 1 frame × 4");
@@ -162,7 +168,13 @@ fn lines_accumulate_to_the_cpu_truth_with_the_same_rays_and_restart_when_the_cam
     tracer.frame(&camera());
     let (nd, third) = tracer.frame(&camera());
     assert_eq!(
-        tracer.chain.stage::<lineao::method::raytraced::RayTracedAo>().map(|t| t.progress()).unwrap().rays_per_pixel,
+        tracer
+            .chain
+            .stage()
+            .and_then(|s| s.downcast::<lineao::method::raytraced::RayTracedAo>())
+            .map(|t| t.progress())
+            .unwrap()
+            .rays_per_pixel,
         12
     );
     assert_same_hits(&nd, &third, &cpu_truth(&tracer, &scene, &nd, 12), 12, "lines, 3 frames × 4");
@@ -172,7 +184,13 @@ fn lines_accumulate_to_the_cpu_truth_with_the_same_rays_and_restart_when_the_cam
     tracer.chain.set_settings(&tracer.gpu.device, more).unwrap();
     let (nd, fourth) = tracer.frame(&camera());
     assert_eq!(
-        tracer.chain.stage::<lineao::method::raytraced::RayTracedAo>().map(|t| t.progress()).unwrap().rays_per_pixel,
+        tracer
+            .chain
+            .stage()
+            .and_then(|s| s.downcast::<lineao::method::raytraced::RayTracedAo>())
+            .map(|t| t.progress())
+            .unwrap()
+            .rays_per_pixel,
         20
     );
     assert_same_hits(&nd, &fourth, &cpu_truth(&tracer, &scene, &nd, 20), 20, "lines, 3 frames × 4 + 8");
@@ -182,7 +200,13 @@ fn lines_accumulate_to_the_cpu_truth_with_the_same_rays_and_restart_when_the_cam
     tracer.chain.encode(&mut encoder, &tracer.lines, &tracer.output.view).unwrap();
     q.submit([encoder.finish()]);
     assert_eq!(
-        tracer.chain.stage::<lineao::method::raytraced::RayTracedAo>().map(|t| t.progress()).unwrap().rays_per_pixel,
+        tracer
+            .chain
+            .stage()
+            .and_then(|s| s.downcast::<lineao::method::raytraced::RayTracedAo>())
+            .map(|t| t.progress())
+            .unwrap()
+            .rays_per_pixel,
         20
     );
     assert_eq!(read_f32(d, q, &tracer.chain.targets().unwrap().ao).unwrap().data, fourth.data);
@@ -190,7 +214,13 @@ fn lines_accumulate_to_the_cpu_truth_with_the_same_rays_and_restart_when_the_cam
     let moved = Camera { eye: Vec3::new(-60.0, 20.0, 120.0), ..camera() };
     let (nd, restarted) = tracer.frame(&moved);
     assert_eq!(
-        tracer.chain.stage::<lineao::method::raytraced::RayTracedAo>().map(|t| t.progress()).unwrap().rays_per_pixel,
+        tracer
+            .chain
+            .stage()
+            .and_then(|s| s.downcast::<lineao::method::raytraced::RayTracedAo>())
+            .map(|t| t.progress())
+            .unwrap()
+            .rays_per_pixel,
         8
     );
     assert_same_hits(&nd, &restarted, &cpu_truth(&tracer, &scene, &nd, 8), 8, "lines, moved");
@@ -221,12 +251,23 @@ fn an_orthographic_view_with_a_mesh_matches_and_the_cap_stops_tracing() {
     tracer.frame(&orthographic);
     // The cap: the second frame traces the 2 rays left, the third none and keeps the picture.
     let (nd, capped) = tracer.frame(&orthographic);
-    let progress = tracer.chain.stage::<lineao::method::raytraced::RayTracedAo>().map(|t| t.progress()).unwrap();
+    let progress = tracer
+        .chain
+        .stage()
+        .and_then(|s| s.downcast::<lineao::method::raytraced::RayTracedAo>())
+        .map(|t| t.progress())
+        .unwrap();
     assert_eq!((progress.rays_per_pixel, progress.frame_rays, progress.converged()), (6, 2, true));
     assert_same_hits(&nd, &capped, &cpu_truth(&tracer, &scene, &nd, 6), 6, "orthographic + mesh, capped at 6");
     let (_, after) = tracer.frame(&orthographic);
     assert_eq!(
-        tracer.chain.stage::<lineao::method::raytraced::RayTracedAo>().map(|t| t.progress()).unwrap().frame_rays,
+        tracer
+            .chain
+            .stage()
+            .and_then(|s| s.downcast::<lineao::method::raytraced::RayTracedAo>())
+            .map(|t| t.progress())
+            .unwrap()
+            .frame_rays,
         0
     );
     assert_eq!(after.data, capped.data);
@@ -384,7 +425,12 @@ fn a_host_renderers_depth_traces_like_the_cpu_truth_through_the_embedding_api() 
     }
     let chain = host.chain();
     assert_eq!(
-        chain.stage::<lineao::method::raytraced::RayTracedAo>().map(|t| t.progress()).unwrap().rays_per_pixel,
+        chain
+            .stage()
+            .and_then(|s| s.downcast::<lineao::method::raytraced::RayTracedAo>())
+            .map(|t| t.progress())
+            .unwrap()
+            .rays_per_pixel,
         16
     );
     let t = chain.targets().unwrap();

@@ -8,7 +8,8 @@ use glam::Vec3;
 use lineao::LineGeometry;
 use lineao::passes::meshes::MeshGeometry;
 use lineao::reference;
-use lineao::verify::{check_policy, line_ao_flip_bound};
+use lineao::reference::line_ao_flip_bound;
+use lineao::verify::check_policy;
 use lineao::{AoMethod, ChainSettings, SurfaceSettings};
 use lineao::{Camera, Projection};
 

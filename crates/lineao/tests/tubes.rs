@@ -10,8 +10,9 @@ use glam::{Mat4, Vec3, Vec4Swizzles};
 use lineao::LineGeometry;
 use lineao::passes::lines::{GeometryOptions, VertexAttributes};
 use lineao::reference;
+use lineao::reference::line_ao_flip_bound;
 use lineao::reference::tubes::{intersect_rounded_cone, pixel_ray, rounded_cone_distance, rounded_cone_normal};
-use lineao::verify::{check_policy, line_ao_flip_bound};
+use lineao::verify::check_policy;
 use lineao::{AoMethod, ChainSettings, TubeSettings};
 use lineao::{Bounds, Camera, FrameView, Projection};
 

@@ -112,6 +112,28 @@ pub struct AoChain {
     timer: Option<PassTimer>,
 }
 
+/// What a frame draws into its G-buffer ([`AoChain::encode`]): the lines (or tubes), and the
+/// context surfaces drawn after them.
+#[derive(Clone, Copy)]
+pub struct Drawn<'g> {
+    /// The lines.
+    pub lines: &'g LineGeometry,
+    /// The context surfaces (drawn with [`ChainSettings::surfaces`]).
+    pub meshes: &'g [&'g MeshGeometry],
+}
+
+impl<'g> From<&'g LineGeometry> for Drawn<'g> {
+    fn from(lines: &'g LineGeometry) -> Drawn<'g> {
+        Drawn { lines, meshes: &[] }
+    }
+}
+
+impl<'g> From<(&'g LineGeometry, &'g [&'g MeshGeometry])> for Drawn<'g> {
+    fn from((lines, meshes): (&'g LineGeometry, &'g [&'g MeshGeometry])) -> Drawn<'g> {
+        Drawn { lines, meshes }
+    }
+}
+
 impl AoChain {
     /// A chain that composites into targets of `format`. A device that cannot run the passes
     /// (whose adapter [`crate::gpu::check_adapter`] refuses) or a `format` that cannot be
@@ -277,13 +299,14 @@ impl AoChain {
         self.slice_volume = volume;
     }
 
-    /// The active method's stage if it is a `T` (its own targets, for readback: SSAO's
-    /// occlusion before its blur, [`crate::method::ssao::SsaoStage::raw`]; VO area's moments,
-    /// [`crate::method::vo_area::VoArea::moments`]; the ray tracer's accumulation and how far
-    /// its picture has come, [`crate::method::raytraced::RayTracedAo::accumulation`] and
-    /// [`crate::method::raytraced::RayTracedAo::progress`]).
-    pub fn stage<T: method::Stage>(&self) -> Option<&T> {
-        self.stages.active_as()
+    /// The active method's stage (none after `none`): its occlusion before its own blur
+    /// ([`method::Stage::unblurred`]); as its own type (`downcast::<T>()`), its own targets and state
+    /// for readback: VO area's moments, [`crate::method::vo_area::VoArea::moments`]; the ray
+    /// tracer's accumulation and how far its picture has come,
+    /// [`crate::method::raytraced::RayTracedAo::accumulation`] and
+    /// [`crate::method::raytraced::RayTracedAo::progress`].
+    pub fn stage(&self) -> Option<&dyn method::Stage> {
+        self.stages.active()
     }
 
     /// Turns per-pass GPU timing on or off (a timer that is on stays as it is, so a host may
@@ -570,28 +593,19 @@ impl AoChain {
     }
 
     /// Records the frame into `encoder`, compositing into `target`: `RENDER_ATTACHMENT`, the
-    /// visible size, the format given to `new` (or its sRGB twin), one sample. A mismatch, or a
-    /// frame not prepared, is an [`Error::Usage`] with nothing recorded; a 0 × 0 chain records
-    /// nothing — as [`crate::HostAo::encode`] and [`crate::OverlayAo::encode`].
-    pub fn encode(
+    /// visible size, the format given to `new` (or its sRGB twin), one sample. `drawn` is the
+    /// lines (`&geometry`), or the lines and context surfaces drawn after them into the same
+    /// G-buffer (`(&geometry, &meshes[..])`, with [`ChainSettings::surfaces`]; the frame's
+    /// `bounds` given to `prepare` should hold them too). A mismatch, or a frame not prepared,
+    /// is an [`Error::Usage`] with nothing recorded; a 0 × 0 chain records nothing — as
+    /// [`crate::HostAo::encode`] and [`crate::OverlayAo::encode`].
+    pub fn encode<'g>(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        geometry: &LineGeometry,
+        drawn: impl Into<Drawn<'g>>,
         target: &wgpu::TextureView,
     ) -> Result<(), Error> {
-        self.encode_with_meshes(encoder, geometry, &[], target)
-    }
-
-    /// [`AoChain::encode`] with context surfaces drawn after the lines into the same G-buffer
-    /// (with [`ChainSettings::surfaces`]; without them the meshes are not drawn). The frame's
-    /// `bounds` given to `prepare` should hold the meshes too.
-    pub fn encode_with_meshes(
-        &self,
-        encoder: &mut wgpu::CommandEncoder,
-        geometry: &LineGeometry,
-        meshes: &[&MeshGeometry],
-        target: &wgpu::TextureView,
-    ) -> Result<(), Error> {
+        let Drawn { lines: geometry, meshes } = drawn.into();
         if self.size.0 == 0 || self.size.1 == 0 {
             return Ok(());
         }

@@ -60,7 +60,7 @@ impl OverlayAo {
         &mut self.chain
     }
 
-    /// [`AoChain::encode_with_meshes`] drawn into a host's frame (after the chain's `prepare`):
+    /// [`AoChain::encode`] with its meshes drawn into a host's frame (after the chain's `prepare`):
     /// `target`'s colour is loaded, not cleared, and only the geometry's pixels are written (the
     /// background shows the host's picture); `depth`, required when the overlay was made with
     /// depth and refused otherwise, gets the lines' depth at the visible size. Both are the

@@ -8,8 +8,12 @@ use crate::method::AoMethod;
 use crate::method::setting::{About, Context, Setting, Value};
 use crate::preset::Preset;
 use crate::settings::ChainSettings;
-use crate::targets::FrameTargets;
+use crate::targets::{FrameTargets, Target};
 use crate::timing::Span;
+
+/// A method's CPU reference of its frame ([`MethodInfo`]'s `reference`).
+#[cfg(feature = "reference")]
+pub(crate) type CpuReference = fn(&crate::verify::FrameInputs) -> Result<crate::verify::ReferenceAo, Error>;
 
 /// How a method builds its stage for a device and settings.
 pub(crate) type BuildStage = fn(&wgpu::Device, &ChainSettings) -> Box<dyn Stage>;
@@ -25,6 +29,12 @@ pub struct MethodInfo {
     /// Whether the method is screen-space AO in the chain, shown by `--grid` and the viewer's
     /// list among the others (the ray-traced truth, progressive and scene-bound, is not).
     pub screen_space: bool,
+    /// Whether it traces rays through the scene (the ray-traced truth): it needs the scene's
+    /// BVH ([`crate::AoChain::set_ray_scene`]), accumulates its picture over frames, and its
+    /// rays start on lines drawn at full detail. The CPU truth (`--truth cpu`) can stand in.
+    pub traces_scene: bool,
+    /// What it estimates: which ray-traced truth `lineao score` holds its picture to.
+    pub estimates: Estimate,
     /// The timing spans its stage can record, in chain order (docs/reference.md's names).
     pub spans: &'static [&'static str],
     /// Its WGSL files, by the name its passes compose them under, and the numbers its WGSL
@@ -44,6 +54,41 @@ pub struct MethodInfo {
     pub(crate) own: &'static dyn OwnSettings,
     /// What `lineao bench` times of it, by docs/reference.md's names.
     pub bench: &'static [BenchPass],
+    /// Its other form that `score`, the fit and `--grid` show as a method of their own.
+    pub variant: Option<Variant>,
+    /// Its stage's occlusion on the CPU from the frame's read-back inputs
+    /// ([`crate::verify::reference_ao`]); `None` where its frame has no reference of its own.
+    #[cfg(feature = "reference")]
+    pub(crate) reference: Option<CpuReference>,
+}
+
+/// A method's other form, made by a value of one of its settings, that `lineao score`, the fit
+/// and `--grid` show beside it as a method of their own (LineAO's `reference`: the authors'
+/// shader beside the paper's equations).
+#[derive(Debug, PartialEq, Eq)]
+pub struct Variant {
+    /// The setting's flag (`variant`).
+    pub setting: &'static str,
+    /// Its value for this form (`reference`); a panel's label adds it in brackets.
+    pub value: &'static str,
+    /// Its value for the method's main form (`paper`).
+    pub main: &'static str,
+    /// Its name as a method of its own (`lineao-reference`).
+    pub name: &'static str,
+    /// What the viewer's label adds (`authors' code`).
+    pub label: &'static str,
+    /// Its line of `--help`.
+    pub help: &'static str,
+}
+
+/// What a method estimates, so the ray-traced truth it is held to (`lineao score`, the fit).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Estimate {
+    /// Ambient occlusion: the share of the hemisphere's rays that hit within the reach.
+    Occlusion,
+    /// Volumetric Obscurance (Loos & Sloan 2010): the share of a ball (a half ball where VO
+    /// clamps to the normal) filled with geometry.
+    Obscurance,
 }
 
 /// A pass of `lineao bench` that times a method: its stage, built and prepared with the bench's
@@ -273,6 +318,13 @@ impl MethodInfo {
         (0..own.len()).map(move |index| ChainSetting { own, index })
     }
 
+    /// Its [`MethodInfo::variant`] where `chain` has that form of it.
+    pub fn variant_of(&self, chain: &ChainSettings) -> Option<&Variant> {
+        let variant = self.variant.as_ref()?;
+        let setting = self.settings().find(|s| s.flag == variant.setting)?;
+        (setting.get(chain) == Value::Choice(variant.value)).then_some(variant)
+    }
+
     /// What a panel calls after one of its controls moved a value of this method's: the others
     /// changed so that the settings stay valid (SSAO's sphere kernel takes only its sample
     /// counts). The command line calls nothing: what it is given is checked, not changed.
@@ -347,4 +399,56 @@ pub trait Stage: wgpu::WasmNotSendSync + std::any::Any {
         targets: &FrameTargets,
         span: &dyn Fn(&'static str) -> Option<Span<'t>>,
     );
+    /// The occlusion of the last frame before the stage's own blur, where it has one (SSAO's
+    /// 4 × 4 box): what docs/reference.md's `ao.npy` holds and what a CPU reference of the
+    /// stage's main pass is compared with. `None`: the stage writes `ao` unblurred.
+    fn unblurred(&self) -> Option<&Target> {
+        None
+    }
+    /// What `lineao render --dump` writes of the method beside the G-buffer under `settings`
+    /// for the last frame, seen as `view`: docs/reference.md's keys of `params.json` and its
+    /// tables (noise tiles, sample sets, pyramids read back from `device`).
+    #[cfg(all(feature = "serde", feature = "reference"))]
+    fn dump(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        settings: &ChainSettings,
+        view: &FrameView,
+    ) -> Result<Dump, Error> {
+        let _ = (device, queue, settings, view);
+        Ok(Dump::default())
+    }
+}
+
+/// A method's part of a `--dump` folder ([`Stage::dump`]).
+#[cfg(all(feature = "serde", feature = "reference"))]
+#[derive(Debug, Default)]
+pub struct Dump {
+    /// Keys of `params.json`.
+    pub params: serde_json::Map<String, serde_json::Value>,
+    /// Tables written as `NAME.npy`: the name, the shape and the values in row-major order.
+    pub arrays: Vec<(String, Vec<u64>, Vec<f32>)>,
+}
+
+#[cfg(all(feature = "serde", feature = "reference"))]
+impl Dump {
+    /// Adds the keys of `object` (a JSON object) to the parameters.
+    pub fn params(&mut self, object: serde_json::Value) {
+        if let serde_json::Value::Object(keys) = object {
+            self.params.extend(keys);
+        }
+    }
+
+    /// Adds a table of vectors as a `[len, 3]` (or `shape`) array.
+    pub fn array(&mut self, name: &str, shape: &[u64], values: Vec<f32>) {
+        self.arrays.push((name.to_string(), shape.to_vec(), values));
+    }
+}
+
+impl dyn Stage {
+    /// This stage if it is a `T` (its own targets and state, for readback).
+    pub fn downcast<T: Stage>(&self) -> Option<&T> {
+        (self as &dyn std::any::Any).downcast_ref()
+    }
 }

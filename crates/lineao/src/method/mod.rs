@@ -33,7 +33,9 @@ pub(crate) mod list;
 mod none;
 mod registry;
 
-pub use info::{BenchPass, ChainSetting, MethodInfo, Reach, Stage};
+#[cfg(all(feature = "serde", feature = "reference"))]
+pub use info::Dump;
+pub use info::{BenchPass, ChainSetting, Estimate, MethodInfo, Reach, Stage, Variant};
 pub(crate) use info::{Own, fits_always, fits_storage};
 pub use list::AoMethod;
 pub use registry::{bench_passes, build, pass_names};

@@ -5,10 +5,15 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     label: "none",
     help: "Plain lines (with the illuminated-lines specular), no occlusion",
     screen_space: true,
+    estimates: super::Estimate::Occlusion,
+    traces_scene: false,
     spans: &[],
     library: crate::shader::Library::SHARED,
     build: None,
     fits: super::fits_always,
     own: super::info::NO_SETTINGS,
     bench: &[],
+    variant: None,
+    #[cfg(feature = "reference")]
+    reference: None,
 };

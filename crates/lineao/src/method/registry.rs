@@ -108,6 +108,13 @@ impl ChainSetting {
 
 /// What the chain's settings do through every method's own.
 impl ChainSettings {
+    /// Whether the culled lines and tubes are drawn at levels of detail: [`ChainSettings::lod`],
+    /// but never for a method that traces the scene (the GPU ray tracer), whose rays start on
+    /// the G-buffer's lines and must find them where the scene it traces has them.
+    pub fn levels_of_detail(&self) -> bool {
+        self.lod && !self.method.info().traces_scene
+    }
+
     /// `self` with `preset`'s values for its method (and LineAO variant): the strength and the
     /// method's own reach (each method's `preset` in its folder: LineAO's s_r, δ scale and r0,
     /// VO's and SSAO's radius in zoom units). Every other method's values are the papers'.
@@ -118,6 +125,19 @@ impl ChainSettings {
         }
         self.method.info().own.preset(preset, &mut self);
         self
+    }
+
+    /// `self` with every method's own values at `preset`, each as it is shown alone, and the
+    /// strength of its method's: what panels that share one chain's settings and show
+    /// different methods start from (the viewer). Else as [`ChainSettings::with_preset`].
+    pub fn with_preset_for_every_method(self, preset: Preset) -> ChainSettings {
+        let strength = self.clone().with_preset(preset).strength;
+        let mut every = self.with_preset(Preset::Paper);
+        for method in AoMethod::REGISTRY {
+            method.info().own.preset(preset, &mut every);
+        }
+        every.strength = strength;
+        every
     }
 
     /// Pyramid levels the chain needs: what its method reads (s_r for LineAO, one for the

@@ -13,8 +13,8 @@ mod volume_ao;
 
 pub use crate::image::{Image, NdImage};
 pub use crate::method::line_ao::reference::{
-    LineAoParams, OUTER_DEPTH_TOLERANCE, delta, depth_weight, hermite, light_weight, line_ao, line_ao_pixel,
-    representative_pixel, upsample_outer, whole_exponent, whole_pow,
+    LineAoParams, OUTER_DEPTH_TOLERANCE, delta, depth_weight, hermite, light_weight, line_ao, line_ao_flip_bound,
+    line_ao_pixel, line_ao_reference_flip_bound, representative_pixel, upsample_outer, whole_exponent, whole_pow,
 };
 pub use crate::method::raytraced::reference::ray_denoise;
 pub use crate::method::ssao::reference::{SSAO_EPSILON, SsaoParams, ViewParams, ssao, ssao_blur, ssao_pixel};

@@ -86,7 +86,7 @@ pub fn render_scene(
     let view = chain.prepare(&gpu.device, &gpu.queue, camera, &bounds).unwrap();
     let output = Target::output(&gpu.device, "test::output", (width, height), OUTPUT_FORMAT);
     let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    chain.encode_with_meshes(&mut encoder, geometry, meshes, &output.view).unwrap();
+    chain.encode(&mut encoder, (geometry, meshes), &output.view).unwrap();
     gpu.queue.submit([encoder.finish()]);
     let t = chain.targets().unwrap();
     let (d, q) = (&gpu.device, &gpu.queue);
@@ -99,7 +99,7 @@ pub fn render_scene(
         specular: read_f32(d, q, &t.specular).unwrap(),
         depth: read_f32(d, q, &t.depth).unwrap(),
         ao: read_f32(d, q, &t.ao).unwrap(),
-        ao_raw: (chain.stage::<lineao::method::ssao::SsaoStage>().and_then(|s| s.raw()))
+        ao_raw: (chain.stage().and_then(|s| s.unblurred()))
             .map(|raw| read_f32(d, q, raw).unwrap())
             .unwrap_or_else(|| Image::from_fn(0, 0, |_, _| 0.0)),
         ao_blurred: t
@@ -107,9 +107,12 @@ pub fn render_scene(
             .as_ref()
             .map(|b| read_f32(d, q, b).unwrap())
             .unwrap_or_else(|| Image::from_fn(0, 0, |_, _| 0.0)),
-        moments: (chain.stage::<lineao::method::vo_area::VoArea>().and_then(|s| s.moments()))
-            .map(|m| m.read(d, q).unwrap())
-            .unwrap_or_default(),
+        moments: (chain
+            .stage()
+            .and_then(|s| s.downcast::<lineao::method::vo_area::VoArea>())
+            .and_then(|s| s.moments()))
+        .map(|m| m.read(d, q).unwrap())
+        .unwrap_or_default(),
         output: read_rgba(d, q, &output).unwrap(),
         octants: t.octants.as_ref().map(|o| lineao::readback::read_image(d, q, o).unwrap()),
         volume_ao: t.volume_ao.as_ref().map(|v| read_f32(d, q, v).unwrap()),

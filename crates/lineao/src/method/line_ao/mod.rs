@@ -78,6 +78,8 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     label: "LineAO",
     help: "LineAO (Eichelbaum et al. 2013): hemispheres of growing radius on a Gaussian pyramid of normals and depth",
     screen_space: true,
+    estimates: super::Estimate::Occlusion,
+    traces_scene: false,
     spans: &["nd-pyramid", "lineao"],
     library: crate::shader::Library {
         files: &[("line_ao.wgsl", include_str!("line_ao.wgsl"))],
@@ -101,6 +103,16 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
         BenchPass::of("lineao-level", &["lineao"], |s, _| s.line_ao.outer = LineAoOuter::Level),
         BenchPass::of("lineao-chain-level", &["nd-pyramid", "lineao"], |s, _| s.line_ao.outer = LineAoOuter::Level),
     ],
+    variant: Some(super::Variant {
+        setting: "variant",
+        value: "reference",
+        main: "paper",
+        name: "lineao-reference",
+        label: "authors' code",
+        help: "LineAO's `reference` variant (the authors' LineVis: radius in zoom units, no pyramid)",
+    }),
+    #[cfg(feature = "reference")]
+    reference: Some(reference::of_frame),
 };
 use crate::targets::{AO_FORMAT, FrameTargets, LevelsUniform, Target};
 use crate::timing::Span;
@@ -467,6 +479,58 @@ impl crate::method::Stage for LineAoStage {
             self.pyramid.encode(encoder, targets, span("nd-pyramid"));
         }
         self.line_ao.encode(encoder, targets, span("lineao"));
+    }
+
+    /// docs/reference.md's LineAO keys (each variant's own) and its noise tile and sample table.
+    #[cfg(all(feature = "serde", feature = "reference"))]
+    fn dump(
+        &self,
+        _: &wgpu::Device,
+        _: &wgpu::Queue,
+        s: &ChainSettings,
+        view: &FrameView,
+    ) -> Result<crate::method::Dump, crate::Error> {
+        use serde_json::json;
+        let ao = &s.line_ao;
+        let lights: Vec<_> = s
+            .lighting
+            .normalized()
+            .iter()
+            .map(|l| json!({"dir": l.dir.to_array(), "intensity": l.intensity}))
+            .collect();
+        let mut dump = crate::method::Dump::default();
+        dump.params(json!({
+            "variant": ao.variant.name(),
+            "s_r": ao.s_r,
+            "s_h": ao.s_h,
+            "light_attenuation": ao.light_attenuation,
+            "lights": lights,
+            "noise_seed": ao.noise_seed,
+            "outer": ao.outer.name(),
+        }));
+        if ao.outer == LineAoOuter::Level {
+            dump.params(json!({"outer_depth_tolerance": OUTER_DEPTH_TOLERANCE}));
+        }
+        dump.params(match ao.variant {
+            LineAoVariant::Paper => json!({
+                "r0_px": s.r0().px,
+                "delta0": ao.delta0,
+                "delta_scale": ao.delta_scale,
+                "epsilon": ao.epsilon,
+                "kd": s.lighting.kd,
+                "ks": s.lighting.ks,
+                "shininess": s.lighting.shininess,
+            }),
+            // Our extension of docs/reference.md: what the authors' radius needs.
+            LineAoVariant::Reference => json!({
+                "reference_radius_px": ao.reference_radius_px,
+                "zoom_fit": view.zoom_fit(),
+            }),
+        });
+        let flat = |v: Vec<[f32; 3]>| v.into_iter().flatten().collect();
+        dump.array("noise", &[64, 64, 3], flat(noise::noise_tile(ao.noise_seed)));
+        dump.array("samples", &[ao.s_r as u64, ao.s_h as u64, 3], flat(sample_table(ao)));
+        Ok(dump)
     }
 }
 

@@ -10,6 +10,7 @@ use crate::image::{Image, NdImage};
 use crate::lighting::Light;
 use crate::reference::level_texel;
 use crate::settings::ChainSettings;
+use crate::verify::{FrameInputs, ReferenceAo};
 
 /// Every number LineAO reads besides the images and the noise.
 #[derive(Clone, Debug, PartialEq)]
@@ -356,6 +357,31 @@ pub fn line_ao(
     })
 }
 
+/// docs/reference.md's bound for every pixel of LineAO: two flipped samples per hemisphere, Σ_j 2/n_j.
+pub fn line_ao_flip_bound(s_r: u32, s_h: u32) -> f32 {
+    (0..s_r).map(|j| 2.0 / crate::noise::samples_on_hemisphere(s_h, j) as f32).sum()
+}
+
+/// The same bound for variant `reference`: two flipped samples per hemisphere, each weighing up
+/// to 1.5/s_h, averaged over the s_r hemispheres: 3/s_h.
+pub fn line_ao_reference_flip_bound(s_h: u32) -> f32 {
+    3.0 / s_h as f32
+}
+
+/// LineAO's frame on the CPU ([`crate::verify::reference_ao`]): its noise tile and sample table
+/// from the settings, the pyramid and zoom map read back, and the variant's flip bound.
+pub(crate) fn of_frame(inputs: &FrameInputs) -> Result<ReferenceAo, crate::Error> {
+    let ao = &inputs.settings.line_ao;
+    let params = LineAoParams::new(inputs.settings, inputs.view);
+    let table = super::sample_table(ao);
+    let noise = crate::noise::noise_tile(ao.noise_seed);
+    let every_pixel_bound = match ao.variant {
+        LineAoVariant::Paper => line_ao_flip_bound(ao.s_r, ao.s_h),
+        LineAoVariant::Reference => line_ao_reference_flip_bound(ao.s_h),
+    };
+    Ok(ReferenceAo { ao: line_ao(inputs.nd, inputs.zoom, &noise, &table, &params), every_pixel_bound })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -379,3 +405,4 @@ mod tests {
         assert_eq!([whole_exponent(32.5), whole_exponent(0.0), whole_exponent(512.0)], [0; 3]);
     }
 }
+

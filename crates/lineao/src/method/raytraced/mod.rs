@@ -48,6 +48,8 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     label: "ray traced (progressive)",
     help: "Ray-traced AO on the GPU, accumulated while the view rests: the ground truth",
     screen_space: false,
+    estimates: super::Estimate::Occlusion,
+    traces_scene: true,
     spans: &["raytraced", "ray-denoise"],
     library: crate::shader::Library {
         files: &[("raytraced_ao.wgsl", include_str!("raytraced_ao.wgsl")), denoise::WGSL],
@@ -77,6 +79,9 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
             s.raytraced.denoise = Some(RayDenoiseSettings::default());
         }),
     ],
+    variant: None,
+    #[cfg(feature = "reference")]
+    reference: None,
 };
 
 /// The bench's ray tracer: one ray per pixel and frame, no denoiser.

@@ -42,6 +42,8 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     label: "Crytek SSAO",
     help: "Crytek SSAO (Mittring 2007), the LineAO paper's baseline, with its 4 × 4 blur",
     screen_space: true,
+    estimates: super::Estimate::Occlusion,
+    traces_scene: false,
     spans: &["ssao", "ssao-blur"],
     library: crate::shader::Library {
         files: &[("ssao.wgsl", include_str!("ssao.wgsl")), blur::WGSL],
@@ -58,6 +60,9 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
         BenchPass::of("ssao-12", &["ssao"], |s, _| s.ssao.samples = 12),
         BenchPass::of("ssao-16-chain", &["ssao", "ssao-blur"], |s, _| s.ssao.samples = 16),
     ],
+    variant: None,
+    #[cfg(feature = "reference")]
+    reference: Some(reference::of_frame),
 };
 use crate::targets::{AO_FORMAT, FrameTargets, Target};
 use crate::timing::Span;
@@ -179,12 +184,6 @@ impl SsaoStage {
     pub fn new(device: &wgpu::Device, settings: &ChainSettings) -> SsaoStage {
         SsaoStage { ssao: Ssao::new(device, &settings.ssao), blur: blur::SsaoBlur::new(device), raw: None }
     }
-
-    /// The occlusion before the blur of the last frame (what docs/reference.md's `ao.npy` holds for
-    /// SSAO).
-    pub fn raw(&self) -> Option<&Target> {
-        self.raw.as_ref()
-    }
 }
 
 impl crate::method::Stage for SsaoStage {
@@ -222,6 +221,34 @@ impl crate::method::Stage for SsaoStage {
     ) {
         self.ssao.encode(encoder, targets, span("ssao"));
         self.blur.encode(encoder, targets, span("ssao-blur"));
+    }
+
+    fn unblurred(&self) -> Option<&Target> {
+        self.raw.as_ref()
+    }
+
+    /// docs/reference.md's SSAO keys, its kernel and its 4 × 4 rotation tile.
+    #[cfg(all(feature = "serde", feature = "reference"))]
+    fn dump(
+        &self,
+        _: &wgpu::Device,
+        _: &wgpu::Queue,
+        s: &ChainSettings,
+        _: &FrameView,
+    ) -> Result<crate::method::Dump, crate::Error> {
+        let ssao = &s.ssao;
+        let mut dump = crate::method::Dump::default();
+        dump.params(serde_json::json!({
+            "samples": ssao.samples,
+            "radius_world": ssao.radius_world,
+            "ssao_range": ssao.range_world,
+            "noise_seed": ssao.noise_seed,
+            "ssao_kernel": ssao.kernel.name(),
+        }));
+        let flat = |v: Vec<[f32; 3]>| v.into_iter().flatten().collect();
+        dump.array("ssao_kernel", &[ssao.samples as u64, 3], flat(ssao.kernel_points()));
+        dump.array("ssao_noise", &[4, 4, 3], flat(crate::noise::ssao_noise(ssao.noise_seed)));
+        Ok(dump)
     }
 }
 

@@ -2,6 +2,7 @@
 //! in the shaders' f32 operation order.
 
 use crate::image::{Image, NdImage};
+use crate::verify::{FrameInputs, ReferenceAo};
 pub use crate::view_params::ViewParams;
 
 pub use super::SSAO_EPSILON;
@@ -84,4 +85,22 @@ pub fn ssao_blur(nd: &NdImage, raw: &Image<f32>) -> Image<f32> {
         }
         sum / count as f32
     })
+}
+
+/// Crytek SSAO's frame on the CPU before its blur ([`crate::verify::reference_ao`]): its kernel
+/// and rotation tile from the settings, level 0 read back; a bound of two flipped samples.
+pub(crate) fn of_frame(inputs: &FrameInputs) -> Result<ReferenceAo, crate::Error> {
+    let (settings, view) = (&inputs.settings.ssao, inputs.view);
+    let params = SsaoParams {
+        view: ViewParams::of(view),
+        radius: settings.radius_world,
+        range: settings.range_world,
+        noise_origin: [view.guard as i32; 2],
+    };
+    let points = settings.kernel_points();
+    if points.len() != settings.samples as usize {
+        return Err(crate::Error::InvalidSettings(format!("no SSAO kernel of {} samples", settings.samples)));
+    }
+    let cpu = ssao(&inputs.nd[0], &points, &crate::noise::ssao_noise(settings.noise_seed), &params);
+    Ok(ReferenceAo { ao: cpu, every_pixel_bound: 2.0 / settings.samples as f32 })
 }

@@ -29,12 +29,17 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     // Not among the screen-space methods that `--grid` and the viewer show, so the snapshots
     // stay the papers' methods in a test build.
     screen_space: false,
+    estimates: super::Estimate::Occlusion,
+    traces_scene: false,
     spans: &["toy"],
     library: crate::shader::Library { files: &[("toy.wgsl", include_str!("toy.wgsl"))], constants: &[] },
     build: Some(|device, _| Box::new(Toy::new(device))),
     fits: super::fits_always,
     own: &super::Own::at(settings::SETTINGS, |c| &c.toy, |c| &mut c.toy, |_, _, _| 1.0),
     bench: &[super::BenchPass::of("toy", &["toy"], |_, _| {})],
+    variant: None,
+    #[cfg(feature = "reference")]
+    reference: None,
 };
 
 struct Toy {

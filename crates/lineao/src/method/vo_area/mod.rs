@@ -40,6 +40,8 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     label: "VO area",
     help: "Volumetric Obscurance with area samples over a pyramid of depth moments (Loos & Sloan 2010, §4.2)",
     screen_space: true,
+    estimates: super::Estimate::Obscurance,
+    traces_scene: false,
     spans: &["moments", "vo-area"],
     library: crate::shader::Library {
         files: &[("vo_area.wgsl", include_str!("vo_area.wgsl")), moments::LIBRARY.files[0], moments::LIBRARY.files[1]],
@@ -52,6 +54,9 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
         ..super::Own::at(AREA_SETTINGS, |c| &c.vo, |c| &mut c.vo, |preset, s, c| vo_preset(preset, s, c, 1.0, 1.0))
     },
     bench: &[super::BenchPass::of("vo-area-1", &["moments", "vo-area"], |s, _| s.vo.area_samples = 1)],
+    variant: None,
+    #[cfg(feature = "reference")]
+    reference: None,
 };
 use crate::targets::FrameTargets;
 use crate::timing::Span;
@@ -149,5 +154,27 @@ impl crate::method::Stage for VoArea {
         span: &dyn Fn(&'static str) -> Option<Span<'t>>,
     ) {
         VoArea::encode(self, encoder, targets, span("moments"), span("vo-area"));
+    }
+
+    /// VO's keys and tables ([`crate::method::vo_line`]'s) with the area samples, and the
+    /// moments pyramid read back (`moments_L.npy`).
+    #[cfg(all(feature = "serde", feature = "reference"))]
+    fn dump(
+        &self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        s: &ChainSettings,
+        _: &FrameView,
+    ) -> Result<crate::method::Dump, crate::Error> {
+        let vo = &s.vo;
+        let mut dump =
+            crate::method::vo_line::dump(vo, vo.area_samples, sample_sets::vo_area_samples(vo.area_samples))?;
+        if let Some(moments) = self.moments() {
+            for (l, level) in moments.read(device, queue)?.into_iter().enumerate() {
+                let shape = [level.height as u64, level.width as u64, 2];
+                dump.array(&format!("moments_{l}"), &shape, level.data.concat());
+            }
+        }
+        Ok(dump)
     }
 }

@@ -46,6 +46,8 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     label: "VO line",
     help: "Volumetric Obscurance with line samples (Loos & Sloan 2010, §4.1)",
     screen_space: true,
+    estimates: super::Estimate::Obscurance,
+    traces_scene: false,
     spans: &["vo-line"],
     library: crate::shader::Library { files: &[("vo_line.wgsl", include_str!("vo_line.wgsl"))], constants: &[] },
     build: Some(|device, settings| Box::new(VoLine::new(device, &settings.vo))),
@@ -60,6 +62,9 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
         )
     },
     bench: &[super::BenchPass::of("vo-line-5", &["vo-line"], |s, _| s.vo.samples = 5)],
+    variant: None,
+    #[cfg(feature = "reference")]
+    reference: None,
 };
 use crate::method::vo_area::moments::Moments;
 use crate::targets::{AO_FORMAT, FrameTargets};
@@ -271,6 +276,42 @@ impl crate::method::Stage for VoLine {
     ) {
         VoLine::encode(self, encoder, targets, span("vo-line"));
     }
+
+    #[cfg(all(feature = "serde", feature = "reference"))]
+    fn dump(
+        &self,
+        _: &wgpu::Device,
+        _: &wgpu::Queue,
+        s: &ChainSettings,
+        _: &FrameView,
+    ) -> Result<crate::method::Dump, crate::Error> {
+        dump(&s.vo, s.vo.samples, sample_sets::vo_disk_samples(s.vo.samples).map(<[_]>::to_vec))
+    }
+}
+
+/// docs/reference.md's VO keys, its `count` samples and its 4 × 4 rotation tile: VO lines' and
+/// VO area's (`samples`: their set, `None` where there is none of that size).
+#[cfg(all(feature = "serde", feature = "reference"))]
+pub(crate) fn dump(
+    vo: &VoSettings,
+    count: u32,
+    samples: Option<Vec<[f32; 3]>>,
+) -> Result<crate::method::Dump, crate::Error> {
+    let samples = samples.ok_or_else(|| crate::Error::InvalidSettings(format!("no VO sample set of {count}")))?;
+    let mut dump = crate::method::Dump::default();
+    dump.params(serde_json::json!({
+        "samples": count,
+        "radius_world": vo.radius_world,
+        "normal_clamp": vo.normal_clamp,
+        "thickness": vo.thickness_world,
+        "noise_seed": vo.noise_seed,
+    }));
+    if let Some(r2) = vo.radius2_world {
+        dump.params(serde_json::json!({"radius2_world": r2, "combine": vo.combine.name()}));
+    }
+    dump.array("vo_samples", &[count as u64, 3], samples.into_iter().flatten().collect());
+    dump.array("vo_noise", &[4, 4, 2], noise::vo_noise(vo.noise_seed).into_iter().flatten().collect());
+    Ok(dump)
 }
 
 #[cfg(test)]
