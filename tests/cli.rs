@@ -68,13 +68,22 @@ fn exit_codes() {
     let png = dir.join("x.png");
     let png = png.to_str().unwrap();
     for (bad, needle) in [
-        (&["render", "--line-width", "0", "-o", png][..], "line width"),
-        (&["render", "--debug-view", "level:3", "-o", png], "debug level 3"),
+        (&["render", "--line-width", "0", "-o", png][..], "--line-width must be in (0, 256] px, got 0"),
+        (
+            &["render", "--debug-view", "level:3", "-o", png],
+            "--debug-view must be a level of the pyramid's: level:0 to level:1, got level:3",
+        ),
         (&["render", "--eye", "0,0,0", "--target", "0,0,0", "-o", png], "coincide"),
         (&["render", "--method", "ssao", "--ssao-kernel", "sphere", "--samples", "10", "-o", png], "sphere kernel"),
-        (&["render", "--variant", "reference", "--outer", "level", "-o", png], "outer = level"),
+        (
+            &["render", "--variant", "reference", "--outer", "level", "-o", png],
+            "--outer does not go with --variant: outer = level applies",
+        ),
         (&["render", "--surface", "/nonexistent/hull.obj", "-o", png], "/nonexistent/hull.obj"),
-        (&["render", "--geometry", "tubes", "--tube-radius=-1", "-o", png], "tube radius"),
+        (
+            &["render", "--geometry", "tubes", "--tube-radius=-1", "-o", png],
+            "--tube-radius must be > 0 world units, got -1",
+        ),
         (
             &["render", "--vertices", "2000", "--width", "64", "--height", "64", "-o", "/nonexistent/dir/x.png"],
             "/nonexistent/dir/x.png",
@@ -688,7 +697,7 @@ fn render_and_dump_let_an_outside_tool_recompute_object_space_ao() {
     }
     let out = lineao(&["render", "--method", "sweep", "--sweep-alpha", "0", "-o", "/tmp/lineao-never.png"]);
     assert_eq!(out.status.code(), Some(1), "{}", stderr(&out));
-    assert!(stderr(&out).contains("opacity"), "{}", stderr(&out));
+    assert!(stderr(&out).contains("--sweep-alpha must be in (0, 1], got 0"), "{}", stderr(&out));
 }
 
 /// `--surface` with the shared glTF sample's triangles, and `--geometry tubes`: one image each.

@@ -505,7 +505,10 @@ fn draw(
         let depth = prepass.and_then(ViewPrepassTextures::depth_only_view);
         let normals = prepass.and_then(ViewPrepassTextures::normal_view);
         let result = match depth {
-            None => Err(lineao::Error::Usage("no prepass depth this frame: add DepthPrepass to the camera".into())),
+            None => Err(lineao::Error::Usage(lineao::Misuse::Missing {
+                input: "the prepass depth",
+                fix: "add DepthPrepass to the camera",
+            })),
             Some(depth) => {
                 let normals = config.normals.and(normals.map(|n| &**n));
                 let inputs = HostInputs { depth, normals, color: Some(target.main_texture_view()) };

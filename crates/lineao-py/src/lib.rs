@@ -440,7 +440,7 @@ fn render_error(e: anyhow::Error) -> PyErr {
     if e.chain().any(|c| {
         matches!(
             c.downcast_ref::<lineao::Error>(),
-            Some(lineao::Error::InvalidSettings(_) | lineao::Error::OutOfRange { .. })
+            Some(lineao::Error::Conflict { .. } | lineao::Error::OutOfRange { .. })
         )
     }) {
         PyValueError::new_err(text)

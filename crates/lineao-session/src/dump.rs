@@ -129,7 +129,7 @@ pub fn write(
     );
     if let Some(stage) = chain.stage() {
         // The method's keys and tables, from its folder.
-        let dump = stage.dump(&gpu.device, &gpu.queue, s, view)?;
+        let dump = stage.dump(gpu, s, view)?;
         params.as_object_mut().context("params.json is an object")?.extend(dump.params);
         for (name, shape, values) in &dump.arrays {
             write_npy(dir, &format!("{name}.npy"), shape, values)?;

@@ -172,13 +172,14 @@ fn panels(args: &RenderArgs, zoom_unit: f32, sky: Sky, longest_side: f32) -> Vec
     }
     let methods = grid_methods();
     let mut all: Vec<Panel> = methods.iter().copied().map(panel).collect();
-    // The third tile: the first method's other form (LineAO as the authors' code computes it,
-    // next to the paper's).
-    if let Some((&first, variant)) = methods.first().and_then(|m| Some((m, m.screen.info().variant.as_ref()?))) {
-        let shown = first.screen.info().variant_of(&all[0].settings).is_some();
+    // After the first method with a variant, its other form (LineAO as the authors' code
+    // computes it, next to the paper's: the third tile).
+    let with_variant = methods.iter().enumerate().find_map(|(i, m)| Some((i, *m, m.screen.info().variant.as_ref()?)));
+    if let Some((i, method, variant)) = with_variant {
+        let shown = method.screen.info().variant_of(&all[i].settings).is_some();
         let mut other = args.clone();
         other.methods.give(variant.setting, Value::Choice(if shown { variant.main } else { variant.value }));
-        all.insert(2, Panel::new(first, settings(&other, first, zoom_unit, sky, longest_side)));
+        all.insert(i + 1, Panel::new(method, settings(&other, method, zoom_unit, sky, longest_side)));
     }
     all
 }

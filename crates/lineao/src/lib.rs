@@ -189,20 +189,29 @@ pub enum Error {
     #[error("the GPU adapter refused a device: {0}")]
     /// The adapter refused a device; the driver's message.
     RequestDevice(String),
-    #[error("invalid settings: {0}")]
-    /// Settings that do not go together, said in words.
-    InvalidSettings(String),
-    /// A method's setting outside its range ([`method::setting::Setting`]): its flag (without
-    /// the dashes), the value and what it takes, in its unit (`[0.25, 4] zoom units`, `> 0
-    /// world units`, `5, 7 or 9`) — what a host matches on to say which setting to change.
-    #[error("invalid settings: --{setting} must be {}{expected}, got {value}", if expected.starts_with(['[', '(']) || expected.contains("..=") { "in " } else { "" })]
+    /// A setting outside its range: its flag (without the dashes), or the field of a type that
+    /// has no flag (`HostConfig::depth_samples`), the value and what it takes, in its unit
+    /// (`[0.25, 4] zoom units`, `> 0 world units`, `5, 7 or 9`) — what a host matches on to say
+    /// which setting to change.
+    #[error("invalid settings: {} must be {}{expected}, got {value}", flag(setting), if expected.starts_with(['[', '(']) || expected.contains("..=") { "in " } else { "" })]
     OutOfRange {
-        /// The setting's flag, without the dashes (`ssao-radius`).
+        /// The setting's flag, without the dashes (`ssao-radius`), or its type's field.
         setting: &'static str,
         /// The value given.
         value: String,
         /// What it takes, in its unit.
         expected: String,
+    },
+    /// Two settings that do not go together: the one that cannot be used, the other that
+    /// rules it out (flags, as [`Error::OutOfRange`]'s), and why.
+    #[error("invalid settings: {} does not go with {}: {why}", flag(setting), flag(with))]
+    Conflict {
+        /// The setting that cannot be used (`outer`).
+        setting: &'static str,
+        /// The setting that rules it out (`variant`).
+        with: &'static str,
+        /// Why, in words.
+        why: &'static str,
     },
     #[error("invalid line geometry: {0}")]
     /// A line geometry that cannot be made (offsets out of order, points that are not finite).
@@ -242,7 +251,95 @@ pub enum Error {
     /// rendered or accumulated stops; a new device starts again.
     #[error("the GPU device was lost: {0}")]
     DeviceLost(String),
-    /// A call out of order, or a host texture that does not fit: the text says what to change.
+    /// A call out of order, or a host's texture or input that does not fit: which, and what to
+    /// change.
     #[error("wrong use of lineao: {0}")]
-    Usage(String),
+    Usage(Misuse),
+}
+
+impl Error {
+    /// [`Error::OutOfRange`]: `setting` took `value`, and takes `expected`.
+    pub(crate) fn out_of_range(setting: &'static str, value: impl std::fmt::Display, expected: &str) -> Error {
+        Error::OutOfRange { setting, value: value.to_string(), expected: expected.to_string() }
+    }
+}
+
+/// A setting's name as an error shows it: a flag with its dashes, a type's field as it is.
+fn flag(setting: &str) -> String {
+    if setting.contains("::") { setting.to_string() } else { format!("--{setting}") }
+}
+
+/// How a host used lineao wrongly ([`Error::Usage`]): what a host matches on, each saying what
+/// to change.
+#[derive(Debug, thiserror::Error)]
+pub enum Misuse {
+    /// A call before the one it needs first (`AoChain::encode` before `AoChain::prepare`).
+    #[error("{call} before {first}: call {first} first")]
+    Order {
+        /// What was called.
+        call: &'static str,
+        /// What must be called first.
+        first: &'static str,
+    },
+    /// A texture without a usage it needs.
+    #[error("{texture} lacks TextureUsages::{usage:?} (has {has:?}): add it where the texture is created")]
+    TextureUsage {
+        /// Which texture (`the composite's target`).
+        texture: String,
+        /// The usage it needs.
+        usage: wgpu::TextureUsages,
+        /// The usages it has.
+        has: wgpu::TextureUsages,
+    },
+    /// A texture of a format or sample count the call cannot take.
+    #[error("{texture} is {format:?} with {samples} samples; it must be {expected}")]
+    TextureFormat {
+        /// Which texture.
+        texture: String,
+        /// Its format.
+        format: wgpu::TextureFormat,
+        /// Its samples per pixel.
+        samples: u32,
+        /// What it must be.
+        expected: String,
+    },
+    /// A texture or a view of another size than the chain's.
+    #[error("{texture} is {}×{} but the chain is {}×{}: call AoChain::resize with the host's size", size.0, size.1, chain.0, chain.1)]
+    Size {
+        /// Which texture or view.
+        texture: String,
+        /// Its size.
+        size: (u32, u32),
+        /// The chain's visible size.
+        chain: (u32, u32),
+    },
+    /// A tile that does not lie inside its picture.
+    #[error("a {}×{} tile at ({}, {}) lies outside its {}×{} picture: resize the chain to the tile first", size.0, size.1, tile.origin[0], tile.origin[1], tile.picture[0], tile.picture[1])]
+    TileOutside {
+        /// The chain's size.
+        size: (u32, u32),
+        /// The tile.
+        tile: Tile,
+    },
+    /// Something the call needs that is not there (the prepass depth of a Bevy camera).
+    #[error("{input} is missing: {fix}")]
+    Missing {
+        /// What is missing.
+        input: &'static str,
+        /// What to change.
+        fix: &'static str,
+    },
+    /// An input passed that the configuration says is absent (`given`), or missing where it
+    /// says it is there.
+    #[error("{input} was {} but {config} says {}: {fix}", if *given { "passed" } else { "not passed" }, if *given { "none" } else { "there is one" })]
+    Input {
+        /// The input (`the overlay's depth`, `HostInputs::normals`).
+        input: &'static str,
+        /// Whether it was passed.
+        given: bool,
+        /// What says otherwise (`OverlayAo::set_depth`, `HostConfig::normals`).
+        config: &'static str,
+        /// What to change.
+        fix: &'static str,
+    },
 }

@@ -118,7 +118,7 @@ impl RayScene {
         max_width: u32,
     ) -> Result<RayScene, Error> {
         if !max_width.is_power_of_two() || max_width < 2 {
-            return Err(Error::Usage(format!("max_width must be a power of two ≥ 2, got {max_width}")));
+            return Err(Error::out_of_range("RayScene::max_width", max_width, "a power of two ≥ 2"));
         }
         let limits = Limits { max_width, max_layers: device.limits().max_texture_array_layers };
         let vertex_count = geometry.positions.len() + geometry.meshes.iter().map(|m| m.0.len()).sum::<usize>();

@@ -60,12 +60,11 @@ impl Default for BilateralSettings {
 impl BilateralSettings {
     /// Checks every range documented above.
     pub fn validate(&self) -> Result<(), crate::Error> {
-        let bad = |what: String| Err(crate::Error::InvalidSettings(what));
         if !(1..=16).contains(&self.radius_px) {
-            return bad(format!("the blur radius must be in 1..=16 px, got {}", self.radius_px));
+            return Err(crate::Error::out_of_range("bilateral-radius", self.radius_px, "1..=16 px"));
         }
         if !(self.depth_sigma_world.is_finite() && self.depth_sigma_world > 0.0) {
-            return bad(format!("the blur's depth sigma must be > 0, got {}", self.depth_sigma_world));
+            return Err(crate::Error::out_of_range("bilateral-sigma", self.depth_sigma_world, "> 0 world units"));
         }
         Ok(())
     }
@@ -186,16 +185,15 @@ impl TransparencySettings {
 
     /// Checks the ranges above, naming each setting.
     pub fn validate(&self) -> Result<(), crate::Error> {
-        let bad = |what: String| Err(crate::Error::InvalidSettings(what));
         if !(self.alpha > 0.0 && self.alpha <= 1.0) {
-            return bad(format!("alpha must be in (0, 1], got {}", self.alpha));
+            return Err(crate::Error::out_of_range("alpha", self.alpha, "(0, 1]"));
         }
         if !(0.0..=1.0).contains(&self.context_alpha) {
-            return bad(format!("context alpha must be in [0, 1], got {}", self.context_alpha));
+            return Err(crate::Error::out_of_range("context-alpha", self.context_alpha, "[0, 1]"));
         }
         if !Self::LAYERS.contains(&self.layers) {
             let (lo, hi) = (Self::LAYERS.start(), Self::LAYERS.end());
-            return bad(format!("layers must be in {lo}..={hi}, got {}", self.layers));
+            return Err(crate::Error::out_of_range("layers", self.layers, &format!("{lo}..={hi}")));
         }
         Ok(())
     }
@@ -497,54 +495,59 @@ impl ChainSettings {
     /// Checks every range documented above but the methods' own settings' (which
     /// [`ChainSettings::validate`] checks after these).
     pub(crate) fn validate_chain(&self) -> Result<(), crate::Error> {
-        let bad = |what: String| Err(crate::Error::InvalidSettings(what));
         if let Some(blur) = &self.blur {
             blur.validate()?;
         }
         if !(self.line_width_px.is_finite() && self.line_width_px > 0.0 && self.line_width_px <= 256.0) {
-            return bad(format!("line width must be in (0, 256] px, got {}", self.line_width_px));
+            return Err(crate::Error::out_of_range("line-width", self.line_width_px, "(0, 256] px"));
         }
         if let Some(tubes) = &self.tubes
             && !(tubes.radius_world.is_finite() && tubes.radius_world > 0.0)
         {
-            return bad(format!("the tube radius must be > 0 world units, got {}", tubes.radius_world));
+            return Err(crate::Error::out_of_range("tube-radius", tubes.radius_world, "> 0 world units"));
         }
         if let Some(volume) = &self.volume
             && !volume.sky.iter().all(|w| (0.0..=1.0).contains(w))
         {
-            return bad(format!("sky intensities must be in [0, 1], got {:?}", volume.sky));
+            return Err(crate::Error::out_of_range("sky", format!("{:?}", volume.sky), "intensities in [0, 1]"));
         }
         if !(self.strength.is_finite() && self.strength >= 0.0) {
-            return bad(format!("strength must be >= 0, got {}", self.strength));
+            return Err(crate::Error::out_of_range("strength", self.strength, "≥ 0"));
         }
         if !(self.zoom_unit.is_finite() && self.zoom_unit > 0.0) {
-            return bad(format!("zoom unit must be > 0, got {}", self.zoom_unit));
+            return Err(crate::Error::out_of_range("zoom-unit", self.zoom_unit, "> 0"));
         }
         if self.lighting.lights.len() > crate::lighting::MAX_LIGHTS {
-            return bad(format!("at most {} lights, got {}", crate::lighting::MAX_LIGHTS, self.lighting.lights.len()));
+            return Err(crate::Error::out_of_range(
+                "ChainSettings::lighting",
+                format!("{} lights", self.lighting.lights.len()),
+                &format!("at most {} lights", crate::lighting::MAX_LIGHTS),
+            ));
         }
         if let Some(slab) = &self.slab
             && !(slab.center.is_finite() && slab.thickness.is_finite() && slab.thickness > 0.0)
         {
-            return bad(format!(
-                "a slab needs a finite centre and a thickness > 0, got centre {} and thickness {}",
-                slab.center, slab.thickness
+            return Err(crate::Error::out_of_range(
+                "slab",
+                format!("centre {} and thickness {}", slab.center, slab.thickness),
+                "a finite centre and a thickness > 0",
             ));
         }
         if let Some(transparency) = &self.transparency {
             transparency.validate()?;
             if transparency.any() && self.tubes.is_some() {
-                return bad("transparency draws lines: tubes are opaque only".into());
+                let why = "transparency draws lines: tubes are opaque only";
+                return Err(crate::Error::Conflict { setting: "alpha", with: "geometry", why });
             }
         }
         if let Some(slices) = &self.slices {
             if let Some(p) = slices.positions.iter().flatten().find(|p| !p.is_finite()) {
-                return bad(format!("slice positions must be finite, got {p}"));
+                return Err(crate::Error::out_of_range("slices", p, "finite positions"));
             }
             if let Some([lo, hi]) = slices.window
                 && !(lo.is_finite() && hi.is_finite() && lo < hi)
             {
-                return bad(format!("a slice window needs finite min < max, got {lo}, {hi}"));
+                return Err(crate::Error::out_of_range("window", format!("{lo}, {hi}"), "finite min < max"));
             }
         }
         Ok(())

@@ -77,8 +77,8 @@ fn the_result_does_not_depend_on_the_thread_count() {
 fn bad_input_is_a_clear_error() {
     let line = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]];
     for (positions, offsets, opts, needle) in [
-        (&line[..], &[0u64, 2][..], options(64, 0.0, 0), "occupancy radius"),
-        (&line, &[0, 2], options(64, f32::NAN, 0), "occupancy radius"),
+        (&line[..], &[0u64, 2][..], options(64, 0.0, 0), "--occupancy-radius must be > 0 world units"),
+        (&line, &[0, 2], options(64, f32::NAN, 0), "--occupancy-radius must be > 0 world units"),
         (&line, &[0, 2], options(4, 1.0, 0), "resolution"),
         (&line, &[0, 3], options(64, 1.0, 0), "streamline 0"),
         (&[], &[0], options(64, 1.0, 0), "no finite points"),

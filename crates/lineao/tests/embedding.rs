@@ -7,13 +7,14 @@ mod common;
 
 use common::{cameras_for_polylines, gpu, host_depth, is_geometry, polylines, sphere_triangles, texture};
 use glam::{Mat4, Vec3, Vec4Swizzles};
+use lineao::Error::Usage;
 use lineao::LineGeometry;
 use lineao::passes::nd_from_depth::{HostConfig, HostInputs, HostNormals};
 use lineao::readback::{read_f32, read_rgba};
 use lineao::reference::tubes::pixel_ray;
 use lineao::reference::{Image, NdImage};
 use lineao::{AoChain, AoMethod, ChainSettings, HostAo, OverlayAo, TubeSettings};
-use lineao::{Bounds, Camera, FrameView, Projection};
+use lineao::{Bounds, Camera, FrameView, Misuse, Projection};
 
 /// What the host path leaves in the chain's targets.
 struct HostFrame {
@@ -321,7 +322,10 @@ fn host_api_misuse_is_an_error_that_says_what_to_change() {
     let output = texture(&gpu, size, common::OUTPUT_FORMAT, U::RENDER_ATTACHMENT, 1);
     let inputs = HostInputs { depth: &depth, normals: None, color: Some(&color) };
     let expect = |result: Result<(), lineao::Error>, says: &str| match result {
-        Err(lineao::Error::Usage(text)) => assert!(text.contains(says), "{text:?} should say {says:?}"),
+        Err(lineao::Error::Usage(misuse)) => {
+            let text = misuse.to_string();
+            assert!(text.contains(says), "{text:?} should say {says:?}")
+        }
         other => panic!("expected a usage error saying {says:?}, got {other:?}"),
     };
 
@@ -335,7 +339,8 @@ fn host_api_misuse_is_an_error_that_says_what_to_change() {
     // A sample count no texture has (an encode before making a HostAo cannot be written).
     let no_samples = HostConfig { depth_samples: 0, ..HostConfig::default() };
     let refused = HostAo::new(d, AoChain::new(d, common::OUTPUT_FORMAT, ChainSettings::default()).unwrap(), no_samples);
-    assert!(matches!(&refused, Err(lineao::Error::InvalidSettings(t)) if t.contains("1..=32")), "{:?}", refused.err());
+    let names_it = |e: &lineao::Error| matches!(e, lineao::Error::OutOfRange { setting: "HostConfig::depth_samples", value, .. } if value == "0");
+    assert!(refused.as_ref().err().is_some_and(names_it), "{:?}", refused.err());
     let mut host = pollster::block_on(HostAo::new_async(d, chain, HostConfig::default())).unwrap();
     expect(host.encode(d, &mut encoder, &inputs, None), "HostAo::prepare");
     expect(host.prepare(d, q, view((32, 32))).map(|_| ()), "resize");
@@ -352,8 +357,8 @@ fn host_api_misuse_is_an_error_that_says_what_to_change() {
         (with(&unsampled, None, None), "TEXTURE_BINDING"),
         (with(&multisampled, None, None), "depth_samples"),
         (with(&small, None, None), "AoChain::resize"),
-        (with(&not_depth, None, None), "not a depth format"),
-        (with(&depth, Some(&color), None), "HostConfig::normals is None"),
+        (with(&not_depth, None, None), "must be a depth format"),
+        (with(&depth, Some(&color), None), "HostInputs::normals was passed but HostConfig::normals says none"),
         (with(&depth, None, Some(&uint_color)), "float or unorm"),
         (with(&depth, None, Some(&small_color)), "32×32"),
     ] {
@@ -363,7 +368,7 @@ fn host_api_misuse_is_an_error_that_says_what_to_change() {
     let normals =
         HostConfig { normals: Some(HostNormals { world_space: false, unorm: true }), ..HostConfig::default() };
     host.set_config(d, normals).unwrap();
-    expect(host.encode(d, &mut encoder, &with(&depth, None, None), None), "HostInputs::normals is None");
+    expect(host.encode(d, &mut encoder, &with(&depth, None, None), None), "HostInputs::normals was not passed");
     pollster::block_on(host.set_config_async(d, HostConfig::default())).unwrap();
 
     // The composite's target: its format, its size, its usage.
@@ -477,12 +482,13 @@ fn the_overlay_keeps_the_hosts_frame_and_writes_its_depth() {
     let output = lineao::targets::Target::output(d, "test::output", size, common::OUTPUT_FORMAT);
     let mut encoder = d.create_command_encoder(&Default::default());
     let result = overlay.encode(&mut encoder, &geometry, &[], &output.view, Some(&other));
-    assert!(matches!(&result, Err(lineao::Error::Usage(t)) if t.contains("Depth24Plus")), "{result:?}");
+    let format = wgpu::TextureFormat::Depth24Plus;
+    assert!(matches!(&result, Err(Usage(Misuse::TextureFormat { format: f, .. })) if *f == format), "{result:?}");
     let result = overlay.encode(&mut encoder, &geometry, &[], &output.view, None);
-    assert!(matches!(&result, Err(lineao::Error::Usage(t)) if t.contains("got none")), "{result:?}");
+    assert!(matches!(&result, Err(Usage(Misuse::Input { given: false, .. }))), "{result:?}");
     overlay.set_depth(d, None).unwrap();
     let result = overlay.encode(&mut encoder, &geometry, &[], &output.view, Some(&other));
-    assert!(matches!(&result, Err(lineao::Error::Usage(t)) if t.contains("without one")), "{result:?}");
+    assert!(matches!(&result, Err(Usage(Misuse::Input { given: true, .. }))), "{result:?}");
     let bad = lineao::OverlayDepth { format: wgpu::TextureFormat::Rgba8Unorm, proj: standard };
     assert!(matches!(overlay.set_depth(d, Some(bad)), Err(lineao::Error::Usage(_))));
     let fresh = AoChain::new(d, common::OUTPUT_FORMAT, ChainSettings::default()).unwrap();
@@ -493,14 +499,16 @@ fn the_overlay_keeps_the_hosts_frame_and_writes_its_depth() {
     let mut chain = AoChain::new(d, common::OUTPUT_FORMAT, ChainSettings::default()).unwrap();
     chain.resize(size.0, size.1).unwrap();
     let result = chain.encode(&mut encoder, &geometry, &output.view);
-    assert!(matches!(&result, Err(lineao::Error::Usage(t)) if t.contains("before AoChain::prepare")), "{result:?}");
+    let order = Misuse::Order { call: "AoChain::encode", first: "AoChain::prepare" };
+    assert!(matches!(&result, Err(Usage(m)) if m.to_string() == order.to_string()), "{result:?}");
     chain.prepare(d, q, &camera, &bounds).unwrap();
     let small = lineao::targets::Target::output(d, "test::small", (size.0 / 2, size.1), common::OUTPUT_FORMAT);
     let result = chain.encode(&mut encoder, &geometry, &small.view);
-    assert!(matches!(&result, Err(lineao::Error::Usage(_))), "{result:?}");
+    assert!(matches!(&result, Err(Usage(Misuse::Size { size, chain, .. })) if size != chain), "{result:?}");
     let float = lineao::targets::Target::output(d, "test::float", size, wgpu::TextureFormat::Rgba16Float);
     let result = chain.encode(&mut encoder, &geometry, &float.view);
-    assert!(matches!(&result, Err(lineao::Error::Usage(t)) if t.contains("Rgba16Float")), "{result:?}");
+    let float = wgpu::TextureFormat::Rgba16Float;
+    assert!(matches!(&result, Err(Usage(Misuse::TextureFormat { format, .. })) if *format == float), "{result:?}");
     chain.encode(&mut encoder, &geometry, &output.view).unwrap();
     chain.resize(0, 0).unwrap();
     chain.encode(&mut encoder, &geometry, &small.view).unwrap();

@@ -153,76 +153,31 @@ fn lines_accumulate_to_the_cpu_truth_with_the_same_rays_and_restart_when_the_cam
     let scene = Scene::lines(60);
     let mut tracer = Tracer::new(&scene, settings(4), None);
     let (nd, first) = tracer.frame(&camera());
-    assert_eq!(
-        tracer
-            .chain
-            .stage()
-            .and_then(|s| s.downcast::<lineao::method::raytraced::RayTracedAo>())
-            .map(|t| t.progress())
-            .unwrap()
-            .rays_per_pixel,
-        4
-    );
+    assert_eq!(progress(&tracer.chain).rays_per_pixel, 4);
     assert_same_hits(&nd, &first, &cpu_truth(&tracer, &scene, &nd, 4), 4, "lines, 1 frame × 4");
     // Two more frames: rays 4..12 continue the same sequence.
     tracer.frame(&camera());
     let (nd, third) = tracer.frame(&camera());
-    assert_eq!(
-        tracer
-            .chain
-            .stage()
-            .and_then(|s| s.downcast::<lineao::method::raytraced::RayTracedAo>())
-            .map(|t| t.progress())
-            .unwrap()
-            .rays_per_pixel,
-        12
-    );
+    assert_eq!(progress(&tracer.chain).rays_per_pixel, 12);
     assert_same_hits(&nd, &third, &cpu_truth(&tracer, &scene, &nd, 12), 12, "lines, 3 frames × 4");
     // More rays per frame continue the picture: rays 12..20, the CPU truth's 20.
     let mut more = tracer.chain.settings().clone();
     more.raytraced.rays_per_frame = 8;
     tracer.chain.set_settings(&tracer.gpu.device, more).unwrap();
     let (nd, fourth) = tracer.frame(&camera());
-    assert_eq!(
-        tracer
-            .chain
-            .stage()
-            .and_then(|s| s.downcast::<lineao::method::raytraced::RayTracedAo>())
-            .map(|t| t.progress())
-            .unwrap()
-            .rays_per_pixel,
-        20
-    );
+    assert_eq!(progress(&tracer.chain).rays_per_pixel, 20);
     assert_same_hits(&nd, &fourth, &cpu_truth(&tracer, &scene, &nd, 20), 20, "lines, 3 frames × 4 + 8");
     // A second encode without a prepare records nothing: the same rays are not added twice.
     let (d, q) = (&tracer.gpu.device, &tracer.gpu.queue);
     let mut encoder = d.create_command_encoder(&Default::default());
     tracer.chain.encode(&mut encoder, &tracer.lines, &tracer.output.view).unwrap();
     q.submit([encoder.finish()]);
-    assert_eq!(
-        tracer
-            .chain
-            .stage()
-            .and_then(|s| s.downcast::<lineao::method::raytraced::RayTracedAo>())
-            .map(|t| t.progress())
-            .unwrap()
-            .rays_per_pixel,
-        20
-    );
+    assert_eq!(progress(&tracer.chain).rays_per_pixel, 20);
     assert_eq!(read_f32(d, q, &tracer.chain.targets().unwrap().ao).unwrap().data, fourth.data);
     // The camera moves: the count starts again, and the picture is the new view's first 8 rays.
     let moved = Camera { eye: Vec3::new(-60.0, 20.0, 120.0), ..camera() };
     let (nd, restarted) = tracer.frame(&moved);
-    assert_eq!(
-        tracer
-            .chain
-            .stage()
-            .and_then(|s| s.downcast::<lineao::method::raytraced::RayTracedAo>())
-            .map(|t| t.progress())
-            .unwrap()
-            .rays_per_pixel,
-        8
-    );
+    assert_eq!(progress(&tracer.chain).rays_per_pixel, 8);
     assert_same_hits(&nd, &restarted, &cpu_truth(&tracer, &scene, &nd, 8), 8, "lines, moved");
 }
 
@@ -251,25 +206,11 @@ fn an_orthographic_view_with_a_mesh_matches_and_the_cap_stops_tracing() {
     tracer.frame(&orthographic);
     // The cap: the second frame traces the 2 rays left, the third none and keeps the picture.
     let (nd, capped) = tracer.frame(&orthographic);
-    let progress = tracer
-        .chain
-        .stage()
-        .and_then(|s| s.downcast::<lineao::method::raytraced::RayTracedAo>())
-        .map(|t| t.progress())
-        .unwrap();
-    assert_eq!((progress.rays_per_pixel, progress.frame_rays, progress.converged()), (6, 2, true));
+    let capped_at = progress(&tracer.chain);
+    assert_eq!((capped_at.rays_per_pixel, capped_at.frame_rays, capped_at.converged()), (6, 2, true));
     assert_same_hits(&nd, &capped, &cpu_truth(&tracer, &scene, &nd, 6), 6, "orthographic + mesh, capped at 6");
     let (_, after) = tracer.frame(&orthographic);
-    assert_eq!(
-        tracer
-            .chain
-            .stage()
-            .and_then(|s| s.downcast::<lineao::method::raytraced::RayTracedAo>())
-            .map(|t| t.progress())
-            .unwrap()
-            .frame_rays,
-        0
-    );
+    assert_eq!(progress(&tracer.chain).frame_rays, 0);
     assert_eq!(after.data, capped.data);
 }
 
@@ -340,7 +281,10 @@ fn a_scene_beyond_the_adapters_texture_arrays_is_too_large_and_no_scene_is_no_oc
         }
         other => panic!("expected TooLarge, got {:?}", other.map(|s| s.bytes())),
     }
-    assert!(matches!(RayScene::with_max_width(d, q, &geometry, 3), Err(lineao::Error::Usage(_))));
+    assert!(matches!(
+        RayScene::with_max_width(d, q, &geometry, 3),
+        Err(lineao::Error::OutOfRange { setting: "RayScene::max_width", .. })
+    ));
     // An empty scene uploads (a texel per texture) and hits nothing.
     let empty = RayScene::new(d, q, &RayGeometry::default()).unwrap();
     assert!(empty.is_empty());
@@ -424,15 +368,7 @@ fn a_host_renderers_depth_traces_like_the_cpu_truth_through_the_embedding_api() 
         q.submit([encoder.finish()]);
     }
     let chain = host.chain();
-    assert_eq!(
-        chain
-            .stage()
-            .and_then(|s| s.downcast::<lineao::method::raytraced::RayTracedAo>())
-            .map(|t| t.progress())
-            .unwrap()
-            .rays_per_pixel,
-        16
-    );
+    assert_eq!(progress(chain).rays_per_pixel, 16);
     let t = chain.targets().unwrap();
     let (nd, ao) = (read_rgba(d, q, &t.nd[0]).unwrap(), read_f32(d, q, &t.ao).unwrap());
 
@@ -612,4 +548,9 @@ fn with_cpu_truths(check: impl FnOnce(&NdImage, &dyn Fn(&truth::TruthSettings) -
     let frame = truth::Frame { nd: &nd, view, lines: true };
     let cancel = std::sync::atomic::AtomicBool::new(false);
     check(&nd, &|s| truth::compute(&bvh, &frame, s, &|_, _| {}, &cancel).unwrap());
+}
+
+/// How far the chain's ray tracer has come.
+fn progress(chain: &AoChain) -> lineao::method::raytraced::RayProgress {
+    chain.stage().and_then(|s| s.downcast::<lineao::method::raytraced::RayTracedAo>()).unwrap().progress()
 }

@@ -56,7 +56,7 @@ pub struct HostAo {
 
 impl HostAo {
     /// `chain` made ready for a host's buffers: their depth's samples and convention and whether
-    /// they have normals. A sample count outside 1..=32 is an [`Error::InvalidSettings`]. Blocks
+    /// they have normals. A sample count outside 1..=32 is an [`Error::OutOfRange`]. Blocks
     /// on wgpu's validation answer as [`AoChain::new`] does; [`HostAo::new_async`] awaits it.
     pub fn new(device: &wgpu::Device, chain: AoChain, config: HostConfig) -> Result<HostAo, Error> {
         pollster::block_on(Self::new_async(device, chain, config))
@@ -69,10 +69,7 @@ impl HostAo {
 
     async fn pass(device: &wgpu::Device, config: HostConfig) -> Result<NdFromDepth, Error> {
         if config.depth_samples == 0 || config.depth_samples > 32 {
-            return Err(Error::InvalidSettings(format!(
-                "depth samples must be in 1..=32, got {}",
-                config.depth_samples
-            )));
+            return Err(Error::out_of_range("HostConfig::depth_samples", config.depth_samples, "1..=32"));
         }
         crate::gpu::validated_async(device, "creating the host pass", || NdFromDepth::new(device, config)).await
     }
@@ -142,9 +139,7 @@ impl HostAo {
             return Ok(());
         }
         if chain.targets.is_none() || chain.view.is_none() {
-            return Err(Error::Usage(
-                "HostAo::encode before HostAo::prepare: prepare with the frame's matrices first".into(),
-            ));
+            return Err(Error::Usage(crate::Misuse::Order { call: "HostAo::encode", first: "HostAo::prepare" }));
         }
         nd_from_depth::check_inputs(&self.pass.config(), inputs, chain.size)?;
         if let Some(target) = target {

@@ -49,7 +49,6 @@ mod overlay;
 
 use std::sync::Arc;
 
-use crate::Error;
 use crate::LineGeometry;
 use crate::camera::{self, Bounds, Camera, FrameView, Tile};
 use crate::gbuffer::{self, Load};
@@ -72,6 +71,7 @@ use crate::stage::Stages;
 use crate::targets::FrameTargets;
 use crate::timing::{PassTime, PassTimer, Span};
 use crate::{DebugView, LineColor};
+use crate::{Error, Misuse};
 
 pub use host::HostAo;
 pub use overlay::OverlayAo;
@@ -153,9 +153,12 @@ impl AoChain {
     ) -> Result<AoChain, Error> {
         settings.validate()?;
         if format.is_depth_stencil_format() {
-            return Err(Error::Usage(format!(
-                "AoChain::new takes the color format the composite writes, not the depth's ({format:?})"
-            )));
+            return Err(Error::Usage(Misuse::TextureFormat {
+                texture: "AoChain::new's format".into(),
+                format,
+                samples: 1,
+                expected: "the colour format the composite writes, not the depth's".into(),
+            }));
         }
         if settings.transparent().is_some() {
             transparency::check_format(device, format)?;
@@ -375,10 +378,7 @@ impl AoChain {
             let (w, h) = self.size;
             let fits = |origin: u32, size: u32, picture: u32| origin as u64 + size as u64 <= picture as u64;
             if !fits(t.origin[0], w, t.picture[0]) || !fits(t.origin[1], h, t.picture[1]) {
-                return Err(Error::Usage(format!(
-                    "a {w}×{h} tile at ({}, {}) lies outside its {}×{} picture: resize the chain to the tile first",
-                    t.origin[0], t.origin[1], t.picture[0], t.picture[1]
-                )));
+                return Err(Error::Usage(Misuse::TileOutside { size: (w, h), tile: t }));
             }
         }
         self.tile = tile;
@@ -458,10 +458,11 @@ impl AoChain {
         let (width, height) = self.size;
         if (view.width, view.height) != (width, height) {
             self.view = None;
-            return Err(Error::Usage(format!(
-                "a {}×{} view but the chain is {width}×{height}: resize the chain first",
-                view.width, view.height
-            )));
+            return Err(Error::Usage(Misuse::Size {
+                texture: "the view".into(),
+                size: (view.width, view.height),
+                chain: (width, height),
+            }));
         }
         let view = FrameView { zoom_unit: self.settings.zoom_unit, ..view };
         Ok(self.prepare_frame(device, queue, view))
@@ -566,21 +567,26 @@ impl AoChain {
     ) -> Result<(), Error> {
         let (width, height) = self.size;
         if !texture.usage().contains(wgpu::TextureUsages::RENDER_ATTACHMENT) {
-            return Err(Error::Usage(format!("{what} lacks TextureUsages::RENDER_ATTACHMENT")));
+            return Err(Error::Usage(Misuse::TextureUsage {
+                texture: what.into(),
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+                has: texture.usage(),
+            }));
         }
         if texture.format().remove_srgb_suffix() != format.remove_srgb_suffix() || texture.sample_count() != 1 {
-            return Err(Error::Usage(format!(
-                "{what} is {:?} with {} samples; {source} {format:?}, 1 sample",
-                texture.format(),
-                texture.sample_count(),
-            )));
+            return Err(Error::Usage(Misuse::TextureFormat {
+                texture: what.into(),
+                format: texture.format(),
+                samples: texture.sample_count(),
+                expected: format!("{format:?} with 1 sample ({source} it)"),
+            }));
         }
         if (texture.width(), texture.height()) != (width, height) {
-            return Err(Error::Usage(format!(
-                "{what} is {}×{} but the chain is {width}×{height}: call AoChain::resize with the host's size",
-                texture.width(),
-                texture.height()
-            )));
+            return Err(Error::Usage(Misuse::Size {
+                texture: what.into(),
+                size: (texture.width(), texture.height()),
+                chain: (width, height),
+            }));
         }
         Ok(())
     }
@@ -610,7 +616,7 @@ impl AoChain {
             return Ok(());
         }
         if self.targets.is_none() || self.view.is_none() {
-            return Err(Error::Usage("AoChain::encode before AoChain::prepare: prepare the frame first".into()));
+            return Err(Error::Usage(Misuse::Order { call: "AoChain::encode", first: "AoChain::prepare" }));
         }
         self.check_target(target)?;
         self.record(
@@ -725,9 +731,7 @@ impl AoChain {
             return Ok(());
         }
         if self.targets.is_none() || self.view.is_none() {
-            return Err(Error::Usage(
-                "AoChain::encode_composite before AoChain::prepare: prepare the frame first".into(),
-            ));
+            return Err(Error::Usage(Misuse::Order { call: "AoChain::encode_composite", first: "AoChain::prepare" }));
         }
         self.check_target(target)?;
         self.composite.encode(encoder, target, None);

@@ -39,7 +39,12 @@ impl OverlayAo {
         if let Some(d) = depth
             && !d.format.has_depth_aspect()
         {
-            return Err(Error::Usage(format!("the overlay's depth format {:?} is not a depth format", d.format)));
+            return Err(Error::Usage(crate::Misuse::TextureFormat {
+                texture: "the overlay's depth".into(),
+                format: d.format,
+                samples: 1,
+                expected: "a depth format".into(),
+            }));
         }
         self.chain.composite.set_overlay(device, depth);
         match (depth, &self.chain.seed) {
@@ -85,14 +90,20 @@ impl OverlayAo {
         chain.check_target(target)?;
         match (chain.composite.overlay_depth().flatten(), depth) {
             (None, Some(_)) => {
-                return Err(Error::Usage(
-                    "a depth was passed but the overlay was made without one: give OverlayAo::set_depth \
-                     Some(OverlayDepth { format, proj })"
-                        .into(),
-                ));
+                return Err(Error::Usage(crate::Misuse::Input {
+                    input: "a depth",
+                    given: true,
+                    config: "OverlayAo::set_depth",
+                    fix: "give OverlayAo::set_depth Some(OverlayDepth { format, proj })",
+                }));
             }
             (Some(_), None) => {
-                return Err(Error::Usage("the overlay was made with depth but OverlayAo::encode got none".into()));
+                return Err(Error::Usage(crate::Misuse::Input {
+                    input: "the overlay's depth",
+                    given: false,
+                    config: "OverlayAo::set_depth",
+                    fix: "pass OverlayAo::encode the depth, or give OverlayAo::set_depth None",
+                }));
             }
             (Some(config), Some(view)) => chain.check_attachment(
                 "the overlay's depth",

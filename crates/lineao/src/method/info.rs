@@ -139,7 +139,7 @@ pub struct Own<S: 'static> {
     /// Sets `preset`'s values of its own settings; the strength it is shown with.
     pub(crate) preset: fn(Preset, &mut S, &Context) -> f32,
     /// Checks how its values depend on each other (each value's range is its description's),
-    /// an [`Error::InvalidSettings`] naming the one out of range.
+    /// an [`Error::OutOfRange`] naming the one out of range, or an [`Error::Conflict`].
     pub(crate) validate: fn(&S, &Context) -> Result<(), Error>,
     /// The levels of the G-buffer's ND pyramid its stage reads under them (1: the
     /// full-resolution maps alone).
@@ -407,16 +407,10 @@ pub trait Stage: wgpu::WasmNotSendSync + std::any::Any {
     }
     /// What `lineao render --dump` writes of the method beside the G-buffer under `settings`
     /// for the last frame, seen as `view`: docs/reference.md's keys of `params.json` and its
-    /// tables (noise tiles, sample sets, pyramids read back from `device`).
+    /// tables (noise tiles, sample sets, pyramids read back from `gpu`).
     #[cfg(all(feature = "serde", feature = "reference"))]
-    fn dump(
-        &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        settings: &ChainSettings,
-        view: &FrameView,
-    ) -> Result<Dump, Error> {
-        let _ = (device, queue, settings, view);
+    fn dump(&self, gpu: &crate::Gpu, settings: &ChainSettings, view: &FrameView) -> Result<Dump, Error> {
+        let _ = (gpu, settings, view);
         Ok(Dump::default())
     }
 }

@@ -156,8 +156,8 @@ impl ChainSettings {
         if let crate::DebugView::Level(k) = self.debug_view
             && k >= self.levels()
         {
-            let what = format!("debug level {k} does not exist: the pyramid has {} levels", self.levels());
-            return Err(crate::Error::InvalidSettings(what));
+            let expected = format!("a level of the pyramid's: level:0 to level:{}", self.levels() - 1);
+            return Err(crate::Error::out_of_range("debug-view", format!("level:{k}"), &expected));
         }
         Ok(())
     }

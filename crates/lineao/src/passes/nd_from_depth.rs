@@ -29,13 +29,13 @@
 
 use glam::Mat4;
 
-use crate::Error;
 use crate::binding::{self, Slot};
 use crate::camera::FrameView;
 use crate::passes::dispatch_full_screen;
 use crate::readback::LateReadback;
 use crate::targets::{AO_FORMAT, COLOR_FORMAT, FrameTargets, ND_FORMAT, Target};
 use crate::timing::Span;
+use crate::{Error, Misuse};
 
 /// How a host's normals are stored.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -93,28 +93,40 @@ pub struct HostInputs<'a> {
 pub fn check_inputs(config: &HostConfig, inputs: &HostInputs, size: (u32, u32)) -> Result<(), Error> {
     let depth = inputs.depth.texture();
     if !depth.format().has_depth_aspect() {
-        return Err(Error::Usage(format!("the host depth is {:?}, not a depth format", depth.format())));
+        return Err(Error::Usage(Misuse::TextureFormat {
+            texture: "the host depth".into(),
+            format: depth.format(),
+            samples: depth.sample_count(),
+            expected: "a depth format".into(),
+        }));
     }
     if depth.sample_count() != config.depth_samples {
-        return Err(Error::Usage(format!(
-            "the host depth has {} samples per pixel but HostConfig::depth_samples is {}: \
-             make the HostAo with the depth's sample count",
-            depth.sample_count(),
-            config.depth_samples
-        )));
+        return Err(Error::Usage(Misuse::TextureFormat {
+            texture: "the host depth".into(),
+            format: depth.format(),
+            samples: depth.sample_count(),
+            expected: format!(
+                "of HostConfig::depth_samples' {} samples: make the HostAo with the depth's sample count",
+                config.depth_samples
+            ),
+        }));
     }
     match (inputs.normals, config.normals) {
         (Some(_), None) => {
-            return Err(Error::Usage(
-                "normals were passed but HostConfig::normals is None: say how they are stored in \
-                 HostConfig, or pass none (normals then come from the depth)"
-                    .into(),
-            ));
+            return Err(Error::Usage(Misuse::Input {
+                input: "HostInputs::normals",
+                given: true,
+                config: "HostConfig::normals",
+                fix: "say how they are stored in HostConfig, or pass none (normals then come from the depth)",
+            }));
         }
         (None, Some(_)) => {
-            return Err(Error::Usage(
-                "HostConfig::normals says the host has normals but HostInputs::normals is None".into(),
-            ));
+            return Err(Error::Usage(Misuse::Input {
+                input: "HostInputs::normals",
+                given: false,
+                config: "HostConfig::normals",
+                fix: "pass the normals, or set HostConfig::normals to None",
+            }));
         }
         _ => {}
     }
@@ -124,16 +136,20 @@ pub fn check_inputs(config: &HostConfig, inputs: &HostInputs, size: (u32, u32)) 
         let texture = view.texture();
         check_texture(name, texture, size)?;
         if texture.sample_count() != 1 {
-            return Err(Error::Usage(format!(
-                "the host {name} texture has {} samples per pixel; resolve it to one first",
-                texture.sample_count()
-            )));
+            return Err(Error::Usage(Misuse::TextureFormat {
+                texture: format!("the host {name} texture"),
+                format: texture.format(),
+                samples: texture.sample_count(),
+                expected: "of one sample: resolve it first".into(),
+            }));
         }
         if !matches!(texture.format().sample_type(None, None), Some(wgpu::TextureSampleType::Float { .. })) {
-            return Err(Error::Usage(format!(
-                "the host {name} texture is {:?}; it must be a float or unorm color format",
-                texture.format()
-            )));
+            return Err(Error::Usage(Misuse::TextureFormat {
+                texture: format!("the host {name} texture"),
+                format: texture.format(),
+                samples: texture.sample_count(),
+                expected: "a float or unorm color format".into(),
+            }));
         }
     }
     Ok(())
@@ -142,20 +158,18 @@ pub fn check_inputs(config: &HostConfig, inputs: &HostInputs, size: (u32, u32)) 
 /// A host texture the chain reads: sampled, 2D, at the chain's size.
 fn check_texture(name: &str, texture: &wgpu::Texture, (width, height): (u32, u32)) -> Result<(), Error> {
     if !texture.usage().contains(wgpu::TextureUsages::TEXTURE_BINDING) {
-        return Err(Error::Usage(format!(
-            "the host {name} texture lacks TextureUsages::TEXTURE_BINDING (has {:?}); add it where the \
-             host creates the texture",
-            texture.usage()
-        )));
+        return Err(Error::Usage(Misuse::TextureUsage {
+            texture: format!("the host {name} texture"),
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            has: texture.usage(),
+        }));
     }
     if texture.dimension() != wgpu::TextureDimension::D2 || (texture.width(), texture.height()) != (width, height) {
-        return Err(Error::Usage(format!(
-            "the host {name} texture is {}×{} ({:?}) but the chain is {width}×{height}: call \
-             AoChain::resize with the host's size",
-            texture.width(),
-            texture.height(),
-            texture.dimension()
-        )));
+        return Err(Error::Usage(Misuse::Size {
+            texture: format!("the host {name} texture ({:?})", texture.dimension()),
+            size: (texture.width(), texture.height()),
+            chain: (width, height),
+        }));
     }
     Ok(())
 }

@@ -167,21 +167,15 @@ impl TruthSettings {
     /// Its ranges, as [`Error::OutOfRange`].
     pub fn validate(&self) -> Result<(), Error> {
         if self.rays == 0 {
-            return Err(Error::InvalidSettings("rays must be at least 1".into()));
+            return Err(Error::out_of_range("rays", self.rays, "≥ 1"));
         }
         if let Some(second) = self.second
             && !(second.distance_world.is_finite() && second.distance_world > 0.0)
         {
-            return Err(Error::InvalidSettings(format!(
-                "the second AO distance must be positive and finite, got {}",
-                second.distance_world
-            )));
+            return Err(Error::out_of_range("bundle-distance", second.distance_world, "> 0 world units"));
         }
         if !(self.distance_world.is_finite() && self.distance_world > 0.0) {
-            return Err(Error::InvalidSettings(format!(
-                "the AO distance must be positive and finite, got {}",
-                self.distance_world
-            )));
+            return Err(Error::out_of_range("ao-distance", self.distance_world, "> 0 world units"));
         }
         Ok(())
     }

@@ -70,13 +70,12 @@ impl Default for DensityOptions {
 /// voxels is empty. Segments with a non-finite end are skipped; a one-point streamline is a
 /// ball.
 pub fn voxelize(positions: &[[f32; 3]], offsets: &[u64], options: &DensityOptions) -> Result<DensityVolume, Error> {
-    let bad = |what: String| Err(Error::InvalidSettings(what));
     let r = options.occupancy_radius;
     if !(r.is_finite() && r > 0.0) {
-        return bad(format!("the occupancy radius must be > 0 world units, got {r}"));
+        return Err(crate::Error::out_of_range("occupancy-radius", r, "> 0 world units"));
     }
     if !(8..=1024).contains(&options.resolution) {
-        return bad(format!("the density resolution must be in 8..=1024 voxels, got {}", options.resolution));
+        return Err(crate::Error::out_of_range("volume-resolution", options.resolution, "8..=1024 voxels"));
     }
     let segments = segments(positions, offsets)?;
     let (lo, hi) = segments

@@ -52,7 +52,7 @@ impl SweepSettings {
     /// Its ranges, as [`Error::OutOfRange`].
     pub fn validate(&self) -> Result<(), Error> {
         if !(self.alpha > 0.0 && self.alpha <= 1.0) {
-            return Err(Error::InvalidSettings(format!("the sweep's opacity α must be in (0, 1], got {}", self.alpha)));
+            return Err(Error::out_of_range("sweep-alpha", self.alpha, "(0, 1]"));
         }
         Ok(())
     }

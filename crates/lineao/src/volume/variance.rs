@@ -55,13 +55,13 @@ impl VarianceSettings {
     /// Its ranges, as [`Error::OutOfRange`].
     pub fn validate(&self) -> Result<(), Error> {
         if !(1..=8).contains(&self.levels) {
-            return Err(Error::InvalidSettings(format!("variance maps need 1..=8 levels, got {}", self.levels)));
+            return Err(Error::out_of_range("VarianceOptions::levels", self.levels, "1..=8"));
         }
         if !(self.iso > 0.0 && self.iso <= 1.0) {
-            return Err(Error::InvalidSettings(format!("the iso-value must be in (0, 1], got {}", self.iso)));
+            return Err(Error::out_of_range("VarianceOptions::iso", self.iso, "(0, 1]"));
         }
         if !(self.offset.is_finite() && self.offset >= 0.0) {
-            return Err(Error::InvalidSettings(format!("the region offset must be ≥ 0 σ, got {}", self.offset)));
+            return Err(Error::out_of_range("VarianceOptions::offset", self.offset, "≥ 0 σ"));
         }
         Ok(())
     }

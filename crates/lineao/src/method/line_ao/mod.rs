@@ -483,13 +483,7 @@ impl crate::method::Stage for LineAoStage {
 
     /// docs/reference.md's LineAO keys (each variant's own) and its noise tile and sample table.
     #[cfg(all(feature = "serde", feature = "reference"))]
-    fn dump(
-        &self,
-        _: &wgpu::Device,
-        _: &wgpu::Queue,
-        s: &ChainSettings,
-        view: &FrameView,
-    ) -> Result<crate::method::Dump, crate::Error> {
+    fn dump(&self, _: &crate::Gpu, s: &ChainSettings, view: &FrameView) -> Result<crate::method::Dump, crate::Error> {
         use serde_json::json;
         let ao = &s.line_ao;
         let lights: Vec<_> = s

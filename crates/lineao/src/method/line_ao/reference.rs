@@ -405,4 +405,3 @@ mod tests {
         assert_eq!([whole_exponent(32.5), whole_exponent(0.0), whole_exponent(512.0)], [0; 3]);
     }
 }
-

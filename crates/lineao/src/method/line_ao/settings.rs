@@ -261,7 +261,7 @@ pub(crate) fn validate(settings: &LineAoSettings, context: &Context) -> Result<(
     settings.validate()?;
     let r0 = settings.r0_px(context);
     if !(r0.is_finite() && r0 >= 0.0) {
-        return Err(crate::Error::InvalidSettings(format!("r0 must be a finite number of pixels >= 0, got {r0}")));
+        return Err(crate::Error::out_of_range("r0", r0, "a finite number of pixels ≥ 0"));
     }
     Ok(())
 }
@@ -276,31 +276,35 @@ impl LineAoSettings {
 
     /// Checks every range documented above.
     pub fn validate(&self) -> Result<(), crate::Error> {
-        let bad = |what: String| Err(crate::Error::InvalidSettings(what));
         if !(1..=crate::MAX_LEVELS).contains(&self.s_r) {
-            return bad(format!("s_r must be in 1..={}, got {}", crate::MAX_LEVELS, self.s_r));
+            return Err(crate::Error::out_of_range("s-r", self.s_r, &format!("1..={}", crate::MAX_LEVELS)));
         }
         if !(1..=256).contains(&self.s_h) {
-            return bad(format!("s_h must be in 1..=256, got {}", self.s_h));
+            return Err(crate::Error::out_of_range("s-h", self.s_h, "1..=256"));
         }
         if !(self.r0_per_width.is_finite() && self.r0_per_width >= 0.0) {
-            return bad(format!("r0 per line width must be finite and >= 0, got {}", self.r0_per_width));
+            return Err(crate::Error::out_of_range("r0", self.r0_per_width, "≥ 0 line widths"));
         }
         if !(self.delta_scale.is_finite() && self.delta_scale > 0.0 && self.delta_scale <= 1.0) {
-            return bad(format!("the δ scale must be in (0, 1], got {}", self.delta_scale));
+            return Err(crate::Error::out_of_range("delta-scale", self.delta_scale, "(0, 1]"));
         }
         let last_delta = self.delta_scale * (1.0 / self.s_r as f32).powi(2);
         if !(self.delta0.is_finite() && self.delta0 >= 0.0 && self.delta0 < last_delta) {
-            return bad(format!("delta0 must be in [0, δ scale · (1/s_r)^2) = [0, {last_delta}), got {}", self.delta0));
+            return Err(crate::Error::out_of_range(
+                "delta0",
+                self.delta0,
+                &format!("[0, δ scale · (1/s_r)²) = [0, {last_delta})"),
+            ));
         }
         if self.variant == LineAoVariant::Reference && self.outer == LineAoOuter::Level {
-            return bad("outer = level applies to variant paper (reference reads level 0 only)".into());
+            let why = "outer = level applies to variant paper (reference reads level 0 only)";
+            return Err(crate::Error::Conflict { setting: "outer", with: "variant", why });
         }
         if !(self.reference_radius_px.is_finite() && self.reference_radius_px >= 0.0) {
-            return bad(format!("the reference radius must be >= 0 px, got {}", self.reference_radius_px));
+            return Err(crate::Error::out_of_range("reference-radius", self.reference_radius_px, "≥ 0 px"));
         }
         if !(self.epsilon.is_finite() && self.epsilon >= 0.0) {
-            return bad(format!("epsilon must be >= 0, got {}", self.epsilon));
+            return Err(crate::Error::out_of_range("epsilon", self.epsilon, "≥ 0"));
         }
         Ok(())
     }

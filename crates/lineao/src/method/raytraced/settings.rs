@@ -166,9 +166,8 @@ impl RayDenoiseSettings {
         if ok {
             return Ok(());
         }
-        Err(crate::Error::InvalidSettings(format!(
-            "ray denoiser: radius 1..=8 px, σ > 0, normal power ≥ 0 and depth tolerance in (0, 1], got {self:?}"
-        )))
+        let expected = "a radius of 1..=8 px, σ > 0, normal power ≥ 0 and depth tolerance in (0, 1]";
+        Err(crate::Error::out_of_range("denoise", format!("{self:?}"), expected))
     }
 }
 
@@ -215,19 +214,17 @@ impl RayTracedSettings {
 
     /// Its ranges, as [`crate::Error::OutOfRange`].
     pub fn validate(&self) -> Result<(), crate::Error> {
-        if self.rays_per_frame == 0 || self.max_rays == 0 {
-            return Err(crate::Error::InvalidSettings(format!(
-                "rays per frame and the ray cap must be at least 1, got {} and {}",
-                self.rays_per_frame, self.max_rays
-            )));
+        if self.rays_per_frame == 0 {
+            return Err(crate::Error::out_of_range("rays-per-frame", self.rays_per_frame, "≥ 1"));
+        }
+        if self.max_rays == 0 {
+            return Err(crate::Error::out_of_range("rays", self.max_rays, "≥ 1"));
         }
         if let Some(denoise) = &self.denoise {
             denoise.validate()?;
         }
         if let Some(share) = self.distance_share.filter(|s| !(*s > 0.0 && *s <= 1.0)) {
-            return Err(crate::Error::InvalidSettings(format!(
-                "the rays' reach as a share of the scene must be in (0, 1], got {share}"
-            )));
+            return Err(crate::Error::out_of_range("ao-distance", share, "a share of the scene in (0, 1]"));
         }
         self.truth(1).validate()
     }

@@ -229,13 +229,7 @@ impl crate::method::Stage for SsaoStage {
 
     /// docs/reference.md's SSAO keys, its kernel and its 4 × 4 rotation tile.
     #[cfg(all(feature = "serde", feature = "reference"))]
-    fn dump(
-        &self,
-        _: &wgpu::Device,
-        _: &wgpu::Queue,
-        s: &ChainSettings,
-        _: &FrameView,
-    ) -> Result<crate::method::Dump, crate::Error> {
+    fn dump(&self, _: &crate::Gpu, s: &ChainSettings, _: &FrameView) -> Result<crate::method::Dump, crate::Error> {
         let ssao = &s.ssao;
         let mut dump = crate::method::Dump::default();
         dump.params(serde_json::json!({

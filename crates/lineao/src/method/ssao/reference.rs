@@ -99,7 +99,7 @@ pub(crate) fn of_frame(inputs: &FrameInputs) -> Result<ReferenceAo, crate::Error
     };
     let points = settings.kernel_points();
     if points.len() != settings.samples as usize {
-        return Err(crate::Error::InvalidSettings(format!("no SSAO kernel of {} samples", settings.samples)));
+        return Err(crate::Error::out_of_range("ssao-samples", settings.samples, "a kernel's sample count"));
     }
     let cpu = ssao(&inputs.nd[0], &points, &crate::noise::ssao_noise(settings.noise_seed), &params);
     Ok(ReferenceAo { ao: cpu, every_pixel_bound: 2.0 / settings.samples as f32 })

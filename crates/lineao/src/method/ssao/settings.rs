@@ -103,22 +103,21 @@ impl Default for SsaoSettings {
 impl SsaoSettings {
     /// Checks every range documented above.
     pub fn validate(&self) -> Result<(), crate::Error> {
-        let bad = |what: String| Err(crate::Error::InvalidSettings(what));
         if !(8..=32).contains(&self.samples) {
-            return bad(format!("SSAO samples must be in 8..=32, got {}", self.samples));
+            return Err(crate::Error::out_of_range("ssao-samples", self.samples, "8..=32"));
         }
         if self.kernel == SsaoKernel::Sphere && !crate::sample_sets::VO_SPHERE_SAMPLE_COUNTS.contains(&self.samples) {
-            return bad(format!(
-                "the sphere kernel has {:?} samples, got {}",
-                crate::sample_sets::VO_SPHERE_SAMPLE_COUNTS,
-                self.samples
+            return Err(crate::Error::out_of_range(
+                "ssao-samples",
+                self.samples,
+                &format!("one of {:?} with the sphere kernel", crate::sample_sets::VO_SPHERE_SAMPLE_COUNTS),
             ));
         }
         if !(self.radius_world.is_finite() && self.radius_world > 0.0) {
-            return bad(format!("the SSAO radius must be > 0 world units, got {}", self.radius_world));
+            return Err(crate::Error::out_of_range("ssao-radius", self.radius_world, "> 0 world units"));
         }
         if !(self.range_world.is_finite() && self.range_world > 0.0) {
-            return bad(format!("the SSAO range must be > 0 world units, got {}", self.range_world));
+            return Err(crate::Error::out_of_range("ssao-range", self.range_world, "> 0 world units"));
         }
         Ok(())
     }

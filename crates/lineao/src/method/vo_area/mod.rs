@@ -159,18 +159,12 @@ impl crate::method::Stage for VoArea {
     /// VO's keys and tables ([`crate::method::vo_line`]'s) with the area samples, and the
     /// moments pyramid read back (`moments_L.npy`).
     #[cfg(all(feature = "serde", feature = "reference"))]
-    fn dump(
-        &self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        s: &ChainSettings,
-        _: &FrameView,
-    ) -> Result<crate::method::Dump, crate::Error> {
+    fn dump(&self, gpu: &crate::Gpu, s: &ChainSettings, _: &FrameView) -> Result<crate::method::Dump, crate::Error> {
         let vo = &s.vo;
         let mut dump =
             crate::method::vo_line::dump(vo, vo.area_samples, sample_sets::vo_area_samples(vo.area_samples))?;
         if let Some(moments) = self.moments() {
-            for (l, level) in moments.read(device, queue)?.into_iter().enumerate() {
+            for (l, level) in moments.read(&gpu.device, &gpu.queue)?.into_iter().enumerate() {
                 let shape = [level.height as u64, level.width as u64, 2];
                 dump.array(&format!("moments_{l}"), &shape, level.data.concat());
             }

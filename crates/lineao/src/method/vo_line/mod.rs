@@ -278,13 +278,7 @@ impl crate::method::Stage for VoLine {
     }
 
     #[cfg(all(feature = "serde", feature = "reference"))]
-    fn dump(
-        &self,
-        _: &wgpu::Device,
-        _: &wgpu::Queue,
-        s: &ChainSettings,
-        _: &FrameView,
-    ) -> Result<crate::method::Dump, crate::Error> {
+    fn dump(&self, _: &crate::Gpu, s: &ChainSettings, _: &FrameView) -> Result<crate::method::Dump, crate::Error> {
         dump(&s.vo, s.vo.samples, sample_sets::vo_disk_samples(s.vo.samples).map(<[_]>::to_vec))
     }
 }
@@ -297,7 +291,7 @@ pub(crate) fn dump(
     count: u32,
     samples: Option<Vec<[f32; 3]>>,
 ) -> Result<crate::method::Dump, crate::Error> {
-    let samples = samples.ok_or_else(|| crate::Error::InvalidSettings(format!("no VO sample set of {count}")))?;
+    let samples = samples.ok_or_else(|| crate::Error::out_of_range("vo-samples", count, "a VO sample set's count"))?;
     let mut dump = crate::method::Dump::default();
     dump.params(serde_json::json!({
         "samples": count,

@@ -192,28 +192,27 @@ impl Default for VoSettings {
 impl VoSettings {
     /// Checks every range documented above.
     pub fn validate(&self) -> Result<(), crate::Error> {
-        let bad = |what: String| Err(crate::Error::InvalidSettings(what));
         if !crate::sample_sets::VO_SAMPLE_COUNTS.contains(&self.samples) {
-            return bad(format!(
-                "VO samples must be one of {:?}, got {}",
-                crate::sample_sets::VO_SAMPLE_COUNTS,
-                self.samples
+            return Err(crate::Error::out_of_range(
+                "vo-samples",
+                self.samples,
+                &format!("one of {:?}", crate::sample_sets::VO_SAMPLE_COUNTS),
             ));
         }
         if !crate::sample_sets::VO_AREA_SAMPLE_COUNTS.contains(&self.area_samples) {
-            return bad(format!(
-                "VO area samples must be one of {:?}, got {}",
-                crate::sample_sets::VO_AREA_SAMPLE_COUNTS,
-                self.area_samples
+            return Err(crate::Error::out_of_range(
+                "vo-area-samples",
+                self.area_samples,
+                &format!("one of {:?}", crate::sample_sets::VO_AREA_SAMPLE_COUNTS),
             ));
         }
         for radius in std::iter::once(self.radius_world).chain(self.radius2_world) {
             if !(radius.is_finite() && radius > 0.0) {
-                return bad(format!("a VO radius must be > 0 world units, got {radius}"));
+                return Err(crate::Error::out_of_range("vo-radius", radius, "> 0 world units"));
             }
         }
         if !(self.thickness_world.is_finite() && self.thickness_world >= 0.0) {
-            return bad(format!("the VO thickness must be >= 0 world units, got {}", self.thickness_world));
+            return Err(crate::Error::out_of_range("thickness", self.thickness_world, "≥ 0 world units"));
         }
         Ok(())
     }
