@@ -31,7 +31,7 @@ pub struct MethodInfo {
     pub screen_space: bool,
     /// Whether it traces rays through the scene (the ray-traced truth): it needs the scene's
     /// BVH ([`crate::AoChain::set_ray_scene`]), accumulates its picture over frames, and its
-    /// rays start on lines drawn at full detail. The CPU truth (`--truth cpu`) can stand in.
+    /// rays start on lines drawn at full detail. The CPU truth (`--cpu`) can stand in.
     pub traces_scene: bool,
     /// What it estimates: which ray-traced truth `lineao score` holds its picture to.
     pub estimates: Estimate,
@@ -434,7 +434,7 @@ impl Dump {
         }
     }
 
-    /// Adds a table of vectors as a `[len, 3]` (or `shape`) array.
+    /// Adds the table `name` of shape `shape`, its values in row-major order.
     pub fn array(&mut self, name: &str, shape: &[u64], values: Vec<f32>) {
         self.arrays.push((name.to_string(), shape.to_vec(), values));
     }
