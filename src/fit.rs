@@ -24,10 +24,11 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 use glam::Quat;
+use lineao::AoMethod;
+use lineao::method::FitCandidate;
 use lineao::reference::Image;
 use lineao::truth::legibility::{self, Pairs, Shading};
 use lineao::truth::{Falloff, TruthSettings};
-use lineao::{AoMethod, ChainSettings, LineAoOuter};
 
 use crate::cli::{Method, RenderArgs, ScoreArgs, ScoreMethod};
 use crate::render::Session;
@@ -39,84 +40,26 @@ pub const FIT_PAIRS: usize = 20_000;
 const MAX_NEAR_BLACK: f64 = 0.02;
 const DARKENING: (f64, f64) = (0.15, 0.45);
 
-/// A family's candidate: a label and what it changes.
-struct Candidate {
-    label: String,
-    apply: Box<dyn Fn(&mut ChainSettings)>,
-}
-
 struct Family {
     method: ScoreMethod,
     /// The first candidate is the paper's (our defaults').
-    candidates: Vec<Candidate>,
+    candidates: Vec<FitCandidate>,
 }
 
+/// What the fit searches: each method's families from its registry entry (its main form, then
+/// its variant), in the registry's order.
 fn families(line_width: f32) -> Vec<Family> {
-    let c = |label: String, apply: Box<dyn Fn(&mut ChainSettings)>| Candidate { label, apply };
-    // The paper's first, then s_r × r0 (multiples of the line width) × the scale of δ(j) × s_h
-    // × where the outer hemispheres are evaluated.
-    let mut lineao = Vec::new();
-    // Outer hemispheres at every pixel: docs/reference.md allows `outer = level` as a default only
-    // within 0.02 of `full`, and it differs by its noise. s_h stays the
-    // paper's 32: it buys less noise, not another picture (s_h 16 against 32 changed no choice
-    // in a trial on the built-in scenes and one real bundle).
-    let paper = (3, 1.5f32, 1.0f32, 32, LineAoOuter::Full);
-    let mut grid = Vec::new();
-    for s_r in [2, 3, 4] {
-        for k in [1.5f32, 3.0, 4.5, 6.0, 8.0] {
-            for delta in [1.0f32, 0.3, 0.1] {
-                grid.push((s_r, k, delta, 32, LineAoOuter::Full));
-            }
+    let mut families = Vec::new();
+    for &method in AoMethod::REGISTRY {
+        let info = method.info();
+        let Some(fit) = info.fit else { continue };
+        families.push(Family { method: ScoreMethod::main(method), candidates: fit(line_width, false) });
+        if let Some(variant) = &info.variant {
+            let method = ScoreMethod { method, variant: Some(variant) };
+            families.push(Family { method, candidates: fit(line_width, true) });
         }
     }
-    for (s_r, k, delta_scale, s_h, outer) in std::iter::once(paper).chain(grid.into_iter().filter(|&c| c != paper)) {
-        let r0 = k * line_width;
-        lineao.push(c(
-            format!("s_r {s_r}, r0 {r0} px, δ scale {delta_scale}, s_h {s_h}, outer {}", outer.name()),
-            Box::new(move |s: &mut ChainSettings| {
-                s.line_ao.s_r = s_r;
-                s.line_ao.r0_px = Some(r0);
-                s.line_ao.delta_scale = delta_scale;
-                s.line_ao.s_h = s_h;
-                s.line_ao.outer = outer;
-            }),
-        ));
-    }
-    let radii = |paper: f32, others: &[f32], set: fn(&mut ChainSettings, f32)| -> Vec<Candidate> {
-        std::iter::once(paper)
-            .chain(others.iter().copied())
-            .map(|r| c(format!("radius {r}"), Box::new(move |s: &mut ChainSettings| set(s, r))))
-            .collect()
-    };
-    let vo = |s: &mut ChainSettings, r: f32| s.vo.radius_world = r;
-    let ssao = |s: &mut ChainSettings, r: f32| {
-        s.ssao.radius_world = r;
-        s.ssao.range_world = r;
-    };
-    // The authors' shader: its base radius, and s_h (its cost: s_h samples on each of its three
-    // hemispheres at full resolution).
-    let mut reference = Vec::new();
-    for s_h in [32, 16] {
-        for radius in [2.0f32, 1.0] {
-            reference.push(c(
-                format!("base radius {radius} px, s_h {s_h}"),
-                Box::new(move |s: &mut ChainSettings| {
-                    s.line_ao.reference_radius_px = radius;
-                    s.line_ao.s_h = s_h;
-                }),
-            ));
-        }
-    }
-    let family = |method, candidates| Family { method: ScoreMethod::main(method), candidates };
-    // LineAO without the Gaussian pyramid: the authors' shader.
-    let authors = ScoreMethod { method: AoMethod::LineAo, variant: AoMethod::LineAo.info().variant.as_ref() };
-    vec![
-        family(AoMethod::LineAo, lineao),
-        Family { method: authors, candidates: reference },
-        family(AoMethod::VoLine, radii(2.0, &[1.0, 4.0], vo)),
-        family(AoMethod::VoArea, radii(2.0, &[1.0, 4.0], vo)),
-        family(AoMethod::Ssao, radii(2.0, &[4.0, 8.0], ssao)),
-    ]
+    families
 }
 
 /// The strengths tried: 0.2 to 2 in steps of 0.2.

@@ -56,6 +56,10 @@ pub struct MethodInfo {
     pub bench: &'static [BenchPass],
     /// Its other form that `score`, the fit and `--grid` show as a method of their own.
     pub variant: Option<Variant>,
+    /// What `lineao score --fit` searches of it for lines `line_width_px` wide, of its main
+    /// form or (`variant`) its variant: the first candidate the paper's (our defaults');
+    /// `None`: the fit leaves it out.
+    pub fit: Option<fn(line_width_px: f32, variant: bool) -> Vec<FitCandidate>>,
     /// Its stage's occlusion on the CPU from the frame's read-back inputs
     /// ([`crate::verify::reference_ao`]); `None` where its frame has no reference of its own.
     #[cfg(feature = "reference")]
@@ -79,6 +83,23 @@ pub struct Variant {
     pub label: &'static str,
     /// Its line of `--help`.
     pub help: &'static str,
+}
+
+/// A candidate of `lineao score --fit`: what its report calls it, and what it changes of the
+/// paper's settings.
+pub struct FitCandidate {
+    /// Its label in the fit's report.
+    pub label: String,
+    /// What it changes.
+    pub apply: Box<dyn Fn(&mut ChainSettings)>,
+}
+
+impl FitCandidate {
+    /// The candidates that set a radius (`set`): the paper's, then `others`.
+    pub(crate) fn radii(paper: f32, others: &[f32], set: fn(&mut ChainSettings, f32)) -> Vec<FitCandidate> {
+        let radius = move |r: f32| FitCandidate { label: format!("radius {r}"), apply: Box::new(move |s| set(s, r)) };
+        std::iter::once(paper).chain(others.iter().copied()).map(radius).collect()
+    }
 }
 
 /// What a method estimates, so the ray-traced truth it is held to (`lineao score`, the fit).

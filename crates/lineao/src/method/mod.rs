@@ -35,7 +35,7 @@ mod registry;
 
 #[cfg(all(feature = "serde", feature = "reference"))]
 pub use info::Dump;
-pub use info::{BenchPass, ChainSetting, Estimate, MethodInfo, Reach, Stage, Variant};
+pub use info::{BenchPass, ChainSetting, Estimate, FitCandidate, MethodInfo, Reach, Stage, Variant};
 pub(crate) use info::{Own, fits_always, fits_storage};
 pub use list::AoMethod;
 pub use registry::{bench_passes, build, pass_names};

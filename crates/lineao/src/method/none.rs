@@ -14,6 +14,7 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     own: super::info::NO_SETTINGS,
     bench: &[],
     variant: None,
+    fit: None,
     #[cfg(feature = "reference")]
     reference: None,
 };

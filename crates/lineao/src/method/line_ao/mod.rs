@@ -73,6 +73,56 @@ pub(crate) use settings::{LineAoOuter, LineAoSettings, LineAoVariant};
 /// the pixel's own level texel by τ or more does not contribute (the shader's too).
 pub const OUTER_DEPTH_TOLERANCE: f32 = 0.005;
 
+/// LineAO's search in `lineao score --fit`. Its paper form: the paper's values first, then s_r ×
+/// r0 (multiples of the line width) × the scale of δ(j), outer hemispheres at every pixel
+/// (docs/reference.md allows `outer = level` as a default only within 0.02 of `full`, and it
+/// differs by its noise) and s_h the paper's 32 (it buys less noise, not another picture: s_h
+/// 16 against 32 changed no choice in a trial on the built-in scenes and one real bundle). The
+/// authors' shader: its base radius, and s_h (its cost: s_h samples on each of its three
+/// hemispheres at full resolution).
+fn fit(line_width: f32, variant: bool) -> Vec<super::FitCandidate> {
+    let c = |label: String, apply: Box<dyn Fn(&mut ChainSettings)>| super::FitCandidate { label, apply };
+    if variant {
+        let mut reference = Vec::new();
+        for s_h in [32, 16] {
+            for radius in [2.0f32, 1.0] {
+                reference.push(c(
+                    format!("base radius {radius} px, s_h {s_h}"),
+                    Box::new(move |s: &mut ChainSettings| {
+                        s.line_ao.reference_radius_px = radius;
+                        s.line_ao.s_h = s_h;
+                    }),
+                ));
+            }
+        }
+        return reference;
+    }
+    let paper = (3, 1.5f32, 1.0f32, 32, LineAoOuter::Full);
+    let mut grid = Vec::new();
+    for s_r in [2, 3, 4] {
+        for k in [1.5f32, 3.0, 4.5, 6.0, 8.0] {
+            for delta in [1.0f32, 0.3, 0.1] {
+                grid.push((s_r, k, delta, 32, LineAoOuter::Full));
+            }
+        }
+    }
+    let mut lineao = Vec::new();
+    for (s_r, k, delta_scale, s_h, outer) in std::iter::once(paper).chain(grid.into_iter().filter(|&c| c != paper)) {
+        let r0 = k * line_width;
+        lineao.push(c(
+            format!("s_r {s_r}, r0 {r0} px, δ scale {delta_scale}, s_h {s_h}, outer {}", outer.name()),
+            Box::new(move |s: &mut ChainSettings| {
+                s.line_ao.s_r = s_r;
+                s.line_ao.r0_px = Some(r0);
+                s.line_ao.delta_scale = delta_scale;
+                s.line_ao.s_h = s_h;
+                s.line_ao.outer = outer;
+            }),
+        ));
+    }
+    lineao
+}
+
 pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     name: "lineao",
     label: "LineAO",
@@ -111,6 +161,7 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
         label: "authors' code",
         help: "LineAO's `reference` variant (the authors' LineVis: radius in zoom units, no pyramid)",
     }),
+    fit: Some(fit),
     #[cfg(feature = "reference")]
     reference: Some(reference::of_frame),
 };

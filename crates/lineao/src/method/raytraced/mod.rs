@@ -80,6 +80,7 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
         }),
     ],
     variant: None,
+    fit: None,
     #[cfg(feature = "reference")]
     reference: None,
 };

@@ -61,6 +61,9 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
         BenchPass::of("ssao-16-chain", &["ssao", "ssao-blur"], |s, _| s.ssao.samples = 16),
     ],
     variant: None,
+    fit: Some(|_, _| {
+        super::FitCandidate::radii(2.0, &[4.0, 8.0], |s, r| (s.ssao.radius_world, s.ssao.range_world) = (r, r))
+    }),
     #[cfg(feature = "reference")]
     reference: Some(reference::of_frame),
 };

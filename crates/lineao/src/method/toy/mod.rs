@@ -38,6 +38,7 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     own: &super::Own::at(settings::SETTINGS, |c| &c.toy, |c| &mut c.toy, |_, _, _| 1.0),
     bench: &[super::BenchPass::of("toy", &["toy"], |_, _| {})],
     variant: None,
+    fit: None,
     #[cfg(feature = "reference")]
     reference: None,
 };

@@ -55,6 +55,7 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     },
     bench: &[super::BenchPass::of("vo-area-1", &["moments", "vo-area"], |s, _| s.vo.area_samples = 1)],
     variant: None,
+    fit: Some(|_, _| super::FitCandidate::radii(2.0, &[1.0, 4.0], |s, r| s.vo.radius_world = r)),
     #[cfg(feature = "reference")]
     reference: None,
 };

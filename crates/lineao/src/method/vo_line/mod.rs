@@ -63,6 +63,7 @@ pub(crate) const METHOD: super::MethodInfo = super::MethodInfo {
     },
     bench: &[super::BenchPass::of("vo-line-5", &["vo-line"], |s, _| s.vo.samples = 5)],
     variant: None,
+    fit: Some(|_, _| super::FitCandidate::radii(2.0, &[1.0, 4.0], |s, r| s.vo.radius_world = r)),
     #[cfg(feature = "reference")]
     reference: None,
 };
