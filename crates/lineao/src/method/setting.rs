@@ -234,6 +234,17 @@ impl About {
         requires: None,
     };
 
+    /// A sphere's radius in world units that `--radius` gives and the preset sets (paper 2):
+    /// SSAO's and VO's.
+    pub const SPHERE_RADIUS: About = About {
+        label: "radius",
+        unit: Unit::WorldUnits,
+        kind: Kind::Above { min: 0.0, open: true, slider: [0.1, 20.0], log: true },
+        default: Some("the preset's; paper 2"),
+        role: Some(Role::Radius),
+        ..About::BASE
+    };
+
     /// Python's keyword argument: the flag with `_` (`ssao_samples`).
     pub fn keyword(&self) -> String {
         self.flag.replace('-', "_")

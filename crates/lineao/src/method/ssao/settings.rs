@@ -34,13 +34,8 @@ pub(crate) const SETTINGS: &[Setting<SsaoSettings>] = &[
     Setting {
         about: About {
             flag: "ssao-radius",
-            label: "radius",
             help: "SSAO: sphere radius (the range check's too, unless --ssao-range gives it)",
-            unit: Unit::WorldUnits,
-            kind: Kind::Above { min: 0.0, open: true, slider: [0.1, 20.0], log: true },
-            default: Some("the preset's; paper 2"),
-            role: Some(Role::Radius),
-            ..About::BASE
+            ..About::SPHERE_RADIUS
         },
         get: |s, _| Value::Number(s.radius_world),
         set: |s, v| (s.radius_world, s.range_world) = (v.as_f32(), v.as_f32()),

@@ -43,16 +43,7 @@ const AREA_SAMPLES: Setting<VoSettings> = Setting {
 };
 
 const RADIUS: Setting<VoSettings> = Setting {
-    about: About {
-        flag: "vo-radius",
-        label: "radius",
-        help: "VO (line and area sampling): sphere radius",
-        unit: Unit::WorldUnits,
-        kind: Kind::Above { min: 0.0, open: true, slider: [0.1, 20.0], log: true },
-        default: Some("the preset's; paper 2"),
-        role: Some(Role::Radius),
-        ..About::BASE
-    },
+    about: About { flag: "vo-radius", help: "VO (line and area sampling): sphere radius", ..About::SPHERE_RADIUS },
     get: |s, _| Value::Number(s.radius_world),
     set: |s, v| s.radius_world = v.as_f32(),
     ..Setting::BASE
